@@ -1,0 +1,1 @@
+"""The executor: one mission run as an explicit state machine (no ROS, no threads)."""

@@ -1,0 +1,110 @@
+"""What the executor tells the outside world (sinks: terminal, journal, report, ROS).
+
+Every event carries ``t``, the navigator clock time in seconds, and is a frozen
+dataclass whose fields are JSON-friendly so the journal can write it as is.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class WaypointOutcome(str, enum.Enum):
+    REACHED = "reached"
+    SKIPPED = "skipped"  # failed, and the policy said go on
+    FAILED = "failed"  # failed, and the mission stopped here
+    NOT_RUN = "not_run"  # the mission ended before this waypoint was tried
+
+
+@dataclass(frozen=True)
+class MissionStarted:
+    t: float
+    waypoint_count: int
+    loops: int | None
+    resumed_from: int | None = None  # waypoint index when resuming a journal
+
+
+@dataclass(frozen=True)
+class LoopStarted:
+    t: float
+    loop: int  # 0-based
+
+
+@dataclass(frozen=True)
+class WaypointStarted:
+    t: float
+    index: int
+    loop: int
+    attempt: int  # 1-based
+    goal_id: int
+    x: float
+    y: float
+    yaw: float
+
+
+@dataclass(frozen=True)
+class WaypointProgress:
+    t: float
+    index: int
+    x: float
+    y: float
+    yaw: float
+    distance_remaining: float | None
+    distance_driven: float
+
+
+@dataclass(frozen=True)
+class AttemptFailed:
+    t: float
+    index: int
+    attempt: int
+    reason: str  # a GoalStatus value, "timeout" or "stalled"
+    will_retry: bool
+
+
+@dataclass(frozen=True)
+class WaypointDwelling:
+    t: float
+    index: int
+    seconds: float
+
+
+@dataclass(frozen=True)
+class WaypointFinished:
+    t: float
+    index: int
+    loop: int
+    outcome: WaypointOutcome
+    attempts: int
+    duration: float
+    distance_driven: float
+    reason: str = ""  # for skipped/failed: last failure reason
+    passed_through: bool = False
+
+
+@dataclass(frozen=True)
+class ServerStatusChanged:
+    t: float
+    available: bool
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class MissionFinished:
+    t: float
+    success: bool  # every waypoint reached
+    reason: str  # "completed", "stopped: waypoint 3 failed", "interrupted", ...
+
+
+MissionEvent = (
+    MissionStarted
+    | LoopStarted
+    | WaypointStarted
+    | WaypointProgress
+    | AttemptFailed
+    | WaypointDwelling
+    | WaypointFinished
+    | ServerStatusChanged
+    | MissionFinished
+)

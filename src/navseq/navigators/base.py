@@ -1,0 +1,117 @@
+"""The small interface every navigator (sim, ros1, later nav2) implements.
+
+A navigator pursues one goal at a time on behalf of the executor. It never decides
+what to do next: it only reports what happened, as events the executor polls.
+Time is the navigator's own (simulated for ``sim``, ROS time for ``ros1``), read
+through :attr:`Navigator.now` and advanced with :meth:`Navigator.spin`.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+from navseq.geometry import Pose2D
+
+
+class GoalStatus(str, enum.Enum):
+    """Terminal outcome of a goal, named after actionlib_msgs/GoalStatus.
+
+    ``LOST`` covers an action server that vanished with the goal active (and
+    actionlib's own LOST status).
+    """
+
+    SUCCEEDED = "SUCCEEDED"
+    ABORTED = "ABORTED"
+    REJECTED = "REJECTED"
+    PREEMPTED = "PREEMPTED"
+    RECALLED = "RECALLED"
+    LOST = "LOST"
+
+
+@dataclass(frozen=True)
+class Goal:
+    """A pose to reach. ``goal_id`` is chosen by the executor and echoed in events."""
+
+    goal_id: int
+    pose: Pose2D
+    z: float = 0.0
+    frame: str = "map"
+
+
+@dataclass(frozen=True)
+class GoalAccepted:
+    goal_id: int
+
+
+@dataclass(frozen=True)
+class GoalFeedback:
+    """The robot is on its way. ``distance_remaining`` is along the plan when known."""
+
+    goal_id: int
+    pose: Pose2D
+    distance_remaining: float | None = None
+
+
+@dataclass(frozen=True)
+class GoalDone:
+    goal_id: int
+    status: GoalStatus
+    text: str = ""
+
+
+@dataclass(frozen=True)
+class ServerLost:
+    """The navigation server disappeared; any active goal is as good as LOST."""
+
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class ServerBack:
+    """The navigation server is reachable again after :class:`ServerLost`."""
+
+
+NavEvent = GoalAccepted | GoalFeedback | GoalDone | ServerLost | ServerBack
+
+
+@runtime_checkable
+class Navigator(Protocol):
+    """What the executor needs from a navigation stack."""
+
+    def now(self) -> float:
+        """Current time in seconds on the navigator's clock."""
+        ...
+
+    def wait_for_server(self, timeout: float) -> bool:
+        """Block up to ``timeout`` seconds of wall time for the server; True when it is there."""
+        ...
+
+    def send_goal(self, goal: Goal) -> None:
+        """Start pursuing ``goal``; any goal still active is replaced."""
+        ...
+
+    def cancel_goal(self) -> None:
+        """Cancel the active goal, if any. Safe to call at any time, also twice."""
+        ...
+
+    def clear_costmaps(self) -> None:
+        """Forget transient obstacles before a retry (no-op where unsupported)."""
+        ...
+
+    def robot_pose(self) -> Pose2D | None:
+        """Latest known robot pose in the mission frame, or None if unknown."""
+        ...
+
+    def poll(self) -> list[NavEvent]:
+        """Events since the last call, oldest first. Never blocks."""
+        ...
+
+    def spin(self, seconds: float) -> None:
+        """Let ``seconds`` of navigator time pass (simulate, or sleep on ROS time)."""
+        ...
+
+    def close(self) -> None:
+        """Release resources; cancels an active goal first."""
+        ...
