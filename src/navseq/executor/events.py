@@ -55,6 +55,15 @@ class WaypointProgress:
 
 
 @dataclass(frozen=True)
+class WaypointPlan:
+    """The navigation stack's global plan for the current attempt (for pictures/markers)."""
+
+    t: float
+    index: int
+    path: tuple[tuple[float, float], ...]
+
+
+@dataclass(frozen=True)
 class AttemptFailed:
     t: float
     index: int
@@ -102,6 +111,7 @@ MissionEvent = (
     | LoopStarted
     | WaypointStarted
     | WaypointProgress
+    | WaypointPlan
     | AttemptFailed
     | WaypointDwelling
     | WaypointFinished

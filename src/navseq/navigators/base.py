@@ -55,6 +55,14 @@ class GoalFeedback:
 
 
 @dataclass(frozen=True)
+class GoalPlan:
+    """The global plan the navigation stack chose for the goal (mission frame, metres)."""
+
+    goal_id: int
+    path: tuple[tuple[float, float], ...]
+
+
+@dataclass(frozen=True)
 class GoalDone:
     goal_id: int
     status: GoalStatus
@@ -73,7 +81,7 @@ class ServerBack:
     """The navigation server is reachable again after :class:`ServerLost`."""
 
 
-NavEvent = GoalAccepted | GoalFeedback | GoalDone | ServerLost | ServerBack
+NavEvent = GoalAccepted | GoalFeedback | GoalPlan | GoalDone | ServerLost | ServerBack
 
 
 @runtime_checkable
