@@ -83,6 +83,7 @@ class Mission:
     loops: int | None = 1  # None = forever (patrol)
     map: Path | None = None
     start: Pose2D | None = None
+    server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
     source: str = "<memory>"
 
     def policy_for(self, index: int) -> Policy:
