@@ -1,0 +1,30 @@
+"""Shared pytest fixtures. ROS tests (marker ``ros``) are skipped where ROS 1 is missing."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from ros_support import RosMaster, rospy_available, running_master
+
+ROS_AVAILABLE, ROS_MISSING_REASON = rospy_available()
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if ROS_AVAILABLE:
+        return
+    skip = pytest.mark.skip(reason=f"ROS 1 not available: {ROS_MISSING_REASON}")
+    for item in items:
+        if "ros" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture
+def ros_master(tmp_path: Path) -> Iterator[RosMaster]:
+    """A private rosmaster on a free 127.0.0.1 port; everything started on it is stopped."""
+    if not ROS_AVAILABLE:
+        pytest.skip(f"ROS 1 not available: {ROS_MISSING_REASON}")
+    with running_master(tmp_path / "ros") as master:
+        yield master
