@@ -1,0 +1,356 @@
+"""The ``ros1`` navigator: goals to a move_base ``MoveBaseAction`` server over actionlib.
+
+How it stays out of actionlib's traps:
+
+- actionlib calls its callbacks on rospy's threads. Here they only put events on a
+  thread-safe queue; :meth:`Ros1Navigator.poll`, called by the executor's loop on the
+  main thread, drains it. No goal is ever sent from inside a callback: the tutorial's
+  ``done_cb`` pattern makes Noetic's ``SimpleActionClient`` ignore the next goal's result
+  (ros/actionlib issue 193) and the mission stalls after its second goal.
+- It uses actionlib's lower-level ``ActionClient``, which reports every status a server
+  can give (SUCCEEDED, ABORTED, REJECTED, PREEMPTED, RECALLED, and LOST when the server
+  forgets a goal) for any goal, also one replaced by a newer goal.
+- A server that stops publishing its status for ``status_timeout`` seconds (move_base
+  publishes it at 5 Hz) is reported as :class:`ServerLost`; the executor then waits and
+  resends the goal after :class:`ServerBack`, which is reported once the server
+  publishes again *and* has connected to our goal and cancel topics (so the resent goal
+  cannot vanish in transit).
+
+Time: :meth:`now` is ROS time and :meth:`spin` sleeps on ROS time, so under
+``use_sim_time`` the executor's timeouts run on the simulation clock. Goals are stamped
+with ``rospy.Time.now()`` (``stamp="now"``, what RViz does); ``stamp="latest"`` stamps
+them with time zero, which tells move_base to use the latest transform when the goal
+frame differs from its global frame — safer when TF lags behind the clock (it avoids
+"extrapolation into the future" errors). Before ``/clock`` arrives, ROS time is zero and
+both are the same.
+
+Robot pose: from TF (``frame`` -> the first of ``base_frames`` that resolves) when
+available, else from the goal feedback's ``base_position``.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections.abc import Sequence
+from typing import Any, Literal
+
+import actionlib
+import rosgraph
+import rosgraph.names
+import rospy
+from actionlib.action_client import CommState
+from move_base_msgs.msg import MoveBaseAction
+from nav_msgs.msg import Path as PathMsg
+from std_srvs.srv import Empty
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+from navseq.navigators.base import (
+    Goal,
+    GoalAccepted,
+    GoalDone,
+    GoalFeedback,
+    GoalPlan,
+    GoalStatus,
+    NavEvent,
+    ServerBack,
+    ServerLost,
+)
+from navseq.ros.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
+from navseq.ros.conversions import terminal_status as terminal_status_of
+
+DEFAULT_NODE_NAME = "navseq"
+MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up
+CANCEL_FLUSH = 1.0  # s of wall time to let a cancel reach the server when closing
+
+
+def ensure_node(name: str = DEFAULT_NODE_NAME, *, anonymous: bool = True) -> None:
+    """Make this process a ROS node if it is not one yet (rospy allows one per process).
+
+    rospy's own signal handlers are disabled: Ctrl-C must reach navseq's runner as
+    KeyboardInterrupt so the active goal is cancelled *before* rospy shuts down.
+    Raises :class:`NavseqError` if no ROS master answers (``init_node`` would otherwise
+    wait for one forever).
+    """
+    if rospy.core.is_initialized():
+        return
+    uri = rosgraph.get_master_uri()
+    deadline = time.monotonic() + MASTER_WAIT
+    while not rosgraph.is_master_online(uri):
+        if time.monotonic() >= deadline:
+            raise NavseqError(
+                f"no ROS master answers at {uri}; start roscore (or roslaunch) first, "
+                "or set ROS_MASTER_URI",
+                source="ROS_MASTER_URI",
+            )
+        time.sleep(0.1)
+    rospy.init_node(name, anonymous=anonymous, disable_signals=True)
+
+
+class _TimedActionClient(actionlib.ActionClient):
+    """actionlib's ActionClient that also remembers when the server last spoke."""
+
+    def __init__(self, ns: str, spec: Any):
+        self.last_status_wall: float | None = None
+        super().__init__(ns, spec)
+
+    def _status_cb(self, msg: Any) -> None:
+        self.last_status_wall = time.monotonic()
+        super()._status_cb(msg)
+
+    def server_connected(self) -> bool:
+        """The server we last heard from is connected to our goal and cancel topics.
+
+        The same test as ``ActionClient.wait_for_server``, without blocking.
+        """
+        status = self.last_status_msg
+        if status is None:
+            return False
+        server_id = status._connection_header["callerid"]
+        return bool(
+            self.pub_goal.impl.has_connection(server_id)
+            and self.pub_cancel.impl.has_connection(server_id)
+        )
+
+
+class Ros1Navigator:
+    """A :class:`~navseq.navigators.base.Navigator` over a move_base action server.
+
+    ``action`` is resolved in ``namespace`` (``namespace="/robot1"`` talks to
+    ``/robot1/move_base``, for fleets). ``frame`` overrides the mission frame in goals
+    (None: each goal's own frame). The caller needs no ``rospy.init_node``: an anonymous
+    node is started if the process is not a node yet.
+    """
+
+    def __init__(
+        self,
+        action: str = "move_base",
+        frame: str | None = None,
+        *,
+        namespace: str = "",
+        base_frames: Sequence[str] = ("base_footprint", "base_link"),
+        stamp: Literal["now", "latest"] = "now",
+        status_timeout: float = 2.0,
+        plan_topic: str | None = "NavfnROS/plan",
+        use_tf: bool = True,
+        node_name: str = DEFAULT_NODE_NAME,
+    ):
+        if stamp not in ("now", "latest"):
+            raise NavseqError(f"stamp must be 'now' or 'latest', not {stamp!r}", subject="stamp")
+        if status_timeout <= 0:
+            raise NavseqError("must be > 0 s", subject="status_timeout")
+        ensure_node(node_name)
+        self.action = rosgraph.names.ns_join(namespace, action) if namespace else action
+        self.resolved_action = rospy.resolve_name(self.action)
+        self.frame = frame
+        self.base_frames = tuple(base_frames)
+        self.stamp = stamp
+        self.status_timeout = status_timeout
+
+        self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
+        self._lock = threading.Lock()
+        self._client = _TimedActionClient(self.action, MoveBaseAction)
+        self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
+        self._goal_id: int | None = None
+        self._accepted = False
+        self._server_up: bool | None = None  # None: not checked yet
+        self._feedback_pose: Pose2D | None = None
+        self._closed = False
+        self._clear_costmaps_warned = False
+
+        self._plan_sub = None
+        if plan_topic:
+            self._plan_sub = rospy.Subscriber(
+                rosgraph.names.ns_join(self.action, plan_topic), PathMsg, self._on_plan,
+                queue_size=1,
+            )
+        self._tf_buffer = None
+        if use_tf:
+            import tf2_ros  # only when asked: it subscribes to /tf, which can be busy
+
+            self._tf_buffer = tf2_ros.Buffer()
+            self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        rospy.on_shutdown(self._on_rospy_shutdown)
+
+    # -- Navigator protocol -----------------------------------------------------------
+
+    def now(self) -> float:
+        return rospy.get_time()
+
+    def spin(self, seconds: float) -> None:
+        rospy.sleep(seconds)
+
+    def wait_for_server(self, timeout: float) -> bool:
+        deadline = time.monotonic() + timeout
+        while not self._server_ready():
+            if time.monotonic() >= deadline or rospy.is_shutdown():
+                return False
+            time.sleep(0.02)
+        self._server_up = True
+        return True
+
+    def require_server(self, timeout: float) -> None:
+        """Like :meth:`wait_for_server`, but a missing server is a clear :class:`NavseqError`."""
+        if not self.wait_for_server(timeout):
+            raise NavseqError(
+                f"no action server '{self.resolved_action}' (move_base_msgs/MoveBaseAction) "
+                f"answered within {timeout:g} s on the ROS master at "
+                f"{rosgraph.get_master_uri()}; is move_base (or `roslaunch navseq "
+                "sim.launch`) running, and is the action name/namespace right?",
+                source=f"action {self.resolved_action}",
+            )
+
+    def send_goal(self, goal: Goal) -> None:
+        frame = self.frame or goal.frame or "map"
+        stamp = rospy.Time.now() if self.stamp == "now" else rospy.Time(0)
+        message = move_base_goal(goal.pose, frame, stamp, goal.z)
+        with self._lock:
+            # The previous goal is simply no longer tracked: like move_base's own
+            # preemption, the new goal replaces it without stopping the robot.
+            self._goal_id = goal.goal_id
+            self._accepted = False
+            self._handle = None
+        # Not under self._lock: actionlib holds its own locks while calling our callbacks,
+        # which take self._lock; holding ours while it takes its own would deadlock.
+        handle = self._client.send_goal(
+            message,
+            transition_cb=lambda h, gid=goal.goal_id: self._on_transition(gid, h),
+            feedback_cb=lambda h, fb, gid=goal.goal_id: self._on_feedback(gid, fb),
+        )
+        with self._lock:
+            # actionlib only keeps a weak reference: this one keeps the goal's callbacks alive.
+            if self._goal_id == goal.goal_id and handle.get_comm_state() != CommState.DONE:
+                self._handle = handle
+
+    def cancel_goal(self) -> None:
+        with self._lock:
+            handle = self._handle
+        if handle is None or handle.get_comm_state() == CommState.DONE:
+            return
+        try:
+            handle.cancel()
+        except (rospy.ROSException, OSError, ValueError) as error:
+            rospy.logwarn("navseq: could not cancel the active goal: %s", error)
+
+    def clear_costmaps(self) -> None:
+        service = rosgraph.names.ns_join(self.action, "clear_costmaps")
+        try:
+            rospy.wait_for_service(service, timeout=1.0)
+            rospy.ServiceProxy(service, Empty)()
+        except (rospy.ROSException, rospy.ServiceException) as error:
+            if not self._clear_costmaps_warned:
+                rospy.logwarn("navseq: %s unavailable, retrying without it (%s)", service, error)
+                self._clear_costmaps_warned = True
+
+    def robot_pose(self) -> Pose2D | None:
+        if self._tf_buffer is not None:
+            frame = self.frame or "map"
+            for base in self.base_frames:
+                try:
+                    transform = self._tf_buffer.lookup_transform(frame, base, rospy.Time(0))
+                except Exception:  # tf2 raises several unrelated types; any means "not now"
+                    continue
+                return pose2d_from_transform(transform)
+        return self._feedback_pose
+
+    def poll(self) -> list[NavEvent]:
+        events: list[NavEvent] = []
+        while True:
+            try:
+                events.append(self._events.get_nowait())
+            except queue.Empty:
+                break
+        events.extend(self._check_server())
+        return events
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self.cancel_goal()
+        self._wait_cancel_delivered(CANCEL_FLUSH)
+
+    # -- server liveness ---------------------------------------------------------------
+
+    def _status_fresh(self) -> bool:
+        last = self._client.last_status_wall
+        return last is not None and time.monotonic() - last <= self.status_timeout
+
+    def _server_ready(self) -> bool:
+        return self._status_fresh() and self._client.server_connected()
+
+    def _check_server(self) -> list[NavEvent]:
+        if self._server_up is None:
+            self._server_up = self._server_ready()
+            return []
+        if self._server_up and not self._status_fresh():
+            self._server_up = False
+            with self._lock:
+                # The goal died with the server: stop tracking it; the executor resends.
+                self._handle = None
+                self._goal_id = None
+            return [
+                ServerLost(
+                    f"no status from {self.resolved_action} for {self.status_timeout:g} s"
+                )
+            ]
+        if not self._server_up and self._server_ready():
+            self._server_up = True
+            return [ServerBack()]
+        return []
+
+    # -- actionlib callbacks (rospy threads: only record and enqueue) ---------------------
+
+    def _on_transition(self, goal_id: int, handle: Any) -> None:
+        with self._lock:
+            if goal_id != self._goal_id:
+                return  # a goal we replaced or gave up on
+            state = handle.get_comm_state()
+            # PENDING only means the server received it; ACTIVE means it took it on.
+            if state == CommState.ACTIVE and not self._accepted:
+                self._accepted = True
+                self._events.put(GoalAccepted(goal_id))
+            elif state == CommState.DONE:
+                status = terminal_status_of(handle.get_goal_status()) or GoalStatus.LOST
+                if status is GoalStatus.LOST:
+                    # The server forgot the goal (e.g. restarted quickly): let poll()
+                    # announce ServerBack once it is ready, so the executor resends.
+                    self._server_up = False
+                self._events.put(GoalDone(goal_id, status, handle.get_goal_status_text()))
+                self._handle = None
+                self._goal_id = None
+
+    def _on_feedback(self, goal_id: int, feedback: Any) -> None:
+        pose = pose2d_from_pose(feedback.base_position.pose)
+        self._feedback_pose = pose
+        if goal_id == self._goal_id:
+            self._events.put(GoalFeedback(goal_id, pose))
+
+    def _on_plan(self, path: Any) -> None:
+        goal_id = self._goal_id
+        if goal_id is None:
+            return
+        points = tuple((p.pose.position.x, p.pose.position.y) for p in path.poses)
+        self._events.put(GoalPlan(goal_id, points))
+
+    def _on_rospy_shutdown(self) -> None:
+        # Runs before rospy closes its publishers (rosnode kill, signal_shutdown), so
+        # the cancel still goes out and the robot does not drive on without us.
+        self.cancel_goal()
+        self._wait_cancel_delivered(CANCEL_FLUSH)
+
+    def _wait_cancel_delivered(self, timeout: float) -> None:
+        """Give a cancel time to reach the server: until it acknowledges, or ``timeout``."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self._lock:
+                handle = self._handle
+            if handle is None or handle.get_comm_state() in (
+                CommState.RECALLING,
+                CommState.PREEMPTING,
+                CommState.DONE,
+            ):
+                return
+            time.sleep(0.02)

@@ -1,0 +1,239 @@
+#!/usr/bin/env python3
+"""A scripted MoveBase action server: a stand-in for move_base whose outcomes tests choose.
+
+Each goal it receives, in arrival order, follows the next behaviour of ``--script``
+(then ``--then`` for every later goal). A behaviour is ``KIND[:SECONDS]``:
+
+``succeed``  accept, drive the reported pose toward the goal, SUCCEEDED after SECONDS
+``abort``    accept, ABORTED after SECONDS
+``reject``   REJECTED after SECONDS without accepting
+``preempt``  accept, then the server itself cancels it: PREEMPTED after SECONDS
+``recall``   leave it pending, then cancel it: RECALLED after SECONDS
+``hang``     accept and never finish (only a cancel or a newer goal ends it)
+``die``      accept, then the whole process exits abruptly after SECONDS (server lost)
+
+Like move_base, a newer goal preempts the active one and a cancel request ends an active
+goal PREEMPTED (a pending one RECALLED). Everything observable — goals with their poses,
+frames and stamps, cancels, results, clear_costmaps calls — is appended as JSON lines to
+``--log`` so tests can assert what a client really sent.
+
+It is a real actionlib ``ActionServer`` on a real ROS master; nothing is mocked.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import actionlib
+import rospy
+from geometry_msgs.msg import PoseStamped
+from move_base_msgs.msg import MoveBaseAction, MoveBaseFeedback, MoveBaseResult
+from nav_msgs.msg import Path as PathMsg
+from std_srvs.srv import Empty, EmptyResponse
+
+KINDS = ("succeed", "abort", "reject", "preempt", "recall", "hang", "die")
+FEEDBACK_PERIOD = 0.1  # s of wall time between feedback messages
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    kind: str
+    seconds: float
+
+    @classmethod
+    def parse(cls, text: str) -> Behaviour:
+        kind, _, seconds = text.partition(":")
+        if kind not in KINDS:
+            raise argparse.ArgumentTypeError(f"unknown behaviour {kind!r}; one of {KINDS}")
+        return cls(kind, float(seconds) if seconds else 0.3)
+
+
+@dataclass
+class TrackedGoal:
+    handle: Any
+    behaviour: Behaviour
+    received: float  # time.monotonic()
+    start_xy: tuple[float, float]
+    goal_xy: tuple[float, float]
+    accepted: bool = False
+    done: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+class ScriptedMoveBase:
+    def __init__(self, action: str, script: list[Behaviour], then: Behaviour, log: Path | None):
+        self._script = list(script)
+        self._then = then
+        self._log_path = log
+        self._lock = threading.RLock()
+        self._goals: list[TrackedGoal] = []
+        self._count = 0
+        self._robot_xy = (0.0, 0.0)
+        self._plan_pub = rospy.Publisher(f"{action}/NavfnROS/plan", PathMsg, queue_size=2)
+        rospy.Service(f"{action}/clear_costmaps", Empty, self._clear_costmaps)
+        self._server = actionlib.ActionServer(
+            action, MoveBaseAction, self._on_goal, self._on_cancel, auto_start=False
+        )
+        self._server.start()
+
+    # -- log ---------------------------------------------------------------------------
+
+    def log(self, event: str, **fields: Any) -> None:
+        if self._log_path is None:
+            return
+        record = {"event": event, "t": time.time(), "pid": os.getpid(), **fields}
+        with open(self._log_path, "a", encoding="utf-8") as sink:
+            sink.write(json.dumps(record) + "\n")
+
+    # -- callbacks (rospy threads) -------------------------------------------------------
+
+    def _on_goal(self, handle: Any) -> None:
+        goal = handle.get_goal()
+        pose = goal.target_pose
+        q = pose.pose.orientation
+        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        with self._lock:
+            behaviour = self._script.pop(0) if self._script else self._then
+            self._count += 1
+            goal_id = handle.get_goal_id().id
+            self.log(
+                "goal",
+                id=goal_id,
+                n=self._count,
+                x=pose.pose.position.x,
+                y=pose.pose.position.y,
+                z=pose.pose.position.z,
+                yaw=yaw,
+                frame=pose.header.frame_id,
+                stamp=pose.header.stamp.to_sec(),
+                behaviour=behaviour.kind,
+            )
+            tracked = TrackedGoal(
+                handle=handle,
+                behaviour=behaviour,
+                received=time.monotonic(),
+                start_xy=self._robot_xy,
+                goal_xy=(pose.pose.position.x, pose.pose.position.y),
+            )
+            # Like move_base: a newer goal preempts whatever is still running.
+            for older in self._goals:
+                if not older.done and older.accepted:
+                    self._finish(older, "PREEMPTED", "preempted by a newer goal")
+            self._goals = [g for g in self._goals if not g.done]
+            self._goals.append(tracked)
+            if behaviour.kind not in ("reject", "recall"):
+                handle.set_accepted()
+                tracked.accepted = True
+                self.log("accepted", id=goal_id)
+                path = PathMsg()
+                path.header.frame_id = pose.header.frame_id
+                for fraction in (0.0, 0.5, 1.0):
+                    point = PoseStamped()
+                    point.header.frame_id = pose.header.frame_id
+                    point.pose.position.x = tracked.start_xy[0] + fraction * (
+                        tracked.goal_xy[0] - tracked.start_xy[0]
+                    )
+                    point.pose.position.y = tracked.start_xy[1] + fraction * (
+                        tracked.goal_xy[1] - tracked.start_xy[1]
+                    )
+                    point.pose.orientation.w = 1.0
+                    path.poses.append(point)
+                self._plan_pub.publish(path)
+
+    def _on_cancel(self, handle: Any) -> None:
+        goal_id = handle.get_goal_id().id
+        with self._lock:
+            self.log("cancel", id=goal_id)
+            for tracked in self._goals:
+                if tracked.handle.get_goal_id().id == goal_id and not tracked.done:
+                    status = "PREEMPTED" if tracked.accepted else "RECALLED"
+                    self._finish(tracked, status, "canceled by the client")
+
+    def _clear_costmaps(self, _request: Any) -> EmptyResponse:
+        self.log("clear_costmaps")
+        return EmptyResponse()
+
+    # -- behaviour -----------------------------------------------------------------------
+
+    def _finish(self, tracked: TrackedGoal, status: str, text: str) -> None:
+        tracked.done = True
+        handle = tracked.handle
+        result = MoveBaseResult()
+        if status == "SUCCEEDED":
+            handle.set_succeeded(result, text)
+        elif status == "ABORTED":
+            handle.set_aborted(result, text)
+        elif status == "REJECTED":
+            handle.set_rejected(result, text)
+        else:
+            # actionlib decides: PREEMPTED for an accepted goal, RECALLED for a pending one.
+            handle.set_canceled(result, text)
+        self.log("done", id=handle.get_goal_id().id, status=status, text=text)
+
+    def step(self) -> None:
+        now = time.monotonic()
+        with self._lock:
+            for tracked in self._goals:
+                if tracked.done:
+                    continue
+                kind, seconds = tracked.behaviour.kind, tracked.behaviour.seconds
+                elapsed = now - tracked.received
+                if tracked.accepted:
+                    self._feedback(tracked, min(1.0, elapsed / max(seconds, 1e-3)))
+                if kind == "hang" or elapsed < seconds:
+                    continue
+                if kind == "die":
+                    self.log("die")
+                    os._exit(3)
+                status = {
+                    "succeed": "SUCCEEDED",
+                    "abort": "ABORTED",
+                    "reject": "REJECTED",
+                    "preempt": "PREEMPTED",
+                    "recall": "RECALLED",
+                }[kind]
+                self._finish(tracked, status, f"scripted {kind}")
+            self._goals = [g for g in self._goals if not g.done]
+
+    def _feedback(self, tracked: TrackedGoal, fraction: float) -> None:
+        if tracked.behaviour.kind == "succeed":
+            (x0, y0), (x1, y1) = tracked.start_xy, tracked.goal_xy
+            self._robot_xy = (x0 + fraction * (x1 - x0), y0 + fraction * (y1 - y0))
+        feedback = MoveBaseFeedback()
+        target = tracked.handle.get_goal().target_pose
+        feedback.base_position.header.frame_id = target.header.frame_id
+        feedback.base_position.header.stamp = rospy.Time.now()
+        feedback.base_position.pose.position.x = self._robot_xy[0]
+        feedback.base_position.pose.position.y = self._robot_xy[1]
+        feedback.base_position.pose.orientation.w = 1.0
+        tracked.handle.publish_feedback(feedback)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--action", default="move_base")
+    parser.add_argument("--node-name", default="scripted_move_base")
+    parser.add_argument("--script", default="", help="space-separated KIND[:SECONDS] per goal")
+    parser.add_argument("--then", type=Behaviour.parse, default=Behaviour("succeed", 0.3))
+    parser.add_argument("--log", type=Path)
+    args = parser.parse_args(rospy.myargv()[1:])
+    script = [Behaviour.parse(item) for item in args.script.split()]
+    rospy.init_node(args.node_name)
+    server = ScriptedMoveBase(args.action, script, args.then, args.log)
+    server.log("ready")
+    print("scripted move_base ready", flush=True)
+    while not rospy.is_shutdown():
+        server.step()
+        time.sleep(FEEDBACK_PERIOD)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,246 @@
+"""Ros1Navigator against a real rosmaster and a scripted move_base action server.
+
+rospy allows one node per process, so the navigator runs in a subprocess: this file is
+also that subprocess's program (``python tests/test_ros1_navigator.py drive ...``). The
+driver sends goals one after the other, prints every navigator event as a JSON line, and
+resends the active goal after ``ServerBack`` like the executor does.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+TESTS = Path(__file__).resolve().parent
+THIS = Path(__file__).resolve()
+SERVER = TESTS / "ros_scripted_server.py"
+
+
+# ---------------------------------------------------------------------------------------
+# Driver (runs in the subprocess)
+# ---------------------------------------------------------------------------------------
+
+
+def _emit(record: dict[str, Any]) -> None:
+    print("EVENT " + json.dumps(record), flush=True)
+
+
+def _drive(argv: list[str]) -> int:
+    import time
+
+    from navseq.errors import NavseqError
+    from navseq.geometry import Pose2D
+    from navseq.navigators.base import Goal, GoalDone, ServerBack
+    from navseq.navigators.ros1 import Ros1Navigator
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--goals", required=True, help="x,y,yaw_deg;x,y,yaw_deg;...")
+    parser.add_argument("--namespace", default="")
+    parser.add_argument("--frame", default=None)
+    parser.add_argument("--stamp", default="now")
+    parser.add_argument("--cancel-after", type=float, default=None)
+    parser.add_argument("--replace-after", type=float, default=None)
+    parser.add_argument("--clear-costmaps", action="store_true")
+    parser.add_argument("--server-wait", type=float, default=10.0)
+    parser.add_argument("--goal-timeout", type=float, default=30.0)
+    args = parser.parse_args(argv)
+    goals = [tuple(float(v) for v in item.split(",")) for item in args.goals.split(";")]
+
+    try:
+        navigator = Ros1Navigator(
+            frame=args.frame, namespace=args.namespace, stamp=args.stamp, use_tf=False
+        )
+        navigator.require_server(args.server_wait)
+    except NavseqError as error:
+        print(f"navseq: {error}", file=sys.stderr, flush=True)
+        return 2
+    if args.clear_costmaps:
+        navigator.clear_costmaps()
+
+    goal_id = 0
+    for index, (x, y, yaw_deg) in enumerate(goals):
+        goal_id += 1
+        goal = Goal(goal_id, Pose2D(x, y, math.radians(yaw_deg)), frame="map")
+        navigator.send_goal(goal)
+        _emit({"type": "sent", "goal_id": goal_id, "index": index})
+        started = time.monotonic()
+        acted = False
+        done = False
+        while not done:
+            for event in navigator.poll():
+                record = {"type": type(event).__name__, **vars(event)}
+                record.pop("pose", None)
+                if "status" in record:
+                    record["status"] = event.status.value
+                _emit(record)
+                if isinstance(event, GoalDone) and event.goal_id == goal.goal_id:
+                    done = True
+                if isinstance(event, ServerBack):
+                    goal_id += 1
+                    goal = Goal(goal_id, goal.pose, frame="map")
+                    navigator.send_goal(goal)
+                    _emit({"type": "sent", "goal_id": goal_id, "index": index})
+            elapsed = time.monotonic() - started
+            if not acted and args.cancel_after is not None and elapsed > args.cancel_after:
+                acted = True
+                navigator.cancel_goal()
+                _emit({"type": "cancel_sent", "goal_id": goal.goal_id})
+            if not acted and args.replace_after is not None and elapsed > args.replace_after:
+                acted = True
+                goal_id += 1
+                goal = Goal(goal_id, Pose2D(x + 1.0, y, 0.0), frame="map")
+                navigator.send_goal(goal)
+                _emit({"type": "sent", "goal_id": goal_id, "index": index})
+            if elapsed > args.goal_timeout:
+                _emit({"type": "driver_timeout", "goal_id": goal.goal_id})
+                return 1
+            navigator.spin(0.02)
+    pose = navigator.robot_pose()
+    _emit({"type": "final_pose", "x": pose.x if pose else None, "y": pose.y if pose else None})
+    navigator.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_drive(sys.argv[2:]) if sys.argv[1:2] == ["drive"] else 64)
+
+
+# ---------------------------------------------------------------------------------------
+# Tests
+# ---------------------------------------------------------------------------------------
+
+from ros_support import RosMaster, RosProcess  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+
+def events_of(process: RosProcess) -> list[dict[str, Any]]:
+    return [
+        json.loads(line[len("EVENT ") :])
+        for line in process.output().splitlines()
+        if line.startswith("EVENT ")
+    ]
+
+
+def server_log(path: Path) -> list[dict[str, Any]]:
+    if not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def start_server(master: RosMaster, log: Path, script: str = "", *extra: str) -> RosProcess:
+    server = master.start_python(SERVER, "--script", script, "--log", str(log), *extra)
+    server.wait_for_output("scripted move_base ready", timeout=20)
+    return server
+
+
+def drive(master: RosMaster, *args: str, timeout: float = 60.0) -> tuple[int, RosProcess]:
+    driver = master.start_python(THIS, "drive", *args, label="driver")
+    code = driver.wait(timeout=timeout)
+    return code, driver
+
+
+def done_statuses(events: list[dict[str, Any]]) -> dict[int, str]:
+    return {e["goal_id"]: e["status"] for e in events if e["type"] == "GoalDone"}
+
+
+def test_every_terminal_status_reaches_the_caller(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "succeed:0.4 abort reject preempt recall")
+    code, driver = drive(ros_master, "--goals", "1,2,90;3,4,0;5,6,0;7,8,0;9,10,0")
+    assert code == 0, driver.output()
+    events = events_of(driver)
+    assert done_statuses(events) == {
+        1: "SUCCEEDED",
+        2: "ABORTED",
+        3: "REJECTED",
+        4: "PREEMPTED",
+        5: "RECALLED",
+    }
+    accepted = {e["goal_id"] for e in events if e["type"] == "GoalAccepted"}
+    assert {1, 2, 4} <= accepted and 3 not in accepted
+    assert any(e["type"] == "GoalFeedback" and e["goal_id"] == 1 for e in events)
+    plans = [e for e in events if e["type"] == "GoalPlan" and e["goal_id"] == 1]
+    assert plans and plans[0]["path"][-1] == [1.0, 2.0]
+    final = next(e for e in events if e["type"] == "final_pose")
+    assert final["x"] == pytest.approx(1.0) and final["y"] == pytest.approx(2.0)
+
+    received = [r for r in server_log(log) if r["event"] == "goal"]
+    assert [(r["x"], r["y"]) for r in received] == [(1, 2), (3, 4), (5, 6), (7, 8), (9, 10)]
+    assert received[0]["yaw"] == pytest.approx(math.pi / 2)
+    assert all(r["frame"] == "map" for r in received)
+    # Stamped with ROS time (wall time here, no use_sim_time), not zero.
+    assert all(r["stamp"] > 1e9 for r in received)
+
+
+def test_cancel_reaches_the_server_and_ends_the_goal_preempted(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "hang")
+    code, driver = drive(
+        ros_master, "--goals", "1,0,0", "--cancel-after", "0.5", "--stamp", "latest"
+    )
+    assert code == 0, driver.output()
+    assert done_statuses(events_of(driver)) == {1: "PREEMPTED"}
+    records = server_log(log)
+    assert [r["event"] for r in records if r["event"] in ("cancel", "done")] == [
+        "cancel",
+        "done",
+    ]
+    assert next(r for r in records if r["event"] == "goal")["stamp"] == 0.0
+
+
+def test_a_new_goal_replaces_the_active_one_without_a_cancel(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "hang succeed:0.3")
+    code, driver = drive(ros_master, "--goals", "1,0,0", "--replace-after", "0.5")
+    assert code == 0, driver.output()
+    # Only the replacing goal is reported; the replaced one is not the caller's any more.
+    assert done_statuses(events_of(driver)) == {2: "SUCCEEDED"}
+    records = server_log(log)
+    assert not [r for r in records if r["event"] == "cancel"]
+    assert [r["status"] for r in records if r["event"] == "done"] == ["PREEMPTED", "SUCCEEDED"]
+
+
+def test_server_lost_mid_goal_and_back_after_restart(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "die:0.5")
+    driver = ros_master.start_python(THIS, "drive", "--goals", "1,1,0;2,2,0", label="driver")
+    driver.wait_for_output('"ServerLost"', timeout=20)
+    start_server(ros_master, log, "succeed:0.3")
+    assert driver.wait(timeout=30) == 0, driver.output()
+    kinds = [e["type"] for e in events_of(driver)]
+    assert kinds.index("ServerLost") < kinds.index("ServerBack")
+    statuses = done_statuses(events_of(driver))
+    assert list(statuses.values()) == ["SUCCEEDED", "SUCCEEDED"]
+    assert 1 not in statuses  # the goal that died with the server is not reported as done
+    goals = [(r["x"], r["y"]) for r in server_log(log) if r["event"] == "goal"]
+    assert goals == [(1, 1), (1, 1), (2, 2)]
+
+
+def test_missing_server_is_a_clear_error_naming_action_and_master(ros_master: RosMaster):
+    code, driver = drive(ros_master, "--goals", "1,0,0", "--server-wait", "0.5")
+    assert code == 2
+    output = driver.output()
+    assert "/move_base" in output and ros_master.uri in output
+    assert "Traceback" not in output
+
+
+def test_namespaced_action_and_clear_costmaps(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "", "__ns:=robot1")
+    code, driver = drive(
+        ros_master, "--goals", "1,0,0", "--namespace", "/robot1", "--clear-costmaps"
+    )
+    assert code == 0, driver.output()
+    assert done_statuses(events_of(driver)) == {1: "SUCCEEDED"}
+    assert [r["event"] for r in server_log(log)].count("clear_costmaps") == 1
