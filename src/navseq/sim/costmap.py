@@ -1,0 +1,111 @@
+"""A costmap like costmap_2d's static + inflation layers: what a robot centre costs here.
+
+Each cell gets a cost byte with costmap_2d's meanings:
+
+- ``LETHAL`` (254): an obstacle cell;
+- ``INSCRIBED`` (253): within ``inscribed_radius`` of an obstacle, so the robot's
+  footprint would certainly touch it — the robot centre must not be here;
+- 1..252: ``252 * exp(-cost_scaling_factor * (d - inscribed_radius))`` for distances
+  ``d`` up to ``inflation_radius``, so plans keep clear of walls where they can;
+- ``FREE`` (0): farther away;
+- ``NO_INFORMATION`` (255): unknown cells. With ``unknown_is_lethal`` (the default,
+  like a planner that does not allow unknown space) they also act as obstacles for
+  inflation; without it they are read as free space, as costmap_2d's static layer does
+  with ``track_unknown_space: false``.
+
+Distances are Euclidean between cell centres (``scipy.ndimage.distance_transform_edt``),
+as costmap_2d's inflation layer computes them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from navseq.sim.occupancy import OccupancyGrid
+
+FREE, INSCRIBED, LETHAL, NO_INFORMATION = 0, 253, 254, 255
+
+
+@dataclass(frozen=True)
+class CostmapParams:
+    """Inflation settings; defaults are the TurtleBot3 burger's navigation parameters."""
+
+    inflation_radius: float = 1.0  # m: cells farther than this from an obstacle cost 0
+    cost_scaling_factor: float = 3.0  # 1/m: how fast the cost decays with distance
+    inscribed_radius: float = 0.105  # m: the footprint's inscribed radius
+    unknown_is_lethal: bool = True
+
+
+@dataclass(frozen=True, eq=False)
+class Costmap:
+    """Per-cell costs (uint8, same shape and orientation as ``grid.data``)."""
+
+    grid: OccupancyGrid
+    params: CostmapParams = field(default_factory=CostmapParams)
+    cost: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.cost is None:
+            object.__setattr__(self, "cost", inflate(self.grid, self.params))
+        if self.cost.shape != self.grid.data.shape:
+            raise ValueError("cost array and grid differ in shape")
+        self.cost.setflags(write=False)
+
+    @classmethod
+    def from_grid(cls, grid: OccupancyGrid, params: CostmapParams | None = None) -> Costmap:
+        return cls(grid, params or CostmapParams())
+
+    @property
+    def resolution(self) -> float:
+        return self.grid.resolution
+
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]:
+        return self.grid.world_to_cell(x, y)
+
+    def cell_to_world(self, row: int, col: int) -> tuple[float, float]:
+        return self.grid.cell_to_world(row, col)
+
+    def cost_at(self, x: float, y: float) -> int:
+        """Cost of the cell under a world point; ``NO_INFORMATION`` off the map."""
+        row, col = self.grid.world_to_cell(x, y)
+        if not self.grid.in_bounds(row, col):
+            return NO_INFORMATION
+        return int(self.cost[row, col])
+
+    def is_free(self, x: float, y: float) -> bool:
+        """True if the robot centre may be at this point (cost below ``INSCRIBED``)."""
+        return self.cost_at(x, y) < INSCRIBED
+
+    def free_mask(self) -> np.ndarray:
+        """Cells where the robot centre may be."""
+        return self.cost < INSCRIBED
+
+
+def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:
+    """The cost array of a grid: lethal obstacles, inscribed band, exponential decay."""
+    obstacles = grid.occupied_mask()
+    unknown = grid.unknown_mask()
+    if params.unknown_is_lethal:
+        obstacles = obstacles | unknown
+
+    cost = np.zeros(grid.data.shape, dtype=np.uint8)
+    if obstacles.any():
+        distance = ndimage.distance_transform_edt(~obstacles) * grid.resolution
+        cost[:] = cost_of_distance(distance, params)
+    if params.unknown_is_lethal:
+        cost[unknown] = NO_INFORMATION
+    return cost
+
+
+def cost_of_distance(distance: np.ndarray, params: CostmapParams) -> np.ndarray:
+    """costmap_2d's ``computeCost``: cost byte for a distance (m) to the nearest obstacle."""
+    beyond_inscribed = np.maximum(distance - params.inscribed_radius, 0.0)
+    decay = np.exp(-params.cost_scaling_factor * beyond_inscribed)
+    # costmap_2d casts to unsigned char, i.e. truncates.
+    cost = np.floor((INSCRIBED - 1) * decay).astype(np.uint8)
+    cost = np.where(distance <= params.inscribed_radius, np.uint8(INSCRIBED), cost)
+    cost = np.where(distance > params.inflation_radius, np.uint8(FREE), cost)
+    return np.where(distance == 0, np.uint8(LETHAL), cost).astype(np.uint8)

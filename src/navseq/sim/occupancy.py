@@ -1,0 +1,339 @@
+"""Occupancy grids in the ROS map_server format (an image plus a YAML description).
+
+A map_server map is a greyscale (or colour) image whose pixels are turned into
+occupancy values by a few YAML settings::
+
+    image: turtlebot3_world.pgm   # relative paths are resolved against the YAML's folder
+    resolution: 0.05              # metres per cell
+    origin: [-10.0, -10.0, 0.0]   # pose (x, y, yaw) of the lower-left corner of the image
+    negate: 0                     # 1: white means occupied instead of black
+    occupied_thresh: 0.65         # occupancy probability above which a cell is occupied
+    free_thresh: 0.196            # ... and below which it is free
+    mode: trinary                 # trinary (default) | scale | raw
+
+``load_map`` follows ROS 1 map_server's ``image_loader.cpp`` pixel by pixel, so a map
+means the same thing here as on a robot:
+
+- the colour channels are averaged; an alpha channel is averaged in too in trinary
+  mode, while in scale and raw mode it is left out and a fully transparent pixel is
+  unknown;
+- ``negate`` flips the average (``255 - avg``) before anything else, in every mode;
+- the occupancy probability is ``p = (255 - avg) / 255``: ``p > occupied_thresh``
+  gives 100, ``p < free_thresh`` gives 0, anything between gives -1 (unknown) in
+  trinary mode and ``1 + 98 * (p - free) / (occupied - free)`` (truncated) in scale
+  mode;
+- raw mode stores the (possibly negated) average itself, as map_server does into an
+  ``int8`` message, so 255 becomes -1 (unknown) and 128..254 become negative;
+- the image's top row is the map's last row: row 0 of ``OccupancyGrid.data`` is the
+  bottom of the picture (``nav_msgs/OccupancyGrid`` order).
+
+Where map_server insists on ``occupied_thresh`` and ``free_thresh``, navseq falls back
+on the values ``map_saver`` writes (0.65 and 0.196).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from PIL import Image, UnidentifiedImageError
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+
+OCCUPIED = 100
+FREE = 0
+UNKNOWN = -1
+
+DEFAULT_OCCUPIED_THRESH = 0.65
+DEFAULT_FREE_THRESH = 0.196
+MODES = ("trinary", "scale", "raw")
+
+
+@dataclass(frozen=True)
+class OccupancyGrid:
+    """A 2-D occupancy map: -1 unknown, 0 free .. 100 occupied, one value per cell.
+
+    ``data[row, col]`` with row 0 at the bottom (``nav_msgs/OccupancyGrid`` order).
+    ``origin`` is the pose of the lower-left corner of cell (0, 0); its yaw rotates the
+    whole grid about that corner, as in ``nav_msgs/MapMetaData``.
+    """
+
+    data: np.ndarray
+    resolution: float
+    origin: Pose2D = field(default_factory=lambda: Pose2D(0.0, 0.0, 0.0))
+    source: str = "<memory>"
+
+    def __post_init__(self) -> None:
+        if self.data.ndim != 2:
+            raise ValueError(f"occupancy data must be 2-D, got shape {self.data.shape}")
+        if not self.resolution > 0:
+            raise ValueError(f"resolution must be positive, got {self.resolution}")
+
+    @property
+    def width(self) -> int:
+        return int(self.data.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.data.shape[0])
+
+    def world_to_grid(self, x: float, y: float) -> tuple[float, float]:
+        """Continuous grid coordinates (col, row) in cells of a world point.
+
+        Cell (row, col) spans ``[col, col + 1) x [row, row + 1)`` in these units.
+        """
+        dx, dy = x - self.origin.x, y - self.origin.y
+        if self.origin.yaw:
+            c, s = math.cos(self.origin.yaw), math.sin(self.origin.yaw)
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        return dx / self.resolution, dy / self.resolution
+
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]:
+        """(row, col) of the cell containing a world point; may be out of bounds."""
+        gx, gy = self.world_to_grid(x, y)
+        return math.floor(gy), math.floor(gx)
+
+    def cell_to_world(self, row: int, col: int) -> tuple[float, float]:
+        """World (x, y) of a cell's centre."""
+        gx, gy = (col + 0.5) * self.resolution, (row + 0.5) * self.resolution
+        if self.origin.yaw:
+            c, s = math.cos(self.origin.yaw), math.sin(self.origin.yaw)
+            gx, gy = c * gx - s * gy, s * gx + c * gy
+        return self.origin.x + gx, self.origin.y + gy
+
+    def cells_to_world(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """World (x, y) of many cell centres at once, shape (N, 2)."""
+        gx = (np.asarray(cols, dtype=float) + 0.5) * self.resolution
+        gy = (np.asarray(rows, dtype=float) + 0.5) * self.resolution
+        c, s = math.cos(self.origin.yaw), math.sin(self.origin.yaw)
+        return np.column_stack((self.origin.x + c * gx - s * gy, self.origin.y + s * gx + c * gy))
+
+    def in_bounds(self, row: int, col: int) -> bool:
+        return 0 <= row < self.height and 0 <= col < self.width
+
+    def contains(self, x: float, y: float) -> bool:
+        """True if the world point lies on the map."""
+        return self.in_bounds(*self.world_to_cell(x, y))
+
+    def occupied_mask(self) -> np.ndarray:
+        """Cells that are obstacles.
+
+        That is value 100 (and, as costmap_2d reads a raw-mode map as unsigned bytes,
+        any other value it would call lethal: 101..127 and -128..-2).
+        """
+        return (self.data >= OCCUPIED) | (self.data < UNKNOWN)
+
+    def unknown_mask(self) -> np.ndarray:
+        """Cells whose occupancy is unknown (value -1)."""
+        return self.data == UNKNOWN
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) in the world of the map's corners."""
+        corners = [(0, 0), (self.width, 0), (0, self.height), (self.width, self.height)]
+        c, s = math.cos(self.origin.yaw), math.sin(self.origin.yaw)
+        xs = [self.origin.x + (c * u - s * v) * self.resolution for u, v in corners]
+        ys = [self.origin.y + (s * u + c * v) * self.resolution for u, v in corners]
+        return min(xs), min(ys), max(xs), max(ys)
+
+
+def load_map(yaml_path: str | Path) -> OccupancyGrid:
+    """Read a map_server map (YAML + PGM/PNG image) into an ``OccupancyGrid``.
+
+    Raises ``NavseqError`` naming the file and the key for anything wrong with it.
+    """
+    path = Path(yaml_path)
+    source = str(path)
+    description = _read_yaml(path)
+    settings = _MapSettings.from_yaml(description, source)
+    image_path = Path(settings.image)
+    if not image_path.is_absolute():
+        image_path = path.parent / image_path
+    pixels = _read_image(image_path, source)
+    data = pixels_to_occupancy(
+        pixels,
+        mode=settings.mode,
+        negate=settings.negate,
+        occupied_thresh=settings.occupied_thresh,
+        free_thresh=settings.free_thresh,
+    )
+    return OccupancyGrid(
+        data=data, resolution=settings.resolution, origin=settings.origin, source=source
+    )
+
+
+def pixels_to_occupancy(
+    pixels: np.ndarray,
+    *,
+    mode: str = "trinary",
+    negate: bool = False,
+    occupied_thresh: float = DEFAULT_OCCUPIED_THRESH,
+    free_thresh: float = DEFAULT_FREE_THRESH,
+) -> np.ndarray:
+    """map_server's pixel rules: image array (top row first) -> int8 grid (bottom row first).
+
+    ``pixels`` is uint8 of shape (H, W) or (H, W, C) with C = 2 (grey + alpha), 3 (RGB)
+    or 4 (RGBA).
+    """
+    if mode not in MODES:
+        raise ValueError(f"unknown mode {mode!r}")
+    channels = pixels[..., np.newaxis] if pixels.ndim == 2 else pixels
+    n_channels = channels.shape[2]
+    has_alpha = n_channels in (2, 4)
+    # map_server: trinary mode averages the alpha channel in with the colours.
+    averaged = n_channels - 1 if has_alpha and mode != "trinary" else n_channels
+    colour = channels[..., :averaged].astype(np.float64).mean(axis=2)
+    alpha = channels[..., -1] if has_alpha else np.full(colour.shape, 255, dtype=np.uint8)
+    if negate:
+        colour = 255.0 - colour
+
+    if mode == "raw":
+        # map_server assigns the int value to an int8 cell: 255 wraps to -1 (unknown).
+        values = colour.astype(np.int64).astype(np.uint8).view(np.int8)
+        return np.ascontiguousarray(np.flipud(values))
+
+    occupancy = (255.0 - colour) / 255.0
+    values = np.full(colour.shape, UNKNOWN, dtype=np.int8)
+    if mode == "scale":
+        # Truncation toward zero, as the C++ double -> int conversion does.
+        ratio = (occupancy - free_thresh) / (occupied_thresh - free_thresh)
+        scaled = (1.0 + 98.0 * ratio).astype(np.int64).clip(-128, 127).astype(np.int8)
+        values = np.where(alpha < 1, np.int8(UNKNOWN), scaled).astype(np.int8)
+    values[occupancy < free_thresh] = FREE
+    values[occupancy > occupied_thresh] = OCCUPIED
+    return np.ascontiguousarray(np.flipud(values))
+
+
+@dataclass(frozen=True)
+class _MapSettings:
+    image: str
+    resolution: float
+    origin: Pose2D
+    negate: bool
+    occupied_thresh: float
+    free_thresh: float
+    mode: str
+
+    @classmethod
+    def from_yaml(cls, doc: dict[str, Any], source: str) -> _MapSettings:
+        def fail(key: str, message: str) -> NavseqError:
+            return NavseqError(message, source=source, subject=f"key {key}")
+
+        image = doc.get("image")
+        if image is None:
+            raise fail("image", "the map YAML has no 'image' (the PGM/PNG file to load)")
+        if not isinstance(image, str) or not image.strip():
+            raise fail("image", f"expected a file name, got {image!r}")
+
+        if "resolution" not in doc:
+            raise fail("resolution", "the map YAML has no 'resolution' (metres per cell)")
+        resolution = _number(doc["resolution"])
+        if resolution is None or not resolution > 0 or not math.isfinite(resolution):
+            raise fail("resolution", f"expected a positive number, got {doc['resolution']!r}")
+
+        origin_value = doc.get("origin", [0.0, 0.0, 0.0])
+        origin_numbers = (
+            [_number(v) for v in origin_value] if isinstance(origin_value, list) else []
+        )
+        if len(origin_numbers) != 3 or any(
+            v is None or not math.isfinite(v) for v in origin_numbers
+        ):
+            raise fail("origin", f"expected [x, y, yaw], got {origin_value!r}")
+        x, y, yaw = (float(v) for v in origin_numbers)  # type: ignore[arg-type]
+
+        negate_value = doc.get("negate", 0)
+        if negate_value not in (0, 1) or isinstance(negate_value, float):
+            raise fail("negate", f"expected 0 or 1, got {negate_value!r}")
+
+        thresholds = {}
+        for key, default in (
+            ("occupied_thresh", DEFAULT_OCCUPIED_THRESH),
+            ("free_thresh", DEFAULT_FREE_THRESH),
+        ):
+            value = _number(doc.get(key, default))
+            if value is None or not 0.0 <= value <= 1.0:
+                raise fail(key, f"expected a probability between 0 and 1, got {doc[key]!r}")
+            thresholds[key] = value
+        if thresholds["free_thresh"] >= thresholds["occupied_thresh"]:
+            raise fail(
+                "free_thresh",
+                f"free_thresh ({thresholds['free_thresh']}) must be below occupied_thresh "
+                f"({thresholds['occupied_thresh']})",
+            )
+
+        mode = doc.get("mode", "trinary")
+        if mode not in MODES:
+            raise fail("mode", f"expected one of {', '.join(MODES)}, got {mode!r}")
+
+        return cls(
+            image=image,
+            resolution=resolution,
+            origin=Pose2D(x, y, yaw),
+            negate=bool(negate_value),
+            occupied_thresh=thresholds["occupied_thresh"],
+            free_thresh=thresholds["free_thresh"],
+            mode=mode,
+        )
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value)
+
+
+def _read_yaml(path: Path) -> dict[str, Any]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise NavseqError("map file not found", source=str(path)) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise NavseqError(f"cannot read the map YAML: {error}", source=str(path)) from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
+        raise NavseqError(f"not valid YAML: {error}", source=where) from None
+    if not isinstance(doc, dict):
+        raise NavseqError(
+            "a map YAML must be a mapping with image, resolution, origin, ...", source=str(path)
+        )
+    return doc
+
+
+def _read_image(image_path: Path, source: str) -> np.ndarray:
+    """Pixels of a PGM/PNG as uint8 (H, W[, C]), top row first."""
+    subject = f"image {image_path}"
+    if not image_path.is_file():
+        raise NavseqError("the map image does not exist", source=source, subject=subject)
+    try:
+        with Image.open(image_path) as image:
+            image.load()
+            return _to_uint8_channels(image)
+    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
+        raise NavseqError(
+            f"cannot read the map image (not a valid PGM/PNG?): {error}",
+            source=source,
+            subject=subject,
+        ) from None
+
+
+def _to_uint8_channels(image: Image.Image) -> np.ndarray:
+    if image.mode in ("L", "LA", "RGB", "RGBA"):
+        return np.asarray(image, dtype=np.uint8)
+    if image.mode == "1":
+        return np.asarray(image.convert("L"), dtype=np.uint8)
+    if image.mode == "P":
+        has_transparency = "transparency" in image.info
+        return np.asarray(image.convert("RGBA" if has_transparency else "RGB"), dtype=np.uint8)
+    if image.mode.startswith("I"):
+        # 16-bit PGM/PNG: keep the top 8 bits, as an 8-bit loader would see it.
+        wide = np.asarray(image, dtype=np.int64)
+        return (wide >> 8).clip(0, 255).astype(np.uint8)
+    return np.asarray(image.convert("RGB"), dtype=np.uint8)

@@ -1,0 +1,185 @@
+"""Global planner: the cheapest 8-connected path on the costmap, found with A*.
+
+The objective is the one scikit-image's ``MCP_Geometric`` minimises, so the two can be
+checked against each other:
+
+- a cell's *traversal cost* is ``1 + TRAVERSAL_COST_WEIGHT * cost / 252`` for costs
+  below ``INSCRIBED`` and infinite (impassable) otherwise; with the default weight of
+  3.0 a cell next to the inscribed band is 4x as expensive to cross as open floor,
+  which keeps plans off walls without long detours;
+- a step to one of the 8 neighbours costs its length (1 or sqrt 2 cells) times the
+  mean of the two cells' traversal costs, in metres (step lengths times resolution),
+  so a plan through open floor costs exactly its length. Diagonal steps between two
+  blocked cells are allowed, as in ``MCP_Geometric``: the cells are blocked for the
+  robot's centre, not solid, and the controller checks the real footprint.
+
+A* uses the octile distance times the smallest traversal cost as its heuristic. It
+never overestimates and is consistent, so the first time the goal leaves the queue its
+cost is optimal. The search runs in a small C extension (``navseq.sim._astar``) when
+it was compiled, otherwise in the pure-Python twin below (same algorithm, ~50x slower).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from navseq.sim.costmap import INSCRIBED, Costmap
+
+try:  # the optional compiled search; the fallback below gives the same plans
+    from navseq.sim import _astar as _compiled_astar
+except ImportError:  # pragma: no cover - depends on the build
+    _compiled_astar = None
+
+TRAVERSAL_COST_WEIGHT = 3.0
+SQRT2 = math.sqrt(2.0)
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A planned path from the start cell to the goal cell."""
+
+    points: np.ndarray  # (N, 2) world x, y of cell centres, start cell first, goal cell last
+    length: float  # metres along ``points``
+    cost: float  # the planner's objective (metres weighted by traversal cost)
+
+
+def traversal_costs(weight: float = TRAVERSAL_COST_WEIGHT) -> np.ndarray:
+    """Traversal cost of each of the 256 cost bytes (``inf`` = impassable)."""
+    table = np.full(256, np.inf)
+    passable = np.arange(INSCRIBED)
+    table[:INSCRIBED] = 1.0 + weight * passable / 252.0
+    return table
+
+
+_TRAVERSAL_LUT = traversal_costs()
+
+
+def compiled_search_available() -> bool:
+    """True when the C search was built (otherwise the pure-Python one is used)."""
+    return _compiled_astar is not None
+
+
+def plan_path(
+    costmap: Costmap,
+    start: tuple[float, float],
+    goal: tuple[float, float],
+    *,
+    use_compiled: bool | None = None,
+) -> Plan | None:
+    """The cheapest path between two world points, or None if there is none.
+
+    Start and goal snap to the cells containing them; either one off the map or not
+    free (cost >= ``INSCRIBED``) means no plan. ``use_compiled`` forces a backend
+    (``None``: the C one if available).
+    """
+    grid = costmap.grid
+    start_cell = grid.world_to_cell(*start)
+    goal_cell = grid.world_to_cell(*goal)
+    for row, col in (start_cell, goal_cell):
+        if not grid.in_bounds(row, col) or costmap.cost[row, col] >= INSCRIBED:
+            return None
+
+    cells = search_cells(costmap.cost, start_cell, goal_cell, use_compiled=use_compiled)
+    if cells is None:
+        return None
+    path_cells, cost_in_cells = cells
+    points = grid.cells_to_world(path_cells[:, 0], path_cells[:, 1])
+    length = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
+    return Plan(points=points, length=length, cost=cost_in_cells * grid.resolution)
+
+
+def search_cells(
+    cost: np.ndarray,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    *,
+    lut: np.ndarray = _TRAVERSAL_LUT,
+    use_compiled: bool | None = None,
+) -> tuple[np.ndarray, float] | None:
+    """A* on a uint8 cost array: ((N, 2) row/col path, objective in cells) or None.
+
+    ``lut`` maps each cost byte to a traversal cost (``inf`` = impassable).
+    """
+    if use_compiled and _compiled_astar is None:
+        raise RuntimeError("the compiled A* (navseq.sim._astar) is not built")
+    compiled = _compiled_astar is not None if use_compiled is None else use_compiled
+    width = cost.shape[1]
+    cost = np.ascontiguousarray(cost, dtype=np.uint8)
+    lut = np.ascontiguousarray(lut, dtype=np.float64)
+    if not (np.isfinite(lut[cost[start]]) and np.isfinite(lut[cost[goal]])):
+        return None
+    finite = lut[np.isfinite(lut)]
+    heuristic_scale = float(finite.min()) if finite.size else 1.0
+    start_index = start[0] * width + start[1]
+    goal_index = goal[0] * width + goal[1]
+    search = _compiled_astar.search if compiled else _search_python  # type: ignore[union-attr]
+    found = search(cost, width, lut, start_index, goal_index, heuristic_scale)
+    if found is None:
+        return None
+    total, indices = found
+    flat = np.asarray(indices, dtype=np.intp)
+    return np.column_stack(np.divmod(flat, width)), float(total)
+
+
+_STEPS = tuple(
+    (dr, dc, SQRT2 if dr and dc else 1.0) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if dr or dc
+)
+
+
+def _search_python(
+    cost: np.ndarray,
+    width: int,
+    lut: np.ndarray,
+    start: int,
+    goal: int,
+    heuristic_scale: float,
+) -> tuple[float, list[int]] | None:
+    """A* over flat cell indices; the readable twin of ``_astar.c``."""
+    traversal = lut[cost.ravel()].tolist()
+    height = cost.size // width
+    goal_row, goal_col = divmod(goal, width)
+    diagonal_extra = SQRT2 - 1.0
+
+    def heuristic(row: int, col: int) -> float:
+        dr, dc = abs(row - goal_row), abs(col - goal_col)
+        return heuristic_scale * (max(dr, dc) + diagonal_extra * min(dr, dc))
+
+    best = {start: 0.0}
+    parent: dict[int, int] = {}
+    closed: set[int] = set()
+    # Ties on f go to the deeper entry (larger g), which expands fewer cells.
+    queue = [(heuristic(*divmod(start, width)), -0.0, start)]
+    inf = math.inf
+    while queue:
+        _, negative_g, cell = heapq.heappop(queue)
+        if cell in closed:
+            continue
+        closed.add(cell)
+        g = -negative_g
+        if cell == goal:
+            path = [cell]
+            while cell != start:
+                cell = parent[cell]
+                path.append(cell)
+            path.reverse()
+            return g, path
+        row, col = divmod(cell, width)
+        here = traversal[cell]
+        for dr, dc, step in _STEPS:
+            r, c = row + dr, col + dc
+            if not (0 <= r < height and 0 <= c < width):
+                continue
+            neighbour = r * width + c
+            there = traversal[neighbour]
+            if there == inf or neighbour in closed:
+                continue
+            candidate = g + step * 0.5 * (here + there)
+            if candidate < best.get(neighbour, inf):
+                best[neighbour] = candidate
+                parent[neighbour] = cell
+                heapq.heappush(queue, (candidate + heuristic(r, c), -candidate, neighbour))
+    return None
