@@ -1,0 +1,386 @@
+"""What a person (or a program) watching ``navseq run`` sees while the mission runs.
+
+Three listeners share one model of the run, :class:`RunView`:
+
+- :class:`LiveProgress`: a rich live panel for terminals (current waypoint n/N and
+  name, status, distance remaining, mission-clock elapsed time, loop, attempt);
+- :class:`LogProgress`: one plain line per thing that happened, for logs and pipes;
+- :class:`JsonProgress`: one JSON object per event, for programs (``--json``).
+
+:func:`make_progress` picks one; :func:`summary_table` is the per-visit table printed
+at the end. Elapsed time is the navigator's clock (simulated time on the simulator).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import asdict
+from typing import IO, Any
+
+from rich.console import Console, Group, RenderableType
+from rich.live import Live
+from rich.markup import escape
+from rich.panel import Panel
+from rich.progress_bar import ProgressBar
+from rich.table import Table
+from rich.text import Text
+
+from navseq.executor.events import (
+    AttemptFailed,
+    LoopStarted,
+    MissionEvent,
+    MissionFinished,
+    MissionStarted,
+    ServerStatusChanged,
+    WaypointDwelling,
+    WaypointFinished,
+    WaypointOutcome,
+    WaypointPlan,
+    WaypointProgress,
+    WaypointStarted,
+)
+from navseq.executor.result import MissionResult
+from navseq.mission.model import Mission
+
+OUTCOME_STYLE = {
+    WaypointOutcome.REACHED: "green",
+    WaypointOutcome.SKIPPED: "dark_orange",
+    WaypointOutcome.FAILED: "red",
+    WaypointOutcome.NOT_RUN: "grey50",
+}
+OUTCOME_MARK = {
+    WaypointOutcome.REACHED: "✓",
+    WaypointOutcome.SKIPPED: "↷",
+    WaypointOutcome.FAILED: "✗",
+    WaypointOutcome.NOT_RUN: "·",
+}
+
+
+def _plural(count: int, word: str) -> str:
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
+class RunView:
+    """The state of a run as a watcher sees it, folded from mission events."""
+
+    def __init__(self, mission: Mission):
+        self.mission = mission
+        self.count = len(mission.waypoints)
+        self.loops = mission.loops
+        self.t = 0.0
+        self.t_start: float | None = None
+        self.loop = 0
+        self.index: int | None = None
+        self.attempt = 0
+        self.status = "starting"
+        self.distance_remaining: float | None = None
+        self.distance_driven = 0.0
+        self.loop_outcomes: dict[int, WaypointOutcome] = {}
+        self.totals: dict[WaypointOutcome, int] = dict.fromkeys(WaypointOutcome, 0)
+        self.finished: MissionFinished | None = None
+
+    @property
+    def elapsed(self) -> float:
+        return self.t - self.t_start if self.t_start is not None else 0.0
+
+    def waypoint_label(self, index: int) -> str:
+        name = self.mission.waypoints[index].name if index < self.count else None
+        return f"waypoint {index + 1}/{self.count}" + (f" '{name}'" if name else "")
+
+    def loop_label(self) -> str:
+        total = "∞" if self.loops is None else str(self.loops)
+        return f"loop {self.loop + 1}/{total}"
+
+    def update(self, event: MissionEvent) -> None:
+        self.t = event.t
+        if isinstance(event, MissionStarted):
+            self.t_start = event.t
+            self.status = "started"
+        elif isinstance(event, LoopStarted):
+            self.loop = event.loop
+            self.loop_outcomes = {}
+        elif isinstance(event, WaypointStarted):
+            self.loop, self.index, self.attempt = event.loop, event.index, event.attempt
+            self.distance_remaining = None
+            self.distance_driven = 0.0 if event.attempt == 1 else self.distance_driven
+            self.status = "driving" if event.attempt == 1 else f"driving (attempt {event.attempt})"
+        elif isinstance(event, WaypointProgress):
+            self.index = event.index
+            self.distance_remaining = event.distance_remaining
+            self.distance_driven = event.distance_driven
+        elif isinstance(event, AttemptFailed):
+            then = "will retry" if event.will_retry else "giving up"
+            self.status = f"attempt {event.attempt} failed ({event.reason}), {then}"
+        elif isinstance(event, WaypointDwelling):
+            self.status = f"dwelling {event.seconds:g} s"
+            self.distance_remaining = 0.0
+        elif isinstance(event, WaypointFinished):
+            outcome = WaypointOutcome(event.outcome)
+            self.loop_outcomes[event.index] = outcome
+            self.totals[outcome] += 1
+            self.status = outcome.value.replace("_", " ")
+        elif isinstance(event, ServerStatusChanged):
+            self.status = (
+                "navigation server back"
+                if event.available
+                else f"navigation server lost{': ' + event.reason if event.reason else ''}"
+                + ", waiting"
+            )
+        elif isinstance(event, MissionFinished):
+            self.finished = event
+            self.status = event.reason
+
+
+class LiveProgress:
+    """A rich live panel, redrawn a few times a second by rich's refresh thread.
+
+    Events only update the :class:`RunView`; drawing happens on refresh, so a fast
+    simulator does not pay for rendering every event.
+    """
+
+    def __init__(self, mission: Mission, console: Console):
+        self.view = RunView(mission)
+        self.console = console
+        self._live = Live(
+            console=console,
+            get_renderable=self.render,
+            refresh_per_second=8,
+            transient=False,
+        )
+
+    def __enter__(self) -> LiveProgress:
+        self._live.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._live.refresh()
+        self._live.stop()
+
+    def __call__(self, event: MissionEvent) -> None:
+        self.view.update(event)
+
+    def render(self) -> RenderableType:
+        view = self.view
+        header = Table.grid(padding=(0, 3))
+        header.add_row(
+            Text(f"elapsed {view.elapsed:7.1f} s", style="bold"),
+            Text(view.loop_label()),
+            Text.assemble(
+                *(
+                    (f"{OUTCOME_MARK[o]} {view.totals[o]}  ", OUTCOME_STYLE[o])
+                    for o in (WaypointOutcome.REACHED, WaypointOutcome.SKIPPED,
+                              WaypointOutcome.FAILED)
+                )
+            ),
+        )
+        rows: list[RenderableType] = [header]
+        if view.index is not None:
+            current = Table.grid(padding=(0, 2))
+            current.add_row(
+                Text(view.waypoint_label(view.index), style="bold cyan"),
+                Text(f"attempt {view.attempt}"),
+                Text(view.status, style="yellow" if "fail" in view.status else ""),
+            )
+            rows.append(current)
+            remaining = view.distance_remaining
+            if remaining is not None and math.isfinite(remaining):
+                total = max(view.distance_driven + remaining, 1e-6)
+                bar = Table.grid(padding=(0, 2))
+                bar.add_row(
+                    ProgressBar(total=total, completed=view.distance_driven, width=40),
+                    Text(f"{remaining:6.2f} m to go, {view.distance_driven:6.2f} m driven"),
+                )
+                rows.append(bar)
+        else:
+            rows.append(Text(view.status))
+        if view.count <= 40:
+            marks = Text()
+            for index in range(view.count):
+                outcome = view.loop_outcomes.get(index)
+                if outcome is not None:
+                    marks.append(f"{index + 1}{OUTCOME_MARK[outcome]} ", OUTCOME_STYLE[outcome])
+                elif index == view.index and view.finished is None:
+                    marks.append(f"{index + 1}▶ ", "bold cyan")
+                else:
+                    marks.append(f"{index + 1}· ", "grey50")
+            rows.append(marks)
+        title = escape(f"navseq · {view.mission.source}")
+        return Panel(Group(*rows), title=title, title_align="left", expand=False)
+
+
+class LogProgress:
+    """Plain one-line log messages, for output that is not a terminal.
+
+    Progress (distance to go) is logged at most once per ``progress_period`` seconds
+    of mission time, so a log of a long run stays readable.
+    """
+
+    def __init__(self, mission: Mission, stream: IO[str], *, progress_period: float = 10.0):
+        self.view = RunView(mission)
+        self.stream = stream
+        self.progress_period = progress_period
+        self._last_progress_t = -math.inf
+
+    def __enter__(self) -> LogProgress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stream.flush()
+
+    def _log(self, text: str) -> None:
+        self.stream.write(f"[{self.view.elapsed:8.1f} s] {text}\n")
+        self.stream.flush()
+
+    def __call__(self, event: MissionEvent) -> None:
+        view = self.view
+        view.update(event)
+        if isinstance(event, MissionStarted):
+            loops = "forever" if event.loops is None else _plural(event.loops, "loop")
+            resumed = (
+                f", resuming at waypoint {event.resumed_from + 1}"
+                if event.resumed_from is not None
+                else ""
+            )
+            self._log(f"mission {view.mission.source}: "
+                      f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}")
+        elif isinstance(event, LoopStarted):
+            if view.loops != 1:
+                self._log(view.loop_label())
+        elif isinstance(event, WaypointStarted):
+            self._last_progress_t = event.t
+            yaw = math.degrees(event.yaw)
+            self._log(f"{view.waypoint_label(event.index)}: going to "
+                      f"({event.x:.2f}, {event.y:.2f}, {yaw:.0f}°), attempt {event.attempt}")
+        elif isinstance(event, WaypointProgress):
+            if event.t - self._last_progress_t >= self.progress_period:
+                self._last_progress_t = event.t
+                to_go = (
+                    f"{event.distance_remaining:.2f} m to go, "
+                    if event.distance_remaining is not None
+                    and math.isfinite(event.distance_remaining)
+                    else ""
+                )
+                self._log(f"{view.waypoint_label(event.index)}: {to_go}"
+                          f"{event.distance_driven:.2f} m driven")
+        elif isinstance(event, AttemptFailed):
+            then = "will retry" if event.will_retry else "giving up"
+            self._log(f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
+                      f"({event.reason}), {then}")
+        elif isinstance(event, WaypointDwelling):
+            self._log(f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s")
+        elif isinstance(event, WaypointFinished):
+            outcome = WaypointOutcome(event.outcome)
+            how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
+            why = (
+                f" ({event.reason})"
+                if event.reason and outcome != WaypointOutcome.REACHED
+                else ""
+            )
+            self._log(f"{view.waypoint_label(event.index)}: {how}{why} after "
+                      f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
+                      f"{_plural(event.attempts, 'attempt')}")
+        elif isinstance(event, ServerStatusChanged):
+            self._log(view.status)
+        elif isinstance(event, MissionFinished):
+            verdict = "success" if event.success else "not every waypoint reached"
+            self._log(f"mission finished: {event.reason} ({verdict})")
+        elif isinstance(event, WaypointPlan):
+            pass  # plans go to the picture, not the log
+
+
+def _json_safe(value: Any) -> Any:
+    """Replace non-finite floats (not valid JSON) by None, recursively."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {key: _json_safe(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(item) for item in value]
+    return value
+
+
+def event_to_json(event: MissionEvent) -> str:
+    """One event as a single-line JSON object: ``{"event": "<ClassName>", ...fields}``."""
+    return json.dumps(
+        {"event": type(event).__name__, **_json_safe(asdict(event))},
+        ensure_ascii=False,
+        separators=(",", ":"),
+    )
+
+
+class JsonProgress:
+    """One JSON object per event on ``stream`` (``navseq run --json``)."""
+
+    def __init__(self, stream: IO[str]):
+        self.stream = stream
+
+    def __enter__(self) -> JsonProgress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stream.flush()
+
+    def __call__(self, event: MissionEvent) -> None:
+        self.stream.write(event_to_json(event) + "\n")
+        self.stream.flush()
+
+    def emit(self, kind: str, fields: Mapping[str, Any]) -> None:
+        """A record that is not a mission event (e.g. the final ``RunFinished``)."""
+        self.stream.write(json.dumps({"event": kind, **_json_safe(dict(fields))}) + "\n")
+        self.stream.flush()
+
+
+ProgressSink = LiveProgress | LogProgress | JsonProgress
+
+
+def make_progress(
+    mission: Mission, *, json_lines: bool, stream: IO[str] | None = None
+) -> ProgressSink:
+    """JSON lines if asked, a live panel on a terminal, plain log lines otherwise."""
+    stream = stream if stream is not None else sys.stdout
+    if json_lines:
+        return JsonProgress(stream)
+    console = Console(file=stream)
+    if console.is_terminal:
+        return LiveProgress(mission, console)
+    return LogProgress(mission, stream)
+
+
+def summary_table(mission: Mission, result: MissionResult) -> Table:
+    """Per-visit outcome, attempts, time and distance, with totals in the footer."""
+    several_loops = any(visit.loop > 0 for visit in result.visits)
+    table = Table(title=Text(f"mission {mission.source}: {result.reason}"), show_footer=True)
+    table.add_column("#", justify="right", footer="total")
+    if several_loops:
+        table.add_column("loop", justify="right")
+    table.add_column("name")
+    table.add_column("outcome")
+    table.add_column("attempts", justify="right",
+                     footer=str(sum(visit.attempts for visit in result.visits)))
+    # Brackets are rich markup: escape the unit.
+    table.add_column(escape("time [s]"), justify="right", footer=f"{result.duration:.1f}")
+    table.add_column(escape("distance [m]"), justify="right",
+                     footer=f"{result.distance_driven:.2f}")
+    table.add_column("reason")
+    for visit in result.visits:
+        outcome = WaypointOutcome(visit.outcome)
+        label = outcome.value.replace("_", " ")
+        if visit.passed_through:
+            label += " (passed)"
+        cells = [str(visit.index + 1)]
+        if several_loops:
+            cells.append(str(visit.loop + 1))
+        cells += [
+            visit.name or "",
+            f"{OUTCOME_MARK[outcome]} {label}",
+            str(visit.attempts),
+            f"{visit.duration:.1f}",
+            f"{visit.distance_driven:.2f}",
+            visit.reason,
+        ]
+        # Text cells: a name or reason with [brackets] is not markup.
+        table.add_row(*(Text(cell) for cell in cells), style=OUTCOME_STYLE[outcome])
+    return table

@@ -1,0 +1,136 @@
+"""The run report: one JSON document saying what happened to every waypoint visit.
+
+Schema (``schema_version`` 1; times in seconds, distances in metres, angles in degrees)::
+
+    {
+      "schema_version": 1,
+      "navseq_version": "0.1.0",
+      "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
+      "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
+      "navigator": {"kind": "sim" | "ros1" | ..., ...options},
+      "map": {"source", "resolution", "width", "height", "origin"} | null,
+      "start": {"x", "y", "yaw_deg"} | null,
+      "success": bool,            # every visit reached
+      "reason": "completed" | "stopped: ..." | "interrupted: SIGINT" | ...,
+      "interrupted": "SIGINT" | "SIGTERM" | null,
+      "exit_code": 0 | 1 | 130 | 143,
+      "totals": {"visits", "reached", "skipped", "failed", "not_run",
+                 "duration_s", "distance_m", "loops_completed"},
+      "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
+                  "attempts", "duration_s", "distance_m", "reason", "passed_through"}],
+      "files": {"journal", "picture", ...}
+    }
+
+``index`` is 0-based (as in events and the journal), ``number`` 1-based (as in
+messages: "waypoint 3"); ``loop`` is 0-based; ``outcome`` is one of reached,
+skipped, failed, not_run.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import math
+import os
+import tempfile
+from collections import Counter
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from navseq import __version__
+from navseq.executor.events import WaypointOutcome
+from navseq.executor.result import MissionResult, WaypointResult
+from navseq.geometry import Pose2D
+from navseq.mission.model import Mission
+
+SCHEMA_VERSION = 1
+
+
+def _rounded(value: float, digits: int = 3) -> float | None:
+    return round(value, digits) if math.isfinite(value) else None
+
+
+def _pose_dict(pose: Pose2D) -> dict[str, float | None]:
+    return {
+        "x": _rounded(pose.x),
+        "y": _rounded(pose.y),
+        "yaw_deg": _rounded(math.degrees(pose.yaw), 1),
+    }
+
+
+def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
+    return {
+        "index": visit.index,
+        "number": visit.index + 1,
+        "loop": visit.loop,
+        "name": visit.name,
+        "x": _rounded(visit.x),
+        "y": _rounded(visit.y),
+        "yaw_deg": _rounded(math.degrees(visit.yaw), 1),
+        "outcome": WaypointOutcome(visit.outcome).value,
+        "attempts": visit.attempts,
+        "duration_s": _rounded(visit.duration, 2),
+        "distance_m": _rounded(visit.distance_driven),
+        "reason": visit.reason,
+        "passed_through": visit.passed_through,
+    }
+
+
+def build_report(
+    mission: Mission,
+    result: MissionResult,
+    *,
+    exit_code: int,
+    navigator: Mapping[str, Any],
+    interrupted: str | None = None,
+    mission_digest: str | None = None,
+    map_info: Mapping[str, Any] | None = None,
+    start: Pose2D | None = None,
+    files: Mapping[str, str] | None = None,
+) -> dict[str, Any]:
+    """The report of one run as a JSON-ready dict (see the module docstring)."""
+    counts = Counter(WaypointOutcome(visit.outcome).value for visit in result.visits)
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "navseq_version": __version__,
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "mission": {
+            "source": mission.source,
+            "name": Path(mission.source).stem,
+            "digest": mission_digest,
+            "frame": mission.frame,
+            "waypoints": len(mission.waypoints),
+            "loops": "forever" if mission.loops is None else mission.loops,
+        },
+        "navigator": dict(navigator),
+        "map": dict(map_info) if map_info is not None else None,
+        "start": _pose_dict(start) if start is not None else None,
+        "success": result.success,
+        "reason": result.reason,
+        "interrupted": interrupted,
+        "exit_code": exit_code,
+        "totals": {
+            "visits": len(result.visits),
+            **{outcome.value: counts.get(outcome.value, 0) for outcome in WaypointOutcome},
+            "duration_s": _rounded(result.duration, 2),
+            "distance_m": _rounded(result.distance_driven),
+            "loops_completed": result.loops_completed,
+        },
+        "visits": [_visit_dict(visit) for visit in result.visits],
+        "files": dict(files or {}),
+    }
+
+
+def write_report(report: Mapping[str, Any], path: Path) -> None:
+    """Write ``report`` as indented JSON, atomically (a temp file renamed into place)."""
+    text = json.dumps(report, indent=2, ensure_ascii=False) + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp_name, path)
+    except BaseException:
+        Path(tmp_name).unlink(missing_ok=True)
+        raise
