@@ -1,1 +1,29 @@
-"""The executor: one mission run as an explicit state machine (no ROS, no threads)."""
+"""The executor: one mission run as an explicit state machine (no ROS, no threads).
+
+- :class:`MissionExecutor` (``machine``): the state machine; feed it navigator
+  events and ticks, apply the commands it returns.
+- :func:`run_mission` (``runner``): the loop that drives it against a navigator and
+  cancels the goal on SIGINT/SIGTERM/exceptions.
+- :class:`ResumePoint` (``resume``): where a resumed run continues (from a journal).
+"""
+
+from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.machine import ExecutorState, MissionExecutor, MissionListener
+from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.resume import ResumePoint
+from navseq.executor.runner import MissionInterrupted, run_mission
+
+__all__ = [
+    "CancelGoal",
+    "ClearCostmaps",
+    "Command",
+    "ExecutorState",
+    "MissionExecutor",
+    "MissionInterrupted",
+    "MissionListener",
+    "MissionResult",
+    "ResumePoint",
+    "SendGoal",
+    "WaypointResult",
+    "run_mission",
+]

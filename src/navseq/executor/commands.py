@@ -1,0 +1,33 @@
+"""What the executor asks the navigator to do.
+
+The executor never calls a navigator itself: every input method of
+:class:`~navseq.executor.machine.MissionExecutor` returns a list of these commands,
+and the runner (or a test) applies them in order. That keeps the state machine free
+of I/O, so it can be driven by hand in tests and by any navigator in production.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from navseq.navigators.base import Goal
+
+
+@dataclass(frozen=True)
+class SendGoal:
+    """Start pursuing ``goal``; it replaces any goal still active (no cancel needed)."""
+
+    goal: Goal
+
+
+@dataclass(frozen=True)
+class CancelGoal:
+    """Cancel the active goal so the robot stops."""
+
+
+@dataclass(frozen=True)
+class ClearCostmaps:
+    """Forget transient obstacles before a retry."""
+
+
+Command = SendGoal | CancelGoal | ClearCostmaps

@@ -1,0 +1,151 @@
+"""Run a mission to the end against a navigator: the loop around the state machine.
+
+:func:`run_mission` is what the CLI and the ROS node call. It owns the one promise
+the state machine cannot keep on its own: whatever ends the run early (Ctrl-C,
+SIGTERM, an exception in a sink or a navigator), the active goal is cancelled on the
+navigator before the error leaves this function, so the robot never keeps driving
+to a goal nobody watches.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import signal
+import threading
+from collections.abc import Iterable, Iterator
+from types import FrameType
+
+from navseq.errors import NavseqError
+from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.machine import MissionExecutor, MissionListener
+from navseq.executor.result import MissionResult
+from navseq.executor.resume import ResumePoint
+from navseq.mission.model import Mission
+from navseq.navigators.base import Navigator
+
+_log = logging.getLogger(__name__)
+
+#: Exit status of a process ended by each signal, as shells report it (128 + number).
+SIGNAL_EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
+
+
+class MissionInterrupted(Exception):
+    """The run was ended by a signal; the goal was cancelled and ``result`` is final.
+
+    ``exit_code`` is the conventional status for the signal (130 for SIGINT, 143 for
+    SIGTERM), for a CLI to ``sys.exit`` with.
+    """
+
+    def __init__(self, signal_name: str, result: MissionResult):
+        self.signal_name = signal_name
+        self.result = result
+        self.exit_code = SIGNAL_EXIT_CODES.get(signal_name, 1)
+        super().__init__(f"mission interrupted by {signal_name}")
+
+
+class _Terminated(BaseException):
+    """Raised by the temporary SIGTERM handler; a BaseException so no ``except
+    Exception`` in a sink or navigator swallows it."""
+
+
+def run_mission(
+    mission: Mission,
+    navigator: Navigator,
+    listeners: Iterable[MissionListener] = (),
+    *,
+    resume: ResumePoint | None = None,
+    tick: float = 0.1,
+    server_wait: float = 10.0,
+) -> MissionResult:
+    """Drive ``mission`` through ``navigator`` until it ends, and return the result.
+
+    ``listeners`` receive every mission event (progress display, journal, report).
+    ``resume`` continues an earlier run (see :mod:`navseq.sinks.journal`). ``tick`` is
+    how much navigator time passes between two looks at the mission (seconds);
+    ``server_wait`` how long to wait (wall time) for the navigation server at start.
+
+    Raises :class:`~navseq.errors.NavseqError` when the server is not there,
+    :class:`MissionInterrupted` on SIGINT/SIGTERM, and re-raises any other exception;
+    in the last two cases only after cancelling the active goal and telling the
+    listeners that the mission finished (``MissionFinished``, reason
+    ``"interrupted: SIGINT"`` and so on).
+    """
+    executor = MissionExecutor(mission, resume=resume)
+    for listener in listeners:
+        executor.add_listener(listener)
+    if not navigator.wait_for_server(server_wait):
+        raise NavseqError(
+            f"no navigation server answered within {server_wait:g} s; is the navigation "
+            "stack (move_base or the simulator) running, and is the action name right?",
+            source="navigator",
+        )
+    with _sigterm_raises():
+        try:
+            _apply(navigator, executor.start(navigator.now()))
+            while not executor.finished:
+                for event in navigator.poll():
+                    _apply(navigator, executor.on_event(event, navigator.now()))
+                if executor.finished:
+                    break
+                _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
+                if not executor.finished:
+                    navigator.spin(tick)
+        except KeyboardInterrupt:
+            result = _abort(executor, navigator, "interrupted: SIGINT")
+            raise MissionInterrupted("SIGINT", result) from None
+        except _Terminated:
+            result = _abort(executor, navigator, "interrupted: SIGTERM")
+            raise MissionInterrupted("SIGTERM", result) from None
+        except BaseException as error:
+            _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+            raise
+    return executor.result
+
+
+def _apply(navigator: Navigator, commands: list[Command]) -> None:
+    for command in commands:
+        if isinstance(command, SendGoal):
+            navigator.send_goal(command.goal)
+        elif isinstance(command, CancelGoal):
+            navigator.cancel_goal()
+        elif isinstance(command, ClearCostmaps):
+            navigator.clear_costmaps()
+
+
+def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> MissionResult:
+    """Stop the robot first, then close the books; never raise from here."""
+    try:
+        navigator.cancel_goal()
+    except Exception:
+        _log.exception("cancelling the active goal failed")
+    try:
+        now = navigator.now()
+    except Exception:
+        now = executor.result.duration
+    try:
+        executor.interrupt(now, reason)  # its CancelGoal was done above
+    except Exception:
+        _log.exception("a mission listener failed while the mission was interrupted")
+    return executor.result
+
+
+@contextlib.contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """While inside, SIGTERM raises :class:`_Terminated` like SIGINT raises KeyboardInterrupt.
+
+    Signal handlers can only be set from the main thread; elsewhere (a ROS node's
+    worker thread, say) the process's own handling stays in place.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def raise_terminated(signum: int, frame: FrameType | None) -> None:
+        raise _Terminated()
+
+    previous = signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

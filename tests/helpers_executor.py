@@ -1,0 +1,90 @@
+"""Helpers for executor tests: small missions and a hand-driven executor harness."""
+
+from __future__ import annotations
+
+from typing import Any, TypeVar
+
+from navseq.executor import CancelGoal, ClearCostmaps, Command, MissionExecutor, SendGoal
+from navseq.executor.events import MissionEvent
+from navseq.executor.resume import ResumePoint
+from navseq.geometry import Pose2D
+from navseq.mission.model import Mission, Policy, Waypoint
+from navseq.navigators.base import GoalDone, GoalFeedback, GoalStatus, ServerBack, ServerLost
+
+E = TypeVar("E")
+
+
+def line_mission(
+    count: int = 3,
+    *,
+    loops: int | None = 1,
+    server_timeout: float | None = 60.0,
+    **policy: Any,
+) -> Mission:
+    """``count`` waypoints 1 m apart along +x (1,0), (2,0), ..., all facing +x."""
+    waypoints = tuple(Waypoint(float(i + 1), 0.0, 0.0, name=f"p{i + 1}") for i in range(count))
+    return Mission(
+        waypoints=waypoints,
+        defaults=Policy(**policy),
+        loops=loops,
+        server_timeout=server_timeout,
+    )
+
+
+class Harness:
+    """Drives a :class:`MissionExecutor` by hand and keeps what it said and asked."""
+
+    def __init__(self, mission: Mission, resume: ResumePoint | None = None):
+        self.executor = MissionExecutor(mission, resume=resume)
+        self.events: list[MissionEvent] = []
+        self.commands: list[Command] = []
+        self.executor.add_listener(self.events.append)
+
+    def _keep(self, commands: list[Command]) -> list[Command]:
+        self.commands.extend(commands)
+        return commands
+
+    def start(self, t: float = 0.0) -> list[Command]:
+        return self._keep(self.executor.start(t))
+
+    @property
+    def goal_id(self) -> int:
+        """Id of the last goal the executor sent."""
+        return self.goals()[-1].goal.goal_id
+
+    def goals(self) -> list[SendGoal]:
+        return [c for c in self.commands if isinstance(c, SendGoal)]
+
+    def cancels(self) -> list[CancelGoal]:
+        return [c for c in self.commands if isinstance(c, CancelGoal)]
+
+    def clears(self) -> list[ClearCostmaps]:
+        return [c for c in self.commands if isinstance(c, ClearCostmaps)]
+
+    def done(self, status: GoalStatus, t: float, goal_id: int | None = None) -> list[Command]:
+        gid = self.goal_id if goal_id is None else goal_id
+        return self._keep(self.executor.on_event(GoalDone(gid, status), t))
+
+    def succeed(self, t: float) -> list[Command]:
+        return self.done(GoalStatus.SUCCEEDED, t)
+
+    def feedback(
+        self, t: float, pose: Pose2D, remaining: float | None = None, goal_id: int | None = None
+    ) -> list[Command]:
+        gid = self.goal_id if goal_id is None else goal_id
+        return self._keep(self.executor.on_event(GoalFeedback(gid, pose, remaining), t))
+
+    def tick(self, t: float, pose: Pose2D | None = None) -> list[Command]:
+        return self._keep(self.executor.on_tick(t, pose))
+
+    def server_lost(self, t: float) -> list[Command]:
+        return self._keep(self.executor.on_event(ServerLost("test"), t))
+
+    def server_back(self, t: float) -> list[Command]:
+        return self._keep(self.executor.on_event(ServerBack(), t))
+
+    def interrupt(self, t: float, reason: str) -> list[Command]:
+        return self._keep(self.executor.interrupt(t, reason))
+
+    def of_type(self, cls: type[E]) -> list[E]:
+        return [e for e in self.events if isinstance(e, cls)]
