@@ -1,0 +1,492 @@
+"""The simulated robot as a ROS 1 node: a TurtleBot3-like base that obeys ``cmd_vel``.
+
+This is the body half of navseq's embedded simulator (the navigation half is
+:mod:`navseq.ros.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
+physics beyond differential-drive kinematics: it integrates velocity commands with
+:class:`navseq.sim.robot.DiffDriveRobot` and refuses any step that would put its
+footprint on an occupied or unknown cell of the map (it stops as if it had hit a bumper).
+
+Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
+``/robot1/cmd_vel`` ...):
+
+- subscribes ``cmd_vel`` (``geometry_msgs/Twist``): forward speed ``linear.x`` and turn
+  rate ``angular.z``; the robot stops when no command arrives for ``~cmd_vel_timeout``
+  seconds, like a real base driver;
+- subscribes ``initialpose`` (``geometry_msgs/PoseWithCovarianceStamped``, RViz's
+  "2D Pose Estimate"): teleports the robot there (refused inside an obstacle);
+- publishes ``odom`` (``nav_msgs/Odometry``) and the TF chain
+  ``map -> odom -> base_footprint`` at every step;
+- publishes ``/clock`` when ``/use_sim_time`` is true, running ``~speed`` times faster
+  than the wall clock (1.0 = real time, for RViz; tests use 5-10);
+- publishes ``map`` (``nav_msgs/OccupancyGrid``, latched) loaded from ``~map`` (a
+  map_server YAML) when ``~publish_map`` is true. Without ``~map`` the node takes the
+  map for its collision checks from the ``map`` topic instead (e.g. a real map_server).
+
+Odometry behaves like a real robot's: the ``odom`` frame starts at the start pose and
+odometry is continuous; a teleport moves the robot in the map and shifts the
+``map -> odom`` transform, as a localisation jump would.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import rospy
+import tf2_ros
+from geometry_msgs.msg import (
+    Point32,
+    PolygonStamped,
+    PoseWithCovarianceStamped,
+    TransformStamped,
+    Twist,
+)
+from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D, normalize_angle, quaternion_to_yaw, yaw_to_quaternion
+from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
+from navseq.sim.occupancy import OccupancyGrid, load_map
+from navseq.sim.robot import DiffDriveLimits, DiffDriveRobot
+
+FOOTPRINT_RATE = 5.0  # Hz of sim time: enough for RViz, cheap at high speed factors
+
+# ---------------------------------------------------------------------------------------
+# Frame algebra and map <-> message conversion (shared with sim_nav_node)
+# ---------------------------------------------------------------------------------------
+
+
+def compose(a: Pose2D, b: Pose2D) -> Pose2D:
+    """The pose ``b`` (expressed in frame ``a``) expressed in ``a``'s parent frame."""
+    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
+    return Pose2D(
+        a.x + cos_a * b.x - sin_a * b.y,
+        a.y + sin_a * b.x + cos_a * b.y,
+        normalize_angle(a.yaw + b.yaw),
+    )
+
+
+def inverse(a: Pose2D) -> Pose2D:
+    """The pose ``p`` with ``compose(a, p)`` = identity."""
+    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
+    return Pose2D(
+        -cos_a * a.x - sin_a * a.y,
+        sin_a * a.x - cos_a * a.y,
+        normalize_angle(-a.yaw),
+    )
+
+
+def pose_from_msg(pose: object) -> Pose2D:
+    """A planar pose from a ``geometry_msgs/Pose`` (roll and pitch are ignored)."""
+    q = pose.orientation  # type: ignore[attr-defined]
+    p = pose.position  # type: ignore[attr-defined]
+    return Pose2D(float(p.x), float(p.y), quaternion_to_yaw(q.x, q.y, q.z, q.w))
+
+
+def fill_pose_msg(target: object, pose: Pose2D) -> None:
+    """Write ``pose`` into a ``geometry_msgs/Pose`` (z = 0)."""
+    target.position.x, target.position.y, target.position.z = pose.x, pose.y, 0.0  # type: ignore[attr-defined]
+    q = target.orientation  # type: ignore[attr-defined]
+    q.x, q.y, q.z, q.w = yaw_to_quaternion(pose.yaw)
+
+
+def grid_to_msg(grid: OccupancyGrid, frame_id: str, stamp: rospy.Time) -> OccupancyGridMsg:
+    """A ``nav_msgs/OccupancyGrid`` with the same cells (both use row 0 = bottom)."""
+    msg = OccupancyGridMsg()
+    msg.header.frame_id = frame_id
+    msg.header.stamp = stamp
+    msg.info.map_load_time = stamp
+    msg.info.resolution = grid.resolution
+    msg.info.width = grid.width
+    msg.info.height = grid.height
+    fill_pose_msg(msg.info.origin, grid.origin)
+    msg.data = grid.data.astype(np.int8).ravel().tolist()
+    return msg
+
+
+def grid_from_msg(msg: OccupancyGridMsg, source: str) -> OccupancyGrid:
+    """navseq's grid from a ``nav_msgs/OccupancyGrid``; ``source`` names it in messages."""
+    width, height = int(msg.info.width), int(msg.info.height)
+    if width <= 0 or height <= 0 or len(msg.data) != width * height:
+        raise NavseqError(
+            f"map message is {width} x {height} cells but carries {len(msg.data)} values",
+            source=source,
+        )
+    data = np.asarray(msg.data, dtype=np.int8).reshape(height, width)
+    return OccupancyGrid(
+        data=data,
+        resolution=float(msg.info.resolution),
+        origin=pose_from_msg(msg.info.origin),
+        source=source,
+    )
+
+
+def make_transform(parent: str, child: str, pose: Pose2D, stamp: rospy.Time) -> TransformStamped:
+    """A planar ``TransformStamped`` placing ``child`` at ``pose`` in ``parent``."""
+    transform = TransformStamped()
+    transform.header.stamp = stamp
+    transform.header.frame_id = parent
+    transform.child_frame_id = child
+    transform.transform.translation.x = pose.x
+    transform.transform.translation.y = pose.y
+    rotation = transform.transform.rotation
+    rotation.x, rotation.y, rotation.z, rotation.w = yaw_to_quaternion(pose.yaw)
+    return transform
+
+
+def _param_error(name: str, message: str) -> NavseqError:
+    return NavseqError(message, source=f"param {rospy.resolve_name('~' + name)}")
+
+
+def float_param(name: str, default: float) -> float:
+    """``~name`` as a float; anything else is a NavseqError naming the parameter."""
+    value = rospy.get_param(f"~{name}", default)
+    if isinstance(value, bool):
+        raise _param_error(name, f"expected a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise _param_error(name, f"expected a number, got {value!r}") from None
+
+
+def str_param(name: str, default: str) -> str:
+    """``~name`` as a string (numbers are accepted and converted)."""
+    return str(rospy.get_param(f"~{name}", default))
+
+
+def bool_param(name: str, default: bool) -> bool:
+    """``~name`` as a boolean (``true``/``false`` strings from roslaunch are accepted)."""
+    value = rospy.get_param(f"~{name}", default)
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.lower() in ("true", "false"):
+        return value.lower() == "true"
+    raise _param_error(name, f"expected true or false, got {value!r}")
+
+
+# ---------------------------------------------------------------------------------------
+# The simulated base, free of ROS: what happens at each step
+# ---------------------------------------------------------------------------------------
+
+
+class SimulatedBase:
+    """A robot body on a map: commanded velocity in, pose (map and odom frames) out.
+
+    ``step`` moves the robot by one time step unless that would make its footprint touch
+    an obstacle, unknown space or the map edge, in which case the robot stops where it is
+    and ``refused_steps`` counts the bump. Without a grid nothing is refused.
+    """
+
+    def __init__(
+        self,
+        start: Pose2D,
+        grid: OccupancyGrid | None,
+        *,
+        footprint: Footprint = TURTLEBOT3_BURGER,
+        limits: DiffDriveLimits | None = None,
+        cmd_vel_timeout: float = 0.5,
+    ) -> None:
+        self.grid = grid
+        self.footprint = footprint
+        self.robot = DiffDriveRobot(start, limits)
+        # The odom frame is where the robot started: odometry reads (0, 0, 0) at start.
+        self.map_to_odom = Pose2D(start.x, start.y, start.yaw)
+        self.cmd_vel_timeout = cmd_vel_timeout
+        self.time = 0.0
+        self.refused_steps = 0
+        self._cmd = (0.0, 0.0)
+        self._cmd_time = -math.inf
+
+    def collides(self, pose: Pose2D) -> bool:
+        return self.grid is not None and footprint_collides(self.grid, self.footprint, pose)
+
+    def command(self, v: float, w: float) -> None:
+        """A new velocity command, valid for ``cmd_vel_timeout`` seconds of sim time."""
+        self._cmd = (v, w)
+        self._cmd_time = self.time
+
+    def step(self, dt: float) -> bool:
+        """Advance ``dt`` seconds; False when the move was refused (the robot bumped)."""
+        self.time += dt
+        fresh = self.time - self._cmd_time <= self.cmd_vel_timeout
+        cmd_v, cmd_w = self._cmd if fresh else (0.0, 0.0)
+        pose, v, w = self.robot.predict(cmd_v, cmd_w, dt)
+        if self.collides(pose):
+            self.robot.stop()
+            self.refused_steps += 1
+            return False
+        self.robot.pose, self.robot.v, self.robot.w = pose, v, w
+        return True
+
+    def teleport(self, pose: Pose2D) -> bool:
+        """Put the robot at ``pose`` (map frame), keeping odometry continuous.
+
+        Returns False (and leaves the robot alone) when ``pose`` is in collision.
+        """
+        if self.collides(pose):
+            return False
+        odom_pose = self.odom_pose
+        self.robot.teleport(pose)
+        self.map_to_odom = compose(pose, inverse(odom_pose))
+        self._cmd = (0.0, 0.0)
+        return True
+
+    @property
+    def pose(self) -> Pose2D:
+        """The robot's true pose in the map frame."""
+        return self.robot.pose
+
+    @property
+    def odom_pose(self) -> Pose2D:
+        """The robot's pose in the odom frame."""
+        return compose(inverse(self.map_to_odom), self.robot.pose)
+
+
+# ---------------------------------------------------------------------------------------
+# The ROS node
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RobotNodeConfig:
+    """The node's private parameters (see the module docstring)."""
+
+    map_yaml: str
+    start: Pose2D
+    speed: float
+    rate: float
+    cmd_vel_timeout: float
+    global_frame: str
+    odom_frame: str
+    base_frame: str
+    publish_map: bool
+    publish_clock: bool
+    use_sim_time: bool
+
+    @classmethod
+    def from_params(cls) -> RobotNodeConfig:
+        config = cls(
+            map_yaml=str_param("map", ""),
+            start=Pose2D(float_param("x", 0.0), float_param("y", 0.0), float_param("yaw", 0.0)),
+            speed=float_param("speed", 1.0),
+            rate=float_param("rate", 20.0),
+            cmd_vel_timeout=float_param("cmd_vel_timeout", 0.5),
+            global_frame=str_param("global_frame", "map"),
+            odom_frame=str_param("odom_frame", "odom"),
+            base_frame=str_param("base_frame", "base_footprint"),
+            publish_map=bool_param("publish_map", True),
+            publish_clock=bool_param("publish_clock", True),
+            use_sim_time=bool(rospy.get_param("/use_sim_time", False)),
+        )
+        for name, value in (("speed", config.speed), ("rate", config.rate)):
+            if not value > 0:
+                raise _param_error(name, f"must be a positive number, got {value}")
+        return config
+
+
+class SimRobotNode:
+    """Runs a :class:`SimulatedBase` in (scaled) real time and speaks ROS around it."""
+
+    def __init__(self, config: RobotNodeConfig) -> None:
+        self.config = config
+        self._lock = threading.Lock()
+        grid = load_map(config.map_yaml) if config.map_yaml else None
+        self.base = SimulatedBase(config.start, grid, cmd_vel_timeout=config.cmd_vel_timeout)
+        if self.base.collides(config.start):
+            raise NavseqError(
+                f"start pose ({config.start.x:.2f}, {config.start.y:.2f}) puts the robot on an "
+                f"obstacle, unknown space or off the map {config.map_yaml}",
+                source=f"params {rospy.resolve_name('~x')}, {rospy.resolve_name('~y')}",
+            )
+        self.dt = 1.0 / config.rate
+        # Under use_sim_time exactly one node may drive /clock; the others follow it.
+        self.drives_clock = config.use_sim_time and config.publish_clock
+        if not self.drives_clock and config.speed != 1.0:
+            rospy.logwarn(
+                "~speed %.2f ignored: only the node publishing /clock sets the speed",
+                config.speed,
+            )
+        self.speed = config.speed if self.drives_clock else 1.0
+
+        self._odom_pub = rospy.Publisher("odom", Odometry, queue_size=10)
+        self._clock_pub = (
+            rospy.Publisher("/clock", Clock, queue_size=10) if self.drives_clock else None
+        )
+        self._tf = tf2_ros.TransformBroadcaster()
+        self._footprint_pub = rospy.Publisher("footprint", PolygonStamped, queue_size=1)
+        self._footprint_every = max(1, round(config.rate / FOOTPRINT_RATE))
+        self._steps = 0
+        self._map_pub = None
+        if grid is not None and config.publish_map:
+            self._map_pub = rospy.Publisher("map", OccupancyGridMsg, queue_size=1, latch=True)
+            self._map_pub.publish(grid_to_msg(grid, config.global_frame, self._stamp()))
+        if grid is None:
+            rospy.Subscriber("map", OccupancyGridMsg, self._on_map, queue_size=1)
+        rospy.Subscriber("cmd_vel", Twist, self._on_cmd_vel, queue_size=10)
+        rospy.Subscriber(
+            "initialpose", PoseWithCovarianceStamped, self._on_initial_pose, queue_size=10
+        )
+
+    # -- callbacks (rospy threads) -------------------------------------------------------
+
+    def _on_cmd_vel(self, msg: Twist) -> None:
+        with self._lock:
+            self.base.command(float(msg.linear.x), float(msg.angular.z))
+
+    def _on_initial_pose(self, msg: PoseWithCovarianceStamped) -> None:
+        frame = msg.header.frame_id.lstrip("/")
+        if frame and frame != self.config.global_frame:
+            rospy.logwarn(
+                "initialpose ignored: frame %r is not the map frame %r",
+                frame,
+                self.config.global_frame,
+            )
+            return
+        pose = pose_from_msg(msg.pose.pose)
+        with self._lock:
+            moved = self.base.teleport(pose)
+        if moved:
+            rospy.loginfo("teleported to (%.2f, %.2f, %.2f rad)", pose.x, pose.y, pose.yaw)
+        else:
+            rospy.logwarn(
+                "initialpose (%.2f, %.2f) refused: the robot would be on an obstacle",
+                pose.x,
+                pose.y,
+            )
+
+    def _on_map(self, msg: OccupancyGridMsg) -> None:
+        try:
+            grid = grid_from_msg(msg, source=f"topic {rospy.resolve_name('map')}")
+        except NavseqError as error:
+            rospy.logerr("%s", error)
+            return
+        with self._lock:
+            self.base.grid = grid
+
+    # -- main loop ------------------------------------------------------------------------
+
+    def _stamp(self) -> rospy.Time:
+        if self.drives_clock:
+            return rospy.Time.from_sec(self.base.time)
+        return rospy.Time.now()
+
+    def publish_state(self) -> None:
+        """Clock, TF and odometry for the current instant."""
+        config = self.config
+        with self._lock:
+            stamp = self._stamp()
+            map_to_odom = self.base.map_to_odom
+            odom_pose = self.base.odom_pose
+            v, w = self.base.robot.v, self.base.robot.w
+        if self._clock_pub is not None:
+            self._clock_pub.publish(Clock(clock=stamp))
+        self._tf.sendTransform(
+            [
+                make_transform(config.global_frame, config.odom_frame, map_to_odom, stamp),
+                make_transform(config.odom_frame, config.base_frame, odom_pose, stamp),
+            ]
+        )
+        odom = Odometry()
+        odom.header.stamp = stamp
+        odom.header.frame_id = config.odom_frame
+        odom.child_frame_id = config.base_frame
+        fill_pose_msg(odom.pose.pose, odom_pose)
+        odom.twist.twist.linear.x = v
+        odom.twist.twist.angular.z = w
+        self._odom_pub.publish(odom)
+        self._steps += 1
+        if self._steps % self._footprint_every == 0:
+            self._publish_footprint(stamp)
+
+    def _publish_footprint(self, stamp: rospy.Time) -> None:
+        """The robot outline in its base frame, for RViz (costmap_2d publishes the same)."""
+        polygon = PolygonStamped()
+        polygon.header.stamp = stamp
+        polygon.header.frame_id = self.config.base_frame
+        polygon.polygon.points = [
+            Point32(x=float(x), y=float(y), z=0.0) for x, y in self.base.footprint.polygon
+        ]
+        self._footprint_pub.publish(polygon)
+
+    def step(self, dt: float | None = None) -> None:
+        with self._lock:
+            moved = self.base.step(self.dt if dt is None else dt)
+        if not moved:
+            rospy.logwarn_throttle(
+                1.0,
+                "cmd_vel refused: the robot would hit an obstacle (bumped %d times)",
+                self.base.refused_steps,
+            )
+        self.publish_state()
+
+    def spin(self) -> None:
+        if self.config.use_sim_time and not self.drives_clock:
+            self._spin_following_clock()
+        else:
+            self._spin_on_wall_clock()
+
+    def _spin_following_clock(self) -> None:
+        """Step at ``~rate`` Hz of ROS time that another node's /clock drives."""
+        rate = rospy.Rate(self.config.rate)
+        last = rospy.Time.now()
+        while not rospy.is_shutdown():
+            try:
+                rate.sleep()
+            except rospy.ROSTimeMovedBackwardsException:
+                last = rospy.Time.now()
+                continue
+            except rospy.ROSInterruptException:
+                break
+            now = rospy.Time.now()
+            self.step(min((now - last).to_sec(), 5 * self.dt))
+            last = now
+
+    def _spin_on_wall_clock(self) -> None:
+        """Step every ``dt / speed`` wall seconds until shutdown.
+
+        Timing uses the wall clock, never ``rospy.sleep``: under ``use_sim_time`` this node
+        is the one that makes ROS time advance.
+        """
+        period = self.dt / self.speed
+        self.publish_state()
+        next_tick = time.monotonic()
+        while not rospy.is_shutdown():
+            self.step()
+            next_tick += period
+            delay = next_tick - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+            elif delay < -0.25:
+                # Too slow for the asked speed (busy CPU): simulated time just runs
+                # slower instead of catching up in a burst.
+                next_tick = time.monotonic()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``rosrun navseq sim_robot_node``."""
+    rospy.init_node("sim_robot", argv=argv if argv is not None else sys.argv)
+    try:
+        node = SimRobotNode(RobotNodeConfig.from_params())
+    except NavseqError as error:
+        rospy.logfatal("%s", error)
+        return 2
+    rospy.loginfo(
+        "sim robot at (%.2f, %.2f, %.2f rad), %s, speed x%.1f",
+        node.base.pose.x,
+        node.base.pose.y,
+        node.base.pose.yaw,
+        f"map {node.config.map_yaml}" if node.config.map_yaml else "map from topic",
+        node.speed,
+    )
+    node.spin()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
