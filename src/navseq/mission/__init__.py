@@ -1,5 +1,26 @@
-"""Missions: the data model and loaders for every source format (no ROS here)."""
+"""Missions: the data model and loaders for every source format (no ROS here).
 
+- :func:`load_mission` reads navseq YAML, rosparam YAML, roslaunch XML or CSV;
+- :func:`validate_mission_file` lists every problem of a file at once;
+- :func:`mission_from_params` reads a ROS node's private parameters;
+- :func:`dump_mission_yaml` / :func:`write_mission` write navseq YAML.
+"""
+
+from navseq.mission.loader import load_mission, validate_mission_file
 from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
+from navseq.mission.params import MISSION_PARAM_KEYS, mission_from_params
+from navseq.mission.writer import dump_mission_yaml, write_mission
 
-__all__ = ["POLICY_FIELDS", "FailureAction", "Mission", "Policy", "Waypoint"]
+__all__ = [
+    "MISSION_PARAM_KEYS",
+    "POLICY_FIELDS",
+    "FailureAction",
+    "Mission",
+    "Policy",
+    "Waypoint",
+    "dump_mission_yaml",
+    "load_mission",
+    "mission_from_params",
+    "validate_mission_file",
+    "write_mission",
+]

@@ -58,7 +58,8 @@ class Waypoint:
     z: float = 0.0
     name: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
-    where: str | None = None  # "file.yaml:12" — where the user wrote it, for messages
+    # "file.yaml:12" — where the user wrote it, for messages; not part of equality
+    where: str | None = field(default=None, compare=False)
 
     @property
     def pose(self) -> Pose2D:
@@ -84,7 +85,7 @@ class Mission:
     map: Path | None = None
     start: Pose2D | None = None
     server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
-    source: str = "<memory>"
+    source: str = field(default="<memory>", compare=False)  # where it was read from
 
     def policy_for(self, index: int) -> Policy:
         return self.defaults.with_overrides(self.waypoints[index].overrides)

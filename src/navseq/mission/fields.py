@@ -1,0 +1,174 @@
+"""Readers that turn one :class:`Located` value into a checked Python value.
+
+Each reader raises :class:`NavseqError` naming the place, the subject (``waypoint 3
+'dock', field yaw``) and what is wrong. Callers that want every problem at once
+catch the error into a :class:`Problems` list and go on with the next field.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Collection
+from typing import Any, TypeVar
+
+from navseq.errors import NavseqError
+from navseq.mission.located import Located, describe
+from navseq.mission.model import FailureAction
+from navseq.mission.problems import Problems, closest_hint
+
+T = TypeVar("T")
+
+
+def field_subject(owner: str | None, name: str) -> str:
+    """``waypoint 2, field x`` — or ``field x`` for mission-wide keys."""
+    return f"{owner}, field {name}" if owner else f"field {name}"
+
+
+def number(node: Located, subject: str) -> float:
+    """A finite real number. Booleans and text are refused, not coerced."""
+    value = node.value
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise NavseqError(f"must be a number, got {describe(value)}", source=node.where,
+                          subject=subject)
+    try:
+        result = float(value)
+    except OverflowError:
+        raise NavseqError("is too large to be a coordinate or a time", source=node.where,
+                          subject=subject) from None
+    if not math.isfinite(result):
+        raise NavseqError(f"must be a finite number, got {value!r}", source=node.where,
+                          subject=subject)
+    return result
+
+
+def bounded_number(node: Located, subject: str, *, minimum: float, inclusive: bool,
+                   unit: str = "") -> float:
+    """A finite number ``>= minimum`` (or ``> minimum`` when not inclusive)."""
+    result = number(node, subject)
+    if result < minimum or (not inclusive and result == minimum):
+        relation = ">=" if inclusive else ">"
+        raise NavseqError(f"must be {relation} {minimum:g}{unit}, got {result:g}",
+                          source=node.where, subject=subject)
+    return result
+
+
+def integer(node: Located, subject: str, *, minimum: int) -> int:
+    """A whole number ``>= minimum`` (``2.0`` is accepted as 2, ``2.5`` is not)."""
+    value = node.value
+    if isinstance(value, float) and math.isfinite(value) and value.is_integer():
+        value = int(value)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise NavseqError(f"must be a whole number, got {describe(node.value)}",
+                          source=node.where, subject=subject)
+    if value < minimum:
+        raise NavseqError(f"must be >= {minimum}, got {value}", source=node.where,
+                          subject=subject)
+    return value
+
+
+def boolean(node: Located, subject: str) -> bool:
+    if not isinstance(node.value, bool):
+        raise NavseqError(f"must be true or false, got {describe(node.value)}",
+                          source=node.where, subject=subject)
+    return node.value
+
+
+def text(node: Located, subject: str, *, allow_numbers: bool = False) -> str:
+    """Non-empty text; with ``allow_numbers`` a number is taken as its text (``name: 7``)."""
+    value = node.value
+    if allow_numbers and isinstance(value, int | float) and not isinstance(value, bool):
+        value = str(value)
+    if not isinstance(value, str) or not value.strip():
+        raise NavseqError(f"must be non-empty text, got {describe(node.value)}",
+                          source=node.where, subject=subject)
+    return value
+
+
+def choice(node: Located, subject: str, options: Collection[str]) -> str:
+    value = node.value
+    if not isinstance(value, str) or value not in options:
+        hint = closest_hint(value, options) if isinstance(value, str) else ""
+        listed = " | ".join(options)
+        raise NavseqError(f"must be one of {listed}, got {describe(value)}{hint}",
+                          source=node.where, subject=subject)
+    return value
+
+
+def mapping(node: Located, subject: str) -> Located:
+    if not node.is_mapping:
+        raise NavseqError(f"must be a mapping of keys to values, got {describe(node.value)}",
+                          source=node.where, subject=subject)
+    return node
+
+
+def sequence(node: Located, subject: str) -> list[Located]:
+    if not node.is_list:
+        raise NavseqError(f"must be a list, got {describe(node.value)}", source=node.where,
+                          subject=subject)
+    return node.value
+
+
+def check_keys(node: Located, known: Collection[str], owner: str | None,
+               problems: Problems) -> None:
+    """Report every key of a mapping that navseq does not know, with the closest known one."""
+    for key in node.value:
+        if key not in known:
+            problems.add(f"unknown key{closest_hint(key, known)}", source=node.where_key(key),
+                         subject=field_subject(owner, key))
+
+
+def attempt(problems: Problems, read: Callable[[], T]) -> T | None:
+    """Run one reader; on a NavseqError record it and return None so parsing goes on."""
+    try:
+        return read()
+    except NavseqError as error:
+        problems.record(error)
+        return None
+
+
+# --- policies ------------------------------------------------------------------------
+
+
+def _optional(reader: Callable[[Located, str], Any]) -> Callable[[Located, str], Any]:
+    """``null`` switches the limit off; anything else goes through ``reader``."""
+
+    def read(node: Located, subject: str) -> Any:
+        return None if node.value is None else reader(node, subject)
+
+    return read
+
+
+def _positive_seconds(node: Located, subject: str) -> float:
+    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s")
+
+
+def _failure_action(node: Located, subject: str) -> FailureAction:
+    return FailureAction(choice(node, subject, [a.value for a in FailureAction]))
+
+
+POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
+    "goal_timeout": _optional(_positive_seconds),
+    "stall_timeout": _optional(_positive_seconds),
+    "retries": lambda node, subject: integer(node, subject, minimum=0),
+    "clear_costmaps_on_retry": boolean,
+    "on_failure": _failure_action,
+    "pass_through": _optional(
+        lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
+                                             unit=" m")),
+    "dwell": lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
+                                                  unit=" s"),
+}
+
+
+def policy_values(node: Located, owner: str | None, problems: Problems) -> dict[str, Any]:
+    """The policy keys present in a mapping, checked; other keys are left to the caller."""
+    values: dict[str, Any] = {}
+    for key, reader in POLICY_READERS.items():
+        entry = node.get(key)
+        if entry is None:
+            continue
+        before = len(problems)
+        value = attempt(problems, lambda r=reader, e=entry, k=key: r(e, field_subject(owner, k)))
+        if len(problems) == before:
+            values[key] = value
+    return values

@@ -1,0 +1,122 @@
+"""One entry point for every mission file format.
+
+The format is chosen by the file's extension and, where that is not conclusive, by
+its content:
+
+- ``.yaml`` / ``.yml``: navseq's mission format, or a rosparam file with the
+  tutorial's ``p_seq`` / ``yea_seq`` (at the top or under a node's name);
+- ``.launch`` / ``.xml``: a roslaunch file setting those parameters;
+- ``.csv``: poses recorded as ``x,y,z,qx,qy,qz,qw``;
+- anything else: sniffed (XML, YAML mapping, or comma-separated numbers).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+from navseq.errors import NavseqError
+from navseq.mission.csv_format import mission_from_csv
+from navseq.mission.launch_xml import mission_from_launch
+from navseq.mission.located import Located
+from navseq.mission.model import Mission
+from navseq.mission.navseq_format import mission_from_document
+from navseq.mission.problems import Problems
+from navseq.mission.reading import read_mission_text
+from navseq.mission.rosparam_format import find_mission_namespaces, mission_from_tree
+from navseq.mission.yaml_doc import parse_yaml
+
+Reader = Callable[[str, str, Path, Problems], "Mission | None"]
+
+_CSV_LINE = re.compile(r"\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+)+\s*")
+_NAVSEQ_KEYS = ("waypoints", "navseq")
+SUPPORTED = ("navseq YAML or rosparam YAML (.yaml, .yml), roslaunch XML (.launch, .xml), "
+             "CSV x,y,z,qx,qy,qz,qw (.csv)")
+
+
+def load_mission(path: str | os.PathLike[str]) -> Mission:
+    """Read a mission file of any supported format.
+
+    Raises NavseqError for one problem and MissionErrors (a NavseqError listing
+    them all) for several.
+    """
+    mission, problems = _load(Path(path))
+    problems.raise_if_any()
+    assert mission is not None, "a loader returned no mission without saying why"
+    return mission
+
+
+def validate_mission_file(path: str | os.PathLike[str]) -> list[NavseqError]:
+    """Every problem of a mission file, at once; an empty list means it loads."""
+    return _load(Path(path))[1].errors
+
+
+def _load(path: Path) -> tuple[Mission | None, Problems]:
+    problems = Problems()
+    source = str(path)
+    mission = None
+    try:
+        text = read_mission_text(path)
+        reader = _reader_for(path, text)
+        mission = reader(text, source, path.resolve().parent, problems)
+    except NavseqError as error:
+        problems.record(error)
+    except RecursionError:
+        problems.add("is nested too deeply to be a mission", source=source)
+    if mission is None and not problems.errors:
+        problems.add("holds no mission", source=source)
+    return (mission if not problems.errors else None), problems
+
+
+def _reader_for(path: Path, text: str) -> Reader:
+    suffix = path.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        return _read_yaml
+    if suffix in (".launch", ".xml"):
+        return _read_launch
+    if suffix == ".csv":
+        return _read_csv
+    return _sniff(path, text)
+
+
+def _sniff(path: Path, text: str) -> Reader:
+    """Guess the format of a file whose extension says nothing."""
+    stripped = text.lstrip()
+    if stripped.startswith("<"):
+        return _read_launch
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    if lines and all(_CSV_LINE.fullmatch(line) for line in lines[1:] or lines):
+        return _read_csv
+    try:
+        doc = parse_yaml(text, str(path), Problems())
+    except NavseqError:
+        doc = None
+    if doc is not None and doc.is_mapping:
+        return _read_yaml
+    raise NavseqError(f"is not a mission file navseq can read; it reads {SUPPORTED}",
+                      source=str(path))
+
+
+def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:
+    doc = parse_yaml(text, source, problems)
+    if _is_rosparam_tree(doc):
+        assert doc is not None
+        return mission_from_tree(doc, source, base_dir, problems)
+    return mission_from_document(doc, source, base_dir, problems)
+
+
+def _is_rosparam_tree(doc: Located | None) -> bool:
+    """A mapping without navseq's own top-level keys, giving p_seq/yea_seq somewhere."""
+    if doc is None or not doc.is_mapping or any(key in doc.value for key in _NAVSEQ_KEYS):
+        return False
+    return bool(find_mission_namespaces(doc))
+
+
+def _read_launch(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:
+    return mission_from_launch(text, source, base_dir, problems)
+
+
+def _read_csv(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:
+    return mission_from_csv(text, source, problems)

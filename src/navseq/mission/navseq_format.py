@@ -1,0 +1,282 @@
+"""navseq's own YAML mission format (reference: docs/mission-format.md).
+
+A mission document is a mapping::
+
+    navseq: 1
+    frame: map
+    map: ../maps/turtlebot3_world.yaml
+    start: {x: -2.0, y: -0.5, yaw: 0}
+    loops: 1
+    defaults: {goal_timeout: 120, retries: 1, on_failure: skip}
+    waypoints:
+      - {name: dock, x: 1.0, y: 2.0, yaw: 90}
+      - [2.0, 0.5, 0]
+
+This module turns such a :class:`Located` tree into a :class:`Mission`, recording
+every problem it finds. The same readers serve ROS parameters (``~waypoints``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D, quaternion_to_yaw
+from navseq.mission import fields
+from navseq.mission.located import Located, describe
+from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
+from navseq.mission.problems import Problems
+
+FORMAT_VERSION = 1
+FOREVER = "forever"
+DEFAULT_SERVER_TIMEOUT = Mission.__dataclass_fields__["server_timeout"].default
+
+MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout")
+TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
+ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
+POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
+WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_FIELDS)
+
+
+def mission_from_document(doc: Located | None, source: str, base_dir: Path | None,
+                          problems: Problems) -> Mission | None:
+    """The Mission a navseq YAML document describes, or None when it has problems."""
+    if doc is None:
+        problems.add("is empty; a mission needs at least one waypoint", source=source)
+        return None
+    if not doc.is_mapping:
+        problems.add(f"must be a mapping with a 'waypoints' list, got {describe(doc.value)}",
+                     source=doc.where)
+        return None
+    before = len(problems)
+    fields.check_keys(doc, TOP_LEVEL_KEYS, None, problems)
+    version = doc.get("navseq")
+    if version is not None and version.value != FORMAT_VERSION:
+        problems.add(f"format version {describe(version.value)} is not supported; this navseq "
+                     f"reads version {FORMAT_VERSION}", source=version.where,
+                     subject="field navseq")
+    defaults = read_defaults(doc.get("defaults"), problems)
+    waypoints_node = doc.get("waypoints")
+    if waypoints_node is None:
+        problems.add("has no 'waypoints' list; a mission needs at least one waypoint",
+                     source=doc.where)
+        waypoints: tuple[Waypoint, ...] = ()
+    else:
+        waypoints = read_waypoints(waypoints_node, problems)
+    settings = read_settings(doc, base_dir, problems)
+    if len(problems) > before:
+        return None
+    return Mission(waypoints=waypoints, defaults=defaults, source=source, **settings)
+
+
+def read_defaults(node: Located | None, problems: Problems) -> Policy:
+    if node is None:
+        return Policy()
+    if fields.attempt(problems, lambda: fields.mapping(node, "field defaults")) is None:
+        return Policy()
+    fields.check_keys(node, POLICY_FIELDS, "defaults", problems)
+    return Policy(**fields.policy_values(node, "defaults", problems))
+
+
+def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> dict[str, Any]:
+    """The mission-wide keys other than policies: frame, map, start, loops, server_timeout."""
+    readers = {
+        "frame": read_frame,
+        "map": lambda entry, subject: read_map_path(entry, subject, base_dir),
+        "start": read_start,
+        "loops": read_loops,
+        "server_timeout": read_server_timeout,
+    }
+    settings: dict[str, Any] = {}
+    for key, reader in readers.items():
+        entry = node.get(key)
+        if entry is None:
+            continue
+        before = len(problems)
+        value = fields.attempt(problems, lambda r=reader, e=entry, k=key: r(e, f"field {k}"))
+        if len(problems) == before:
+            settings[key] = value
+    return settings
+
+
+def read_frame(node: Located, subject: str) -> str:
+    frame = fields.text(node, subject)
+    if any(ch.isspace() for ch in frame):
+        raise NavseqError(f"a frame id has no spaces, got {frame!r}", source=node.where,
+                          subject=subject)
+    return frame
+
+
+def read_map_path(node: Located, subject: str, base_dir: Path | None) -> Path:
+    """A map_server YAML path; relative paths are relative to the mission file's folder."""
+    path = Path(fields.text(node, subject)).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    return path.resolve()
+
+
+def read_loops(node: Located, subject: str) -> int | None:
+    """How many times the waypoint list is run; ``forever`` (None) patrols until stopped."""
+    if node.value == FOREVER:
+        return None
+    if isinstance(node.value, str):
+        raise NavseqError(f"must be a whole number >= 1 or '{FOREVER}', got "
+                          f"{describe(node.value)}", source=node.where, subject=subject)
+    return fields.integer(node, subject, minimum=1)
+
+
+def read_server_timeout(node: Located, subject: str) -> float | None:
+    if node.value is None:
+        return None
+    return fields.bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s")
+
+
+def read_start(node: Located, subject: str) -> Pose2D:
+    """The simulator's start pose: ``{x, y, yaw}`` (yaw in degrees, or yaw_rad/orientation)."""
+    fields.mapping(node, subject)
+    problems = Problems()
+    fields.check_keys(node, ("x", "y", *ORIENTATION_KEYS), "start", problems)
+    x = _required_number(node, "x", "start", problems)
+    y = _required_number(node, "y", "start", problems)
+    yaw = read_yaw(node, "start", problems)
+    problems.raise_if_any()
+    assert x is not None and y is not None and yaw is not None
+    return Pose2D(x, y, yaw)
+
+
+def read_waypoints(node: Located, problems: Problems) -> tuple[Waypoint, ...]:
+    items = fields.attempt(problems, lambda: fields.sequence(node, "field waypoints"))
+    if items is None:
+        return ()
+    if not items:
+        problems.add("the waypoint list is empty; a mission needs at least one waypoint",
+                     source=node.where, subject="field waypoints")
+        return ()
+    waypoints = [read_waypoint(item, index, problems) for index, item in enumerate(items)]
+    check_unique_names(items, problems)
+    return tuple(w for w in waypoints if w is not None)
+
+
+def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | None:
+    """One waypoint: a mapping, or the short form ``[x, y]`` / ``[x, y, yaw_degrees]``."""
+    if node.is_list:
+        return _waypoint_from_list(node, index, problems)
+    label = f"waypoint {index + 1}"
+    if not node.is_mapping:
+        problems.add(f"must be a mapping like {{x: 1.0, y: 2.0, yaw: 90}}, got "
+                     f"{describe(node.value)}", source=node.where, subject=label)
+        return None
+    before = len(problems)
+    name = None
+    if node.get("name") is not None:
+        name_node = node.value["name"]
+        name = fields.attempt(problems, lambda: fields.text(name_node, f"{label}, field name",
+                                                            allow_numbers=True))
+        if name is not None:
+            label = f"{label} '{name}'"
+    fields.check_keys(node, WAYPOINT_KEYS, label, problems)
+    x = _required_number(node, "x", label, problems)
+    y = _required_number(node, "y", label, problems)
+    z = _optional_number(node, "z", label, problems)
+    yaw = read_yaw(node, label, problems)
+    overrides = fields.policy_values(node, label, problems)
+    if len(problems) > before or x is None or y is None or yaw is None:
+        return None
+    return Waypoint(x=x, y=y, z=z or 0.0, yaw=yaw, name=name,
+                    overrides=MappingProxyType(overrides), where=node.where)
+
+
+def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoint | None:
+    label = f"waypoint {index + 1}"
+    items: Sequence[Located] = node.value
+    if len(items) not in (2, 3):
+        problems.add(f"the short form is [x, y] or [x, y, yaw_degrees], got {len(items)} values",
+                     source=node.where, subject=label)
+        return None
+    names = ("x", "y", "yaw")
+    before = len(problems)
+    values = [fields.attempt(problems, lambda i=item, n=name: fields.number(
+        i, fields.field_subject(label, n))) for item, name in zip(items, names, strict=False)]
+    if len(problems) > before:
+        return None
+    x, y, *rest = (v for v in values if v is not None)
+    yaw = math.radians(rest[0]) if rest else 0.0
+    return Waypoint(x=x, y=y, yaw=yaw, where=node.where)
+
+
+def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:
+    """Yaw in radians from exactly one of ``yaw`` (degrees), ``yaw_rad``, ``orientation``.
+
+    None (with a recorded problem) when the orientation is invalid; 0 when absent.
+    """
+    given = [key for key in ORIENTATION_KEYS if node.get(key) is not None]
+    if len(given) > 1:
+        problems.add(f"give only one of {', '.join(given)}", source=node.where,
+                     subject=fields.field_subject(owner, given[1]))
+        return None
+    if not given:
+        return 0.0
+    key = given[0]
+    entry = node.value[key]
+    subject = fields.field_subject(owner, key)
+    if key == "yaw":
+        degrees = fields.attempt(problems, lambda: fields.number(entry, subject))
+        return None if degrees is None else math.radians(degrees)
+    if key == "yaw_rad":
+        return fields.attempt(problems, lambda: fields.number(entry, subject))
+    return fields.attempt(problems, lambda: read_quaternion_yaw(entry, subject))
+
+
+def read_quaternion_yaw(node: Located, subject: str) -> float:
+    """Yaw of an ``{x, y, z, w}`` quaternion; it is normalised, but must not be zero."""
+    fields.mapping(node, subject)
+    problems = Problems()
+    fields.check_keys(node, ("x", "y", "z", "w"), subject, problems)
+    parts = [_required_number(node, key, subject, problems) for key in ("x", "y", "z", "w")]
+    problems.raise_if_any()
+    return quaternion_yaw_checked([p for p in parts if p is not None], node.where, subject)
+
+
+def quaternion_yaw_checked(parts: Sequence[float], where: str, subject: str) -> float:
+    qx, qy, qz, qw = parts
+    norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+    if not math.isfinite(norm) or norm < 1e-9:
+        raise NavseqError("the quaternion (x, y, z, w) has length 0; it is no rotation",
+                          source=where, subject=subject)
+    return quaternion_to_yaw(qx / norm, qy / norm, qz / norm, qw / norm)
+
+
+def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
+    """Names identify waypoints in reports and on resume, so each may be used once."""
+    first_use: dict[str, int] = {}
+    for index, item in enumerate(items):
+        name_node = item.get("name")
+        if name_node is None or isinstance(name_node.value, bool | list | dict):
+            continue
+        name = str(name_node.value)
+        if name in first_use:
+            problems.add(f"the name '{name}' is already used by waypoint {first_use[name] + 1}; "
+                         "names must be unique", source=name_node.where,
+                         subject=f"waypoint {index + 1}, field name")
+        else:
+            first_use[name] = index
+
+
+def _required_number(node: Located, key: str, owner: str, problems: Problems) -> float | None:
+    entry = node.get(key)
+    if entry is None:
+        problems.add(f"'{key}' is missing", source=node.where,
+                     subject=fields.field_subject(owner, key))
+        return None
+    return fields.attempt(problems, lambda: fields.number(entry, fields.field_subject(owner, key)))
+
+
+def _optional_number(node: Located, key: str, owner: str, problems: Problems) -> float | None:
+    entry = node.get(key)
+    if entry is None:
+        return None
+    return fields.attempt(problems, lambda: fields.number(entry, fields.field_subject(owner, key)))

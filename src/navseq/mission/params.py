@@ -1,0 +1,114 @@
+"""Missions given as ROS parameters: the node's private namespace, or the parameters a
+launch file or rosparam YAML file sets for a node.
+
+Three ways to give the waypoints, exactly one per namespace:
+
+- ``p_seq`` + ``yea_seq``: the tutorial's flat lists (see :mod:`tutorial_format`);
+- ``waypoints``: the structured list of navseq's YAML format;
+- ``mission``: the path of a mission file in any format navseq reads.
+
+Next to them, optional mission-wide keys: ``frame``, ``loops``, ``map``, ``start``,
+``server_timeout`` and every policy key (``goal_timeout``, ``retries``, ...), which
+override what a ``mission`` file says.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Collection, Mapping
+from pathlib import Path
+from typing import Any
+
+from navseq.mission import fields
+from navseq.mission.located import Located, from_plain
+from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
+from navseq.mission.navseq_format import MISSION_SETTINGS, read_settings, read_waypoints
+from navseq.mission.problems import Problems
+from navseq.mission.tutorial_format import POSITIONS_KEY, YAWS_KEY, waypoints_from_sequences
+
+WAYPOINT_SOURCES = (POSITIONS_KEY, YAWS_KEY, "waypoints", "mission")
+MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_FIELDS)
+
+
+def mission_from_params(params: Mapping[str, Any], source: str = "param ~", *,
+                        ignore: Collection[str] = ()) -> Mission:
+    """The mission a ROS node's private parameters describe.
+
+    ``params`` is the node's private namespace as a dict (``rospy.get_param("~")``);
+    ``source`` prefixes parameter names in messages (``param ~p_seq``). Keys in
+    ``ignore`` belong to the node itself (``action_name``...) and are not checked;
+    any other unknown key is an error naming the closest known one. Raises
+    NavseqError, or MissionErrors when there are several problems.
+    """
+    values = {str(key): from_plain(value, f"{source}{key}") for key, value in params.items()
+              if str(key) not in ignore}
+    namespace = Located(values, source.rstrip() or "params",
+                        {key: node.where for key, node in values.items()})
+    problems = Problems()
+    mission = mission_from_namespace(namespace, problems, base_dir=None, strict=True)
+    problems.raise_if_any()
+    assert mission is not None
+    return mission
+
+
+def mission_from_namespace(namespace: Located, problems: Problems, *, base_dir: Path | None,
+                           strict: bool) -> Mission | None:
+    """Build the mission from one parameter namespace, recording every problem.
+
+    ``strict`` reports unknown keys (a node's own namespace); launch and rosparam
+    files are read leniently, since a node's namespace there may hold other settings.
+    ``base_dir`` anchors relative ``mission`` and ``map`` paths (None: the current folder).
+    """
+    before = len(problems)
+    if strict:
+        fields.check_keys(namespace, MISSION_PARAM_KEYS, None, problems)
+    given = [key for key in ("waypoints", "mission") if namespace.get(key) is not None]
+    if namespace.get(POSITIONS_KEY) is not None or namespace.get(YAWS_KEY) is not None:
+        given.insert(0, f"{POSITIONS_KEY}/{YAWS_KEY}")
+    if len(given) != 1:
+        what = " and ".join(given) if given else "none of them"
+        problems.add(f"give the waypoints exactly one way: {POSITIONS_KEY} + {YAWS_KEY} (the "
+                     f"tutorial's lists), waypoints, or mission (a file); found {what}",
+                     source=namespace.where)
+        return None
+    settings = read_settings(namespace, base_dir, problems)
+    policy = fields.policy_values(namespace, None, problems)
+    if given[0] == "mission":
+        base = _mission_from_file(namespace.value["mission"], base_dir, problems)
+        if base is None or len(problems) > before:
+            return None
+        return dataclasses.replace(base, defaults=base.defaults.with_overrides(policy),
+                                   **settings)
+    waypoints: tuple[Waypoint, ...]
+    if given[0] == "waypoints":
+        waypoints = read_waypoints(namespace.value["waypoints"], problems)
+        source = namespace.value["waypoints"].where
+    else:
+        positions = namespace.get(POSITIONS_KEY)
+        waypoints = waypoints_from_sequences(positions, namespace.get(YAWS_KEY), problems)
+        source = positions.where if positions is not None else namespace.where
+    if len(problems) > before:
+        return None
+    return Mission(waypoints=waypoints, defaults=Policy(**policy), source=source, **settings)
+
+
+def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems
+                       ) -> Mission | None:
+    from navseq.errors import NavseqError
+    from navseq.mission.loader import load_mission  # the loader reads launch files via here
+
+    path_text = fields.attempt(problems, lambda: fields.text(node, "field mission"))
+    if path_text is None:
+        return None
+    if "$(" in path_text:
+        problems.add(f"uses a roslaunch substitution ({path_text[:40]}) that navseq cannot "
+                     "resolve here", source=node.where, subject="field mission")
+        return None
+    path = Path(path_text).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    try:
+        return load_mission(path)
+    except NavseqError as error:
+        problems.record(error)
+        return None

@@ -1,0 +1,173 @@
+"""Writing a Mission as navseq YAML: readable (yaw in degrees, one line per waypoint)
+and exact (reading the file back gives the same mission).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import secrets
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
+from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
+
+HEADER = "# navseq mission (format reference: docs/mission-format.md)\n"
+# A yaw someone typed keeps up to ten decimals exactly; one computed from a quaternion
+# is rounded to a millionth of a degree (2e-8 rad, far below what a robot can tell).
+_EXACT_YAW_DECIMALS = 10
+_ROUNDED_YAW_DECIMALS = 6
+
+
+class _FlowMapping(dict):
+    """A mapping written on one line: a waypoint, the start pose."""
+
+
+class _MissionDumper(yaml.SafeDumper):
+    """Block style with lists indented under their key; waypoints one per line."""
+
+    def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
+        super().increase_indent(flow, False)
+
+
+_MissionDumper.add_representer(
+    _FlowMapping,
+    lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data,
+                                                  flow_style=True),
+)
+
+
+def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
+    """The mission as navseq YAML text.
+
+    With ``base_dir`` (the folder the file will be written to) the map path is written
+    relative to it, so mission and map can be moved together.
+    """
+    doc: dict[str, Any] = {"navseq": FORMAT_VERSION, "frame": mission.frame}
+    if mission.map is not None:
+        doc["map"] = _map_text(mission.map, base_dir)
+    if mission.start is not None:
+        doc["start"] = _pose(mission.start)
+    doc["loops"] = FOREVER if mission.loops is None else mission.loops
+    doc["server_timeout"] = mission.server_timeout
+    doc["defaults"] = _policy_values(mission.defaults, POLICY_FIELDS)
+    doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
+    return HEADER + yaml.dump(doc, Dumper=_MissionDumper, sort_keys=False,
+                              default_flow_style=False, allow_unicode=True, width=4096)
+
+
+def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: bool = False
+                  ) -> None:
+    """Write ``mission`` to ``path`` as navseq YAML, atomically.
+
+    Refuses to replace an existing file unless ``overwrite`` is true. The text goes
+    to a temporary file in the same folder first, so a crash leaves either the old
+    file or the complete new one, never half a mission.
+    """
+    target = Path(path)
+    source = str(target)
+    if target.is_dir():
+        raise NavseqError("is a folder; give the path of the mission file to write",
+                          source=source)
+    if not target.parent.is_dir():
+        raise NavseqError(f"the folder {target.parent} does not exist", source=source)
+    if target.exists() and not overwrite:
+        raise NavseqError("exists already; not overwriting it", source=source)
+    text = dump_mission_yaml(mission, base_dir=target.parent.resolve())
+    temporary = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp"
+    try:
+        # O_EXCL: never follow or reuse someone else's file; the mode honours the umask.
+        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        if overwrite:
+            os.replace(temporary, target)
+        else:
+            _publish_without_replacing(temporary, target)
+    except FileExistsError:
+        raise NavseqError("exists already; not overwriting it", source=source) from None
+    except OSError as error:
+        raise NavseqError(f"cannot be written: {error.strerror or error}",
+                          source=source) from None
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def _publish_without_replacing(temporary: Path, target: Path) -> None:
+    """Give the finished file its name unless that name appeared meanwhile."""
+    try:
+        os.link(temporary, target)  # fails if target exists: no check-then-write race
+    except FileExistsError:
+        raise
+    except OSError:  # file systems without hard links
+        if target.exists():
+            raise FileExistsError(str(target)) from None
+        os.replace(temporary, target)
+
+
+def yaw_degrees_for_file(yaw: float) -> float | int:
+    """Degrees as a person would write them (``90``, not ``89.99999999999999``).
+
+    The shortest rounding (up to ten decimals) that converts back to exactly ``yaw``
+    is used, so yaws written in degrees survive a write and a read unchanged; others
+    (from quaternions or radians) are rounded to a millionth of a degree.
+    """
+    degrees = math.degrees(yaw)
+    for decimals in range(_EXACT_YAW_DECIMALS + 1):
+        candidate = round(degrees, decimals)
+        if math.radians(candidate) == yaw:
+            return _tidy(candidate)
+    return _tidy(round(degrees, _ROUNDED_YAW_DECIMALS))
+
+
+def _tidy(value: float) -> float | int:
+    if value.is_integer() and abs(value) < 2**53:
+        return int(value)
+    return value
+
+
+def _map_text(map_path: Path, base_dir: Path | None) -> str:
+    if base_dir is None:
+        return str(map_path)
+    try:
+        return os.path.relpath(map_path, base_dir)
+    except ValueError:  # another drive (Windows)
+        return str(map_path)
+
+
+def _pose(pose: Pose2D) -> _FlowMapping:
+    return _FlowMapping(x=pose.x, y=pose.y, **_yaw_entry(pose.yaw))
+
+
+def _yaw_entry(yaw: float) -> dict[str, Any]:
+    if not math.isfinite(math.degrees(yaw)):  # only absurd radians overflow as degrees
+        return {"yaw_rad": yaw}
+    return {"yaw": yaw_degrees_for_file(yaw)}
+
+
+def _waypoint(waypoint: Waypoint) -> _FlowMapping:
+    entry = _FlowMapping()
+    if waypoint.name is not None:
+        entry["name"] = waypoint.name
+    entry["x"] = waypoint.x
+    entry["y"] = waypoint.y
+    if waypoint.z != 0.0:
+        entry["z"] = waypoint.z
+    entry.update(_yaw_entry(waypoint.yaw))
+    entry.update(_policy_values(Policy().with_overrides(waypoint.overrides),
+                                [key for key in POLICY_FIELDS if key in waypoint.overrides]))
+    return entry
+
+
+def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
+    values = {key: getattr(policy, key) for key in keys}
+    return {key: value.value if isinstance(value, FailureAction) else value
+            for key, value in values.items()}
+

@@ -1,0 +1,162 @@
+"""Safe YAML parsing into :class:`Located` trees with line numbers.
+
+PyYAML's SafeLoader *composes* the document (syntax only, no object construction);
+navseq then walks the node graph itself so that every value keeps its line number.
+Only plain YAML types are accepted (null, bool, int, float, str, lists, mappings):
+any other tag is an error. Aliases are allowed but every node reached through them
+counts toward a cap, so an "alias bomb" (a few lines that expand to billions of
+nodes) is refused instead of exhausting memory.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import yaml
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+
+from navseq.errors import NavseqError
+from navseq.mission.located import MAX_DEPTH, Located
+from navseq.mission.problems import Problems
+
+MAX_YAML_NODES = 200_000
+
+_TAG = "tag:yaml.org,2002:"
+_SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
+# PyYAML follows YAML 1.1, where "1e3" (no dot) is text; YAML 1.2 and every user
+# reads it as a number.
+_EXPONENT_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+
+
+def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1
+               ) -> Located | None:
+    """Parse one YAML document. Syntax errors raise; duplicate keys are recorded.
+
+    ``first_line`` is the file line of the text's first line (YAML inside a launch
+    file). Returns None for an empty document.
+    """
+    offset = first_line - 1
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        where = f"{source}:{mark.line + 1 + offset}" if mark is not None else source
+        what = error.problem or error.context or "syntax error"
+        raise NavseqError(f"is not valid YAML: {what}", source=where) from None
+    except yaml.YAMLError as error:
+        raise NavseqError(f"is not valid YAML: {error}", source=source) from None
+    except RecursionError:
+        raise NavseqError("is nested too deeply to be a mission", source=source) from None
+    if root is None:
+        return None
+    return _Walker(source, problems, offset).walk(root, 0)
+
+
+def parse_yaml_value(text: str, source: str, *, first_line: int = 1) -> Located | None:
+    """A YAML value written inside another file (a launch file's attribute or body)."""
+    problems = Problems()
+    result = parse_yaml(text, source, problems, first_line=first_line)
+    problems.raise_if_any()
+    return result
+
+
+class _Walker:
+    """Turns composed nodes into Located values, counting nodes to stop alias bombs."""
+
+    def __init__(self, source: str, problems: Problems, line_offset: int):
+        self.source = source
+        self.line_offset = line_offset
+        self.problems = problems
+        self.visited = 0
+        self.constructor = yaml.SafeLoader("")
+
+    def where(self, node: Node) -> str:
+        return f"{self.source}:{node.start_mark.line + 1 + self.line_offset}"
+
+    def walk(self, node: Node, depth: int) -> Located:
+        self.visited += 1
+        if self.visited > MAX_YAML_NODES:
+            raise NavseqError(f"has more than {MAX_YAML_NODES} values (counting what aliases "
+                              "repeat); refusing it", source=self.where(node))
+        if depth > MAX_DEPTH:
+            raise NavseqError(f"is nested more than {MAX_DEPTH} levels deep",
+                              source=self.where(node))
+        if isinstance(node, ScalarNode):
+            return Located(self.scalar(node), self.where(node))
+        if isinstance(node, SequenceNode):
+            self.require_tag(node, _TAG + "seq")
+            return Located([self.walk(item, depth + 1) for item in node.value], self.where(node))
+        if isinstance(node, MappingNode):
+            self.require_tag(node, _TAG + "map")
+            return self.mapping(node, depth)
+        raise NavseqError("holds an unknown kind of YAML node", source=self.where(node))
+
+    def require_tag(self, node: Node, tag: str) -> None:
+        if node.tag != tag:
+            kind = str(node.tag).removeprefix(_TAG)
+            raise NavseqError(f"uses the YAML type '{kind}', which navseq does not accept",
+                              source=self.where(node))
+
+    def scalar(self, node: ScalarNode) -> Any:
+        if node.tag not in _SCALAR_TAGS:
+            kind = node.tag.removeprefix(_TAG)
+            raise NavseqError(f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
+                              "navseq does not accept (quote it if it is text)",
+                              source=self.where(node))
+        if node.tag == _TAG + "str" and node.style is None and _EXPONENT_FLOAT.fullmatch(
+            node.value
+        ):
+            return float(node.value)
+        try:
+            return self.constructor.construct_object(node)
+        except (yaml.YAMLError, ValueError, OverflowError) as error:
+            raise NavseqError(f"cannot read the value {node.value!r}: {error}",
+                              source=self.where(node)) from None
+
+    def mapping(self, node: MappingNode, depth: int) -> Located:
+        values: dict[str, Located] = {}
+        key_where: dict[str, str] = {}
+        for key_node, value_node in self.entries(node, depth):
+            if not isinstance(key_node, ScalarNode):
+                raise NavseqError("has a key that is a list or mapping; keys must be names",
+                                  source=self.where(key_node))
+            key = key_node.value
+            if key in values:
+                first_line = key_where[key].rsplit(":", 1)[1]
+                self.problems.add(
+                    f"the key '{key}' appears twice (first at line {first_line}); "
+                    "the second one would silently win",
+                    source=self.where(key_node),
+                )
+                continue
+            values[key] = self.walk(value_node, depth + 1)
+            key_where[key] = self.where(key_node)
+        return Located(values, self.where(node), key_where)
+
+    def entries(self, node: MappingNode, depth: int) -> list[tuple[Node, Node]]:
+        """Key/value pairs with YAML merge keys (``<<: *defaults``) expanded; explicit win."""
+        explicit: list[tuple[Node, Node]] = []
+        merged: list[tuple[Node, Node]] = []
+        for key_node, value_node in node.value:
+            if key_node.tag != _TAG + "merge":
+                explicit.append((key_node, value_node))
+                continue
+            sources = value_node.value if isinstance(value_node, SequenceNode) else [value_node]
+            for source in sources:
+                if not isinstance(source, MappingNode):
+                    raise NavseqError("a merge key (<<) must refer to a mapping",
+                                      source=self.where(source))
+                if depth > MAX_DEPTH:  # also ends a mapping that merges itself
+                    raise NavseqError(f"merge keys (<<) nest more than {MAX_DEPTH} levels",
+                                      source=self.where(source))
+                self.visited += len(source.value)
+                merged.extend(self.entries(source, depth + 1))
+        names = {k.value for k, _ in explicit if isinstance(k, ScalarNode)}
+        kept: list[tuple[Node, Node]] = []
+        for key_node, value_node in merged:
+            name = key_node.value if isinstance(key_node, ScalarNode) else None
+            if name not in names:
+                names.add(name)
+                kept.append((key_node, value_node))
+        return kept + explicit
