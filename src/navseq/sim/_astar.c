@@ -1,0 +1,234 @@
+/*
+ * navseq.sim._astar — the planner's A* search in C (optional; planner.py has a
+ * pure-Python twin with the same semantics, `_search_python`).
+ *
+ * search(cost, width, lut, start, goal, heuristic_scale) -> (total, [cells]) | None
+ *
+ *   cost   : C-contiguous uint8 buffer, height x width costmap bytes (row-major)
+ *   lut    : 256 float64 traversal costs, one per cost byte; inf = impassable
+ *   start, goal : flat cell indices (row * width + col)
+ *   heuristic_scale : a lower bound on every finite traversal cost
+ *
+ * A step between 8-neighbours a -> b costs |step| * (lut[a] + lut[b]) / 2, |step|
+ * being 1 or sqrt(2). The heuristic is the octile distance times heuristic_scale,
+ * which is admissible and consistent, so the goal's first pop is optimal. Queue
+ * entries are never decreased in place: a better route pushes a new entry and the
+ * stale one is skipped when popped (cells are closed once). The GIL is released
+ * during the search.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+typedef struct {
+    double f;     /* g + heuristic */
+    double g;     /* cost from the start */
+    int64_t cell;
+} Entry;
+
+typedef struct {
+    Entry *items;
+    size_t size;
+    size_t capacity;
+} Heap;
+
+/* Smaller f first; on ties the deeper entry (larger g), which expands fewer cells. */
+static inline int before(const Entry *a, const Entry *b) {
+    return a->f < b->f || (a->f == b->f && a->g > b->g);
+}
+
+static int heap_push(Heap *heap, Entry entry) {
+    if (heap->size == heap->capacity) {
+        size_t capacity = heap->capacity ? 2 * heap->capacity : 1024;
+        Entry *items = realloc(heap->items, capacity * sizeof(Entry));
+        if (items == NULL) return -1;
+        heap->items = items;
+        heap->capacity = capacity;
+    }
+    size_t i = heap->size++;
+    while (i > 0) {
+        size_t parent = (i - 1) / 2;
+        if (!before(&entry, &heap->items[parent])) break;
+        heap->items[i] = heap->items[parent];
+        i = parent;
+    }
+    heap->items[i] = entry;
+    return 0;
+}
+
+static Entry heap_pop(Heap *heap) {
+    Entry top = heap->items[0];
+    Entry last = heap->items[--heap->size];
+    size_t n = heap->size, i = 0;
+    if (n == 0) return top;
+    for (;;) {
+        size_t child = 2 * i + 1;
+        if (child >= n) break;
+        if (child + 1 < n && before(&heap->items[child + 1], &heap->items[child])) child++;
+        if (!before(&heap->items[child], &last)) break;
+        heap->items[i] = heap->items[child];
+        i = child;
+    }
+    heap->items[i] = last;
+    return top;
+}
+
+typedef enum { FOUND, NO_PATH, OUT_OF_MEMORY } Outcome;
+
+static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const double *lut,
+                     int64_t start, int64_t goal, double heuristic_scale, int32_t *parent,
+                     double *best, uint8_t *closed, double *total) {
+    static const int d_row[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+    static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+    const double diagonal = sqrt(2.0), diagonal_extra = sqrt(2.0) - 1.0;
+    const int64_t goal_row = goal / width, goal_col = goal % width;
+    int64_t n = height * width;
+    for (int64_t i = 0; i < n; i++) best[i] = INFINITY;
+
+    Heap heap = {NULL, 0, 0};
+    Outcome outcome = NO_PATH;
+    best[start] = 0.0;
+    parent[start] = (int32_t)start;
+    {
+        int64_t dr = llabs(start / width - goal_row), dc = llabs(start % width - goal_col);
+        double h = heuristic_scale * (fmax(dr, dc) + diagonal_extra * fmin(dr, dc));
+        if (heap_push(&heap, (Entry){h, 0.0, start}) < 0) return OUT_OF_MEMORY;
+    }
+    while (heap.size > 0) {
+        Entry entry = heap_pop(&heap);
+        int64_t cell = entry.cell;
+        if (closed[cell]) continue;
+        closed[cell] = 1;
+        if (cell == goal) {
+            *total = entry.g;
+            outcome = FOUND;
+            break;
+        }
+        int64_t row = cell / width, col = cell % width;
+        double here = lut[cost[cell]];
+        for (int k = 0; k < 8; k++) {
+            int64_t r = row + d_row[k], c = col + d_col[k];
+            if (r < 0 || r >= height || c < 0 || c >= width) continue;
+            int64_t next = r * width + c;
+            if (closed[next]) continue;
+            double there = lut[cost[next]];
+            if (isinf(there)) continue;
+            double step = (d_row[k] != 0 && d_col[k] != 0) ? diagonal : 1.0;
+            double g = entry.g + step * 0.5 * (here + there);
+            if (g < best[next]) {
+                best[next] = g;
+                parent[next] = (int32_t)cell;
+                int64_t dr = llabs(r - goal_row), dc = llabs(c - goal_col);
+                double h = heuristic_scale * (fmax(dr, dc) + diagonal_extra * fmin(dr, dc));
+                if (heap_push(&heap, (Entry){g + h, g, next}) < 0) {
+                    outcome = OUT_OF_MEMORY;
+                    break;
+                }
+            }
+        }
+        if (outcome == OUT_OF_MEMORY) break;
+    }
+    free(heap.items);
+    return outcome;
+}
+
+static PyObject *search(PyObject *self, PyObject *args) {
+    Py_buffer cost_buffer, lut_buffer;
+    Py_ssize_t width, start, goal;
+    double heuristic_scale;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*ny*nnd", &cost_buffer, &width, &lut_buffer, &start, &goal,
+                          &heuristic_scale))
+        return NULL;
+
+    PyObject *result = NULL;
+    int32_t *parent = NULL;
+    double *best = NULL;
+    uint8_t *closed = NULL;
+    Py_ssize_t n = cost_buffer.len;
+    if (width <= 0 || n % width != 0) {
+        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+        goto done;
+    }
+    if (n > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "grids above 2**31 cells are not supported");
+        goto done;
+    }
+    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64 values");
+        goto done;
+    }
+    if (start < 0 || start >= n || goal < 0 || goal >= n) {
+        PyErr_SetString(PyExc_IndexError, "start or goal cell outside the grid");
+        goto done;
+    }
+    const uint8_t *cost = cost_buffer.buf;
+    const double *lut = lut_buffer.buf;
+    if (isinf(lut[cost[start]]) || isinf(lut[cost[goal]])) {
+        result = Py_NewRef(Py_None);
+        goto done;
+    }
+    parent = malloc((size_t)n * sizeof(int32_t));
+    best = malloc((size_t)n * sizeof(double));
+    closed = calloc((size_t)n, 1);
+    if (parent == NULL || best == NULL || closed == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+
+    Outcome outcome;
+    double total = 0.0;
+    Py_BEGIN_ALLOW_THREADS
+    outcome = astar(cost, n / width, width, lut, start, goal, heuristic_scale, parent, best,
+                    closed, &total);
+    Py_END_ALLOW_THREADS
+
+    if (outcome == OUT_OF_MEMORY) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (outcome == NO_PATH) {
+        result = Py_NewRef(Py_None);
+        goto done;
+    }
+    Py_ssize_t length = 1;
+    for (int64_t cell = goal; cell != start; cell = parent[cell]) length++;
+    PyObject *cells = PyList_New(length);
+    if (cells == NULL) goto done;
+    int64_t cell = goal;
+    for (Py_ssize_t i = length - 1; i >= 0; i--) {
+        PyObject *index = PyLong_FromLongLong(cell);
+        if (index == NULL) {
+            Py_DECREF(cells);
+            goto done;
+        }
+        PyList_SET_ITEM(cells, i, index);
+        cell = parent[cell];
+    }
+    result = Py_BuildValue("(dN)", total, cells);
+
+done:
+    free(parent);
+    free(best);
+    free(closed);
+    PyBuffer_Release(&cost_buffer);
+    PyBuffer_Release(&lut_buffer);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"search", search, METH_VARARGS,
+     "search(cost, width, lut, start, goal, heuristic_scale) -> (total, cells) or None\n\n"
+     "A* over an 8-connected uint8 costmap; see navseq.sim.planner."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_astar", "Compiled A* search for navseq's global planner.", -1,
+    methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__astar(void) { return PyModule_Create(&module); }
