@@ -1,0 +1,407 @@
+"""The mission journal: an append-only JSON-lines record of a run, enough to resume it.
+
+Writing::
+
+    journal = JournalWriter("run.journal", "mission.yaml", mission_digest("mission.yaml"))
+    run_mission(mission, navigator, [journal])
+
+Resuming after a crash (``navseq run --resume run.journal``)::
+
+    state = read_journal("run.journal")
+    point = resume_point(state, mission_digest=mission_digest(state.mission_source))
+    journal = JournalWriter.resume("run.journal", point)
+    run_mission(mission, navigator, [journal], resume=point)
+
+The first line is a header (format, version, mission source and its sha256, wall
+start time); every further line is one mission event (``{"kind": "event", "type":
+"WaypointStarted", "t": ..., ...}``) or a ``resumed`` record. Each line is written
+with a single ``write`` call on a file opened in append mode, so a crash (even
+``kill -9``) leaves at most one truncated last line; the reader tolerates it, and a
+resumed run starts a fresh line after it. ``WaypointProgress`` events are thinned out
+to at most one per second of mission time; everything else is kept.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import enum
+import hashlib
+import json
+import os
+import types
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union, get_args, get_origin, get_type_hints
+
+from navseq.errors import NavseqError
+from navseq.executor import events as ev
+from navseq.executor.result import WaypointResult
+from navseq.executor.resume import ResumePoint
+
+JOURNAL_FORMAT = "navseq-journal"
+JOURNAL_VERSION = 1
+#: Mission time between two journaled WaypointProgress events (s).
+PROGRESS_INTERVAL = 1.0
+
+_EVENT_TYPES: dict[str, type] = {
+    cls.__name__: cls
+    for cls in (
+        ev.MissionStarted,
+        ev.LoopStarted,
+        ev.WaypointStarted,
+        ev.WaypointProgress,
+        ev.WaypointPlan,
+        ev.AttemptFailed,
+        ev.WaypointDwelling,
+        ev.WaypointFinished,
+        ev.ServerStatusChanged,
+        ev.MissionFinished,
+    )
+}
+_DONE_OUTCOMES = (ev.WaypointOutcome.REACHED, ev.WaypointOutcome.SKIPPED)
+
+
+def mission_digest(path: str | os.PathLike[str]) -> str:
+    """sha256 (hex) of a mission file's bytes: a resumed run must use the same mission."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as error:
+        raise NavseqError(
+            f"cannot read the mission file: {error.strerror}", source=str(path)
+        ) from None
+
+
+class JournalWriter:
+    """A mission listener that appends every event to a journal file, one JSON per line.
+
+    A new journal refuses to replace an existing non-empty file unless ``overwrite``;
+    use :meth:`resume` to continue one. ``fsync`` makes every line durable against
+    power loss too (slower); without it a killed process still loses nothing.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        mission_source: str,
+        mission_digest: str,
+        *,
+        overwrite: bool = False,
+        fsync: bool = False,
+    ):
+        self.path = Path(path)
+        if not overwrite and self.path.exists() and self.path.stat().st_size > 0:
+            raise NavseqError(
+                "a journal already exists here; resume it, or choose another journal path",
+                source=str(self.path),
+            )
+        self._open(os.O_TRUNC, fsync)
+        self._write(
+            {
+                "kind": "header",
+                "format": JOURNAL_FORMAT,
+                "version": JOURNAL_VERSION,
+                "mission_source": mission_source,
+                "mission_digest": mission_digest,
+                "started": _wall_clock(),
+            }
+        )
+
+    @classmethod
+    def resume(
+        cls, path: str | os.PathLike[str], point: ResumePoint, *, fsync: bool = False
+    ) -> JournalWriter:
+        """Continue an existing journal: append a ``resumed`` record, then the new events."""
+        self = cls.__new__(cls)
+        self.path = Path(path)
+        read_journal(self.path)  # refuse to append to something that is not a journal
+        self._open(0, fsync)
+        if not _ends_with_newline(self.path):
+            os.write(self._fd, b"\n")  # end the line a crash cut short
+        self._write(
+            {
+                "kind": "resumed",
+                "loop": point.loop,
+                "index": point.index,
+                "at": _wall_clock(),
+            }
+        )
+        return self
+
+    def _open(self, extra_flags: int, fsync: bool) -> None:
+        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | extra_flags
+        try:
+            self._fd: int | None = os.open(self.path, flags, 0o644)
+        except OSError as error:
+            raise NavseqError(
+                f"cannot write the journal: {error.strerror}", source=str(self.path)
+            ) from None
+        self._fsync = fsync
+        self._last_progress_t: float | None = None
+
+    def __call__(self, event: ev.MissionEvent) -> None:
+        if isinstance(event, ev.WaypointProgress):
+            last = self._last_progress_t
+            # A resumed run's clock may start again from zero: t < last also passes.
+            if last is not None and 0.0 <= event.t - last < PROGRESS_INTERVAL:
+                return
+            self._last_progress_t = event.t
+        record = {"kind": "event", "type": type(event).__name__, **dataclasses.asdict(event)}
+        self._write(record)
+
+    def _write(self, record: Mapping[str, Any]) -> None:
+        if self._fd is None:
+            raise ValueError(f"journal {self.path} is closed")
+        data = (json.dumps(record, default=_json_default) + "\n").encode()
+        view = memoryview(data)
+        while view:  # one write call in practice; loop only if the OS writes less
+            written = os.write(self._fd, view)
+            view = view[written:]
+        if self._fsync:
+            os.fsync(self._fd)
+
+    def close(self) -> None:
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
+
+    def __enter__(self) -> JournalWriter:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+
+@dataclass
+class JournalState:
+    """What a journal says about a mission run (all segments, if it was resumed)."""
+
+    path: Path
+    version: int
+    mission_source: str
+    mission_digest: str
+    started: str
+    events: list[ev.MissionEvent] = field(default_factory=list)
+    segments: int = 1  # 1 + number of resumed records
+    damaged_lines: list[int] = field(default_factory=list)  # tolerated truncated lines
+    visits: dict[tuple[int, int], WaypointResult] = field(default_factory=dict)
+    previous_duration: float = 0.0  # mission time covered by all segments (s)
+    finish_reason: str | None = None  # of the last segment, if it finished
+
+    @property
+    def mission_started(self) -> ev.MissionStarted | None:
+        return next((e for e in self.events if isinstance(e, ev.MissionStarted)), None)
+
+
+def read_journal(path: str | os.PathLike[str]) -> JournalState:
+    """Read a journal; a truncated last line (of any run segment) is tolerated.
+
+    Raises :class:`NavseqError` naming ``path:line`` when the file is not a navseq
+    journal or is damaged anywhere else.
+    """
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise NavseqError(f"cannot read the journal: {error.strerror}", source=str(path)) from None
+    lines = raw.split(b"\n")
+    if lines and lines[-1] == b"":
+        lines.pop()
+    records: list[tuple[int, dict[str, Any] | None]] = [
+        (number, _parse_line(line)) for number, line in enumerate(lines, start=1) if line.strip()
+    ]
+    if not records or records[0][1] is None or records[0][0] != 1:
+        raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
+    header = records[0][1]
+    if header.get("kind") != "header" or header.get("format") != JOURNAL_FORMAT:
+        raise NavseqError(
+            "not a navseq journal (the first line is no journal header)", source=f"{path}:1"
+        )
+    version = header.get("version")
+    if not isinstance(version, int) or version > JOURNAL_VERSION:
+        raise NavseqError(
+            f"journal format version {version!r} is newer than this navseq understands "
+            f"({JOURNAL_VERSION}); upgrade navseq",
+            source=f"{path}:1",
+        )
+    state = JournalState(
+        path=path,
+        version=version,
+        mission_source=str(header.get("mission_source", "")),
+        mission_digest=str(header.get("mission_digest", "")),
+        started=str(header.get("started", "")),
+    )
+    segment_start: float | None = None
+    segment_end: float | None = None
+    for position, (number, record) in enumerate(records[1:], start=1):
+        if record is None:
+            following = records[position + 1][1] if position + 1 < len(records) else None
+            if position + 1 == len(records) or (following or {}).get("kind") == "resumed":
+                state.damaged_lines.append(number)  # a crash cut this line short
+                continue
+            raise NavseqError(
+                "damaged journal line (not JSON) in the middle of the journal",
+                source=f"{path}:{number}",
+            )
+        kind = record.get("kind")
+        if kind == "resumed":
+            state.segments += 1
+            state.finish_reason = None
+            if segment_start is not None and segment_end is not None:
+                state.previous_duration += max(0.0, segment_end - segment_start)
+            segment_start = segment_end = None
+            continue
+        if kind != "event":
+            raise NavseqError(f"unknown journal record kind {kind!r}", source=f"{path}:{number}")
+        event = _event_from_record(record, f"{path}:{number}")
+        if event is None:
+            continue  # an event type from a newer navseq: not needed to resume
+        state.events.append(event)
+        if isinstance(event, ev.MissionStarted):
+            segment_start = event.t
+        segment_end = event.t
+        if isinstance(event, ev.WaypointFinished):
+            state.visits[(event.loop, event.index)] = WaypointResult(
+                index=event.index,
+                loop=event.loop,
+                name=None,
+                x=0.0,
+                y=0.0,
+                yaw=0.0,
+                outcome=event.outcome,
+                attempts=event.attempts,
+                duration=event.duration,
+                distance_driven=event.distance_driven,
+                reason=event.reason,
+                passed_through=event.passed_through,
+            )
+        elif isinstance(event, ev.MissionFinished):
+            state.finish_reason = event.reason
+    if segment_start is not None and segment_end is not None:
+        state.previous_duration += max(0.0, segment_end - segment_start)
+    return state
+
+
+def resume_point(state: JournalState, *, mission_digest: str | None = None) -> ResumePoint:
+    """Where to continue: the first visit, in mission order, not yet reached or skipped.
+
+    That is the visit that was active when the run ended (or the one after the last
+    finished visit, if the run ended between two). Reached and skipped visits are not
+    run again. With ``mission_digest`` (see :func:`mission_digest`), a mission file
+    that changed since the journal was written is refused.
+    """
+    source = str(state.path)
+    if mission_digest is not None and mission_digest != state.mission_digest:
+        raise NavseqError(
+            f"the mission file changed since this journal was written (sha256 "
+            f"{mission_digest[:12]}… now, {state.mission_digest[:12]}… then); resuming "
+            "could skip or repeat the wrong waypoints. Restore the original mission "
+            "file, or start a new run",
+            source=source,
+        )
+    started = state.mission_started
+    if started is None:
+        return ResumePoint(loop=0, index=0)
+    count, loops = started.waypoint_count, started.loops
+    if count <= 0:
+        raise NavseqError("the journal records a mission without waypoints", source=source)
+    loop, index = 0, 0
+    while state.visits.get((loop, index)) is not None and (
+        state.visits[(loop, index)].outcome in _DONE_OUTCOMES
+    ):
+        index += 1
+        if index == count:
+            loop, index = loop + 1, 0
+        if loops is not None and loop >= loops:
+            raise NavseqError(
+                "nothing to resume: the journal records every waypoint of the mission "
+                f"as finished ({state.finish_reason or 'completed'})",
+                source=source,
+            )
+    done = tuple(
+        visit
+        for key, visit in sorted(state.visits.items())
+        if key < (loop, index) and visit.outcome in _DONE_OUTCOMES
+    )
+    return ResumePoint(loop=loop, index=index, done=done, previous_duration=state.previous_duration)
+
+
+def _parse_line(line: bytes) -> dict[str, Any] | None:
+    try:
+        record = json.loads(line)
+    except (ValueError, UnicodeDecodeError):
+        return None
+    return record if isinstance(record, dict) else None
+
+
+def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | None:
+    cls = _EVENT_TYPES.get(str(record.get("type")))
+    if cls is None:
+        return None
+    hints = get_type_hints(cls)
+    values: dict[str, Any] = {}
+    try:
+        for spec in dataclasses.fields(cls):
+            if spec.name in record:
+                values[spec.name] = _coerce(record[spec.name], hints[spec.name])
+        return cls(**values)  # type: ignore[no-any-return]
+    except (TypeError, ValueError) as error:
+        raise NavseqError(
+            f"journal event {cls.__name__} is malformed: {error}", source=where
+        ) from None
+
+
+def _coerce(value: Any, hint: Any) -> Any:
+    """Turn a JSON value back into the event field's type (enums, tuples of points)."""
+    if value is None:
+        return None
+    origin = get_origin(hint)
+    if origin in (Union, types.UnionType):
+        options = [a for a in get_args(hint) if a is not type(None)]
+        return _coerce(value, options[0]) if len(options) == 1 else value
+    if isinstance(hint, type) and issubclass(hint, enum.Enum):
+        return hint(value)
+    if origin is tuple:
+        if not isinstance(value, list):
+            raise TypeError(f"expected a list, got {type(value).__name__}")
+        inner = get_args(hint)
+        if len(inner) == 2 and inner[1] is Ellipsis:
+            return tuple(_coerce(item, inner[0]) for item in value)
+        return tuple(value)
+    if hint is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    return value
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot journal a {type(value).__name__}")
+
+
+def _ends_with_newline(path: Path) -> bool:
+    with path.open("rb") as handle:
+        handle.seek(0, os.SEEK_END)
+        if handle.tell() == 0:
+            return True
+        handle.seek(-1, os.SEEK_END)
+        return handle.read(1) == b"\n"
+
+
+def _wall_clock() -> str:
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+__all__ = [
+    "JOURNAL_FORMAT",
+    "JOURNAL_VERSION",
+    "PROGRESS_INTERVAL",
+    "JournalState",
+    "JournalWriter",
+    "mission_digest",
+    "read_journal",
+    "resume_point",
+]

@@ -1,0 +1,243 @@
+"""The journal file: what is written, what the reader tolerates, where a run resumes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from helpers_executor import line_mission
+from helpers_subprocess import journal_records
+from navseq.errors import NavseqError
+from navseq.executor import run_mission
+from navseq.executor.events import (
+    MissionFinished,
+    WaypointFinished,
+    WaypointOutcome,
+    WaypointPlan,
+    WaypointProgress,
+    WaypointStarted,
+)
+from navseq.mission.model import FailureAction
+from navseq.navigators.base import GoalStatus
+from navseq.navigators.scripted import Finish, ScriptedNavigator
+from navseq.sinks.journal import (
+    JournalWriter,
+    mission_digest,
+    read_journal,
+    resume_point,
+)
+
+
+@pytest.fixture
+def mission_file(tmp_path: Path) -> Path:
+    path = tmp_path / "mission.yaml"
+    path.write_text("waypoints: [...]\n")
+    return path
+
+
+def journal_of_run(tmp_path: Path, mission_file: Path, **policy) -> Path:  # type: ignore[no-untyped-def]
+    path = tmp_path / "run.journal"
+    with JournalWriter(path, str(mission_file), mission_digest(mission_file)) as journal:
+        run_mission(line_mission(4, **policy), ScriptedNavigator(speed=0.5), [journal])
+    return path
+
+
+def records(path: Path) -> list[dict]:  # type: ignore[type-arg]
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def cut_after(path: Path, predicate, keep_half_of_next: bool = True) -> None:  # type: ignore[no-untyped-def]
+    """Simulate a crash: keep lines up to the first matching record, then half a line."""
+    lines = path.read_bytes().split(b"\n")
+    index = next(i for i, line in enumerate(lines) if predicate(json.loads(line)))
+    kept = b"\n".join(lines[: index + 1]) + b"\n"
+    if keep_half_of_next:
+        kept += lines[index + 1][: len(lines[index + 1]) // 2]
+    path.write_bytes(kept)
+
+
+def test_header_then_one_event_per_line(tmp_path: Path, mission_file: Path) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    header, *events = records(path)
+    assert header["kind"] == "header" and header["format"] == "navseq-journal"
+    assert header["version"] == 1 and header["mission_source"] == str(mission_file)
+    assert header["mission_digest"] == mission_digest(mission_file)
+    assert len(header["mission_digest"]) == 64
+    assert events[0]["type"] == "MissionStarted" and events[-1]["type"] == "MissionFinished"
+    assert [e["outcome"] for e in events if e["type"] == "WaypointFinished"] == ["reached"] * 4
+    state = read_journal(path)
+    assert state.finish_reason == "completed" and state.damaged_lines == []
+    assert len(state.visits) == 4
+
+
+def test_progress_is_thinned_to_one_per_second_of_mission_time(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    journal = JournalWriter(path, "m.yaml", "0" * 64)
+    for step in range(31):
+        journal(WaypointProgress(step * 0.1, 0, 0.0, 0.0, 0.0, 1.0, 0.0))
+        journal(WaypointPlan(step * 0.1, 0, ((0.0, 0.0), (1.0, 2.0))))
+    journal.close()
+    types = [r["type"] for r in records(path)[1:]]
+    assert types.count("WaypointPlan") == 31
+    progress = [r["t"] for r in records(path)[1:] if r["type"] == "WaypointProgress"]
+    assert progress == pytest.approx([0.0, 1.0, 2.0, 3.0])
+    plans = [e for e in read_journal(path).events if isinstance(e, WaypointPlan)]
+    assert plans[0].path == ((0.0, 0.0), (1.0, 2.0))
+
+
+def test_events_read_back_as_they_were(tmp_path: Path, mission_file: Path) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    events = read_journal(path).events
+    finished = [e for e in events if isinstance(e, WaypointFinished)]
+    assert finished[0].outcome is WaypointOutcome.REACHED
+    assert finished[0].distance_driven == pytest.approx(1.0)
+    assert isinstance(events[-1], MissionFinished) and events[-1].success
+
+
+def test_a_new_journal_never_replaces_an_existing_file(tmp_path: Path) -> None:
+    path = tmp_path / "run.journal"
+    path.write_text("precious\n")
+    with pytest.raises(NavseqError, match="already exists"):
+        JournalWriter(path, "m.yaml", "0" * 64)
+    assert path.read_text() == "precious\n"
+
+
+def test_truncated_last_line_is_tolerated_and_resume_starts_at_the_active_waypoint(
+    tmp_path: Path, mission_file: Path
+) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    cut_after(path, lambda r: r.get("type") == "WaypointStarted" and r["index"] == 2)
+    state = read_journal(path)
+    assert state.damaged_lines == [len(path.read_bytes().split(b"\n"))]
+    assert state.finish_reason is None
+    point = resume_point(state, mission_digest=mission_digest(mission_file))
+    assert (point.loop, point.index) == (0, 2)
+    assert [(v.index, v.outcome) for v in point.done] == [
+        (0, WaypointOutcome.REACHED),
+        (1, WaypointOutcome.REACHED),
+    ]
+
+
+def test_resume_appends_to_the_same_journal_after_a_cut_line(
+    tmp_path: Path, mission_file: Path
+) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    cut_after(path, lambda r: r.get("type") == "WaypointFinished" and r["index"] == 0)
+    before = path.read_bytes()
+    point = resume_point(read_journal(path))
+    nav = ScriptedNavigator(speed=0.5)
+    with JournalWriter.resume(path, point) as journal:
+        result = run_mission(line_mission(4), nav, [journal], resume=point)
+    assert path.read_bytes().startswith(before)  # nothing already journaled was touched
+    assert [g.pose.x for g in nav.sent_goals] == [2.0, 3.0, 4.0]
+    assert result.success and [v.attempts for v in result.visits] == [1, 1, 1, 1]
+    state = read_journal(path)
+    assert state.segments == 2 and len(state.damaged_lines) == 1
+    assert state.finish_reason == "completed"
+    assert [r["kind"] for r in journal_records(path)].count("resumed") == 1
+    with pytest.raises(NavseqError, match="nothing to resume"):
+        resume_point(state)
+
+
+def test_skipped_visits_are_not_rerun_but_a_failed_stop_is(
+    tmp_path: Path, mission_file: Path
+) -> None:
+    path = tmp_path / "run.journal"
+    nav = ScriptedNavigator([Finish(GoalStatus.ABORTED), Finish(GoalStatus.ABORTED)])
+    with JournalWriter(path, str(mission_file), mission_digest(mission_file)) as journal:
+        result = run_mission(line_mission(3, on_failure=FailureAction.SKIP), nav, [journal])
+    assert [v.outcome for v in result.visits][:2] == [WaypointOutcome.SKIPPED] * 2
+    with pytest.raises(NavseqError, match="nothing to resume"):
+        resume_point(read_journal(path))
+
+    stopped = tmp_path / "stopped.journal"
+    nav = ScriptedNavigator([Finish(GoalStatus.SUCCEEDED), Finish(GoalStatus.ABORTED)])
+    with JournalWriter(stopped, str(mission_file), mission_digest(mission_file)) as journal:
+        result = run_mission(line_mission(3), nav, [journal])
+    assert result.reason.startswith("stopped")
+    point = resume_point(read_journal(stopped))
+    assert (point.loop, point.index) == (0, 1)  # the failed one is tried again
+
+
+def test_resume_point_in_a_later_loop(tmp_path: Path, mission_file: Path) -> None:
+    path = tmp_path / "run.journal"
+    with JournalWriter(path, str(mission_file), mission_digest(mission_file)) as journal:
+        run_mission(line_mission(2, loops=3), ScriptedNavigator(), [journal])
+    cut_after(path, lambda r: r.get("type") == "WaypointFinished" and r["loop"] == 1)
+    point = resume_point(read_journal(path))
+    assert (point.loop, point.index) == (1, 1)
+    nav = ScriptedNavigator()
+    result = run_mission(line_mission(2, loops=3), nav, resume=point)
+    assert [g.pose.x for g in nav.sent_goals] == [2.0, 1.0, 2.0]
+    assert result.success and len(result.visits) == 6 and result.loops_completed == 3
+
+
+def test_changed_mission_is_refused(tmp_path: Path, mission_file: Path) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    cut_after(path, lambda r: r.get("type") == "WaypointStarted" and r["index"] == 1)
+    mission_file.write_text("waypoints: [something else]\n")
+    with pytest.raises(NavseqError, match="mission file changed") as caught:
+        resume_point(read_journal(path), mission_digest=mission_digest(mission_file))
+    assert caught.value.source == str(path)
+
+
+def test_damage_in_the_middle_names_the_line(tmp_path: Path, mission_file: Path) -> None:
+    path = journal_of_run(tmp_path, mission_file)
+    lines = path.read_text().splitlines()
+    lines[3] = lines[3][:10]
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(NavseqError, match="damaged journal line") as caught:
+        read_journal(path)
+    assert caught.value.source == f"{path}:4"
+
+
+@pytest.mark.parametrize(
+    "content",
+    [
+        b"",
+        b"waypoints:\n  - {x: 1, y: 2}\n",
+        b'{"kind": "header", "format": "something-else", "version": 1}\n',
+        b"\x89PNG\r\n\x1a\n\x00\x00binary",
+        b'{"kind": "header", "format": "navseq-journal", "version": 99}\n',
+    ],
+)
+def test_not_a_journal_is_a_clear_error(tmp_path: Path, content: bytes) -> None:
+    path = tmp_path / "not.journal"
+    path.write_bytes(content)
+    with pytest.raises(NavseqError) as caught:
+        read_journal(path)
+    assert caught.value.source == f"{path}:1"
+
+
+def test_malformed_event_names_the_line(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    JournalWriter(path, "m", "0" * 64).close()
+    with path.open("a") as handle:
+        handle.write(json.dumps({"kind": "event", "type": "WaypointFinished", "outcome": "x"}))
+        handle.write("\n")
+    with pytest.raises(NavseqError, match="WaypointFinished is malformed") as caught:
+        read_journal(path)
+    assert caught.value.source == f"{path}:2"
+
+
+def test_journal_of_an_interrupted_run_resumes_at_the_interrupted_visit(
+    tmp_path: Path, mission_file: Path
+) -> None:
+    path = tmp_path / "run.journal"
+
+    def crash_on_third_goal(event: object) -> None:
+        if isinstance(event, WaypointStarted) and event.index == 2:
+            raise RuntimeError("power cut")
+
+    with (
+        JournalWriter(path, str(mission_file), mission_digest(mission_file)) as journal,
+        pytest.raises(RuntimeError),
+    ):
+        run_mission(line_mission(4), ScriptedNavigator(), [journal, crash_on_third_goal])
+    state = read_journal(path)
+    assert state.finish_reason == "interrupted: RuntimeError: power cut"
+    point = resume_point(state)
+    assert (point.loop, point.index) == (0, 2)
+    assert point.previous_duration == pytest.approx(2.0, abs=0.3)
