@@ -73,6 +73,11 @@ def _waypoint(cells: list[str], index: int, where: str, problems: Problems) -> W
         problems.add(f"has {len(cells)} values, expected {len(COLUMNS)}: "
                      + ",".join(COLUMNS), source=where, subject=label)
         return None
+    if not any(_is_number(cell) for cell in cells):
+        shown = ",".join(cells)
+        problems.add(f"holds no numbers ({shown[:60]!r}); only the first line may be a header",
+                     source=where, subject=label)
+        return None
     before = len(problems)
     values = [fields.attempt(problems, lambda c=cell, n=name: _number(c, where, label, n))
               for cell, name in zip(cells, COLUMNS, strict=True)]

@@ -67,7 +67,14 @@ def _load(path: Path) -> tuple[Mission | None, Problems]:
         problems.add("is nested too deeply to be a mission", source=source)
     if mission is None and not problems.errors:
         problems.add("holds no mission", source=source)
+    problems.errors.sort(key=_line_number)  # read like the file, top to bottom
     return (mission if not problems.errors else None), problems
+
+
+def _line_number(error: NavseqError) -> int:
+    """The line an error points at (``file:12``), 0 when it names the whole file."""
+    _, _, line = (error.source or "").rpartition(":")
+    return int(line) if line.isdigit() else 0
 
 
 def _reader_for(path: Path, text: str) -> Reader:

@@ -18,6 +18,7 @@ every problem it finds. The same readers serve ROS parameters (``~waypoints``).
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -61,10 +62,12 @@ def mission_from_document(doc: Located | None, source: str, base_dir: Path | Non
                      subject="field navseq")
     defaults = read_defaults(doc.get("defaults"), problems)
     waypoints_node = doc.get("waypoints")
+    waypoints: tuple[Waypoint, ...] = ()
     if waypoints_node is None:
-        problems.add("has no 'waypoints' list; a mission needs at least one waypoint",
-                     source=doc.where)
-        waypoints: tuple[Waypoint, ...] = ()
+        # A misspelt 'waypoints' key is already reported with its correction.
+        if not any(difflib.get_close_matches(key, ["waypoints"], cutoff=0.6) for key in doc.value):
+            problems.add("has no 'waypoints' list; a mission needs at least one waypoint "
+                         "(or p_seq/yea_seq, the tutorial's lists)", source=doc.where)
     else:
         waypoints = read_waypoints(waypoints_node, problems)
     settings = read_settings(doc, base_dir, problems)

@@ -3,9 +3,10 @@
 PyYAML's SafeLoader *composes* the document (syntax only, no object construction);
 navseq then walks the node graph itself so that every value keeps its line number.
 Only plain YAML types are accepted (null, bool, int, float, str, lists, mappings):
-any other tag is an error. Aliases are allowed but every node reached through them
-counts toward a cap, so an "alias bomb" (a few lines that expand to billions of
-nodes) is refused instead of exhausting memory.
+any other tag is an error. Aliases are allowed, but before anything is built the
+document's size *with aliases expanded* is computed on the node graph (linear in
+the written size): an "alias bomb" (a few lines that expand to billions of values)
+or an alias that contains itself is refused at once.
 """
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ from navseq.errors import NavseqError
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.problems import Problems
 
-MAX_YAML_NODES = 200_000
+# Aliases may repeat what was written, but not blow it up: the expanded document may
+# hold at most this many values more than were written.
+MAX_ALIAS_EXPANSION = 100_000
 
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
@@ -50,7 +53,9 @@ def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 
         raise NavseqError("is nested too deeply to be a mission", source=source) from None
     if root is None:
         return None
-    return _Walker(source, problems, offset).walk(root, 0)
+    walker = _Walker(source, problems, offset)
+    walker.check_expansion(root)
+    return walker.walk(root, 0)
 
 
 def parse_yaml_value(text: str, source: str, *, first_line: int = 1) -> Located | None:
@@ -62,26 +67,57 @@ def parse_yaml_value(text: str, source: str, *, first_line: int = 1) -> Located 
 
 
 class _Walker:
-    """Turns composed nodes into Located values, counting nodes to stop alias bombs."""
+    """Turns composed nodes into Located values; an aliased node is built once and shared."""
 
     def __init__(self, source: str, problems: Problems, line_offset: int):
         self.source = source
         self.line_offset = line_offset
         self.problems = problems
-        self.visited = 0
+        self.built: dict[int, Located] = {}
         self.constructor = yaml.SafeLoader("")
+
+    def check_expansion(self, root: Node) -> None:
+        """Refuse documents whose aliases contain themselves or expand far beyond the text."""
+        sizes: dict[int, int] = {}
+        in_progress: set[int] = set()
+
+        def expanded_size(node: Node, depth: int) -> int:
+            key = id(node)
+            if key in sizes:
+                return sizes[key]
+            if key in in_progress:
+                raise NavseqError("an alias refers to a value that contains it (a loop)",
+                                  source=self.where(node))
+            if depth > MAX_DEPTH:
+                raise NavseqError(f"is nested more than {MAX_DEPTH} levels deep",
+                                  source=self.where(node))
+            in_progress.add(key)
+            if isinstance(node, SequenceNode):
+                children: list[Node] = node.value
+            elif isinstance(node, MappingNode):
+                children = [part for pair in node.value for part in pair]
+            else:
+                children = []
+            size = 1 + sum(expanded_size(child, depth + 1) for child in children)
+            in_progress.discard(key)
+            sizes[key] = size
+            return size
+
+        total = expanded_size(root, 0)
+        if total > len(sizes) + MAX_ALIAS_EXPANSION:
+            raise NavseqError(f"has aliases that expand {len(sizes)} written values to {total}; "
+                              "refusing it (an alias bomb?)", source=self.where(root))
 
     def where(self, node: Node) -> str:
         return f"{self.source}:{node.start_mark.line + 1 + self.line_offset}"
 
     def walk(self, node: Node, depth: int) -> Located:
-        self.visited += 1
-        if self.visited > MAX_YAML_NODES:
-            raise NavseqError(f"has more than {MAX_YAML_NODES} values (counting what aliases "
-                              "repeat); refusing it", source=self.where(node))
-        if depth > MAX_DEPTH:
-            raise NavseqError(f"is nested more than {MAX_DEPTH} levels deep",
-                              source=self.where(node))
+        built = self.built.get(id(node))
+        if built is None:
+            built = self.built[id(node)] = self.build(node, depth)
+        return built
+
+    def build(self, node: Node, depth: int) -> Located:
         if isinstance(node, ScalarNode):
             return Located(self.scalar(node), self.where(node))
         if isinstance(node, SequenceNode):
@@ -147,10 +183,6 @@ class _Walker:
                 if not isinstance(source, MappingNode):
                     raise NavseqError("a merge key (<<) must refer to a mapping",
                                       source=self.where(source))
-                if depth > MAX_DEPTH:  # also ends a mapping that merges itself
-                    raise NavseqError(f"merge keys (<<) nest more than {MAX_DEPTH} levels",
-                                      source=self.where(source))
-                self.visited += len(source.value)
                 merged.extend(self.entries(source, depth + 1))
         names = {k.value for k, _ in explicit if isinstance(k, ScalarNode)}
         kept: list[tuple[Node, Node]] = []
