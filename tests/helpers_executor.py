@@ -83,6 +83,9 @@ class Harness:
     def server_back(self, t: float) -> list[Command]:
         return self._keep(self.executor.on_event(ServerBack(), t))
 
+    def skip(self, t: float, reason: str = "skipped by operator") -> list[Command]:
+        return self._keep(self.executor.skip(t, reason))
+
     def interrupt(self, t: float, reason: str) -> list[Command]:
         return self._keep(self.executor.interrupt(t, reason))
 

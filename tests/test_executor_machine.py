@@ -392,6 +392,23 @@ def test_interrupt_cancels_and_leaves_the_rest_not_run() -> None:
     assert h.tick(3.0, Pose2D(0, 0)) == [] and h.succeed(3.0) == []
 
 
+def test_operator_skip_goes_on_without_cancel_but_cancels_the_last_goal() -> None:
+    h = Harness(line_mission(3, on_failure=FailureAction.STOP, dwell=2.0))
+    h.start(0.0)
+    commands = h.skip(1.0)
+    assert commands == [SendGoal(h.goals()[-1].goal)]
+    assert h.goals()[-1].goal.pose.x == 2.0
+    h.succeed(2.0)
+    h.skip(2.5)  # while dwelling: it was reached, the dwell is cut short
+    assert len(h.executor.result.visits) == 3
+    assert h.executor.current_goal is not None and h.executor.current_goal.pose.x == 3.0
+    assert h.skip(3.0, "operator says no") == [CancelGoal()]
+    result = h.executor.result
+    assert h.executor.finished and not result.success
+    assert outcomes(h) == [WaypointOutcome.SKIPPED, REACHED, WaypointOutcome.SKIPPED]
+    assert result.visits[2].reason == "operator says no"
+
+
 def test_resume_starts_at_the_resume_point_and_keeps_earlier_visits() -> None:
     done = tuple(
         WaypointResult(index=i, loop=0, name=None, x=0, y=0, yaw=0, outcome=REACHED, attempts=1)

@@ -8,7 +8,7 @@ import pytest
 
 from helpers_executor import line_mission
 from navseq.errors import NavseqError
-from navseq.executor import MissionInterrupted, run_mission
+from navseq.executor import MissionControl, MissionInterrupted, run_mission
 from navseq.executor.events import (
     AttemptFailed,
     MissionEvent,
@@ -198,6 +198,23 @@ def test_exception_cancels_the_goal_and_is_reraised() -> None:
     assert len(nav.cancels) == 1
     assert isinstance(seen[-1], MissionFinished)
     assert seen[-1].reason == "interrupted: OSError: disk full"
+
+
+def test_skip_requested_through_mission_control() -> None:
+    control = MissionControl()
+
+    class OperatorAtTwoSeconds(ScriptedNavigator):
+        def spin(self, seconds: float) -> None:
+            super().spin(seconds)
+            if abs(self.now() - 2.0) < 1e-6:
+                control.request_skip("operator skip")
+
+    nav = OperatorAtTwoSeconds([Succeed(), Hang()])
+    result = run_mission(line_mission(3), nav, control=control)
+    assert [v.outcome for v in result.visits] == [REACHED, WaypointOutcome.SKIPPED, REACHED]
+    assert result.visits[1].reason == "operator skip"
+    assert nav.cancels == []  # the next goal replaced the skipped one
+    assert [g.pose.x for g in nav.sent_goals] == [1.0, 2.0, 3.0]
 
 
 def test_sigterm_handler_is_restored_after_the_run() -> None:

@@ -5,9 +5,11 @@
 - :func:`run_mission` (``runner``): the loop that drives it against a navigator and
   cancels the goal on SIGINT/SIGTERM/exceptions.
 - :class:`ResumePoint` (``resume``): where a resumed run continues (from a journal).
+- :class:`MissionControl` (``control``): operator requests (skip) from other threads.
 """
 
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.control import MissionControl
 from navseq.executor.machine import ExecutorState, MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult, WaypointResult
 from navseq.executor.resume import ResumePoint
@@ -18,6 +20,7 @@ __all__ = [
     "ClearCostmaps",
     "Command",
     "ExecutorState",
+    "MissionControl",
     "MissionExecutor",
     "MissionInterrupted",
     "MissionListener",

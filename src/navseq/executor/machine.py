@@ -162,6 +162,11 @@ class MissionExecutor:
         return self._state is ExecutorState.FINISHED
 
     @property
+    def now(self) -> float:
+        """The latest time any input gave the executor (navigator clock, seconds)."""
+        return self._now
+
+    @property
     def current_goal(self) -> Goal | None:
         """The goal the navigator is pursuing for the mission, if one is out."""
         if self._state in (ExecutorState.ACTIVE, ExecutorState.WAITING_SERVER) and self._attempt:
@@ -245,6 +250,25 @@ class MissionExecutor:
             if commands:
                 return commands
         return self._check_clock(now)
+
+    def skip(self, now: float, reason: str = "skipped by operator") -> list[Command]:
+        """Give up the current visit (outcome SKIPPED) and go on with the next one.
+
+        An operator's decision, whatever the waypoint's ``on_failure`` says. A visit
+        already reached and dwelling just ends its dwell (outcome REACHED). When no
+        visit follows, the goal is cancelled and the mission ends.
+        """
+        self._now = max(self._now, now)
+        if self._state in (ExecutorState.IDLE, ExecutorState.FINISHED):
+            return []
+        if self._state is ExecutorState.DWELLING:
+            self._finish_visit(now, WaypointOutcome.REACHED, "")
+        else:
+            self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
+        commands = self._advance(now)
+        if self.finished:
+            return [CancelGoal(), *commands]  # no next goal replaces the active one
+        return commands
 
     def interrupt(self, now: float, reason: str) -> list[Command]:
         """End the run at once (``reason`` like ``"interrupted: SIGINT"``); cancels the goal."""

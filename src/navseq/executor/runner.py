@@ -18,6 +18,7 @@ from types import FrameType
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.control import MissionControl
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
@@ -57,6 +58,7 @@ def run_mission(
     resume: ResumePoint | None = None,
     tick: float = 0.1,
     server_wait: float = 10.0,
+    control: MissionControl | None = None,
 ) -> MissionResult:
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
@@ -64,6 +66,7 @@ def run_mission(
     ``resume`` continues an earlier run (see :mod:`navseq.sinks.journal`). ``tick`` is
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
+    ``control`` lets other threads file operator requests (skip the current waypoint).
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
     :class:`MissionInterrupted` on SIGINT/SIGTERM, and re-raises any other exception;
@@ -86,6 +89,11 @@ def run_mission(
             while not executor.finished:
                 for event in navigator.poll():
                     _apply(navigator, executor.on_event(event, navigator.now()))
+                if executor.finished:
+                    break
+                if control is not None:
+                    for reason in control.take_skips():
+                        _apply(navigator, executor.skip(navigator.now(), reason))
                 if executor.finished:
                     break
                 _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
@@ -122,7 +130,7 @@ def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> Miss
     try:
         now = navigator.now()
     except Exception:
-        now = executor.result.duration
+        now = executor.now
     try:
         executor.interrupt(now, reason)  # its CancelGoal was done above
     except Exception:
