@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml scripts/bootstrap
+$(STAMP): pyproject.toml setup.py scripts/bootstrap
 	scripts/bootstrap $(VENV)
 	touch $(STAMP)
 
