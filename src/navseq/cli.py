@@ -1,13 +1,106 @@
-"""The ``navseq`` command line (placeholder until the CLI lands)."""
+"""The ``navseq`` command line: parse arguments, dispatch to a subcommand, map errors
+to exit statuses.
+
+Exit statuses (the same for every subcommand):
+
+- 0: done (for ``run``: every waypoint reached);
+- 1: ``run`` finished but not every waypoint was reached;
+- 2: bad input (mission, map, arguments) — a readable message, never a traceback;
+- 130 / 143: interrupted by SIGINT / SIGTERM (``run`` cancels the active goal first).
+
+Anything else that goes wrong is a bug: one line "internal error" on stderr, and
+``--debug`` shows the traceback.
+"""
 
 from __future__ import annotations
 
+import argparse
+import signal
 import sys
+import traceback
+from types import FrameType
+
+from navseq import __version__
+from navseq.commands import SUBCOMMANDS
+from navseq.errors import NavseqError
+
+EXIT_OK = 0
+EXIT_NOT_ALL_REACHED = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERNAL_ERROR = 3
+EXIT_SIGINT = 128 + signal.SIGINT
+EXIT_SIGTERM = 128 + signal.SIGTERM
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived outside a mission run (the runner handles it during a run)."""
+
+
+def _raise_terminated(signum: int, frame: FrameType | None) -> None:
+    raise Terminated()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    # --debug is accepted before and after the subcommand name; SUPPRESS keeps the
+    # subparser from overwriting a --debug given before it.
+    debug_parent = argparse.ArgumentParser(add_help=False)
+    debug_parent.add_argument(
+        "--debug",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="show the traceback of an internal error",
+    )
+    parser = argparse.ArgumentParser(
+        prog="navseq",
+        description="Send a sequence of navigation goals to a robot and see the mission through.",
+        parents=[debug_parent],
+    )
+    parser.add_argument("--version", action="version", version=f"navseq {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for sub in SUBCOMMANDS:
+        module = sub.load()
+        sub_parser = subparsers.add_parser(
+            sub.name, help=sub.summary, description=sub.summary, parents=[debug_parent]
+        )
+        module.configure(sub_parser)
+        sub_parser.set_defaults(command_module=module)
+    return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    print("navseq: not implemented yet", file=sys.stderr)
-    return 2
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if getattr(args, "command_module", None) is None:
+        parser.print_help(sys.stderr)
+        return EXIT_BAD_INPUT
+    debug = getattr(args, "debug", False)
+    previous_sigterm = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        return args.command_module.run(args)
+    except NavseqError as error:
+        # MissionErrors is a NavseqError whose text lists every problem.
+        print(f"navseq {args.command}: {error}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print(f"navseq {args.command}: interrupted", file=sys.stderr)
+        return EXIT_SIGINT
+    except Terminated:
+        print(f"navseq {args.command}: terminated", file=sys.stderr)
+        return EXIT_SIGTERM
+    except BrokenPipeError:
+        # Output piped into `head` and the like: not an error of ours.
+        return EXIT_OK
+    except Exception as error:
+        if debug:
+            traceback.print_exc()
+        print(
+            f"navseq {args.command}: internal error: {type(error).__name__}: {error}"
+            + ("" if debug else " (run again with --debug to see the traceback)"),
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL_ERROR
+    finally:
+        signal.signal(signal.SIGTERM, previous_sigterm)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,7 @@
+"""``python -m navseq`` is the ``navseq`` command."""
+
+import sys
+
+from navseq.cli import main
+
+sys.exit(main())

@@ -1,0 +1,88 @@
+"""Argument types and helpers shared by several subcommands."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+    from navseq.sim.costmap import Costmap
+
+
+def parse_pose(text: str) -> Pose2D:
+    """``x,y,yaw`` (metres, metres, degrees — like mission files) as a Pose2D in radians."""
+    parts = [part.strip() for part in text.split(",")]
+    if len(parts) not in (2, 3):
+        raise argparse.ArgumentTypeError(
+            f"expected x,y,yaw (metres, metres, degrees), got {text!r}"
+        )
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected numbers x,y,yaw (metres, metres, degrees), got {text!r}"
+        ) from None
+    if not all(math.isfinite(value) for value in values):
+        raise argparse.ArgumentTypeError(f"x,y,yaw must be finite numbers, got {text!r}")
+    yaw_degrees = values[2] if len(values) == 3 else 0.0
+    return Pose2D(values[0], values[1], math.radians(yaw_degrees))
+
+
+def parse_loops(text: str) -> int | None:
+    """A loop count >= 1, or ``forever`` (None)."""
+    if text.strip().lower() == "forever":
+        return None
+    try:
+        loops = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number >= 1 or 'forever', got {text!r}"
+        ) from None
+    if loops < 1:
+        raise argparse.ArgumentTypeError(f"loops must be >= 1 (or 'forever'), got {loops}")
+    return loops
+
+
+def existing_file(text: str) -> Path:
+    """A path that must exist as a file (checked here so the message names the argument)."""
+    path = Path(text)
+    if not path.exists():
+        raise argparse.ArgumentTypeError(f"no such file: {text}")
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a directory, not a file")
+    return path
+
+
+def format_pose(pose: Pose2D) -> str:
+    return f"({pose.x:.2f}, {pose.y:.2f}, {math.degrees(pose.yaw):.0f}°)"
+
+
+def preflight_errors(
+    mission: Mission, costmap: Costmap, start: Pose2D | None
+) -> list[NavseqError]:
+    """Every problem of ``mission`` against the map (empty when it is fine to run)."""
+    from navseq.preflight import check_mission
+
+    return check_mission(mission, costmap, start)
+
+
+def costmap_for_map(map_path: Path) -> Costmap:
+    """The default (TurtleBot3 burger) costmap of a map_server YAML file."""
+    from navseq.sim.costmap import Costmap
+    from navseq.sim.occupancy import load_map
+
+    return Costmap.from_grid(load_map(map_path))
+
+
+def require_file(path: Path, what: str) -> None:
+    """A clear NavseqError for a missing path given by the user (``what`` names the role)."""
+    if not path.exists():
+        raise NavseqError(f"no such file: {path}", source=what)
+    if path.is_dir():
+        raise NavseqError(f"{path} is a directory, not a file", source=what)

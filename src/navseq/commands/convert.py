@@ -1,0 +1,38 @@
+"""``navseq convert INPUT OUTPUT [--force]``: any supported mission format to navseq YAML.
+
+Never overwrites an existing file unless ``--force`` is given.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "input",
+        type=Path,
+        metavar="INPUT",
+        help="mission file (navseq YAML, launch, rosparam, CSV)",
+    )
+    parser.add_argument("output", type=Path, metavar="OUTPUT", help="navseq YAML file to write")
+    parser.add_argument(
+        "--force", action="store_true", help="overwrite OUTPUT if it exists"
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from navseq.errors import NavseqError
+    from navseq.mission import load_mission, write_mission
+
+    mission = load_mission(args.input)
+    if args.output.exists() and not args.force:
+        raise NavseqError(
+            "exists already; not overwriting it (use --force to replace it)",
+            source=str(args.output),
+        )
+    write_mission(mission, args.output, overwrite=args.force)
+    count = len(mission.waypoints)
+    print(f"wrote {args.output} ({count} waypoint{'s' if count != 1 else ''} from {args.input})")
+    return 0
