@@ -157,6 +157,18 @@ def test_missing_server_is_a_clear_error() -> None:
     assert nav.sent_goals == []
 
 
+def test_ctrl_c_while_waiting_for_the_server_is_an_interrupt_too() -> None:
+    class SlowServer(ScriptedNavigator):
+        def wait_for_server(self, timeout: float) -> bool:
+            raise KeyboardInterrupt
+
+    nav = SlowServer()
+    with pytest.raises(MissionInterrupted) as caught:
+        run_mission(line_mission(2), nav)
+    assert caught.value.exit_code == 130 and nav.sent_goals == []
+    assert [v.outcome for v in caught.value.result.visits] == [WaypointOutcome.NOT_RUN] * 2
+
+
 class _InterruptedNavigator(ScriptedNavigator):
     """Raises ``error`` from spin once its clock passes ``at``: a signal mid-mission."""
 

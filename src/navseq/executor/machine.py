@@ -49,7 +49,6 @@ from navseq.geometry import Pose2D, normalize_angle
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
 from navseq.navigators.base import (
     Goal,
-    GoalAccepted,
     GoalDone,
     GoalFeedback,
     GoalPlan,
@@ -230,8 +229,7 @@ class MissionExecutor:
             return []
         if isinstance(event, GoalDone):
             return self._on_goal_done(now, event)
-        assert isinstance(event, GoalAccepted)
-        return []
+        return []  # GoalAccepted needs no reaction: timeouts run from the send
 
     def on_tick(self, now: float, pose: Pose2D | None) -> list[Command]:
         """Let time pass: check timeouts, dwell, back-off and pass-through."""

@@ -77,28 +77,11 @@ def run_mission(
     executor = MissionExecutor(mission, resume=resume)
     for listener in listeners:
         executor.add_listener(listener)
-    if not navigator.wait_for_server(server_wait):
-        raise NavseqError(
-            f"no navigation server answered within {server_wait:g} s; is the navigation "
-            "stack (move_base or the simulator) running, and is the action name right?",
-            source="navigator",
-        )
     with _sigterm_raises():
         try:
-            _apply(navigator, executor.start(navigator.now()))
-            while not executor.finished:
-                for event in navigator.poll():
-                    _apply(navigator, executor.on_event(event, navigator.now()))
-                if executor.finished:
-                    break
-                if control is not None:
-                    for reason in control.take_skips():
-                        _apply(navigator, executor.skip(navigator.now(), reason))
-                if executor.finished:
-                    break
-                _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
-                if not executor.finished:
-                    navigator.spin(tick)
+            server_up = navigator.wait_for_server(server_wait)
+            if server_up:
+                _drive(executor, navigator, tick, control)
         except KeyboardInterrupt:
             result = _abort(executor, navigator, "interrupted: SIGINT")
             raise MissionInterrupted("SIGINT", result) from None
@@ -108,7 +91,29 @@ def run_mission(
         except BaseException as error:
             _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
             raise
+    if not server_up:
+        raise NavseqError(
+            f"no navigation server answered within {server_wait:g} s; is the navigation "
+            "stack (move_base or the simulator) running, and is the action name right?",
+            source="navigator",
+        )
     return executor.result
+
+
+def _drive(
+    executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
+) -> None:
+    """The loop: navigator events, operator requests and the clock in; commands out."""
+    _apply(navigator, executor.start(navigator.now()))
+    while not executor.finished:
+        for event in navigator.poll():
+            _apply(navigator, executor.on_event(event, navigator.now()))
+        if control is not None:
+            for reason in control.take_skips():
+                _apply(navigator, executor.skip(navigator.now(), reason))
+        _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
+        if not executor.finished:
+            navigator.spin(tick)
 
 
 def _apply(navigator: Navigator, commands: list[Command]) -> None:
