@@ -1,24 +1,54 @@
-"""Build hook shared by pip and catkin; project metadata lives in pyproject.toml.
+"""Build hook shared by pip and catkin; pip's project metadata lives in pyproject.toml.
 
-- pip: builds the one optional C extension, ``navseq.sim._astar`` (the global
-  planner's A* search). ``optional=True``: without a C compiler the install still
-  succeeds and the planner falls back on its pure-Python search (same plans, slower).
-- catkin: ``catkin_python_setup()`` in CMakeLists.txt reads ``packages`` and
-  ``package_dir`` from this call to install the ``navseq`` Python package into the
-  workspace (it ignores the extension, so catkin installs use the Python search).
+- pip: packages from ``src/`` plus the one optional C extension, ``navseq.sim._astar``
+  (the global planner's A* search). ``optional=True``: without a C compiler the install
+  still succeeds and the planner falls back on its pure-Python search (same plans,
+  slower).
+- catkin: ``catkin_python_setup()`` (CMakeLists.txt) runs this file through catkin's
+  ``interrogate_setup_dot_py.py`` to learn where the package lives (devel space), and
+  ``catkin_make install`` runs it for real with ``CATKIN_BINARY_DIR`` set. Catkin needs
+  the name and version in the ``setup()`` call: they come from package.xml (keep its
+  version equal to pyproject.toml's). Catkin installs use the pure-Python search.
 """
+
+import os
+import sys
+from pathlib import Path
 
 from setuptools import Extension, find_packages, setup
 
-setup(
-    packages=find_packages("src"),
-    package_dir={"": "src"},
-    ext_modules=[
-        Extension(
-            "navseq.sim._astar",
-            sources=["src/navseq/sim/_astar.c"],
-            extra_compile_args=["-O3"],
-            optional=True,
+PACKAGES = find_packages("src")
+PACKAGE_DIR = {"": "src"}
+
+
+def _run_by_catkin() -> bool:
+    # The interrogation runs this file with runpy from catkin's own script, which stays
+    # the __main__ module; the install step sets CATKIN_BINARY_DIR.
+    main_file = getattr(sys.modules.get("__main__"), "__file__", None) or ""
+    interrogated = Path(main_file).name == "interrogate_setup_dot_py.py"
+    return interrogated or "CATKIN_BINARY_DIR" in os.environ
+
+
+if _run_by_catkin():
+    from catkin_pkg.python_setup import generate_distutils_setup
+
+    setup(
+        **generate_distutils_setup(
+            packages=PACKAGES,
+            package_dir=PACKAGE_DIR,
+            package_data={"navseq": ["py.typed"]},
         )
-    ],
-)
+    )
+else:
+    setup(
+        packages=PACKAGES,
+        package_dir=PACKAGE_DIR,
+        ext_modules=[
+            Extension(
+                "navseq.sim._astar",
+                sources=["src/navseq/sim/_astar.c"],
+                extra_compile_args=["-O3"],
+                optional=True,
+            )
+        ],
+    )
