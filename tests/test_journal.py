@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from helpers_executor import line_mission
 from helpers_subprocess import journal_records
 from navseq.errors import NavseqError
-from navseq.executor import run_mission
+from navseq.executor import MissionExecutor, run_mission
 from navseq.executor.events import (
     MissionFinished,
     WaypointFinished,
@@ -241,3 +244,86 @@ def test_journal_of_an_interrupted_run_resumes_at_the_interrupted_visit(
     point = resume_point(state)
     assert (point.loop, point.index) == (0, 2)
     assert point.previous_duration == pytest.approx(2.0, abs=0.3)
+
+
+# ---------------------------------------------------------------- robustness (property-based)
+
+_JOURNAL_SETTINGS = settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+
+
+def _read_and_resume(path: Path) -> None:
+    """What ``navseq run --resume`` does with a journal: only NavseqError may come out."""
+    with contextlib.suppress(NavseqError):
+        point = resume_point(read_journal(path))
+        MissionExecutor(line_mission(3, loops=2), resume=point).start(0.0)
+
+
+@_JOURNAL_SETTINGS
+@given(content=st.binary(max_size=2000))
+def test_arbitrary_bytes_raise_only_navseq_errors(tmp_path: Path, content: bytes) -> None:
+    path = tmp_path / "fuzz.journal"
+    path.write_bytes(content)
+    _read_and_resume(path)
+
+
+@pytest.fixture(scope="module")
+def valid_journal(tmp_path_factory: pytest.TempPathFactory) -> bytes:
+    folder = tmp_path_factory.mktemp("valid")
+    path = folder / "run.journal"
+    nav = ScriptedNavigator([Finish(GoalStatus.ABORTED, after=0.5)])
+    with JournalWriter(path, "mission.yaml", "0" * 64) as journal:
+        run_mission(line_mission(3, loops=2, retries=1), nav, [journal])
+    return path.read_bytes()
+
+
+@_JOURNAL_SETTINGS
+@given(data=st.data())
+def test_mutated_journals_raise_only_navseq_errors(
+    tmp_path: Path, valid_journal: bytes, data: st.DataObject
+) -> None:
+    content = bytearray(valid_journal)
+    for _ in range(data.draw(st.integers(1, 5), label="mutations")):
+        if not content:
+            break
+        at = data.draw(st.integers(0, len(content) - 1), label="at")
+        action = data.draw(st.sampled_from(["flip", "cut", "insert", "drop"]), label="action")
+        if action == "flip":
+            content[at] = data.draw(st.integers(0, 255), label="byte")
+        elif action == "cut":
+            del content[at:]
+        elif action == "insert":
+            content[at:at] = data.draw(st.sampled_from([b'"', b"1", b"-", b"null", b"[]", b"\n"]))
+        else:
+            del content[at]
+    path = tmp_path / "mutated.journal"
+    path.write_bytes(bytes(content))
+    _read_and_resume(path)
+
+
+@_JOURNAL_SETTINGS
+@given(
+    field=st.sampled_from(["index", "loop", "attempts", "outcome", "t", "duration", "reason"]),
+    value=st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(),
+        st.floats(),
+        st.text(max_size=5),
+        st.lists(st.integers(), max_size=2),
+    ),
+)
+def test_wrongly_typed_event_fields_raise_only_navseq_errors(
+    tmp_path: Path, valid_journal: bytes, field: str, value: object
+) -> None:
+    lines = valid_journal.decode().splitlines()
+    for number, line in enumerate(lines):
+        record = json.loads(line)
+        if record.get("type") == "WaypointFinished":
+            record[field] = value
+            lines[number] = json.dumps(record)
+            break
+    path = tmp_path / "typed.journal"
+    path.write_text("\n".join(lines) + "\n")
+    _read_and_resume(path)

@@ -23,6 +23,7 @@ to at most one per second of mission time; everything else is kept.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import datetime
 import enum
@@ -44,6 +45,7 @@ JOURNAL_FORMAT = "navseq-journal"
 JOURNAL_VERSION = 1
 #: Mission time between two journaled WaypointProgress events (s).
 PROGRESS_INTERVAL = 1.0
+_MAX_HEADER_BYTES = 64 * 1024
 
 _EVENT_TYPES: dict[str, type] = {
     cls.__name__: cls
@@ -201,40 +203,55 @@ def read_journal(path: str | os.PathLike[str]) -> JournalState:
     journal or is damaged anywhere else.
     """
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as error:
-        raise NavseqError(f"cannot read the journal: {error.strerror}", source=str(path)) from None
-    lines = raw.split(b"\n")
-    if lines and lines[-1] == b"":
-        lines.pop()
-    records: list[tuple[int, dict[str, Any] | None]] = [
-        (number, _parse_line(line)) for number, line in enumerate(lines, start=1) if line.strip()
-    ]
-    if not records or records[0][1] is None or records[0][0] != 1:
-        raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
-    header = records[0][1]
-    if header.get("kind") != "header" or header.get("format") != JOURNAL_FORMAT:
-        raise NavseqError(
-            "not a navseq journal (the first line is no journal header)", source=f"{path}:1"
-        )
-    version = header.get("version")
-    if not isinstance(version, int) or version > JOURNAL_VERSION:
-        raise NavseqError(
-            f"journal format version {version!r} is newer than this navseq understands "
-            f"({JOURNAL_VERSION}); upgrade navseq",
-            source=f"{path}:1",
-        )
+    header, records = _read_records(path)
     state = JournalState(
         path=path,
-        version=version,
+        version=header["version"],
         mission_source=str(header.get("mission_source", "")),
         mission_digest=str(header.get("mission_digest", "")),
         started=str(header.get("started", "")),
     )
+    _replay(state, records)
+    return state
+
+
+def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str, Any] | None]]]:
+    """The header, then (line number, record or None if unreadable) for every other line."""
+    try:
+        with path.open("rb") as handle:
+            # Check the header before reading on, so a huge wrong file fails fast.
+            header = _parse_line(handle.readline(_MAX_HEADER_BYTES))
+            if header is None or header.get("kind") != "header":
+                raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
+            rest = handle.read()
+    except OSError as error:
+        raise NavseqError(f"cannot read the journal: {error.strerror}", source=str(path)) from None
+    if header.get("format") != JOURNAL_FORMAT:
+        raise NavseqError(
+            f"not a navseq journal (format {header.get('format')!r})", source=f"{path}:1"
+        )
+    version = header.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version > JOURNAL_VERSION:
+        raise NavseqError(
+            f"journal format version {version!r} is not one this navseq understands "
+            f"(up to {JOURNAL_VERSION}); upgrade navseq",
+            source=f"{path}:1",
+        )
+    lines = rest.split(b"\n")
+    if lines[-1] == b"":
+        lines.pop()
+    records = [
+        (number, _parse_line(line)) for number, line in enumerate(lines, start=2) if line.strip()
+    ]
+    return header, records
+
+
+def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]]) -> None:
+    """Fill ``state`` from the records after the header, segment by segment."""
+    path = state.path
     segment_start: float | None = None
     segment_end: float | None = None
-    for position, (number, record) in enumerate(records[1:], start=1):
+    for position, (number, record) in enumerate(records):
         if record is None:
             following = records[position + 1][1] if position + 1 < len(records) else None
             if position + 1 == len(records) or (following or {}).get("kind") == "resumed":
@@ -262,25 +279,29 @@ def read_journal(path: str | os.PathLike[str]) -> JournalState:
             segment_start = event.t
         segment_end = event.t
         if isinstance(event, ev.WaypointFinished):
-            state.visits[(event.loop, event.index)] = WaypointResult(
-                index=event.index,
-                loop=event.loop,
-                name=None,
-                x=0.0,
-                y=0.0,
-                yaw=0.0,
-                outcome=event.outcome,
-                attempts=event.attempts,
-                duration=event.duration,
-                distance_driven=event.distance_driven,
-                reason=event.reason,
-                passed_through=event.passed_through,
-            )
+            state.visits[(event.loop, event.index)] = _visit_of(event)
         elif isinstance(event, ev.MissionFinished):
             state.finish_reason = event.reason
     if segment_start is not None and segment_end is not None:
         state.previous_duration += max(0.0, segment_end - segment_start)
-    return state
+
+
+def _visit_of(event: ev.WaypointFinished) -> WaypointResult:
+    """A finished visit as the result lists it (the waypoint's pose comes from the mission)."""
+    return WaypointResult(
+        index=event.index,
+        loop=event.loop,
+        name=None,
+        x=0.0,
+        y=0.0,
+        yaw=0.0,
+        outcome=event.outcome,
+        attempts=event.attempts,
+        duration=event.duration,
+        distance_driven=event.distance_driven,
+        reason=event.reason,
+        passed_through=event.passed_through,
+    )
 
 
 def resume_point(state: JournalState, *, mission_digest: str | None = None) -> ResumePoint:
@@ -353,25 +374,35 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
 
 
 def _coerce(value: Any, hint: Any) -> Any:
-    """Turn a JSON value back into the event field's type (enums, tuples of points)."""
-    if value is None:
-        return None
+    """Check a JSON value against the event field's type and rebuild enums and tuples."""
     origin = get_origin(hint)
     if origin in (Union, types.UnionType):
-        options = [a for a in get_args(hint) if a is not type(None)]
-        return _coerce(value, options[0]) if len(options) == 1 else value
+        options = get_args(hint)
+        if value is None and type(None) in options:
+            return None
+        for option in options:
+            if option is not type(None):
+                with contextlib.suppress(TypeError, ValueError):
+                    return _coerce(value, option)
+        raise TypeError(f"{value!r} is not a {hint}")
     if isinstance(hint, type) and issubclass(hint, enum.Enum):
         return hint(value)
     if origin is tuple:
         if not isinstance(value, list):
-            raise TypeError(f"expected a list, got {type(value).__name__}")
+            raise TypeError(f"expected a list, got {value!r}")
         inner = get_args(hint)
         if len(inner) == 2 and inner[1] is Ellipsis:
             return tuple(_coerce(item, inner[0]) for item in value)
-        return tuple(value)
-    if hint is float and isinstance(value, int) and not isinstance(value, bool):
+        if len(value) != len(inner):
+            raise TypeError(f"expected {len(inner)} items, got {len(value)}")
+        return tuple(_coerce(item, kind) for item, kind in zip(value, inner, strict=True))
+    if isinstance(value, bool) and hint is not bool:
+        raise TypeError(f"expected a {hint.__name__}, got {value!r}")
+    if hint is float and isinstance(value, (int, float)):
         return float(value)
-    return value
+    if hint in (int, str, bool) and isinstance(value, hint):
+        return value
+    raise TypeError(f"expected a {getattr(hint, '__name__', hint)}, got {value!r}")
 
 
 def _json_default(value: Any) -> Any:
