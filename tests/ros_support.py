@@ -21,6 +21,8 @@ after a bounded wait) when the fixture ends, and the master's port is free again
 from __future__ import annotations
 
 import contextlib
+import http.client
+import json
 import os
 import signal
 import socket
@@ -348,6 +350,37 @@ class RosMaster:
             )
 
         wait_for(ready, timeout, f"action server {action}")
+
+    def kill_node(self, node: str) -> None:
+        """What ``rosnode kill`` does: ask the node over XML-RPC to shut down."""
+        uri = self._call("lookupNode", node)
+        # A node may close its XML-RPC server while handling the request (rosnode
+        # ignores this too); tests assert what the node did, not this reply.
+        with contextlib.suppress(OSError, xmlrpc.client.ProtocolError, http.client.HTTPException):
+            xmlrpc.client.ServerProxy(uri).shutdown("/ros_support", "killed by the test")
+
+    def call_service(
+        self, service: str, srv_type: str = "std_srvs/Trigger", timeout: float = 20.0
+    ) -> dict[str, Any]:
+        """Call a service with an empty request from a subprocess; the response as a dict.
+
+        (Debian ships no ``rosservice`` command, and rospy belongs in subprocesses.)
+        """
+        package, name = srv_type.split("/")
+        code = (
+            "import json, sys, rospy, importlib\n"
+            f"srv = getattr(importlib.import_module('{package}.srv'), '{name}')\n"
+            f"rospy.wait_for_service('{service}', timeout=10)\n"
+            f"response = rospy.ServiceProxy('{service}', srv)()\n"
+            "print('RESPONSE ' + json.dumps({k: getattr(response, k) "
+            "for k in response.__slots__}), flush=True)\n"
+        )
+        caller = self.start([sys.executable, "-c", code], label="service-call")
+        status = caller.wait(timeout)
+        for line in caller.output().splitlines():
+            if line.startswith("RESPONSE "):
+                return dict(json.loads(line[len("RESPONSE ") :]))
+        raise RuntimeError(f"calling {service} failed ({status}):\n{caller.output()[-3000:]}")
 
     def wait_for_action_server_gone(self, action: str, timeout: float = 15.0) -> None:
         action = action.rstrip("/")

@@ -154,6 +154,7 @@ class Ros1Navigator:
         self._client = _TimedActionClient(self.action, MoveBaseAction)
         self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
         self._goal_id: int | None = None
+        self._send_seq = 0  # increases with every goal sent; identifies the tracked one
         self._accepted = False
         self._server_up: bool | None = None  # None: not checked yet
         self._feedback_pose: Pose2D | None = None
@@ -208,7 +209,11 @@ class Ros1Navigator:
         message = move_base_goal(goal.pose, frame, stamp, goal.z)
         with self._lock:
             # The previous goal is simply no longer tracked: like move_base's own
-            # preemption, the new goal replaces it without stopping the robot.
+            # preemption, the new goal replaces it without stopping the robot. Callbacks
+            # carry the send number, so a replaced goal's late callbacks are ignored even
+            # when the same goal is sent again (pause/resume).
+            self._send_seq += 1
+            seq = self._send_seq
             self._goal_id = goal.goal_id
             self._accepted = False
             self._handle = None
@@ -216,12 +221,12 @@ class Ros1Navigator:
         # which take self._lock; holding ours while it takes its own would deadlock.
         handle = self._client.send_goal(
             message,
-            transition_cb=lambda h, gid=goal.goal_id: self._on_transition(gid, h),
-            feedback_cb=lambda h, fb, gid=goal.goal_id: self._on_feedback(gid, fb),
+            transition_cb=lambda h: self._on_transition(seq, goal.goal_id, h),
+            feedback_cb=lambda h, fb: self._on_feedback(seq, goal.goal_id, fb),
         )
         with self._lock:
             # actionlib only keeps a weak reference: this one keeps the goal's callbacks alive.
-            if self._goal_id == goal.goal_id and handle.get_comm_state() != CommState.DONE:
+            if seq == self._send_seq and handle.get_comm_state() != CommState.DONE:
                 self._handle = handle
 
     def cancel_goal(self) -> None:
@@ -303,9 +308,9 @@ class Ros1Navigator:
 
     # -- actionlib callbacks (rospy threads: only record and enqueue) ---------------------
 
-    def _on_transition(self, goal_id: int, handle: Any) -> None:
+    def _on_transition(self, seq: int, goal_id: int, handle: Any) -> None:
         with self._lock:
-            if goal_id != self._goal_id:
+            if seq != self._send_seq or self._goal_id is None:
                 return  # a goal we replaced or gave up on
             state = handle.get_comm_state()
             # PENDING only means the server received it; ACTIVE means it took it on.
@@ -322,10 +327,10 @@ class Ros1Navigator:
                 self._handle = None
                 self._goal_id = None
 
-    def _on_feedback(self, goal_id: int, feedback: Any) -> None:
+    def _on_feedback(self, seq: int, goal_id: int, feedback: Any) -> None:
         pose = pose2d_from_pose(feedback.base_position.pose)
         self._feedback_pose = pose
-        if goal_id == self._goal_id:
+        if seq == self._send_seq and self._goal_id is not None:
             self._events.put(GoalFeedback(goal_id, pose))
 
     def _on_plan(self, path: Any) -> None:

@@ -1,0 +1,207 @@
+"""The navseq ROS node: a drop-in for the tutorial's ``move_base_seq`` node, done right.
+
+``rosrun navseq navseq_node`` (or a ``<node>`` in a launch file) reads the mission from
+its private parameters, exactly as the tutorial's launch file sets them:
+
+- ``~p_seq`` (flat list x1,y1,z1,x2,...) and ``~yea_seq`` (yaw degrees), or
+- ``~mission``: the path of a mission file in any format navseq reads, or
+- ``~waypoints``: a structured list as in navseq's YAML format,
+
+plus optional mission settings and policies (``~loops``, ``~goal_timeout``,
+``~retries``, ``~on_failure``, ``~pass_through`` ...; see docs/mission-format.md).
+The node's own parameters: ``~action`` (default ``move_base``, resolved in the node's
+namespace, so ``<group ns="robot1">`` drives ``/robot1/move_base``), ``~server_wait``
+(s, default 30), ``~stamp`` (``now`` or ``latest``), ``~status_timeout`` (s without
+action status before the server counts as lost, default 2), ``~base_frames``,
+``~plan_topic``, ``~use_tf``, ``~tick`` (s between executor looks, default 0.1).
+
+It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
+numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
+and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``.
+Ctrl-C, SIGTERM, ``rosnode kill`` and roslaunch's shutdown all cancel the active goal
+before the node exits. Exit status: 0 all waypoints reached, 1 not, 2 bad parameters or
+no action server, 130/143 interrupted by SIGINT/SIGTERM.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+from dataclasses import asdict
+from typing import Any
+
+import rospy
+from std_msgs.msg import String
+from std_srvs.srv import Trigger, TriggerResponse
+from visualization_msgs.msg import MarkerArray
+
+from navseq.errors import NavseqError
+from navseq.executor.events import (
+    MissionEvent,
+    MissionFinished,
+    WaypointFinished,
+    WaypointOutcome,
+    WaypointProgress,
+    WaypointStarted,
+)
+from navseq.executor.runner import MissionInterrupted, run_mission
+from navseq.mission.model import Mission
+from navseq.mission.params import mission_from_params
+from navseq.navigators.ros1 import Ros1Navigator, ensure_node
+from navseq.ros.markers import MarkerStatus, waypoint_markers
+from navseq.ros.operator import OperatorCancel, OperatorNavigator
+
+NODE_NAME = "navseq"
+# Private parameters that configure the node itself rather than the mission.
+NODE_PARAMS: dict[str, Any] = {
+    "action": "move_base",
+    "server_wait": 30.0,
+    "stamp": "now",
+    "status_timeout": 2.0,
+    "base_frames": ["base_footprint", "base_link"],
+    "plan_topic": "NavfnROS/plan",
+    "use_tf": True,
+    "tick": 0.1,
+}
+PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
+
+_OUTCOME_MARKERS = {
+    WaypointOutcome.REACHED: MarkerStatus.REACHED,
+    WaypointOutcome.SKIPPED: MarkerStatus.SKIPPED,
+    WaypointOutcome.FAILED: MarkerStatus.FAILED,
+    WaypointOutcome.NOT_RUN: MarkerStatus.PENDING,
+}
+
+
+class MissionTopics:
+    """A mission listener publishing the ``~status`` JSON and the ``~waypoints`` markers."""
+
+    def __init__(self, mission: Mission):
+        self.mission = mission
+        self.statuses: dict[int, MarkerStatus] = {}
+        self._status_pub = rospy.Publisher("~status", String, queue_size=10, latch=True)
+        self._marker_pub = rospy.Publisher("~waypoints", MarkerArray, queue_size=2, latch=True)
+        self._last_progress = float("-inf")
+        self._lock = threading.Lock()
+        self.publish_markers()
+        self.publish_status({"state": "waiting_for_server", "waypoints": len(mission)})
+
+    def publish_markers(self) -> None:
+        self._marker_pub.publish(waypoint_markers(self.mission, self.statuses))
+
+    def publish_status(self, fields: dict[str, Any]) -> None:
+        self._status_pub.publish(String(data=json.dumps(fields, default=str)))
+
+    def __call__(self, event: MissionEvent) -> None:
+        with self._lock:
+            if isinstance(event, WaypointProgress):
+                if event.t - self._last_progress < PROGRESS_PERIOD:
+                    return
+                self._last_progress = event.t
+            if isinstance(event, WaypointStarted):
+                if event.index == 0 and event.attempt == 1:
+                    # A new loop of a patrol: every waypoint is to come again.
+                    self.statuses.clear()
+                self.statuses[event.index] = MarkerStatus.ACTIVE
+                self.publish_markers()
+            elif isinstance(event, WaypointFinished):
+                self.statuses[event.index] = _OUTCOME_MARKERS[event.outcome]
+                self.publish_markers()
+            fields = {"event": type(event).__name__, **asdict(event)}
+            fields["state"] = (
+                ("succeeded" if event.success else "failed")
+                if isinstance(event, MissionFinished)
+                else "running"
+            )
+            fields["waypoints"] = len(self.mission)
+            self.publish_status(fields)
+
+
+def read_params() -> tuple[Mission, dict[str, Any]]:
+    """The mission and the node settings from the node's private parameters."""
+    private: dict[str, Any] = rospy.get_param("~", {}) or {}
+    settings = {key: private.get(key, default) for key, default in NODE_PARAMS.items()}
+    mission = mission_from_params(private, "param ~", ignore=NODE_PARAMS.keys())
+    return mission, settings
+
+
+def _trigger_service(name: str, operator: OperatorNavigator) -> None:
+    def handle(_request: Any) -> TriggerResponse:
+        ok, message = operator.request(name)
+        return TriggerResponse(success=ok, message=message)
+
+    rospy.Service(f"~{name}", Trigger, handle)
+
+
+def _skip_unsupported(_request: Any) -> TriggerResponse:
+    return TriggerResponse(
+        success=False,
+        message="skip is not available yet: the mission executor has no skip hook",
+    )
+
+
+def run_node() -> int:
+    """Run the mission given by the node's parameters; the exit status (see module doc)."""
+    try:
+        mission, settings = read_params()
+    except NavseqError as error:
+        rospy.logerr("navseq: %s", error)
+        return 2
+    navigator = Ros1Navigator(
+        action=str(settings["action"]),
+        base_frames=tuple(settings["base_frames"]),
+        stamp=settings["stamp"],
+        status_timeout=float(settings["status_timeout"]),
+        plan_topic=settings["plan_topic"] or None,
+        use_tf=bool(settings["use_tf"]),
+    )
+    operator = OperatorNavigator(navigator)
+    topics = MissionTopics(mission)
+    for name in ("pause", "resume", "cancel"):
+        _trigger_service(name, operator)
+    rospy.Service("~skip", Trigger, _skip_unsupported)
+    try:
+        rospy.loginfo(
+            "navseq: %d waypoints from %s; waiting for %s",
+            len(mission), mission.source, navigator.resolved_action,
+        )
+        navigator.require_server(float(settings["server_wait"]))
+        result = run_mission(mission, operator, [topics], tick=float(settings["tick"]))
+    except NavseqError as error:
+        rospy.logerr("navseq: %s", error)
+        topics.publish_status({"state": "error", "reason": str(error)})
+        return 2
+    except MissionInterrupted as interrupted:
+        rospy.logwarn("navseq: %s; the active goal was cancelled", interrupted)
+        return interrupted.exit_code
+    except OperatorCancel as cancelled:
+        rospy.logwarn("navseq: %s", cancelled)
+        return 1
+    except rospy.ROSInterruptException:
+        # rosnode kill / master shutdown: the shutdown hook already cancelled the goal.
+        return 1
+    finally:
+        navigator.close()
+    rospy.loginfo(
+        "navseq: mission %s (%s)", "succeeded" if result.success else "failed", result.reason
+    )
+    return result.exit_code
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``rosrun navseq navseq_node`` (argv: ROS remappings, ``_param:=``)."""
+    if argv is not None:
+        sys.argv = [sys.argv[0], *argv]
+    try:
+        ensure_node(NODE_NAME, anonymous=False)
+    except NavseqError as error:
+        print(f"navseq: {error}", file=sys.stderr)
+        sys.exit(2)
+    code = run_node()
+    rospy.signal_shutdown(f"navseq finished with status {code}")
+    sys.exit(code)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,167 @@
+"""The navseq node against a real rosmaster and the scripted move_base server.
+
+The node gets its mission exactly as the tutorial's launch file gives it (private
+``p_seq`` / ``yea_seq`` parameters) and runs as its own process, like under rosrun.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from ros_support import RosMaster, RosProcess, wait_for
+
+pytestmark = pytest.mark.ros
+
+SERVER = Path(__file__).resolve().parent / "ros_scripted_server.py"
+# The tutorial's launch file contents.
+P_SEQ = [-1, -4, 0, 1, -4, 0, 1, -1, 0]
+YEA_SEQ = [90, 0, 180]
+
+
+def server_log(path: Path) -> list[dict[str, Any]]:
+    if not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def events(path: Path, kind: str) -> list[dict[str, Any]]:
+    return [r for r in server_log(path) if r["event"] == kind]
+
+
+def start_server(master: RosMaster, log: Path, script: str = "", then: str = "succeed:0.3"):
+    server = master.start_python(SERVER, "--script", script, "--then", then, "--log", str(log))
+    server.wait_for_output("scripted move_base ready", timeout=20)
+    return server
+
+
+def start_node(master: RosMaster, **params: Any) -> RosProcess:
+    for key, value in {"p_seq": P_SEQ, "yea_seq": YEA_SEQ, **params}.items():
+        master.set_param(f"/navseq/{key}", value)
+    return master.start_python("-m", "navseq.ros.navseq_node", label="navseq_node")
+
+
+def test_node_with_only_the_tutorial_params_completes_the_sequence(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = start_node(ros_master)
+    assert node.wait(timeout=60) == 0, node.output()
+    goals = events(log, "goal")
+    assert [(g["x"], g["y"]) for g in goals] == [(-1, -4), (1, -4), (1, -1)]
+    assert [g["yaw"] for g in goals] == pytest.approx([math.pi / 2, 0.0, math.pi])
+    assert all(g["frame"] == "map" for g in goals)
+    assert [d["status"] for d in events(log, "done")] == ["SUCCEEDED"] * 3
+    assert "Traceback" not in node.output()
+
+
+def test_node_publishes_latched_status_and_markers(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, then="hang")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "goal"), 20, "the first goal")
+    status = ros_master.start(["rostopic", "echo", "-n", "1", "/navseq/status"])
+    assert status.wait(timeout=20) == 0, status.output()
+    assert '\\"state\\": \\"running\\"' in status.output()
+    markers = ros_master.start(
+        ["rostopic", "echo", "-n", "1", "/navseq/waypoints/markers[0]/color"]
+    )
+    assert markers.wait(timeout=20) == 0, markers.output()
+    # Waypoint 1 is the active goal: blue.
+    assert "b: 1.0" in markers.output()
+    node.stop(signal.SIGINT)
+
+
+@pytest.mark.parametrize(
+    ("sig", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"]
+)
+def test_signal_to_the_node_cancels_the_active_goal(
+    ros_master: RosMaster, tmp_path: Path, sig: int, code: int
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, then="hang")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    node.send_signal(sig)
+    assert node.wait(timeout=20) == code, node.output()
+    cancels = events(log, "cancel")
+    assert [c["id"] for c in cancels] == [events(log, "goal")[0]["id"]]
+    assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"]
+    assert "Traceback" not in node.output()
+
+
+def test_rosnode_kill_cancels_the_active_goal(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, then="hang")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    ros_master.kill_node("/navseq")
+    node.wait(timeout=20)
+    assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"], node.output()
+
+
+def test_server_killed_mid_goal_and_restarted_mission_completes(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, script="succeed:0.3 die:0.8")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "die"), 20, "the server to die on goal 2")
+    time.sleep(1.0)  # the node notices after its status timeout (2 s)
+    start_server(ros_master, log)
+    assert node.wait(timeout=60) == 0, node.output()
+    goals = [(g["x"], g["y"]) for g in events(log, "goal")]
+    assert goals == [(-1, -4), (1, -4), (1, -4), (1, -1)]
+
+
+def test_pause_stops_the_robot_and_resume_sends_the_goal_again(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, script="succeed:0.3 hang", then="succeed:0.3")
+    node = start_node(ros_master)
+    wait_for(lambda: len(events(log, "accepted")) == 2, 20, "goal 2 to be accepted")
+    response = ros_master.call_service("/navseq/pause")
+    assert response["success"], response
+    assert [c["id"] for c in events(log, "cancel")] == [events(log, "goal")[1]["id"]]
+    assert node.running()
+    assert not ros_master.call_service("/navseq/pause")["success"]  # already paused
+    assert ros_master.call_service("/navseq/resume")["success"]
+    assert node.wait(timeout=60) == 0, node.output()
+    goals = [(g["x"], g["y"]) for g in events(log, "goal")]
+    assert goals == [(-1, -4), (1, -4), (1, -4), (1, -1)]
+
+
+def test_cancel_service_ends_the_mission_and_stops_the_robot(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, then="hang")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    assert ros_master.call_service("/navseq/cancel")["success"]
+    assert node.wait(timeout=20) == 1, node.output()
+    assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"]
+    assert len(events(log, "goal")) == 1
+
+
+def test_bad_params_are_one_clear_error_and_exit_2(ros_master: RosMaster):
+    node = start_node(ros_master, yea_seq=[90, 0])
+    assert node.wait(timeout=30) == 2
+    output = node.output()
+    assert "yea_seq" in output and "3" in output and "2" in output
+    assert "Traceback" not in output
+
+
+def test_missing_action_server_is_a_clear_error(ros_master: RosMaster):
+    node = start_node(ros_master, server_wait=0.5)
+    assert node.wait(timeout=30) == 2
+    assert "/move_base" in node.output() and ros_master.uri in node.output()
+    assert "Traceback" not in node.output()
