@@ -154,3 +154,26 @@ def test_cells_match_a_dense_sampling_reference(
     # Every reported cell really overlaps the polygon: a dense sample of the polygon
     # grown by 1 mm hits it (sampling alone could miss slivers thinner than that).
     assert found <= reference_cells(grid, grown(polygon, 0.001), spacing=0.0004)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    x=st.floats(-0.1, 1.1),
+    y=st.floats(-0.1, 1.1),
+    yaw=st.floats(-math.pi, math.pi),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_collides_exactly_when_an_overlapped_cell_is_blocked(
+    x: float, y: float, yaw: float, seed: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    data = rng.choice(np.array([0, 0, 0, 0, 0, 0, 0, 0, 50, 100, -1], np.int8), size=(20, 20))
+    grid = OccupancyGrid(data, 0.05, Pose2D(0.0, 0.0, 0.0))
+    pose = Pose2D(x, y, yaw)
+    cells = footprint_cells(grid, TURTLEBOT3_BURGER, pose)
+    if cells is None:
+        expected = True  # part of the robot is off the map
+    else:
+        values = data[cells]
+        expected = bool(((values == 100) | (values == -1)).any())
+    assert footprint_collides(grid, TURTLEBOT3_BURGER, pose) == expected

@@ -68,56 +68,91 @@ class Footprint:
 
 
 def footprint_collides(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) -> bool:
-    """True if the footprint at ``pose`` overlaps an occupied or unknown cell or leaves the map."""
-    cells = footprint_cells(grid, footprint, pose)
-    if cells is None:
+    """True if the footprint at ``pose`` overlaps an occupied or unknown cell or leaves the map.
+
+    Cheap where it matters (every simulation step): only the blocked cells inside the
+    footprint's bounding box get the exact overlap test, and there are usually none.
+    """
+    placed = _PlacedHull.of(grid, footprint, pose)
+    if placed.leaves(grid):
         return True
-    rows, cols = cells
-    values = grid.data[rows, cols]
-    return bool(np.any((values >= 100) | (values < 0)))
+    col0, row0, col1, row1 = placed.box()
+    window = grid.blocked_mask()[row0:row1, col0:col1]
+    if not window.any():
+        return False
+    rows, cols = np.nonzero(window)
+    return bool(placed.overlaps(rows + row0, cols + col0).any())
 
 
 def footprint_cells(
     grid: OccupancyGrid, footprint: Footprint, pose: Pose2D
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """(rows, cols) of every cell the footprint overlaps, or None if one is off the map."""
-    # Work in grid units (cells), where cell (r, c) is the square [c, c+1] x [r, r+1].
-    gx, gy = grid.world_to_grid(pose.x, pose.y)
-    yaw = pose.yaw - grid.origin.yaw
-    c, s = math.cos(yaw), math.sin(yaw)
-    rotation = np.array([[c, s], [-s, c]])
-    hull = footprint._hull @ rotation / grid.resolution + (gx, gy)
-    normals = footprint._normals @ rotation
-
-    low = np.floor(hull.min(axis=0)).astype(int)
-    high = np.ceil(hull.max(axis=0)).astype(int)  # exclusive
-    col_range = np.arange(low[0], high[0])
-    row_range = np.arange(low[1], high[1])
-    centre_x, centre_y = np.meshgrid(col_range + 0.5, row_range + 0.5)
-    centre_x, centre_y = centre_x.ravel(), centre_y.ravel()
-
-    # Separating axes: the grid axes are handled by the bounding box above; along each
-    # edge normal the cell's projection is its centre's +- half the square's extent.
-    hull_projection = hull @ normals.T  # (vertices, edges)
-    hull_min, hull_max = hull_projection.min(axis=0), hull_projection.max(axis=0)
-    half_extent = 0.5 * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
-    centre_projection = np.outer(centre_x, normals[:, 0]) + np.outer(centre_y, normals[:, 1])
-    keep = np.all(
-        (centre_projection - half_extent < hull_max - 1e-9)
-        & (centre_projection + half_extent > hull_min + 1e-9),
-        axis=1,
-    )
-    cols = np.floor(centre_x[keep]).astype(np.intp)
-    rows = np.floor(centre_y[keep]).astype(np.intp)
-    if (
-        rows.size == 0
-        or rows.min() < 0
-        or cols.min() < 0
-        or rows.max() >= grid.height
-        or cols.max() >= grid.width
-    ):
+    """(rows, cols) of every cell the footprint overlaps, or None if it leaves the map."""
+    placed = _PlacedHull.of(grid, footprint, pose)
+    if placed.leaves(grid):
         return None
-    return rows, cols
+    col0, row0, col1, row1 = placed.box()
+    rows, cols = np.mgrid[row0:row1, col0:col1]
+    rows, cols = rows.ravel(), cols.ravel()
+    keep = placed.overlaps(rows, cols)
+    return rows[keep], cols[keep]
+
+
+@dataclass(frozen=True)
+class _PlacedHull:
+    """The footprint's convex hull at a pose, in grid units.
+
+    In grid units cell (row, col) is the unit square [col, col + 1] x [row, row + 1].
+    Touching counts as no overlap (a tolerance of 1e-9 cells absorbs rounding).
+    """
+
+    vertices: np.ndarray  # (N, 2) x = column axis, y = row axis
+    normals: np.ndarray  # (N, 2) unit normals of the hull's edges
+
+    @classmethod
+    def of(cls, grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) -> _PlacedHull:
+        gx, gy = grid.world_to_grid(pose.x, pose.y)
+        yaw = pose.yaw - grid.origin.yaw
+        c, s = math.cos(yaw), math.sin(yaw)
+        rotation = np.array([[c, s], [-s, c]])
+        vertices = footprint._hull @ rotation / grid.resolution + (gx, gy)
+        return cls(vertices, footprint._normals @ rotation)
+
+    def leaves(self, grid: OccupancyGrid) -> bool:
+        """True if part of the hull lies outside the map's rectangle."""
+        low, high = self.vertices.min(axis=0), self.vertices.max(axis=0)
+        return bool(
+            low[0] < -_EPSILON
+            or low[1] < -_EPSILON
+            or high[0] > grid.width + _EPSILON
+            or high[1] > grid.height + _EPSILON
+        )
+
+    def box(self) -> tuple[int, int, int, int]:
+        """(col0, row0, col1, row1), end exclusive: the cells the bounding box overlaps."""
+        low = np.floor(self.vertices.min(axis=0) + _EPSILON).astype(int)
+        high = np.ceil(self.vertices.max(axis=0) - _EPSILON).astype(int)
+        return max(low[0], 0), max(low[1], 0), int(high[0]), int(high[1])
+
+    def overlaps(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Which of these cells (all inside ``box()``) the hull overlaps: separating axes.
+
+        The grid axes are settled by the bounding box; along each edge normal a cell
+        projects to its centre's projection +- half the square's extent.
+        """
+        normals = self.normals
+        hull_projection = self.vertices @ normals.T  # (vertices, edges)
+        hull_min, hull_max = hull_projection.min(axis=0), hull_projection.max(axis=0)
+        half_extent = 0.5 * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
+        centres = np.column_stack((cols + 0.5, rows + 0.5))
+        centre_projection = centres @ normals.T  # (cells, edges)
+        separated = (centre_projection - half_extent >= hull_max - _EPSILON) | (
+            centre_projection + half_extent <= hull_min + _EPSILON
+        )
+        return ~separated.any(axis=1)
+
+
+_EPSILON = 1e-9
 
 
 def _convex_hull(points: np.ndarray) -> np.ndarray:

@@ -54,13 +54,14 @@ DEFAULT_FREE_THRESH = 0.196
 MODES = ("trinary", "scale", "raw")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class OccupancyGrid:
     """A 2-D occupancy map: -1 unknown, 0 free .. 100 occupied, one value per cell.
 
     ``data[row, col]`` with row 0 at the bottom (``nav_msgs/OccupancyGrid`` order).
     ``origin`` is the pose of the lower-left corner of cell (0, 0); its yaw rotates the
-    whole grid about that corner, as in ``nav_msgs/MapMetaData``.
+    whole grid about that corner, as in ``nav_msgs/MapMetaData``. Grids compare (and
+    hash) by identity: ``data`` is large and treated as immutable.
     """
 
     data: np.ndarray
@@ -131,6 +132,15 @@ class OccupancyGrid:
     def unknown_mask(self) -> np.ndarray:
         """Cells whose occupancy is unknown (value -1)."""
         return self.data == UNKNOWN
+
+    def blocked_mask(self) -> np.ndarray:
+        """Cells a robot must not overlap: occupied or unknown (computed once, read-only)."""
+        cached = self.__dict__.get("_blocked")
+        if cached is None:
+            cached = self.occupied_mask() | self.unknown_mask()
+            cached.setflags(write=False)
+            object.__setattr__(self, "_blocked", cached)
+        return cached
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
