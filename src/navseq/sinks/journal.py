@@ -115,13 +115,13 @@ class JournalWriter:
         cls, path: str | os.PathLike[str], point: ResumePoint, *, fsync: bool = False
     ) -> JournalWriter:
         """Continue an existing journal: append a ``resumed`` record, then the new events."""
-        self = cls.__new__(cls)
-        self.path = Path(path)
-        read_journal(self.path)  # refuse to append to something that is not a journal
-        self._open(0, fsync)
-        if not _ends_with_newline(self.path):
-            os.write(self._fd, b"\n")  # end the line a crash cut short
-        self._write(
+        writer = cls.__new__(cls)  # skip __init__: no new header
+        writer.path = Path(path)
+        read_journal(writer.path)  # refuse to append to something that is not a journal
+        writer._open(0, fsync)
+        if not _ends_with_newline(writer.path):
+            os.write(writer._fd, b"\n")  # end the line a crash cut short
+        writer._write(
             {
                 "kind": "resumed",
                 "loop": point.loop,
@@ -129,7 +129,7 @@ class JournalWriter:
                 "at": _wall_clock(),
             }
         )
-        return self
+        return writer
 
     def _open(self, extra_flags: int, fsync: bool) -> None:
         flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | extra_flags
