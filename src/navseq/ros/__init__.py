@@ -1,0 +1,11 @@
+"""ROS 1 nodes and adapters: the only package (with ``navigators.ros1``) that imports rospy.
+
+- :mod:`navseq.ros.navseq_node`: the sequencer node (tutorial params, markers, services);
+- :mod:`navseq.ros.record`: waypoint recorder (``navseq record`` and ``record_node``);
+- :mod:`navseq.ros.markers`: RViz markers of a mission;
+- :mod:`navseq.ros.operator`: pause/resume/cancel on top of any navigator (no ROS);
+- :mod:`navseq.ros.conversions`: navseq types <-> ROS messages, shared by all nodes;
+- ``sim_robot_node`` / ``sim_nav_node``: the embedded simulator served as ROS nodes.
+
+Importing this package imports nothing from ROS; each module does so itself.
+"""
