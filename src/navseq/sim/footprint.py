@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from navseq.geometry import Pose2D
-from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.occupancy import OccupancyGrid, blocked_values
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,6 +35,7 @@ class Footprint:
     inscribed_radius: float = field(init=False)
     circumscribed_radius: float = field(init=False)
     _hull: np.ndarray = field(init=False, repr=False, compare=False)
+    _hull_points: tuple[tuple[float, float], ...] = field(init=False, repr=False, compare=False)
     _normals: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -48,6 +49,7 @@ class Footprint:
         normals /= np.linalg.norm(normals, axis=1, keepdims=True)
         object.__setattr__(self, "polygon", polygon)
         object.__setattr__(self, "_hull", hull)
+        object.__setattr__(self, "_hull_points", tuple(map(tuple, hull.tolist())))
         object.__setattr__(self, "_normals", normals)
         object.__setattr__(self, "inscribed_radius", _distance_to_boundary(polygon))
         object.__setattr__(
@@ -77,7 +79,8 @@ def footprint_collides(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) 
     if placed.leaves(grid):
         return True
     col0, row0, col1, row1 = placed.box()
-    window = grid.blocked_mask()[row0:row1, col0:col1]
+    # No cache of blocked cells: grid.data may be edited in place (tests, clearing).
+    window = blocked_values(grid.data[row0:row1, col0:col1])
     if not window.any():
         return False
     rows, cols = np.nonzero(window)
@@ -103,36 +106,43 @@ class _PlacedHull:
     """The footprint's convex hull at a pose, in grid units.
 
     In grid units cell (row, col) is the unit square [col, col + 1] x [row, row + 1].
-    Touching counts as no overlap (a tolerance of 1e-9 cells absorbs rounding).
+    Touching counts as no overlap (a tolerance of 1e-9 cells absorbs rounding). The
+    few vertices are plain floats: numpy's per-call overhead would dominate.
     """
 
-    vertices: np.ndarray  # (N, 2) x = column axis, y = row axis
-    normals: np.ndarray  # (N, 2) unit normals of the hull's edges
+    xs: tuple[float, ...]  # vertex coordinates along the column axis
+    ys: tuple[float, ...]  # ... and along the row axis
+    rotation: np.ndarray  # robot frame -> grid frame, for row vectors
+    footprint: Footprint
 
     @classmethod
     def of(cls, grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) -> _PlacedHull:
         gx, gy = grid.world_to_grid(pose.x, pose.y)
         yaw = pose.yaw - grid.origin.yaw
         c, s = math.cos(yaw), math.sin(yaw)
-        rotation = np.array([[c, s], [-s, c]])
-        vertices = footprint._hull @ rotation / grid.resolution + (gx, gy)
-        return cls(vertices, footprint._normals @ rotation)
+        scale = 1.0 / grid.resolution
+        points = footprint._hull_points
+        xs = tuple(gx + (c * px - s * py) * scale for px, py in points)
+        ys = tuple(gy + (s * px + c * py) * scale for px, py in points)
+        return cls(xs, ys, np.array([[c, s], [-s, c]]), footprint)
 
     def leaves(self, grid: OccupancyGrid) -> bool:
         """True if part of the hull lies outside the map's rectangle."""
-        low, high = self.vertices.min(axis=0), self.vertices.max(axis=0)
-        return bool(
-            low[0] < -_EPSILON
-            or low[1] < -_EPSILON
-            or high[0] > grid.width + _EPSILON
-            or high[1] > grid.height + _EPSILON
+        return (
+            min(self.xs) < -_EPSILON
+            or min(self.ys) < -_EPSILON
+            or max(self.xs) > grid.width + _EPSILON
+            or max(self.ys) > grid.height + _EPSILON
         )
 
     def box(self) -> tuple[int, int, int, int]:
         """(col0, row0, col1, row1), end exclusive: the cells the bounding box overlaps."""
-        low = np.floor(self.vertices.min(axis=0) + _EPSILON).astype(int)
-        high = np.ceil(self.vertices.max(axis=0) - _EPSILON).astype(int)
-        return max(low[0], 0), max(low[1], 0), int(high[0]), int(high[1])
+        return (
+            max(math.floor(min(self.xs) + _EPSILON), 0),
+            max(math.floor(min(self.ys) + _EPSILON), 0),
+            math.ceil(max(self.xs) - _EPSILON),
+            math.ceil(max(self.ys) - _EPSILON),
+        )
 
     def overlaps(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Which of these cells (all inside ``box()``) the hull overlaps: separating axes.
@@ -140,8 +150,9 @@ class _PlacedHull:
         The grid axes are settled by the bounding box; along each edge normal a cell
         projects to its centre's projection +- half the square's extent.
         """
-        normals = self.normals
-        hull_projection = self.vertices @ normals.T  # (vertices, edges)
+        normals = self.footprint._normals @ self.rotation
+        vertices = np.column_stack((self.xs, self.ys))
+        hull_projection = vertices @ normals.T  # (vertices, edges)
         hull_min, hull_max = hull_projection.min(axis=0), hull_projection.max(axis=0)
         half_extent = 0.5 * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
         centres = np.column_stack((cols + 0.5, rows + 0.5))

@@ -134,13 +134,8 @@ class OccupancyGrid:
         return self.data == UNKNOWN
 
     def blocked_mask(self) -> np.ndarray:
-        """Cells a robot must not overlap: occupied or unknown (computed once, read-only)."""
-        cached = self.__dict__.get("_blocked")
-        if cached is None:
-            cached = self.occupied_mask() | self.unknown_mask()
-            cached.setflags(write=False)
-            object.__setattr__(self, "_blocked", cached)
-        return cached
+        """Cells a robot must not overlap: occupied or unknown."""
+        return blocked_values(self.data)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -150,6 +145,11 @@ class OccupancyGrid:
         xs = [self.origin.x + (c * u - s * v) * self.resolution for u, v in corners]
         ys = [self.origin.y + (s * u + c * v) * self.resolution for u, v in corners]
         return min(xs), min(ys), max(xs), max(ys)
+
+
+def blocked_values(values: np.ndarray) -> np.ndarray:
+    """Occupied or unknown, for any slice of grid values (see ``occupied_mask``)."""
+    return (values >= OCCUPIED) | (values < FREE)
 
 
 def load_map(yaml_path: str | Path) -> OccupancyGrid:
