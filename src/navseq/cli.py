@@ -15,6 +15,7 @@ Anything else that goes wrong is a bug: one line "internal error" on stderr, and
 from __future__ import annotations
 
 import argparse
+import re
 import signal
 import sys
 import traceback
@@ -67,9 +68,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Options whose value may start with a minus sign (``--start -2,-0.5,0``), which
+# argparse would otherwise take for an option.
+NEGATIVE_VALUE_OPTIONS = ("--start",)
+_NUMBER_START = re.compile(r"-[0-9.]")
+
+
+def _attach_negative_values(argv: list[str]) -> list[str]:
+    """``--start -2,-0.5,0`` -> ``--start=-2,-0.5,0`` so that argparse accepts it."""
+    joined: list[str] = []
+    index = 0
+    while index < len(argv):
+        arg = argv[index]
+        following = argv[index + 1] if index + 1 < len(argv) else ""
+        if arg in NEGATIVE_VALUE_OPTIONS and _NUMBER_START.match(following):
+            joined.append(f"{arg}={following}")
+            index += 2
+        else:
+            joined.append(arg)
+            index += 1
+    return joined
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_attach_negative_values(sys.argv[1:] if argv is None else argv))
     if getattr(args, "command_module", None) is None:
         parser.print_help(sys.stderr)
         return EXIT_BAD_INPUT

@@ -336,7 +336,8 @@ def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, boo
     from navseq.commands.output import create_run_folder, default_run_folder
 
     if args.out is not None:
-        return create_run_folder(args.out, fresh=False), False
+        existed = args.out.exists()
+        return create_run_folder(args.out, fresh=False), not existed
     if setup.journal is not None:  # a resumed run writes beside its journal
         return create_run_folder(setup.journal.parent, fresh=False), False
     return create_run_folder(default_run_folder(setup.mission_path.stem), fresh=True), True
@@ -387,7 +388,7 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
     from navseq.commands.output import reserve_file
 
-    folder, fresh = _output_folder(setup, args)
+    folder, created = _output_folder(setup, args)
     # Resuming appends to the run's own journal; a new run starts a new one.
     journal_path = setup.journal or reserve_file(folder, "journal.jsonl")
     for note in setup.notes:
@@ -397,7 +398,7 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     except BaseException:
         # No result to report (e.g. no navigation server): leave no empty files behind.
         if setup.journal is None:
-            _discard_unused(journal_path, folder if fresh else None)
+            _discard_unused(journal_path, folder if created else None)
         raise
     # Reserved only now, so that a run killed with -9 leaves no empty report behind.
     files = {

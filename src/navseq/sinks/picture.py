@@ -102,6 +102,13 @@ class Box:
         )
 
 
+def _new_file_mode() -> int:
+    """Permissions of an ordinary new file under the current umask (mkstemp uses 0600)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 def waypoint_outcomes(result: MissionResult, count: int) -> list[WaypointOutcome]:
     """One outcome per waypoint: its worst visit that ran (not run if none ran)."""
     outcomes = [WaypointOutcome.NOT_RUN] * count
@@ -263,6 +270,7 @@ def draw_mission_picture(
     fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
     os.close(fd)
     try:
+        os.chmod(tmp_name, _new_file_mode())
         # "tight" keeps the legend and axis labels that sit outside the axes.
         fig.savefig(tmp_name, format="png", bbox_inches="tight", pad_inches=0.15)
         os.replace(tmp_name, path)
@@ -319,12 +327,14 @@ def mission_figure(
 
     outcomes = waypoint_outcomes(result, len(waypoints))
     last = len(waypoints) - 1
+    drew_radius = False
     for index, (waypoint, outcome) in enumerate(zip(waypoints, outcomes, strict=True)):
         colour = OUTCOME_COLOURS[outcome]
         radius = mission.policy_for(index).pass_through
         if radius and index != last and mission.policy_for(index).dwell == 0:
             ax.add_patch(Circle((waypoint.x, waypoint.y), radius, fill=False, edgecolor=colour,
                                 linestyle=(0, (2, 2)), linewidth=1.0, zorder=4))
+            drew_radius = True
         _draw_pose_arrow(ax, waypoint.pose, arrow_length, colour, zorder=5, width=arrow_width)
         ax.plot(waypoint.x, waypoint.y, marker="o", markersize=15, color=colour,
                 markeredgecolor="black", markeredgewidth=0.8, zorder=6)
@@ -353,6 +363,10 @@ def mission_figure(
     if plan_arrays:
         handles.append(Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR,
                               label="planned path"))
+    if drew_radius:
+        handles.append(Line2D([], [], marker="o", markersize=11, fillstyle="none",
+                              linestyle="none", markeredgecolor="#555555",
+                              label="pass-through radius"))
     if lines is not None:
         handles.append(Line2D([], [], linewidth=2.4, color="#21918c", label="driven path"))
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),

@@ -122,6 +122,8 @@ class RunView:
             self.loop_outcomes[event.index] = outcome
             self.totals[outcome] += 1
             self.status = outcome.value.replace("_", " ")
+            if outcome == WaypointOutcome.REACHED:
+                self.distance_remaining = 0.0
         elif isinstance(event, ServerStatusChanged):
             self.status = (
                 "navigation server back"
@@ -357,7 +359,7 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
     if several_loops:
         table.add_column("loop", justify="right")
     table.add_column("name")
-    table.add_column("outcome")
+    table.add_column("outcome", no_wrap=True)
     table.add_column("attempts", justify="right",
                      footer=str(sum(visit.attempts for visit in result.visits)))
     # Brackets are rich markup: escape the unit.
@@ -367,9 +369,7 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
     table.add_column("reason")
     for visit in result.visits:
         outcome = WaypointOutcome(visit.outcome)
-        label = outcome.value.replace("_", " ")
-        if visit.passed_through:
-            label += " (passed)"
+        label = "passed through" if visit.passed_through else outcome.value.replace("_", " ")
         cells = [str(visit.index + 1)]
         if several_loops:
             cells.append(str(visit.loop + 1))
