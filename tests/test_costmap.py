@@ -120,3 +120,12 @@ def test_turtlebot3_world_costmap() -> None:
     assert costmap.cost_at(0.2, 0.0) == LETHAL
     assert costmap.cost_at(0.0, 0.0) == NO_INFORMATION
     assert not costmap.is_free(0.27, 0.0)  # within 0.105 m of the pillar wall
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [{"inflation_radius": -1.0}, {"cost_scaling_factor": float("nan")}, {"inscribed_radius": "x"}],
+)
+def test_bad_params_are_refused(settings: dict) -> None:
+    with pytest.raises(ValueError, match=next(iter(settings))):
+        CostmapParams(**settings)

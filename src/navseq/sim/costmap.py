@@ -38,6 +38,12 @@ class CostmapParams:
     inscribed_radius: float = 0.105  # m: the footprint's inscribed radius
     unknown_is_lethal: bool = True
 
+    def __post_init__(self) -> None:
+        for name in ("inflation_radius", "cost_scaling_factor", "inscribed_radius"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and 0.0 <= value < float("inf")):
+                raise ValueError(f"costmap {name} must be a number >= 0, got {value!r}")
+
 
 @dataclass(frozen=True, eq=False)
 class Costmap:
