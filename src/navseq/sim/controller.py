@@ -80,6 +80,7 @@ class RegulatedPurePursuit:
         self._carrot = 0
         self._locate_on_whole_path = True
         self._rotating = False
+        self._long_way_sign = 0.0
         self._xy_reached = False
         self.distance_to_path = 0.0
         self.distance_remaining = 0.0
@@ -111,6 +112,7 @@ class RegulatedPurePursuit:
         self._carrot = 0
         self._locate_on_whole_path = True
         self._rotating = False
+        self._long_way_sign = 0.0
 
     def compute(self, pose: Pose2D, v: float, w: float) -> tuple[float, float]:
         """Velocity command ``(v, w)`` for a robot at ``pose`` moving at ``(v, w)``."""
@@ -121,6 +123,8 @@ class RegulatedPurePursuit:
         distance_to_goal = math.hypot(goal.x - x, goal.y - y)
         self._track_progress(x, y)
 
+        if self._xy_reached and distance_to_goal > params.xy_tolerance:
+            self._xy_reached = False  # pushed away (by an evasive move): approach again
         if not self._xy_reached:
             braking = v * v / (2.0 * limits.acc_v)
             self._xy_reached = distance_to_goal + braking <= params.xy_tolerance
@@ -212,9 +216,22 @@ class RegulatedPurePursuit:
             return 0.0
         return self._turn_rate_toward(error)
 
+    def turn_the_long_way(self, turn_rate: float) -> None:
+        """Make the turn in place now under way (``turn_rate``) go round the other way.
+
+        Used when the short way round is blocked. Holds until the remaining angle has
+        come round to the other side, where the short way is the way the robot turns.
+        """
+        self._long_way_sign = math.copysign(1.0, turn_rate)
+
     def _turn_rate_toward(self, angle: float) -> float:
         """Turn in place by ``angle``: top speed, then brake so as to stop on it."""
         params = self.params
+        if self._long_way_sign:
+            if math.copysign(1.0, angle) == self._long_way_sign:
+                angle -= math.copysign(2.0 * math.pi, angle)
+            else:
+                self._long_way_sign = 0.0
         rate = min(params.rotate_speed, params.limits.max_w,
                    math.sqrt(2.0 * params.rotate_decel * abs(angle)))
         return math.copysign(rate, angle)

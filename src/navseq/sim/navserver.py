@@ -9,8 +9,10 @@ the first control step plans on the costmap. It ends
 
 - SUCCEEDED when the controller has the robot within the xy and yaw tolerances;
 - ABORTED when no plan exists (start or goal not free, goal unreachable) or when the
-  next step could not be taken without the footprint touching an obstacle — the
-  command is then zero, so the robot stops rather than collides;
+  next step could not be taken without the footprint touching an obstacle and no
+  evasive move (turning the other way, creeping forward or back) is safe either, or
+  evading has not brought the robot 0.2 m closer within ``blocked_patience`` seconds —
+  the command is then zero, so the robot stops rather than collides;
 - CANCELED on :meth:`cancel`.
 
 Replanning happens when the robot strays more than ``stray_distance`` from the plan
@@ -60,6 +62,9 @@ class NavParams(ControllerParams):
     stray_distance: float = 0.3
     replan_period: float | None = None  # the simulated world is static: off by default
     start_search_radius: float = 0.25
+    escape_speed: float = 0.05  # m/s, forward or back, when the controller's move is unsafe
+    escape_distance: float = 0.1  # m crept before the controller gets another try
+    blocked_patience: float = 10.0  # s blocked without 0.2 m of progress before ABORT
 
 
 class NavigationServer:
@@ -82,6 +87,11 @@ class NavigationServer:
         self.distance_remaining: float | None = None
         self._needs_plan = False
         self._since_plan = 0.0
+        self._goal_time = 0.0
+        self._blocked_since = None
+        self._remaining_when_blocked = math.inf
+        self._escape_command = (0.0, 0.0)
+        self._escape_time_left = 0.0
         self._use_costmap(costmap)
 
     # -- goal life cycle -------------------------------------------------------------
@@ -93,6 +103,10 @@ class NavigationServer:
         self.status_text = ""
         self.distance_remaining = None
         self._needs_plan = True
+        self._goal_time = 0.0
+        self._blocked_since: float | None = None  # goal time the controller was first blocked
+        self._remaining_when_blocked = math.inf
+        self._escape_time_left = 0.0
 
     def cancel(self) -> None:
         """Stop pursuing the active goal (state CANCELED); nothing happens when idle."""
@@ -116,15 +130,42 @@ class NavigationServer:
         if wants_plan and not self._replan(pose):
             return 0.0, 0.0
 
+        self._goal_time += dt
+        if self._blocked_since is not None and (
+            self._goal_time - self._blocked_since > self.params.blocked_patience
+        ):
+            self._finish(NavState.ABORTED, "stopped: blocked by an obstacle, no way around it")
+            return 0.0, 0.0
+
+        if self._escape_time_left > 0.0:
+            self._escape_time_left -= dt
+            if self._command_is_safe(pose, v, w, *self._escape_command, dt):
+                return self._escape_command
+            self._escape_time_left = 0.0
+
         cmd_v, cmd_w = controller.compute(pose, v, w)
-        self.distance_remaining = controller.distance_remaining
+        self.distance_remaining = remaining = controller.distance_remaining
         if controller.goal_reached:
             self._finish(NavState.SUCCEEDED, "goal reached")
             return 0.0, 0.0
-        if not self._command_is_safe(pose, v, w, cmd_v, cmd_w, dt):
+        if self._blocked_since is not None and remaining < self._remaining_when_blocked - 0.2:
+            self._blocked_since = None  # real progress since: the obstacle is behind us
+        if self._command_is_safe(pose, v, w, cmd_v, cmd_w, dt):
+            return cmd_v, cmd_w
+
+        if self._blocked_since is None:
+            self._blocked_since = self._goal_time
+            self._remaining_when_blocked = remaining
+        evasion = self._evasive_command(pose, v, w, cmd_v, cmd_w, dt)
+        if evasion is None:
             self._finish(NavState.ABORTED, "stopped: the footprint would hit an obstacle")
             return 0.0, 0.0
-        return cmd_v, cmd_w
+        if evasion[0] != 0.0:  # creep on for a while, or the controller steers straight back
+            self._escape_command = evasion
+            self._escape_time_left = self.params.escape_distance / self.params.escape_speed
+        else:
+            controller.turn_the_long_way(cmd_w)
+        return evasion
 
     # -- services ------------------------------------------------------------------------
 
@@ -207,6 +248,29 @@ class NavigationServer:
         if 0 <= row < clearance.shape[0] and 0 <= col < clearance.shape[1]:
             return float(clearance[row, col])
         return 0.0
+
+    def _evasive_command(
+        self, pose: Pose2D, v: float, w: float, cmd_v: float, cmd_w: float, dt: float
+    ) -> tuple[float, float] | None:
+        """A safe move when the controller's is not, or None: the robot is boxed in.
+
+        A blocked turn in place is tried the long way round; otherwise the robot creeps
+        straight forward or back, whichever leads to more clearance, until the
+        controller's own command is safe again (move_base's recovery, in small).
+        """
+        candidates: list[tuple[float, float]] = []
+        if cmd_v == 0.0 and cmd_w != 0.0:
+            candidates.append((0.0, -cmd_w))
+        speed = self.params.escape_speed
+        step_x, step_y = 0.1 * math.cos(pose.yaw), 0.1 * math.sin(pose.yaw)
+        ahead = self._clearance_at(pose.x + step_x, pose.y + step_y)
+        behind = self._clearance_at(pose.x - step_x, pose.y - step_y)
+        escapes = [(speed, 0.0), (-speed, 0.0)]
+        candidates.extend(escapes if ahead >= behind else escapes[::-1])
+        for candidate in candidates:
+            if self._command_is_safe(pose, v, w, *candidate, dt):
+                return candidate
+        return None
 
     def _command_is_safe(
         self, pose: Pose2D, v: float, w: float, cmd_v: float, cmd_w: float, dt: float
