@@ -182,6 +182,15 @@ class RegulatedPurePursuit:
         self._closest = best
         self.distance_to_path = math.sqrt(best_squared)
         self.distance_remaining = self._remaining_after[best] + self.distance_to_path
+        if best + 1 < len(xs):
+            # Past the closest point already: measure via the next one, so the figure
+            # shrinks smoothly instead of in cell-sized steps.
+            next_x, next_y = xs[best + 1], ys[best + 1]
+            along = (x - xs[best]) * (next_x - xs[best]) + (y - ys[best]) * (next_y - ys[best])
+            if along > 0.0:
+                self.distance_remaining = self._remaining_after[best + 1] + math.hypot(
+                    next_x - x, next_y - y
+                )
 
     def _carrot_point(self, x: float, y: float, lookahead: float) -> tuple[float, float]:
         """The point where a circle of radius ``lookahead`` about the robot leaves the plan."""

@@ -1,0 +1,147 @@
+"""The ``sim`` navigator: navseq's embedded simulator behind the Navigator interface.
+
+It drives a :class:`navseq.sim.world.SimWorld` in simulated time, as fast as the CPU
+allows: :meth:`SimNavigator.spin` steps the world, and ``now()`` is the world's clock.
+Events follow what an actionlib client of move_base would see:
+
+- ``GoalAccepted`` as soon as a goal is sent;
+- ``GoalPlan`` each time the navigation server adopts a new plan for it;
+- ``GoalFeedback`` (pose, distance remaining along the plan) every ``feedback_period``
+  seconds of simulated time while the goal is active;
+- ``GoalDone`` with SUCCEEDED or ABORTED (the server's verdict and its reason), or
+  PREEMPTED for a goal that was cancelled or replaced by a newer one.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from navseq.geometry import Pose2D
+from navseq.navigators.base import (
+    Goal,
+    GoalAccepted,
+    GoalDone,
+    GoalFeedback,
+    GoalPlan,
+    GoalStatus,
+    NavEvent,
+)
+from navseq.sim.navserver import NavParams, NavState
+from navseq.sim.occupancy import load_map
+from navseq.sim.world import SimWorld, default_start
+
+_TERMINAL = {NavState.SUCCEEDED: GoalStatus.SUCCEEDED, NavState.ABORTED: GoalStatus.ABORTED}
+
+
+class SimNavigator:
+    """A :class:`navseq.navigators.base.Navigator` on an in-process simulated robot.
+
+    ``trajectory`` records ``(t, x, y)`` of the robot at the start and after every
+    step in which it moved, for reports and pictures.
+    """
+
+    def __init__(self, world: SimWorld, *, feedback_period: float = 0.2) -> None:
+        if not feedback_period > 0:
+            raise ValueError(f"feedback_period must be positive, got {feedback_period}")
+        self.world = world
+        self.feedback_period = feedback_period
+        pose = world.robot.pose
+        self.trajectory: list[tuple[float, float, float]] = [(world.time, pose.x, pose.y)]
+        self._events: list[NavEvent] = []
+        self._active: Goal | None = None
+        self._plan_version = world.server.plan_version
+        self._next_feedback = math.inf
+        self._unspun = 0.0  # simulated seconds asked for but shorter than a step
+
+    @classmethod
+    def from_map(
+        cls,
+        map_yaml: str | Path,
+        start: Pose2D | None = None,
+        *,
+        nav_params: NavParams | None = None,
+        feedback_period: float = 0.2,
+    ) -> SimNavigator:
+        """A navigator on a map_server map; ``start=None`` uses :func:`default_start`.
+
+        Raises ``NavseqError`` for an unreadable map or a start pose in an obstacle.
+        """
+        grid = load_map(map_yaml)
+        if start is None:
+            start = default_start(grid)
+        world = SimWorld(grid, start, nav_params=nav_params)
+        return cls(world, feedback_period=feedback_period)
+
+    # -- Navigator protocol ----------------------------------------------------------
+
+    def now(self) -> float:
+        return self.world.time
+
+    def wait_for_server(self, timeout: float) -> bool:
+        return True  # the server lives in this process
+
+    def send_goal(self, goal: Goal) -> None:
+        if self._active is not None:
+            self._events.append(
+                GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "replaced by a new goal")
+            )
+        self._active = goal
+        self.world.server.set_goal(goal.pose)
+        self._events.append(GoalAccepted(goal.goal_id))
+        self._next_feedback = self.world.time + self.feedback_period
+
+    def cancel_goal(self) -> None:
+        if self._active is None:
+            return
+        self.world.server.cancel()
+        self._events.append(GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "canceled"))
+        self._active = None
+
+    def clear_costmaps(self) -> None:
+        self.world.server.clear_costmaps()
+
+    def robot_pose(self) -> Pose2D | None:
+        return self.world.robot.pose
+
+    def poll(self) -> list[NavEvent]:
+        events, self._events = self._events, []
+        return events
+
+    def spin(self, seconds: float) -> None:
+        world = self.world
+        self._unspun += seconds
+        steps = math.floor(self._unspun / world.dt + 1e-9)
+        self._unspun -= steps * world.dt
+        robot = world.robot
+        trajectory = self.trajectory
+        for _ in range(steps):
+            before = robot.pose
+            world.step()
+            if robot.pose is not before:
+                trajectory.append((world.time, robot.pose.x, robot.pose.y))
+            if self._active is not None:
+                self._report(self._active)
+
+    def close(self) -> None:
+        self.cancel_goal()
+
+    # -- internals ---------------------------------------------------------------------
+
+    def _report(self, goal: Goal) -> None:
+        """Turn what the server did during the last step into events."""
+        world = self.world
+        server = world.server
+        if server.plan_version != self._plan_version and server.plan is not None:
+            self._plan_version = server.plan_version
+            path = tuple((float(x), float(y)) for x, y in server.plan.points)
+            self._events.append(GoalPlan(goal.goal_id, path))
+        status = _TERMINAL.get(server.state)
+        if status is not None:
+            self._events.append(GoalDone(goal.goal_id, status, server.status_text))
+            self._active = None
+        elif world.time >= self._next_feedback - 1e-9:
+            self._next_feedback += self.feedback_period
+            self._events.append(
+                GoalFeedback(goal.goal_id, world.robot.pose, server.distance_remaining)
+            )
