@@ -16,6 +16,7 @@ from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
+from navseq.mission.yaml_doc import EXPONENT_FLOAT
 
 HEADER = "# navseq mission (format reference: docs/mission-format.md)\n"
 # A yaw someone typed keeps up to ten decimals exactly; one computed from a quaternion
@@ -35,6 +36,18 @@ class _MissionDumper(yaml.SafeDumper):
         super().increase_indent(flow, False)
 
 
+def _represent_text(dumper: yaml.SafeDumper, data: str) -> yaml.ScalarNode:
+    # PyYAML writes NEL and Unicode line separators raw inside single quotes, where
+    # reading folds them away; double quotes escape them.
+    style = '"' if any(ch in _LINE_BREAKS for ch in data) else None
+    return dumper.represent_scalar("tag:yaml.org,2002:str", data, style=style)
+
+
+_LINE_BREAKS = "\n\r\x85\u2028\u2029"
+_MissionDumper.add_representer(str, _represent_text)
+# The reader takes plain ``1e3`` as a number (YAML 1.2); text that looks like it is quoted.
+_MissionDumper.add_implicit_resolver("tag:yaml.org,2002:float", EXPONENT_FLOAT,
+                                     list("-+0123456789."))
 _MissionDumper.add_representer(
     _FlowMapping,
     lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data,

@@ -29,7 +29,7 @@ _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 # PyYAML follows YAML 1.1, where "1e3" (no dot) is text; YAML 1.2 and every user
 # reads it as a number.
-_EXPONENT_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+EXPONENT_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
 
 
 def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1
@@ -140,7 +140,7 @@ class _Walker:
             raise NavseqError(f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
                               "navseq does not accept (quote it if it is text)",
                               source=self.where(node))
-        if node.tag == _TAG + "str" and node.style is None and _EXPONENT_FLOAT.fullmatch(
+        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(
             node.value
         ):
             return float(node.value)
