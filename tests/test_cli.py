@@ -397,3 +397,17 @@ def test_ros1_without_a_server_is_a_clean_error(tmp_path):
     assert_clean_error(result)
     assert "master" in result.stderr.lower() or "move_base" in result.stderr
     assert not (tmp_path / "out").exists()  # no run, no output folder
+
+
+def test_reader_going_away_stops_the_run_quietly(tmp_path):
+    mission = write_mission(tmp_path / "m.yaml", SQUARE)
+    log = tmp_path / "nav.log"
+    process = start_navseq("run", mission, "--navigator", "scripted", "--json", "--out",
+                           tmp_path / "out", "--scripted-realtime", "2", "--scripted-log", log,
+                           cwd=tmp_path)
+    assert json.loads(process.stdout.readline())["event"] == "MissionStarted"
+    process.stdout.close()  # like `navseq run --json ... | head -1`
+    stderr = process.stderr.read()
+    assert process.wait(timeout=60) == 141  # as if killed by SIGPIPE
+    assert "Traceback" not in stderr
+    assert scripted_log(log, "cancel_goal")  # the robot was not left driving

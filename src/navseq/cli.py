@@ -15,6 +15,8 @@ Anything else that goes wrong is a bug: one line "internal error" on stderr, and
 from __future__ import annotations
 
 import argparse
+import logging
+import os
 import re
 import signal
 import sys
@@ -31,6 +33,7 @@ EXIT_BAD_INPUT = 2
 EXIT_INTERNAL_ERROR = 3
 EXIT_SIGINT = 128 + signal.SIGINT
 EXIT_SIGTERM = 128 + signal.SIGTERM
+EXIT_SIGPIPE = 128 + signal.SIGPIPE
 
 
 class Terminated(BaseException):
@@ -90,6 +93,26 @@ def _attach_negative_values(argv: list[str]) -> list[str]:
     return joined
 
 
+class _BriefFormatter(logging.Formatter):
+    """Log records as one ``navseq: message`` line; tracebacks only with --debug."""
+
+    def __init__(self, debug: bool):
+        super().__init__("navseq: %(message)s")
+        self.debug = debug
+
+    def format(self, record: logging.LogRecord) -> str:
+        if not self.debug:
+            record.exc_info = None
+            record.exc_text = None
+        return super().format(record)
+
+
+def _configure_logging(debug: bool) -> None:
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(_BriefFormatter(debug))
+    logging.basicConfig(level=logging.DEBUG if debug else logging.WARNING, handlers=[handler])
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(_attach_negative_values(sys.argv[1:] if argv is None else argv))
@@ -97,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_BAD_INPUT
     debug = getattr(args, "debug", False)
+    _configure_logging(debug)
     previous_sigterm = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         return args.command_module.run(args)
@@ -111,8 +135,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"navseq {args.command}: terminated", file=sys.stderr)
         return EXIT_SIGTERM
     except BrokenPipeError:
-        # Output piped into `head` and the like: not an error of ours.
-        return EXIT_OK
+        # The reader of our output went away (`navseq run ... | head`): stop quietly,
+        # as a process killed by SIGPIPE would, and keep Python from complaining
+        # about the unflushable stdout at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_SIGPIPE
     except Exception as error:
         if debug:
             traceback.print_exc()

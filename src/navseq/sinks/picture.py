@@ -233,7 +233,7 @@ def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> 
     verdict = "success" if result.success else (f"interrupted ({interrupted})"
                                                 if interrupted else result.reason)
     return (
-        f"{name}: {verdict}\n"
+        f"{name} — {verdict}\n"
         f"{reached}/{len(result.visits)} visits reached · {result.duration:.1f} s · "
         f"{result.distance_driven:.1f} m driven"
     )
