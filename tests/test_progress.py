@@ -148,6 +148,8 @@ def test_live_panel_shows_waypoint_status_distance_loop_and_attempt():
     assert "0.20 m to go" in text
     assert "loop 1/2" in text
     assert "elapsed     3.0 s" in text
+    # The latest notable event is shown under the current state.
+    assert "[    0.0 s] waypoint 1/3 'dock': going to (1.00, 0.00, 0°), attempt 1" in text
 
 
 def test_summary_table_lists_every_visit_with_totals():

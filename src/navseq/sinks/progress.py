@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import asdict
 from typing import IO, Any
@@ -38,7 +39,6 @@ from navseq.executor.events import (
     WaypointDwelling,
     WaypointFinished,
     WaypointOutcome,
-    WaypointPlan,
     WaypointProgress,
     WaypointStarted,
 )
@@ -139,13 +139,16 @@ class RunView:
 class LiveProgress:
     """A rich live panel, redrawn a few times a second by rich's refresh thread.
 
+    Under the current state it shows the last few notable events (as in the log).
+
     Events only update the :class:`RunView`; drawing happens on refresh, so a fast
     simulator does not pay for rendering every event.
     """
 
-    def __init__(self, mission: Mission, console: Console):
+    def __init__(self, mission: Mission, console: Console, *, recent_lines: int = 4):
         self.view = RunView(mission)
         self.console = console
+        self.recent: deque[str] = deque(maxlen=recent_lines)
         self._live = Live(
             console=console,
             get_renderable=self.render,
@@ -163,6 +166,9 @@ class LiveProgress:
 
     def __call__(self, event: MissionEvent) -> None:
         self.view.update(event)
+        text = describe(event, self.view)
+        if text is not None:
+            self.recent.append(f"[{self.view.elapsed:7.1f} s] {text}")
 
     def render(self) -> RenderableType:
         view = self.view
@@ -209,8 +215,51 @@ class LiveProgress:
                 else:
                     marks.append(f"{index + 1}· ", "grey50")
             rows.append(marks)
+        rows.extend(Text(line, style="dim", overflow="ellipsis", no_wrap=True)
+                    for line in self.recent)
         title = escape(f"navseq · {view.mission.source}")
         return Panel(Group(*rows), title=title, title_align="left", expand=False)
+
+
+def describe(event: MissionEvent, view: RunView) -> str | None:
+    """One line for a person about a notable event (None for progress, plans, ...).
+
+    ``view`` must already have been updated with ``event``.
+    """
+    if isinstance(event, MissionStarted):
+        loops = "forever" if event.loops is None else _plural(event.loops, "loop")
+        resumed = (
+            f", resuming at waypoint {event.resumed_from + 1}"
+            if event.resumed_from is not None
+            else ""
+        )
+        return (f"mission {view.mission.source}: "
+                f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}")
+    if isinstance(event, LoopStarted):
+        return view.loop_label() if view.loops != 1 else None
+    if isinstance(event, WaypointStarted):
+        yaw = math.degrees(event.yaw)
+        return (f"{view.waypoint_label(event.index)}: going to "
+                f"({event.x:.2f}, {event.y:.2f}, {yaw:.0f}°), attempt {event.attempt}")
+    if isinstance(event, AttemptFailed):
+        then = "will retry" if event.will_retry else "giving up"
+        return (f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
+                f"({event.reason}), {then}")
+    if isinstance(event, WaypointDwelling):
+        return f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s"
+    if isinstance(event, WaypointFinished):
+        outcome = WaypointOutcome(event.outcome)
+        how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
+        why = f" ({event.reason})" if event.reason and outcome != WaypointOutcome.REACHED else ""
+        return (f"{view.waypoint_label(event.index)}: {how}{why} after "
+                f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
+                f"{_plural(event.attempts, 'attempt')}")
+    if isinstance(event, ServerStatusChanged):
+        return view.status
+    if isinstance(event, MissionFinished):
+        verdict = "success" if event.success else "not every waypoint reached"
+        return f"mission finished: {event.reason} ({verdict})"
+    return None  # WaypointProgress, WaypointPlan
 
 
 class LogProgress:
@@ -239,24 +288,9 @@ class LogProgress:
     def __call__(self, event: MissionEvent) -> None:
         view = self.view
         view.update(event)
-        if isinstance(event, MissionStarted):
-            loops = "forever" if event.loops is None else _plural(event.loops, "loop")
-            resumed = (
-                f", resuming at waypoint {event.resumed_from + 1}"
-                if event.resumed_from is not None
-                else ""
-            )
-            self._log(f"mission {view.mission.source}: "
-                      f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}")
-        elif isinstance(event, LoopStarted):
-            if view.loops != 1:
-                self._log(view.loop_label())
-        elif isinstance(event, WaypointStarted):
+        if isinstance(event, WaypointStarted):
             self._last_progress_t = event.t
-            yaw = math.degrees(event.yaw)
-            self._log(f"{view.waypoint_label(event.index)}: going to "
-                      f"({event.x:.2f}, {event.y:.2f}, {yaw:.0f}°), attempt {event.attempt}")
-        elif isinstance(event, WaypointProgress):
+        if isinstance(event, WaypointProgress):
             if event.t - self._last_progress_t >= self.progress_period:
                 self._last_progress_t = event.t
                 to_go = (
@@ -267,30 +301,10 @@ class LogProgress:
                 )
                 self._log(f"{view.waypoint_label(event.index)}: {to_go}"
                           f"{event.distance_driven:.2f} m driven")
-        elif isinstance(event, AttemptFailed):
-            then = "will retry" if event.will_retry else "giving up"
-            self._log(f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
-                      f"({event.reason}), {then}")
-        elif isinstance(event, WaypointDwelling):
-            self._log(f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s")
-        elif isinstance(event, WaypointFinished):
-            outcome = WaypointOutcome(event.outcome)
-            how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
-            why = (
-                f" ({event.reason})"
-                if event.reason and outcome != WaypointOutcome.REACHED
-                else ""
-            )
-            self._log(f"{view.waypoint_label(event.index)}: {how}{why} after "
-                      f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
-                      f"{_plural(event.attempts, 'attempt')}")
-        elif isinstance(event, ServerStatusChanged):
-            self._log(view.status)
-        elif isinstance(event, MissionFinished):
-            verdict = "success" if event.success else "not every waypoint reached"
-            self._log(f"mission finished: {event.reason} ({verdict})")
-        elif isinstance(event, WaypointPlan):
-            pass  # plans go to the picture, not the log
+            return
+        text = describe(event, view)
+        if text is not None:
+            self._log(text)
 
 
 def _json_safe(value: Any) -> Any:
