@@ -289,6 +289,8 @@ def test_self_referencing_yaml_is_refused(tmp_path):
         ({"waypoints": [{"x": 1}]}, ["param ~waypoints", "waypoint 1, field y", "missing"]),
         ({"mission": "/nonexistent/m.yaml"}, ["/nonexistent/m.yaml", "no such file"]),
         ({"p_seq": "[1, 2, 0, 5]", "yea_seq": "[0]"}, ["param ~p_seq", "4 numbers"]),
+        ({"mission": "m\x00.yaml"}, ["param ~mission", "NUL"]),
+        ({"p_seq": [1, 2, 0], "yea_seq": [0], "map": "m\x00.yaml"}, ["param ~map", "NUL"]),
     ],
 )
 def test_param_mistakes(params, expected):
@@ -296,6 +298,13 @@ def test_param_mistakes(params, expected):
         mission_from_params(params)
     for part in expected:
         assert part in str(raised.value)
+
+
+def test_a_launch_file_naming_itself_as_its_mission_does_not_recurse(tmp_path):
+    path = write(tmp_path, "self.launch", '<launch><node pkg="a" type="b" name="n">'
+                 '<param name="mission" value="self.launch"/></node></launch>')
+    message = only_error(path)
+    assert f"{path}:1, field mission" in message and "cannot itself name another" in message
 
 
 def test_param_source_prefix_is_used_in_messages():

@@ -87,6 +87,18 @@ def test_launch_file_rosparam_file_is_followed_relative_to_the_launch_file(tmp_p
     assert poses(load_mission(path)) == [(1.0, 1.0, 45.0)]
 
 
+def test_launch_file_may_name_a_mission_file(tmp_path):
+    path = write(tmp_path, "run.launch", f"""<launch>
+  <node pkg="navseq" type="navseq_node" name="navseq">
+    <param name="mission" value="{EXAMPLES / 'patrol.yaml'}"/>
+    <param name="loops" value="2"/>
+  </node>
+</launch>""")
+    mission = load_mission(path)
+    assert [w.name for w in mission.waypoints] == ["south", "east", "north", "west"]
+    assert mission.loops == 2
+
+
 def test_launch_file_elements_switched_off_by_if_are_ignored(tmp_path):
     path = write(tmp_path, "seq.launch", """<launch>
   <node pkg="p" type="t" name="seq">
@@ -100,6 +112,7 @@ def test_launch_file_elements_switched_off_by_if_are_ignored(tmp_path):
 
 def test_rosparam_file_nested_under_the_node_name():
     mission = load_mission(EXAMPLES / "tutorial_params.yaml")
+    assert mission.source == str(EXAMPLES / "tutorial_params.yaml")
     assert poses(mission) == [(-1.6, -0.5, -30.0), (0.5, -1.6, 60.0), (1.6, 0.5, 150.0),
                               (-0.5, 1.6, -120.0)]
 

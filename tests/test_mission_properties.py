@@ -139,8 +139,10 @@ def test_samples_are_valid_before_mutation(scratch):
         assert validate_mission_file(path) == [], name
 
 
+# Text that looks like paths, substitutions and lists reaches the file-naming keys.
+PARAM_TEXT = st.text(max_size=8) | st.text(st.sampled_from(list("~/.$()[],1 e\x00")), max_size=8)
 PARAM_VALUES = st.recursive(
-    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=8),
+    st.none() | st.booleans() | st.integers() | st.floats() | PARAM_TEXT,
     lambda inner: st.lists(inner, max_size=6) | st.dictionaries(st.text(max_size=6), inner,
                                                                 max_size=4),
     max_leaves=20,

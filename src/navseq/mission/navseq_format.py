@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 from collections.abc import Sequence
 from pathlib import Path
 from types import MappingProxyType
@@ -116,10 +117,19 @@ def read_frame(node: Located, subject: str) -> str:
 
 def read_map_path(node: Located, subject: str, base_dir: Path | None) -> Path:
     """A map_server YAML path; relative paths are relative to the mission file's folder."""
-    path = Path(fields.text(node, subject)).expanduser()
+    return read_path(node, subject, base_dir).resolve()
+
+
+def read_path(node: Located, subject: str, base_dir: Path | None) -> Path:
+    """A file path as written, ``~`` expanded, anchored at ``base_dir`` when relative."""
+    written = fields.text(node, subject)
+    if "\0" in written:
+        raise NavseqError("a file path cannot contain a NUL character", source=node.where,
+                          subject=subject)
+    path = Path(os.path.expanduser(written))  # unlike Path.expanduser, never raises
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
-    return path.resolve()
+    return path
 
 
 def read_loops(node: Located, subject: str) -> int | None:

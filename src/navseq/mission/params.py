@@ -16,18 +16,28 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Collection, Mapping
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
 from navseq.mission import fields
 from navseq.mission.located import Located, from_plain
 from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
-from navseq.mission.navseq_format import MISSION_SETTINGS, read_settings, read_waypoints
+from navseq.mission.navseq_format import (
+    MISSION_SETTINGS,
+    read_path,
+    read_settings,
+    read_waypoints,
+)
 from navseq.mission.problems import Problems
 from navseq.mission.tutorial_format import POSITIONS_KEY, YAWS_KEY, waypoints_from_sequences
 
 WAYPOINT_SOURCES = (POSITIONS_KEY, YAWS_KEY, "waypoints", "mission")
 MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_FIELDS)
+
+# True while loading a file named by a 'mission' parameter: that file may not name
+# another one, so a launch file that names itself cannot recurse.
+_reading_named_file: ContextVar[bool] = ContextVar("_reading_named_file", default=False)
 
 
 def mission_from_params(params: Mapping[str, Any], source: str = "param ~", *,
@@ -73,6 +83,11 @@ def mission_from_namespace(namespace: Located, problems: Problems, *, base_dir: 
         return None
     settings = read_settings(namespace, base_dir, problems)
     policy = fields.policy_values(namespace, None, problems)
+    if given[0] == "mission" and _reading_named_file.get():
+        problems.add("a mission file named by a 'mission' parameter cannot itself name "
+                     "another one", source=namespace.value["mission"].where,
+                     subject="field mission")
+        return None
     if given[0] == "mission":
         base = _mission_from_file(namespace.value["mission"], base_dir, problems)
         if base is None or len(problems) > before:
@@ -97,18 +112,18 @@ def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems
     from navseq.errors import NavseqError
     from navseq.mission.loader import load_mission  # the loader reads launch files via here
 
-    path_text = fields.attempt(problems, lambda: fields.text(node, "field mission"))
-    if path_text is None:
+    path = fields.attempt(problems, lambda: read_path(node, "field mission", base_dir))
+    if path is None:
         return None
-    if "$(" in path_text:
-        problems.add(f"uses a roslaunch substitution ({path_text[:40]}) that navseq cannot "
+    if "$(" in str(path):
+        problems.add(f"uses a roslaunch substitution ({node.value[:40]}) that navseq cannot "
                      "resolve here", source=node.where, subject="field mission")
         return None
-    path = Path(path_text).expanduser()
-    if not path.is_absolute() and base_dir is not None:
-        path = base_dir / path
+    token = _reading_named_file.set(True)
     try:
         return load_mission(path)
     except NavseqError as error:
         problems.record(error)
         return None
+    finally:
+        _reading_named_file.reset(token)

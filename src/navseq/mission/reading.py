@@ -24,6 +24,8 @@ def read_mission_text(path: Path, *, max_bytes: int = MAX_MISSION_BYTES) -> str:
         raise NavseqError("no such file", source=source) from None
     except OSError as error:
         raise NavseqError(f"cannot be read: {error.strerror or error}", source=source) from None
+    except ValueError:  # a NUL byte in the name
+        raise NavseqError("is not a valid file name", source=repr(source)) from None
     if stat.S_ISDIR(info.st_mode):
         raise NavseqError("is a folder, not a mission file", source=source)
     if not stat.S_ISREG(info.st_mode):

@@ -7,6 +7,7 @@ them; other parameters in the tree are ignored.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from navseq.mission.located import Located
@@ -44,4 +45,5 @@ def mission_from_tree(tree: Located, source: str, base_dir: Path | None, problem
                      "per file", source=source)
         return None
     _, namespace = namespaces[0]
-    return mission_from_namespace(namespace, problems, base_dir=base_dir, strict=False)
+    mission = mission_from_namespace(namespace, problems, base_dir=base_dir, strict=False)
+    return None if mission is None else dataclasses.replace(mission, source=source)
