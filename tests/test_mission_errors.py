@@ -83,6 +83,19 @@ def test_two_nodes_with_missions_in_one_launch_file(tmp_path):
     assert "/one" in message and "/two" in message
 
 
+def test_broken_yaml_inside_rosparam_is_located_in_the_launch_file(tmp_path):
+    path = write(tmp_path, "body.launch", """<launch>
+  <node pkg="a" type="b" name="n">
+    <rosparam>
+      p_seq: [1, 2, 0]
+      yea_seq: {0
+    </rosparam>
+  </node>
+</launch>""")
+    message = only_error(path)
+    assert f"{path}:6" in message and "not valid YAML" in message
+
+
 def test_launch_without_any_mission(tmp_path):
     path = write(tmp_path, "x.launch", '<launch><node pkg="a" type="b" name="c"/></launch>')
     assert "p_seq" in only_error(path)

@@ -48,7 +48,10 @@ def mission_from_launch(text: str, source: str, base_dir: Path | None,
                      "expected <launch>", source=f"{source}:{root.line}")
         return None
     reader = _LaunchReader(source, base_dir, problems)
+    before = len(problems)
     reader.walk(root, "/", None)
+    if len(problems) > before:  # a broken <rosparam> body; what it set is unknown
+        return None
     return mission_from_tree(reader.tree.located(), source, base_dir, problems,
                              not_followed=reader.not_followed)
 

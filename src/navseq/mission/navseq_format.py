@@ -38,6 +38,7 @@ FOREVER = "forever"
 DEFAULT_SERVER_TIMEOUT = Mission.__dataclass_fields__["server_timeout"].default
 
 MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout")
+OPTIONAL_SETTINGS = ("map", "start")  # null: none, like leaving the key out
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
 POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
@@ -57,7 +58,8 @@ def mission_from_document(doc: Located | None, source: str, base_dir: Path | Non
     before = len(problems)
     fields.check_keys(doc, TOP_LEVEL_KEYS, None, problems)
     version = doc.get("navseq")
-    if version is not None and version.value != FORMAT_VERSION:
+    if version is not None and (isinstance(version.value, bool)
+                                or version.value != FORMAT_VERSION):
         problems.add(f"format version {describe(version.value)} is not supported; this navseq "
                      f"reads version {FORMAT_VERSION}", source=version.where,
                      subject="field navseq")
@@ -99,6 +101,9 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
     for key, reader in readers.items():
         entry = node.get(key)
         if entry is None:
+            continue
+        if entry.value is None and key in OPTIONAL_SETTINGS:
+            settings[key] = None
             continue
         before = len(problems)
         value = fields.attempt(problems, lambda r=reader, e=entry, k=key: r(e, f"field {k}"))
