@@ -347,9 +347,11 @@ def mission_figure(
                               "edgecolor": "none", "alpha": 0.75})
 
     if start is not None:
-        _draw_pose_arrow(ax, start, arrow_length, START_COLOUR, zorder=5, width=arrow_width)
-        ax.plot(start.x, start.y, marker="s", markersize=10, color=START_COLOUR,
-                markeredgecolor="black", markeredgewidth=0.8, zorder=6)
+        # Under the waypoint markers and a little larger, so that a waypoint at the
+        # start pose (a tour that returns home) stays visible with the square around it.
+        _draw_pose_arrow(ax, start, arrow_length, START_COLOUR, zorder=4.5, width=arrow_width)
+        ax.plot(start.x, start.y, marker="s", markersize=17, color=START_COLOUR,
+                markeredgecolor="black", markeredgewidth=0.8, zorder=5.5)
 
     handles = [
         Line2D([], [], marker="o", linestyle="none", markersize=9, color=OUTCOME_COLOURS[o],

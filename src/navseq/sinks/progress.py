@@ -380,7 +380,9 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
     table.add_column(escape("time [s]"), justify="right", footer=f"{result.duration:.1f}")
     table.add_column(escape("distance [m]"), justify="right",
                      footer=f"{result.distance_driven:.2f}")
-    table.add_column("reason")
+    any_reason = any(visit.reason for visit in result.visits)
+    if any_reason:
+        table.add_column("reason")
     for visit in result.visits:
         outcome = WaypointOutcome(visit.outcome)
         label = "passed through" if visit.passed_through else outcome.value.replace("_", " ")
@@ -393,8 +395,9 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
             str(visit.attempts),
             f"{visit.duration:.1f}",
             f"{visit.distance_driven:.2f}",
-            visit.reason,
         ]
+        if any_reason:
+            cells.append(visit.reason)
         # Text cells: a name or reason with [brackets] is not markup.
         table.add_row(*(Text(cell) for cell in cells), style=OUTCOME_STYLE[outcome])
     return table
