@@ -70,13 +70,20 @@ def test_every_example_converts_to_navseq_yaml_that_loads_the_same(tmp_path, nam
 
 
 def test_map_path_is_written_relative_to_the_new_file(tmp_path):
-    mission = load_mission(EXAMPLES / "patrol.yaml")
+    mission = small_mission(map=(tmp_path / "maps" / "arena.yaml").resolve())
     target = tmp_path / "deep" / "copy.yaml"
     target.parent.mkdir()
     write_mission(mission, target)
     written = yaml.safe_load(target.read_text())["map"]
-    assert not Path(written).is_absolute()
+    assert written == "../maps/arena.yaml"
     assert load_mission(target).map == mission.map
+
+
+def test_map_path_stays_absolute_when_only_the_root_is_shared(tmp_path):
+    mission = small_mission(map=Path("/nonexistent-navseq-maps/arena.yaml"))
+    write_mission(mission, tmp_path / "m.yaml")
+    written = yaml.safe_load((tmp_path / "m.yaml").read_text())["map"]
+    assert written == "/nonexistent-navseq-maps/arena.yaml"
 
 
 def test_refuses_to_overwrite_an_existing_file(tmp_path):

@@ -147,12 +147,17 @@ def _tidy(value: float) -> float | int:
 
 
 def _map_text(map_path: Path, base_dir: Path | None) -> str:
-    if base_dir is None:
+    """Relative to the mission's folder when both live in one tree (a project, a
+    package), so they can move together; absolute when they only share the root."""
+    if base_dir is None or not map_path.is_absolute():
         return str(map_path)
     try:
-        return os.path.relpath(map_path, base_dir)
+        shared = Path(os.path.commonpath([map_path, base_dir]))
     except ValueError:  # another drive (Windows)
         return str(map_path)
+    if shared == Path(shared.anchor):
+        return str(map_path)
+    return os.path.relpath(map_path, base_dir)
 
 
 def _pose(pose: Pose2D) -> _FlowMapping:
