@@ -226,7 +226,7 @@ def test_computed_yaws_round_to_a_millionth_of_a_degree_and_then_stay(scratch, m
 
 @settings(max_examples=30, deadline=None)
 @given(mission=missions())
-def test_write_mission_round_trip_with_relative_map(scratch, mission):
+def test_write_mission_then_load_gives_the_same_mission(scratch, mission):
     folder = Path(tempfile.mkdtemp(dir=scratch))
     target = folder / "mission.yaml"
     write_mission(mission, target)
