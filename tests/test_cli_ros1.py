@@ -1,0 +1,70 @@
+"""``navseq run --navigator ros1`` against a real rosmaster and the simulator's ROS nodes.
+
+The robot node and the move_base stand-in (``nodes/sim_robot_node``,
+``nodes/sim_nav_node``) run at several times real time; navseq talks to them only
+through actionlib, exactly as it would to a real robot's move_base.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+
+import pytest
+
+from ros_support import REPO_ROOT, RosMaster, RosProcess
+from test_cli import NAVSEQ, journal_events, wait_for, write_mission
+
+pytestmark = pytest.mark.ros
+
+MAP = REPO_ROOT / "maps" / "turtlebot3_world.yaml"
+SPEED = 8.0  # sim seconds per wall second
+
+
+def start_sim(master: RosMaster) -> RosProcess:
+    """The sim robot and navigation nodes; returns the navigation node (move_base)."""
+    master.set_param("/use_sim_time", True)
+    master.start([REPO_ROOT / "nodes" / "sim_robot_node", f"_map:={MAP}", "_x:=-2.0",
+                  "_y:=-0.5", "_yaw:=0.0", f"_speed:={SPEED}"], label="sim_robot")
+    nav = master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}"],
+                       label="move_base")
+    master.wait_for_action_server("/move_base", timeout=30)
+    return nav
+
+
+def mission(tmp_path):
+    return write_mission(tmp_path / "ros.yaml", (
+        "  - {name: west, x: -1.6, y: -0.5, yaw: 90}\n"
+        "  - {name: south, x: -0.55, y: -1.75, yaw: 0}\n"
+    ), "defaults: {goal_timeout: 120}\n")
+
+
+def test_ros1_run_completes_and_reports(ros_master, tmp_path):
+    start_sim(ros_master)
+    out = tmp_path / "out"
+    process = ros_master.start([NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1",
+                                "--map", MAP, "--start", "-2,-0.5,0", "--out", out],
+                               cwd=tmp_path, label="navseq")
+    assert process.wait(timeout=120) == 0, process.output()
+    report = json.loads((out / "report.json").read_text())
+    assert report["success"] is True
+    assert report["navigator"] == {"kind": "ros1", "action": "move_base", "frame": "map",
+                                   "ns": ""}
+    assert [v["outcome"] for v in report["visits"]] == ["reached", "reached"]
+    assert report["visits"][1]["distance_m"] > 0.5
+    assert (out / "mission.png").exists()
+
+
+def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
+    nav = start_sim(ros_master)
+    out = tmp_path / "out"
+    process = ros_master.start([NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1",
+                                "--out", out], cwd=tmp_path, label="navseq")
+    journal = out / "journal.jsonl"
+    wait_for(lambda: journal_events(journal, "WaypointProgress"), 60, "the robot moving")
+    process.send_signal(signal.SIGINT)
+    assert process.wait(timeout=60) == 130, process.output()
+    report = json.loads((out / "report.json").read_text())
+    assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130
+    assert "Traceback" not in process.output()
+    nav.wait_for_output("goal canceled", timeout=10)  # the robot was not left driving
