@@ -411,3 +411,12 @@ def test_reader_going_away_stops_the_run_quietly(tmp_path):
     assert process.wait(timeout=60) == 141  # as if killed by SIGPIPE
     assert "Traceback" not in stderr
     assert scripted_log(log, "cancel_goal")  # the robot was not left driving
+
+
+def test_record_refuses_to_overwrite_a_mission_file(tmp_path):
+    existing = tmp_path / "mine.yaml"
+    existing.write_text("# my mission\n")
+    result = navseq("record", existing, cwd=tmp_path)
+    assert_clean_error(result)
+    assert "mine.yaml" in result.stderr
+    assert existing.read_text() == "# my mission\n"

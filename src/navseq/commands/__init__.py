@@ -7,8 +7,8 @@ A subcommand module provides two functions:
 
 Modules are imported when the parser is built, so they must import only light
 things at module level (argparse, pathlib) and import the heavy machinery (the
-simulator, matplotlib, rospy) inside ``run``. Adding a subcommand (for example
-``navseq record``) is one module plus one line in :data:`SUBCOMMANDS`.
+simulator, matplotlib, rospy) inside ``run``. Adding a subcommand is one module
+plus one line in :data:`SUBCOMMANDS` (``navseq record`` lives in ``navseq.ros.record``).
 """
 
 from __future__ import annotations
@@ -48,5 +48,11 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "convert",
         "write any supported mission format as navseq YAML",
         "navseq.commands.convert",
+    ),
+    # Lives with the ROS code; it imports rospy only when recording starts.
+    Subcommand(
+        "record",
+        "record waypoints from RViz goals (or a pose topic) into a mission file (ROS 1)",
+        "navseq.ros.record",
     ),
 )
