@@ -180,7 +180,10 @@ class ScriptedMoveBase:
 
     def step(self) -> None:
         now = time.monotonic()
-        with self._lock:
+        # actionlib calls _on_goal/_on_cancel holding the server's lock, and they take
+        # ours; take the two in the same order here, or a goal arriving while a result
+        # goes out deadlocks the server.
+        with self._server.lock, self._lock:
             for tracked in self._goals:
                 if tracked.done:
                     continue
