@@ -420,3 +420,12 @@ def test_record_refuses_to_overwrite_a_mission_file(tmp_path):
     assert_clean_error(result)
     assert "mine.yaml" in result.stderr
     assert existing.read_text() == "# my mission\n"
+
+
+def test_out_pointing_at_a_file_is_a_clean_error(tmp_path):
+    not_a_folder = tmp_path / "notes.txt"
+    not_a_folder.write_text("keep me\n")
+    result = run_scripted(tmp_path, "--out", not_a_folder)
+    assert_clean_error(result)
+    assert "notes.txt" in result.stderr and "not a folder" in result.stderr
+    assert not_a_folder.read_text() == "keep me\n"

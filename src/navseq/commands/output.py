@@ -6,6 +6,8 @@ import datetime
 import os
 from pathlib import Path
 
+from navseq.errors import NavseqError
+
 DEFAULT_ROOT = Path("navseq-out")
 
 
@@ -22,18 +24,25 @@ def create_run_folder(folder: Path, *, fresh: bool) -> Path:
     same second), use ``folder-2``, ``folder-3``, ... instead. Otherwise (``--out``)
     an existing folder is used as is; :func:`reserve_file` keeps its files safe.
     """
-    if not fresh:
-        folder.mkdir(parents=True, exist_ok=True)
-        return folder
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    candidate, number = folder, 1
-    while True:
-        try:
-            candidate.mkdir()
-            return candidate
-        except FileExistsError:
-            number += 1
-            candidate = folder.with_name(f"{folder.name}-{number}")
+    try:
+        if not fresh:
+            if folder.exists() and not folder.is_dir():
+                raise NavseqError("exists and is not a folder", source=f"output folder {folder}")
+            folder.mkdir(parents=True, exist_ok=True)
+            return folder
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        candidate, number = folder, 1
+        while True:
+            try:
+                candidate.mkdir()
+                return candidate
+            except FileExistsError:
+                number += 1
+                candidate = folder.with_name(f"{folder.name}-{number}")
+    except OSError as error:
+        raise NavseqError(
+            f"cannot create it: {error.strerror}", source=f"output folder {folder}"
+        ) from None
 
 
 def reserve_file(folder: Path, name: str) -> Path:
@@ -52,3 +61,7 @@ def reserve_file(folder: Path, name: str) -> Path:
         except FileExistsError:
             number += 1
             candidate = folder / f"{stem}-{number}{suffix}"
+        except OSError as error:
+            raise NavseqError(
+                f"cannot create it: {error.strerror}", source=str(candidate)
+            ) from None
