@@ -49,16 +49,6 @@ def parse_loops(text: str) -> int | None:
     return loops
 
 
-def existing_file(text: str) -> Path:
-    """A path that must exist as a file (checked here so the message names the argument)."""
-    path = Path(text)
-    if not path.exists():
-        raise argparse.ArgumentTypeError(f"no such file: {text}")
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a directory, not a file")
-    return path
-
-
 def format_pose(pose: Pose2D) -> str:
     return f"({pose.x:.2f}, {pose.y:.2f}, {math.degrees(pose.yaw):.0f}°)"
 

@@ -26,7 +26,6 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.progress import JsonProgress
     from navseq.sinks.recorder import RunRecorder
@@ -148,15 +147,28 @@ def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
 
 
 def _check_against_map(
-    mission: Mission, costmap: Costmap, start: Pose2D | None, enabled: bool
+    mission: Mission, grid: OccupancyGrid, start: Pose2D | None, enabled: bool
 ) -> None:
+    """Pre-flight: every problem of the mission on this map, raised together."""
     from navseq.commands.common import preflight_errors
     from navseq.errors import MissionErrors
+    from navseq.sim.costmap import Costmap
 
     if enabled:
-        problems = preflight_errors(mission, costmap, start)
+        problems = preflight_errors(mission, Costmap.from_grid(grid), start)
         if problems:
             raise MissionErrors(problems)
+
+
+def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyGrid | None:
+    """The map, if one is known, with the mission checked against it."""
+    from navseq.sim.occupancy import load_map
+
+    if setup["map_path"] is None:
+        return None
+    grid = load_map(setup["map_path"])
+    _check_against_map(setup["mission"], grid, setup["start"], not args.no_preflight)
+    return grid
 
 
 def prepare(args: argparse.Namespace) -> RunSetup:
@@ -200,7 +212,6 @@ def prepare(args: argparse.Namespace) -> RunSetup:
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.errors import NavseqError
     from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
     from navseq.sim.world import SimWorld, default_start
 
@@ -223,8 +234,7 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
         )
     # Pre-flight first: it lists every problem, where building the world would stop at
     # the first (a start pose inside an obstacle).
-    costmap = Costmap.from_grid(grid)
-    _check_against_map(mission, costmap, start, not args.no_preflight)
+    _check_against_map(mission, grid, start, not args.no_preflight)
     world = SimWorld(grid, start)
     return RunSetup(
         **setup,
@@ -236,16 +246,9 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
 
 def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.commands.common import costmap_for_map
-    from navseq.sim.occupancy import load_map
-
     mission: Mission = setup["mission"]
     frame = args.frame or mission.frame
-    grid = None
-    if setup["map_path"] is not None:
-        grid = load_map(setup["map_path"])
-        _check_against_map(mission, costmap_for_map(setup["map_path"]), setup["start"],
-                           not args.no_preflight)
+    grid = _optional_map(args, setup)
 
     def make_navigator() -> Navigator:
         from navseq.errors import NavseqError
@@ -293,14 +296,7 @@ def _prepare_scripted(args: argparse.Namespace, setup: dict[str, Any]) -> RunSet
     from navseq.navigators.scripted import ScriptedNavigator
 
     start: Pose2D | None = setup["start"]
-    grid = None
-    if setup["map_path"] is not None:
-        from navseq.commands.common import costmap_for_map
-        from navseq.sim.occupancy import load_map
-
-        grid = load_map(setup["map_path"])
-        _check_against_map(setup["mission"], costmap_for_map(setup["map_path"]), start,
-                           not args.no_preflight)
+    grid = _optional_map(args, setup)
 
     def make_navigator() -> Navigator:
         return ScriptedNavigator(
