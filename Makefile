@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml setup.py scripts/bootstrap
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/navseq run examples/turtlebot3_world.yaml --out navseq-out
+	$(VENV)/bin/navseq run examples/turtlebot3_world.yaml
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
