@@ -47,6 +47,13 @@ def start_node(master: RosMaster, **params: Any) -> RosProcess:
     return master.start_python("-m", "navseq.ros.navseq_node", label="navseq_node")
 
 
+def watch_status(master: RosMaster) -> RosProcess:
+    """``rostopic echo`` of the node's status, once it has printed the latched message."""
+    status = master.start(["rostopic", "echo", "/navseq/status"])
+    status.wait_for_output("data:", timeout=20)
+    return status
+
+
 def test_node_with_only_the_tutorial_params_completes_the_sequence(
     ros_master: RosMaster, tmp_path: Path
 ):
@@ -89,11 +96,14 @@ def test_signal_to_the_node_cancels_the_active_goal(
     start_server(ros_master, log, then="hang")
     node = start_node(ros_master)
     wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    status = watch_status(ros_master)
     node.send_signal(sig)
     assert node.wait(timeout=20) == code, node.output()
     cancels = events(log, "cancel")
     assert [c["id"] for c in cancels] == [events(log, "goal")[0]["id"]]
     assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"]
+    assert f"interrupted ({signal.Signals(sig).name})" in node.output()
+    wait_for(lambda: '\\"state\\": \\"interrupted\\"' in status.output(), 10, "status")
     assert "Traceback" not in node.output()
 
 
@@ -103,8 +113,44 @@ def test_rosnode_kill_cancels_the_active_goal(ros_master: RosMaster, tmp_path: P
     node = start_node(ros_master)
     wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
     ros_master.kill_node("/navseq")
-    node.wait(timeout=20)
+    assert node.wait(timeout=20) == 1, node.output()
     assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"], node.output()
+    # Said as an interruption with rospy's reason, not as a waypoint that failed.
+    output = node.output()
+    assert "interrupted (external shutdown request" in output, output
+    assert "killed by the test" in output and "PREEMPTED" not in output, output
+    assert "Traceback" not in output
+
+
+def test_skip_service_skips_a_hanging_goal_and_the_mission_goes_on(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, script="hang", then="succeed:0.3")
+    node = start_node(ros_master)
+    wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    status = watch_status(ros_master)
+    response = ros_master.call_service("/navseq/skip")
+    assert response["success"], response
+    assert "waypoint 1" in response["message"]
+    # Mission goes on, but not every waypoint was reached: exit status 1.
+    assert node.wait(timeout=60) == 1, node.output()
+    goals = [(g["x"], g["y"]) for g in events(log, "goal")]
+    assert goals == [(-1, -4), (1, -4), (1, -1)]
+    assert [d["status"] for d in events(log, "done")] == ["PREEMPTED", "SUCCEEDED", "SUCCEEDED"]
+    assert "waypoint 1 skipped (skipped by the operator (~skip))" in node.output()
+    wait_for(lambda: '\\"outcome\\": \\"skipped\\"' in status.output(), 10, "status")
+    assert "Traceback" not in node.output()
+
+
+def test_skip_service_refuses_when_no_waypoint_is_underway(ros_master: RosMaster):
+    # No action server: the node waits for one, so no waypoint is underway yet.
+    node = start_node(ros_master, server_wait=30)
+    ros_master.wait_for_service("/navseq/skip")
+    response = ros_master.call_service("/navseq/skip")
+    assert not response["success"] and "no waypoint" in response["message"], response
+    assert node.stop(signal.SIGINT) == 130
+    assert "interrupted (SIGINT)" in node.output() and "Traceback" not in node.output()
 
 
 def test_server_killed_mid_goal_and_restarted_mission_completes(

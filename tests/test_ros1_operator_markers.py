@@ -11,11 +11,13 @@ import threading
 
 import pytest
 
+from navseq.executor.events import MissionFinished, WaypointFinished
+from navseq.executor.runner import run_mission
 from navseq.geometry import Pose2D
 from navseq.mission import Mission, Waypoint
 from navseq.navigators.base import Goal, GoalDone, GoalStatus
 from navseq.navigators.scripted import Hang, ScriptedNavigator
-from navseq.ros.operator import OperatorCancel, OperatorNavigator
+from navseq.ros.operator import NodeShutdown, OperatorCancel, OperatorNavigator
 
 
 def request_and_poll(operator: OperatorNavigator, kind: str) -> tuple[bool, str, list]:
@@ -78,6 +80,28 @@ def test_events_pass_through_when_not_paused():
     assert [e.status for e in events if isinstance(e, GoalDone)] == [GoalStatus.SUCCEEDED]
 
 
+def test_a_shutdown_ends_the_mission_as_interrupted_not_as_a_preempted_waypoint():
+    """Like ``rosnode kill``: the goal is cancelled underneath, then the stop reason shows."""
+    inner = ScriptedNavigator([Hang()])
+    stop: list[str] = []
+
+    def stop_reason() -> str | None:
+        if inner.now() >= 2.0 and not stop:
+            inner.cancel_goal()  # what the navigator's own shutdown hook does first
+            stop.append("external shutdown request: killed")
+        return stop[0] if stop else None
+
+    seen: list = []
+    mission = Mission([Waypoint(3.0, 0.0, 0.0), Waypoint(0.0, 0.0, 0.0)])
+    operator = OperatorNavigator(inner, stop_reason=stop_reason)
+    with pytest.raises(NodeShutdown, match="killed"):
+        run_mission(mission, operator, [seen.append], tick=0.5)
+    finished = [e for e in seen if isinstance(e, WaypointFinished)]
+    assert [e.reason for e in finished] == [
+        "interrupted: NodeShutdown: external shutdown request: killed"
+    ]
+    assert isinstance(seen[-1], MissionFinished) and not seen[-1].success
+    assert seen[-1].reason.startswith("interrupted")
 
 
 def test_markers_show_every_waypoint_with_heading_number_and_status_colour():

@@ -17,10 +17,13 @@ action status before the server counts as lost, default 2), ``~base_frames``,
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
-and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``.
+and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``
+(the active waypoint ends SKIPPED and the mission goes on with the next one).
 Ctrl-C, SIGTERM, ``rosnode kill`` and roslaunch's shutdown all cancel the active goal
-before the node exits. Exit status: 0 all waypoints reached, 1 not, 2 bad parameters or
-no action server, 130/143 interrupted by SIGINT/SIGTERM.
+before the node exits, which logs ``interrupted (<signal or shutdown reason>)`` and
+publishes the state ``interrupted``. Exit status: 0 all waypoints reached, 1 not (also
+after ``rosnode kill``), 2 bad parameters or no action server, 130/143 interrupted by
+SIGINT/SIGTERM.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 from visualization_msgs.msg import MarkerArray
 
 from navseq.errors import NavseqError
+from navseq.executor.control import MissionControl
 from navseq.executor.events import (
     MissionEvent,
     MissionFinished,
@@ -45,12 +49,12 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.runner import MissionInterrupted, run_mission
+from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
-from navseq.navigators.ros1 import Ros1Navigator, ensure_node
+from navseq.navigators.ros1 import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros.markers import MarkerStatus, waypoint_markers
-from navseq.ros.operator import OperatorCancel, OperatorNavigator
+from navseq.ros.operator import NodeShutdown, OperatorCancel, OperatorNavigator
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -65,6 +69,9 @@ NODE_PARAMS: dict[str, Any] = {
     "tick": 0.1,
 }
 PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
+# s to wait for rospy to name its shutdown reason: it does so only after the navigator's
+# shutdown hook has waited (up to CANCEL_FLUSH) for the goal's cancel to go out.
+SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
 
 _OUTCOME_MARKERS = {
     WaypointOutcome.REACHED: MarkerStatus.REACHED,
@@ -84,6 +91,7 @@ class MissionTopics:
         self._marker_pub = rospy.Publisher("~waypoints", MarkerArray, queue_size=2, latch=True)
         self._last_progress = float("-inf")
         self._lock = threading.Lock()
+        self.active_waypoint: int | None = None  # 0-based index of the visit underway
         self.publish_markers()
         self.publish_status({"state": "waiting_for_server", "waypoints": len(mission)})
 
@@ -104,18 +112,74 @@ class MissionTopics:
                     # A new loop of a patrol: every waypoint is to come again.
                     self.statuses.clear()
                 self.statuses[event.index] = MarkerStatus.ACTIVE
+                self.active_waypoint = event.index
                 self.publish_markers()
             elif isinstance(event, WaypointFinished):
                 self.statuses[event.index] = _OUTCOME_MARKERS[event.outcome]
+                self.active_waypoint = None
                 self.publish_markers()
+            elif isinstance(event, MissionFinished):
+                self.active_waypoint = None
             fields = {"event": type(event).__name__, **asdict(event)}
-            fields["state"] = (
-                ("succeeded" if event.success else "failed")
-                if isinstance(event, MissionFinished)
-                else "running"
-            )
+            fields["state"] = _state(event)
             fields["waypoints"] = len(self.mission)
             self.publish_status(fields)
+
+
+def _state(event: MissionEvent) -> str:
+    """The ``state`` field of a status message: running, succeeded, failed or interrupted."""
+    if not isinstance(event, MissionFinished):
+        return "running"
+    if event.success:
+        return "succeeded"
+    # The runner's reason for a run ended from outside ("interrupted: SIGINT" ...).
+    return "interrupted" if event.reason.startswith("interrupted") else "failed"
+
+
+def log_waypoint_outcome(event: MissionEvent) -> None:
+    """A mission listener logging each waypoint not reached, with the reason.
+
+    The waypoint an interruption ends is left to the interruption's own log line.
+    """
+    if (
+        isinstance(event, WaypointFinished)
+        and event.outcome in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
+        and not event.reason.startswith("interrupted")
+    ):
+        rospy.logwarn(
+            "navseq: waypoint %d %s (%s)", event.index + 1, event.outcome.value, event.reason
+        )
+
+
+class ShutdownWatch:
+    """Tells the mission's thread that ROS is shutting the node down, and why.
+
+    On ``rosnode kill`` or a master shutdown, rospy runs its shutdown in the thread that
+    got the request: first the client hooks (the navigator's, which cancels the active
+    goal), then the pre-shutdown hooks, the only ones told the reason. The mission must
+    stop before that cancel comes back as a PREEMPTED (failed) waypoint, so a call looks
+    at rospy's "shutdown requested" flag, raised before any hook runs, and only then
+    waits (bounded) for the reason. (rospy has closed its connections by then: the
+    final status message no longer reaches anyone; the log line does.)
+    """
+
+    def __init__(self, reason_wait: float = SHUTDOWN_REASON_WAIT):
+        self._reason = "ROS shutdown"
+        self._reason_known = threading.Event()
+        self._reason_wait = reason_wait
+        rospy.core.add_preshutdown_hook(self._on_preshutdown)
+
+    def _on_preshutdown(self, reason: str) -> None:
+        if reason:
+            self._reason = reason
+        self._reason_known.set()
+
+    def __call__(self) -> str | None:
+        """None while the node runs on; the shutdown reason once ROS is stopping it."""
+        if not rospy.core.is_shutdown_requested():
+            return None
+        self._reason_known.wait(self._reason_wait)
+        return self._reason
 
 
 def read_params() -> tuple[Mission, dict[str, Any]]:
@@ -134,11 +198,18 @@ def _trigger_service(name: str, operator: OperatorNavigator) -> None:
     rospy.Service(f"~{name}", Trigger, handle)
 
 
-def _skip_unsupported(_request: Any) -> TriggerResponse:
-    return TriggerResponse(
-        success=False,
-        message="skip is not available yet: the mission executor has no skip hook",
-    )
+def _skip_service(topics: MissionTopics, control: MissionControl) -> None:
+    def handle(_request: Any) -> TriggerResponse:
+        index = topics.active_waypoint
+        if index is None:
+            # Filed now, the request would skip whichever waypoint comes next.
+            return TriggerResponse(success=False, message="no waypoint is underway")
+        control.request_skip("skipped by the operator (~skip)")
+        return TriggerResponse(
+            success=True, message=f"waypoint {index + 1} skipped; going on with the next one"
+        )
+
+    rospy.Service("~skip", Trigger, handle)
 
 
 def run_node() -> int:
@@ -156,37 +227,58 @@ def run_node() -> int:
         plan_topic=settings["plan_topic"] or None,
         use_tf=bool(settings["use_tf"]),
     )
-    operator = OperatorNavigator(navigator)
+    operator = OperatorNavigator(navigator, stop_reason=ShutdownWatch())
     topics = MissionTopics(mission)
+    control = MissionControl()
     for name in ("pause", "resume", "cancel"):
         _trigger_service(name, operator)
-    rospy.Service("~skip", Trigger, _skip_unsupported)
+    _skip_service(topics, control)
     try:
         rospy.loginfo(
             "navseq: %d waypoints from %s; waiting for %s",
             len(mission), mission.source, navigator.resolved_action,
         )
         navigator.require_server(float(settings["server_wait"]))
-        result = run_mission(mission, operator, [topics], tick=float(settings["tick"]))
+        result = run_mission(
+            mission,
+            operator,
+            [topics, log_waypoint_outcome],
+            tick=float(settings["tick"]),
+            control=control,
+        )
     except NavseqError as error:
         rospy.logerr("navseq: %s", error)
         topics.publish_status({"state": "error", "reason": str(error)})
         return 2
     except MissionInterrupted as interrupted:
-        rospy.logwarn("navseq: %s; the active goal was cancelled", interrupted)
+        _log_interrupted(interrupted.signal_name)
         return interrupted.exit_code
+    except KeyboardInterrupt:
+        # Ctrl-C while still waiting for the action server: no goal is out yet.
+        rospy.logwarn("navseq: interrupted (SIGINT) while waiting for the action server")
+        return SIGNAL_EXIT_CODES["SIGINT"]
+    except NodeShutdown as shutdown:
+        # rosnode kill / master shutdown: the navigator's shutdown hook cancelled the goal.
+        _log_interrupted(str(shutdown))
+        return 1
+    except rospy.ROSInterruptException:
+        # A shutdown seen first by rospy.sleep (simulated time), not by the poll.
+        _log_interrupted("ROS shutdown")
+        return 1
     except OperatorCancel as cancelled:
         rospy.logwarn("navseq: %s", cancelled)
         return 1
-    except rospy.ROSInterruptException:
-        # rosnode kill / master shutdown: the shutdown hook already cancelled the goal.
-        return 1
     finally:
         navigator.close()
-    rospy.loginfo(
-        "navseq: mission %s (%s)", "succeeded" if result.success else "failed", result.reason
-    )
+    if result.success:
+        rospy.loginfo("navseq: mission succeeded (%s)", result.reason)
+    else:
+        rospy.logwarn("navseq: mission ended without reaching every waypoint (%s)", result.reason)
     return result.exit_code
+
+
+def _log_interrupted(cause: str) -> None:
+    rospy.logwarn("navseq: interrupted (%s); the active goal was cancelled", cause)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -12,6 +12,10 @@ navigator and does it with the navigator interface alone:
 - **cancel** raises :class:`OperatorCancel` out of :meth:`poll`; the runner then cancels
   the active goal and ends the mission like any interruption.
 
+Besides the operator, the process around the mission may have to stop it (the ROS node
+being shut down): ``stop_reason`` is asked at every poll, and a reason it gives is
+raised as :class:`NodeShutdown` the same way.
+
 Requests come from any thread (:meth:`request`), are queued and applied on the
 executor's thread in :meth:`poll`; the caller waits (bounded) for the outcome.
 """
@@ -20,6 +24,7 @@ from __future__ import annotations
 
 import queue
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from navseq.geometry import Pose2D
@@ -40,6 +45,10 @@ class OperatorCancel(Exception):
     """The operator asked to end the mission (the ``~cancel`` service)."""
 
 
+class NodeShutdown(Exception):
+    """The process running the mission is being shut down; ``str()`` says why."""
+
+
 @dataclass
 class _Request:
     kind: str
@@ -49,10 +58,15 @@ class _Request:
 
 
 class OperatorNavigator:
-    """A :class:`~navseq.navigators.base.Navigator` that adds pause/resume/cancel to ``inner``."""
+    """A :class:`~navseq.navigators.base.Navigator` that adds pause/resume/cancel to ``inner``.
 
-    def __init__(self, inner: Navigator):
+    ``stop_reason``, if given, is called from :meth:`poll` and returns why the mission
+    must end now, or None to go on.
+    """
+
+    def __init__(self, inner: Navigator, stop_reason: Callable[[], str | None] | None = None):
         self.inner = inner
+        self._stop_reason = stop_reason
         self._requests: queue.SimpleQueue[_Request] = queue.SimpleQueue()
         self._active: Goal | None = None  # the goal the executor believes is out
         self._held: Goal | None = None  # while paused: the goal to send on resume
@@ -151,6 +165,12 @@ class OperatorNavigator:
             if isinstance(event, GoalDone) and active and event.goal_id == active.goal_id:
                 self._active = None
             events.append(event)
+        # Asked after taking the events: a shutdown is announced before it cancels the
+        # goal, so the PREEMPTED end that cancel causes is always dropped here, never
+        # passed on as a failed waypoint.
+        stop = self._stop_reason() if self._stop_reason is not None else None
+        if stop is not None:
+            raise NodeShutdown(stop)
         return events
 
     def spin(self, seconds: float) -> None:
