@@ -11,6 +11,7 @@ import pytest
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, normalize_angle
+from navseq.sim.costmap import Costmap, CostmapParams
 from navseq.sim.footprint import TURTLEBOT3_BURGER, footprint_collides
 from navseq.sim.navserver import NavState
 from navseq.sim.occupancy import OccupancyGrid, load_map
@@ -148,3 +149,26 @@ def test_no_collision_on_random_goals_on_generated_maps(seed: int) -> None:
     world = SimWorld(grid, default_start(grid))
     outcomes = drive_random_goals(world, goals=25, seed=100 + seed)
     assert outcomes[NavState.SUCCEEDED] >= 0.85 * 25
+
+
+def test_a_prebuilt_costmap_is_the_one_the_server_plans_on(arena: OccupancyGrid) -> None:
+    # Not the default parameters, so the world cannot have built an equal one itself.
+    costmap = Costmap.from_grid(arena, CostmapParams(inflation_radius=1.5))
+    world = SimWorld(arena, Pose2D(-2.0, -0.5, 0.0), costmap=costmap)
+    assert world.costmap is costmap and world.server.costmap is costmap
+    world.server.set_goal(Pose2D(1.6, -0.5, 0.0))
+    world.run(GOAL_TIME_LIMIT)
+    assert world.server.state is NavState.SUCCEEDED and world.collisions == 0
+
+
+def test_a_costmap_of_another_grid_is_refused(arena: OccupancyGrid) -> None:
+    other = load_map(MAP)  # same file, another grid object: not what the body moves on
+    with pytest.raises(ValueError, match="another grid"):
+        SimWorld(arena, Pose2D(-2.0, -0.5, 0.0), costmap=Costmap.from_grid(other))
+    with pytest.raises(ValueError, match="costmap_params"):
+        SimWorld(
+            arena,
+            Pose2D(-2.0, -0.5, 0.0),
+            costmap=Costmap.from_grid(arena),
+            costmap_params=CostmapParams(inflation_radius=0.5),
+        )

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
+    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.progress import JsonProgress
     from navseq.sinks.recorder import RunRecorder
@@ -146,28 +147,26 @@ def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
     }
 
 
-def _check_against_map(
-    mission: Mission, grid: OccupancyGrid, start: Pose2D | None, enabled: bool
-) -> None:
+def _check_against_map(mission: Mission, costmap: Costmap, start: Pose2D | None) -> None:
     """Pre-flight: every problem of the mission on this map, raised together."""
     from navseq.commands.common import preflight_errors
     from navseq.errors import MissionErrors
-    from navseq.sim.costmap import Costmap
 
-    if enabled:
-        problems = preflight_errors(mission, Costmap.from_grid(grid), start)
-        if problems:
-            raise MissionErrors(problems)
+    problems = preflight_errors(mission, costmap, start)
+    if problems:
+        raise MissionErrors(problems)
 
 
 def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyGrid | None:
     """The map, if one is known, with the mission checked against it."""
+    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
 
     if setup["map_path"] is None:
         return None
     grid = load_map(setup["map_path"])
-    _check_against_map(setup["mission"], grid, setup["start"], not args.no_preflight)
+    if not args.no_preflight:
+        _check_against_map(setup["mission"], Costmap.from_grid(grid), setup["start"])
     return grid
 
 
@@ -212,6 +211,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.errors import NavseqError
     from navseq.navigators.sim import SimNavigator
+    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
     from navseq.sim.world import SimWorld, default_start
 
@@ -232,10 +232,13 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
             f"no start pose given (--start or start:): the robot starts at "
             f"{format_pose(start)}, the roomy point nearest the map origin"
         )
+    # One costmap for pre-flight and the simulated navigation server alike.
+    costmap = Costmap.from_grid(grid)
     # Pre-flight first: it lists every problem, where building the world would stop at
     # the first (a start pose inside an obstacle).
-    _check_against_map(mission, grid, start, not args.no_preflight)
-    world = SimWorld(grid, start)
+    if not args.no_preflight:
+        _check_against_map(mission, costmap, start)
+    world = SimWorld(grid, start, costmap=costmap)
     return RunSetup(
         **setup,
         grid=grid,

@@ -21,7 +21,12 @@ from navseq.sim.robot import DiffDriveRobot
 
 
 class SimWorld:
-    """A map, a robot on it, its :class:`NavigationServer`, and simulated ``time`` (s)."""
+    """A map, a robot on it, its :class:`NavigationServer`, and simulated ``time`` (s).
+
+    The server's costmap is built from ``grid`` with ``costmap_params``, unless the
+    caller passes one already built on this very ``grid`` as ``costmap`` (inflating a
+    large map takes a while; the CLI's pre-flight check has one ready).
+    """
 
     def __init__(
         self,
@@ -32,13 +37,21 @@ class SimWorld:
         costmap_params: CostmapParams | None = None,
         nav_params: NavParams | None = None,
         footprint: Footprint = TURTLEBOT3_BURGER,
+        costmap: Costmap | None = None,
     ) -> None:
         if not dt > 0:
             raise ValueError(f"dt must be positive, got {dt}")
+        if costmap is not None:
+            # Grids compare by identity; a costmap of another grid would let the server
+            # plan on one map while the body collides on another.
+            if costmap.grid is not grid:
+                raise ValueError("costmap was built on another grid than the world's")
+            if costmap_params is not None and costmap_params != costmap.params:
+                raise ValueError("costmap_params differ from the given costmap's params")
         self.grid = grid
         self.dt = dt
         self.footprint = footprint
-        self.costmap = Costmap.from_grid(grid, costmap_params)
+        self.costmap = costmap if costmap is not None else Costmap.from_grid(grid, costmap_params)
         self.server = NavigationServer(self.costmap, nav_params, footprint)
         self.robot = DiffDriveRobot(start, self.server.params.limits)
         self.time = 0.0
