@@ -189,6 +189,7 @@ def start_client(
     namespace: str = "",
     label: str = "sim_client",
 ) -> RosProcess:
+    tmp_path.mkdir(parents=True, exist_ok=True)
     script = tmp_path / "sim_client.py"
     script.write_text(CLIENT)
     base_frame = f"{namespace}/base_footprint" if namespace else "base_footprint"

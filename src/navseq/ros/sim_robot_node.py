@@ -17,7 +17,10 @@ Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
 - publishes ``odom`` (``nav_msgs/Odometry``) and the TF chain
   ``map -> odom -> base_footprint`` at every step;
 - publishes ``/clock`` when ``/use_sim_time`` is true, running ``~speed`` times faster
-  than the wall clock (1.0 = real time, for RViz; tests use 5-10);
+  than the wall clock (1.0 = real time, for RViz; tests use 5-10). With several robots
+  exactly one node drives the clock; the others get ``~publish_clock: false`` and step
+  with the ROS time it publishes;
+- publishes ``footprint`` (``geometry_msgs/PolygonStamped``, base frame) at 5 Hz for RViz;
 - publishes ``map`` (``nav_msgs/OccupancyGrid``, latched) loaded from ``~map`` (a
   map_server YAML) when ``~publish_map`` is true. Without ``~map`` the node takes the
   map for its collision checks from the ``map`` topic instead (e.g. a real map_server).
