@@ -3,7 +3,9 @@
 rospy allows one node per process, so the navigator runs in a subprocess: this file is
 also that subprocess's program (``python tests/test_ros1_navigator.py drive ...``). The
 driver sends goals one after the other, prints every navigator event as a JSON line, and
-resends the active goal after ``ServerBack`` like the executor does.
+resends the active goal after ``ServerBack`` like the executor does. Two more programs
+test ``spin`` under ``use_sim_time``: ``clock`` publishes a simulation clock, and
+``spin-sim`` spins on it.
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ def _drive(argv: list[str]) -> int:
     parser.add_argument("--clear-costmaps", action="store_true")
     parser.add_argument("--server-wait", type=float, default=10.0)
     parser.add_argument("--goal-timeout", type=float, default=30.0)
+    parser.add_argument("--spin", type=float, default=0.02, help="s of ROS time per spin")
     args = parser.parse_args(argv)
     goals = [tuple(float(v) for v in item.split(",")) for item in args.goals.split(";")]
 
@@ -72,8 +75,12 @@ def _drive(argv: list[str]) -> int:
         started = time.monotonic()
         acted = False
         done = False
+        spun_for: float | None = None  # ROS time the last spin took, until reported
         while not done:
-            for event in navigator.poll():
+            events = navigator.poll()
+            if spun_for is not None:
+                _emit({"type": "spun", "ros_seconds": spun_for, "then_polled": len(events)})
+            for event in events:
                 record = {"type": type(event).__name__, **vars(event)}
                 record.pop("pose", None)
                 if "status" in record:
@@ -100,15 +107,69 @@ def _drive(argv: list[str]) -> int:
             if elapsed > args.goal_timeout:
                 _emit({"type": "driver_timeout", "goal_id": goal.goal_id})
                 return 1
-            navigator.spin(0.02)
+            if not done:
+                spin_began = navigator.now()
+                navigator.spin(args.spin)
+                spun_for = navigator.now() - spin_began
     pose = navigator.robot_pose()
     _emit({"type": "final_pose", "x": pose.x if pose else None, "y": pose.y if pose else None})
     navigator.close()
     return 0
 
 
+def _publish_clock(argv: list[str]) -> int:
+    """Publish /clock from ``--start`` s on, running ``--speed`` times the wall clock."""
+    import time
+
+    import rospy
+    from rosgraph_msgs.msg import Clock
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--start", type=float, default=100.0)
+    parser.add_argument("--speed", type=float, required=True)
+    args = parser.parse_args(argv)
+    rospy.init_node("test_clock", disable_signals=True)
+    publisher = rospy.Publisher("/clock", Clock, queue_size=1)
+    began = time.monotonic()
+    while not rospy.core.is_shutdown_requested():
+        clock = Clock()
+        clock.clock = rospy.Time.from_sec(args.start + args.speed * (time.monotonic() - began))
+        publisher.publish(clock)
+        time.sleep(0.01)
+    return 0
+
+
+def _spin_on_sim_time(argv: list[str]) -> int:
+    """Wait for the simulation clock, spin once with no goal, report both clocks."""
+    import time
+
+    from navseq.navigators.ros1 import Ros1Navigator
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seconds", type=float, required=True)
+    args = parser.parse_args(argv)
+    navigator = Ros1Navigator(use_tf=False, plan_topic=None)
+    deadline = time.monotonic() + 20.0
+    while navigator.now() == 0.0 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    ros_began, wall_began = navigator.now(), time.monotonic()
+    navigator.spin(args.seconds)
+    _emit(
+        {
+            "type": "spun",
+            "ros_began": ros_began,
+            "ros_seconds": navigator.now() - ros_began,
+            "wall_seconds": time.monotonic() - wall_began,
+        }
+    )
+    return 0
+
+
+PROGRAMS = {"drive": _drive, "clock": _publish_clock, "spin-sim": _spin_on_sim_time}
+
 if __name__ == "__main__":
-    sys.exit(_drive(sys.argv[2:]) if sys.argv[1:2] == ["drive"] else 64)
+    program = PROGRAMS.get(sys.argv[1] if len(sys.argv) > 1 else "")
+    sys.exit(program(sys.argv[2:]) if program else 64)
 
 
 # ---------------------------------------------------------------------------------------
@@ -244,3 +305,36 @@ def test_namespaced_action_and_clear_costmaps(ros_master: RosMaster, tmp_path: P
     assert code == 0, driver.output()
     assert done_statuses(events_of(driver)) == {1: "SUCCEEDED"}
     assert [r["event"] for r in server_log(log)].count("clear_costmaps") == 1
+
+
+def test_spin_returns_as_soon_as_the_server_reports(ros_master: RosMaster, tmp_path: Path):
+    # Spins of 30 s of ROS time, each cut short by the goal's acceptance, feedback and
+    # result: the executor answers a result with the next goal at once, not after its
+    # tick. A spin that slept its full time would show here as a 30 s spin.
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "succeed:0.5 succeed:0.5")
+    code, driver = drive(
+        ros_master, "--goals", "1,0,0;2,0,0", "--spin", "30", "--goal-timeout", "60",
+        timeout=150,
+    )
+    assert code == 0, driver.output()
+    events = events_of(driver)
+    assert done_statuses(events) == {1: "SUCCEEDED", 2: "SUCCEEDED"}
+    spins = [e for e in events if e["type"] == "spun"]
+    assert spins, driver.output()
+    assert all(spin["ros_seconds"] < 30.0 for spin in spins), spins
+    # Each spin ended because there was news, never with nothing to report.
+    assert all(spin["then_polled"] >= 1 for spin in spins), spins
+
+
+def test_spin_waits_on_the_simulation_clock(ros_master: RosMaster):
+    # A clock at half the wall clock's speed: one second of ROS time takes two of wall
+    # time, and spin must wait for the ROS second, not the wall second.
+    ros_master.set_param("/use_sim_time", True)
+    ros_master.start_python(THIS, "clock", "--speed", "0.5", label="clock")
+    ros_master.wait_for_publisher("/clock", timeout=20)
+    spinner = ros_master.start_python(THIS, "spin-sim", "--seconds", "1.0", label="spinner")
+    assert spinner.wait(timeout=60) == 0, spinner.output()
+    (spun,) = [e for e in events_of(spinner) if e["type"] == "spun"]
+    assert spun["ros_began"] >= 100.0  # simulation time, not wall time
+    assert spun["ros_seconds"] >= 1.0

@@ -16,13 +16,16 @@ How it stays out of actionlib's traps:
   publishes again *and* has connected to our goal and cancel topics (so the resent goal
   cannot vanish in transit).
 
-Time: :meth:`now` is ROS time and :meth:`spin` sleeps on ROS time, so under
-``use_sim_time`` the executor's timeouts run on the simulation clock. Goals are stamped
-with ``rospy.Time.now()`` (``stamp="now"``, what RViz does); ``stamp="latest"`` stamps
-them with time zero, which tells move_base to use the latest transform when the goal
-frame differs from its global frame — safer when TF lags behind the clock (it avoids
-"extrapolation into the future" errors). Before ``/clock`` arrives, ROS time is zero and
-both are the same.
+Time: :meth:`now` is ROS time and :meth:`spin` waits on ROS time, so under
+``use_sim_time`` the executor's timeouts run on the simulation clock. :meth:`spin`
+returns early as soon as a callback queues an event (or the server is lost or back):
+the executor answers a result with the next goal at once, not at the end of its tick.
+
+Goals are stamped with ``rospy.Time.now()`` (``stamp="now"``, what RViz does);
+``stamp="latest"`` stamps them with time zero, which tells move_base to use the latest
+transform when the goal frame differs from its global frame — safer when TF lags behind
+the clock (it avoids "extrapolation into the future" errors). Before ``/clock`` arrives,
+ROS time is zero and both are the same.
 
 Robot pose: from TF (``frame`` -> the first of ``base_frames`` that resolves) when
 available, else from the goal feedback's ``base_position``.
@@ -33,7 +36,7 @@ from __future__ import annotations
 import queue
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Literal
 
 import actionlib
@@ -43,6 +46,7 @@ import rospy
 from actionlib.action_client import CommState
 from move_base_msgs.msg import MoveBaseAction
 from nav_msgs.msg import Path as PathMsg
+from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
 from navseq.errors import NavseqError
@@ -64,6 +68,8 @@ from navseq.ros.conversions import terminal_status as terminal_status_of
 DEFAULT_NODE_NAME = "navseq"
 MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up
 CANCEL_FLUSH = 1.0  # s of wall time to let a cancel reach the server when closing
+# Longest wall-time wait in spin() between looks at the clock, the server and shutdown.
+SPIN_SLICE = 0.1
 
 
 def ensure_node(name: str = DEFAULT_NODE_NAME, *, anonymous: bool = True) -> None:
@@ -90,15 +96,20 @@ def ensure_node(name: str = DEFAULT_NODE_NAME, *, anonymous: bool = True) -> Non
 
 
 class _TimedActionClient(actionlib.ActionClient):
-    """actionlib's ActionClient that also remembers when the server last spoke."""
+    """actionlib's ActionClient that also remembers when the server last spoke.
 
-    def __init__(self, ns: str, spec: Any):
+    ``on_status`` is called (on a rospy thread) after every status message.
+    """
+
+    def __init__(self, ns: str, spec: Any, on_status: Callable[[], None]):
         self.last_status_wall: float | None = None
+        self._on_status = on_status  # set before super(): its subscribers start at once
         super().__init__(ns, spec)
 
     def _status_cb(self, msg: Any) -> None:
         self.last_status_wall = time.monotonic()
         super()._status_cb(msg)
+        self._on_status()
 
     def server_connected(self) -> bool:
         """The server we last heard from is connected to our goal and cancel topics.
@@ -150,8 +161,10 @@ class Ros1Navigator:
         self.status_timeout = status_timeout
 
         self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
+        # Set after an event is queued (and on anything else spin() must look at); the
+        # queue itself, not this flag, says whether an event is waiting.
+        self._wake = threading.Event()
         self._lock = threading.Lock()
-        self._client = _TimedActionClient(self.action, MoveBaseAction)
         self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
         self._goal_id: int | None = None
         self._send_seq = 0  # increases with every goal sent; identifies the tracked one
@@ -160,6 +173,8 @@ class Ros1Navigator:
         self._feedback_pose: Pose2D | None = None
         self._closed = False
         self._clear_costmaps_warned = False
+        # Created after the state its callbacks read: they may run at once.
+        self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
         self._plan_sub = None
         if plan_topic:
@@ -173,6 +188,11 @@ class Ros1Navigator:
 
             self._tf_buffer = tf2_ros.Buffer()
             self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        self._clock_sub = None
+        if not rospy.rostime.is_wallclock():
+            # Under use_sim_time, each /clock message wakes spin() to look at the time:
+            # a wall-time slice would overshoot a short wait on a fast simulation clock.
+            self._clock_sub = rospy.Subscriber("/clock", Clock, self._on_clock)
         rospy.on_shutdown(self._on_rospy_shutdown)
 
     # -- Navigator protocol -----------------------------------------------------------
@@ -181,7 +201,32 @@ class Ros1Navigator:
         return rospy.get_time()
 
     def spin(self, seconds: float) -> None:
-        rospy.sleep(seconds)
+        """Wait until ``seconds`` of ROS time have passed or :meth:`poll` has news.
+
+        News is an event queued by an actionlib callback, or the server lost or back.
+        Like ``rospy.sleep``: under ``use_sim_time`` the wait is on the simulation clock
+        and, while the clock has not started (time zero), lasts until ``seconds`` after
+        it starts; raises ``rospy.ROSInterruptException`` on ROS shutdown and
+        ``ROSTimeMovedBackwardsException`` when ROS time jumps back.
+        """
+        start = rospy.get_time()
+        while not self._has_news():
+            now = rospy.get_time()
+            if start == 0.0:
+                start = now  # the simulation clock has not started: wait from when it does
+            elif now < start:
+                raise rospy.exceptions.ROSTimeMovedBackwardsException(start - now)
+            elif now - start >= seconds:
+                return
+            if rospy.is_shutdown():
+                raise rospy.ROSInterruptException("ROS shutdown request")
+            wait = SPIN_SLICE
+            if self._clock_sub is None:
+                wait = min(wait, start + seconds - now)  # wall clock: ROS time is wall time
+            self._wake.wait(wait)
+            # Clear before looking at the queue again: an event queued from here on sets
+            # the flag anew, one queued before is seen by _has_news().
+            self._wake.clear()
 
     def wait_for_server(self, timeout: float) -> bool:
         deadline = time.monotonic() + timeout
@@ -277,7 +322,23 @@ class Ros1Navigator:
         self.cancel_goal()
         self._wait_cancel_delivered(CANCEL_FLUSH)
 
+    def _has_news(self) -> bool:
+        """:meth:`poll` has something to report: a queued event, or the server lost or back."""
+        return not self._events.empty() or self._server_news()
+
+    def _queue(self, event: NavEvent) -> None:
+        self._events.put(event)
+        self._wake.set()  # after the put, so that a woken spin() finds the event
+
     # -- server liveness ---------------------------------------------------------------
+
+    def _server_news(self) -> bool:
+        """:meth:`_check_server` would report ServerLost or ServerBack now."""
+        if self._server_up is None:
+            return False
+        if self._server_up:
+            return not self._status_fresh()
+        return self._server_ready()
 
     def _status_fresh(self) -> bool:
         last = self._client.last_status_wall
@@ -316,14 +377,14 @@ class Ros1Navigator:
             # PENDING only means the server received it; ACTIVE means it took it on.
             if state == CommState.ACTIVE and not self._accepted:
                 self._accepted = True
-                self._events.put(GoalAccepted(goal_id))
+                self._queue(GoalAccepted(goal_id))
             elif state == CommState.DONE:
                 status = terminal_status_of(handle.get_goal_status()) or GoalStatus.LOST
                 if status is GoalStatus.LOST:
                     # The server forgot the goal (e.g. restarted quickly): let poll()
                     # announce ServerBack once it is ready, so the executor resends.
                     self._server_up = False
-                self._events.put(GoalDone(goal_id, status, handle.get_goal_status_text()))
+                self._queue(GoalDone(goal_id, status, handle.get_goal_status_text()))
                 self._handle = None
                 self._goal_id = None
 
@@ -331,16 +392,24 @@ class Ros1Navigator:
         pose = pose2d_from_pose(feedback.base_position.pose)
         self._feedback_pose = pose
         if seq == self._send_seq and self._goal_id is not None:
-            self._events.put(GoalFeedback(goal_id, pose))
+            self._queue(GoalFeedback(goal_id, pose))
 
     def _on_plan(self, path: Any) -> None:
         goal_id = self._goal_id
         if goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in path.poses)
-        self._events.put(GoalPlan(goal_id, points))
+        self._queue(GoalPlan(goal_id, points))
+
+    def _on_status(self) -> None:
+        if self._server_up is False:
+            self._wake.set()  # the server may be back: let spin() check
+
+    def _on_clock(self, _clock: Any) -> None:
+        self._wake.set()  # ROS time moved: let spin() check its deadline
 
     def _on_rospy_shutdown(self) -> None:
+        self._wake.set()
         # Runs before rospy closes its publishers (rosnode kill, signal_shutdown), so
         # the cancel still goes out and the robot does not drive on without us.
         self.cancel_goal()
