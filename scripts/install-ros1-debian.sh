@@ -8,6 +8,9 @@ packages=(
   python3-geometry-msgs python3-visualization-msgs python3-std-srvs python3-tf2-msgs
   python3-tf2-ros python3-rosmaster python3-roslaunch python3-rosparam python3-rostopic
   rosbash catkin python3-venv
+  # What the nodes import besides ROS, for catkin installs run by /usr/bin/python3
+  # (a venv has its own copies from PyPI).
+  python3-numpy python3-scipy python3-pil python3-yaml
 )
 missing=()
 for p in "${packages[@]}"; do
