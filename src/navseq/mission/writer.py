@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import math
 import os
-import secrets
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from navseq.errors import NavseqError
+from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
@@ -92,37 +92,13 @@ def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: boo
     if target.exists() and not overwrite:
         raise NavseqError("exists already; not overwriting it", source=source)
     text = dump_mission_yaml(mission, base_dir=target.parent.resolve())
-    temporary = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp"
     try:
-        # O_EXCL: never follow or reuse someone else's file; the mode honours the umask.
-        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        if overwrite:
-            os.replace(temporary, target)
-        else:
-            _publish_without_replacing(temporary, target)
+        write_atomically(target, text, replace=overwrite)
     except FileExistsError:
         raise NavseqError("exists already; not overwriting it", source=source) from None
     except OSError as error:
         raise NavseqError(f"cannot be written: {error.strerror or error}",
                           source=source) from None
-    finally:
-        temporary.unlink(missing_ok=True)
-
-
-def _publish_without_replacing(temporary: Path, target: Path) -> None:
-    """Give the finished file its name unless that name appeared meanwhile."""
-    try:
-        os.link(temporary, target)  # fails if target exists: no check-then-write race
-    except FileExistsError:
-        raise
-    except OSError:  # file systems without hard links
-        if target.exists():
-            raise FileExistsError(str(target)) from None
-        os.replace(temporary, target)
 
 
 def yaw_degrees_for_file(yaw: float) -> float | int:

@@ -13,9 +13,8 @@ Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display need
 
 from __future__ import annotations
 
+import io
 import math
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +24,7 @@ import numpy as np
 
 from navseq.executor.events import WaypointOutcome
 from navseq.executor.result import MissionResult
+from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 
@@ -100,13 +100,6 @@ class Box:
             min(self.xmax, other.xmax),
             min(self.ymax, other.ymax),
         )
-
-
-def _new_file_mode() -> int:
-    """Permissions of an ordinary new file under the current umask (mkstemp uses 0600)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
 
 
 def waypoint_outcomes(result: MissionResult, count: int) -> list[WaypointOutcome]:
@@ -266,17 +259,11 @@ def draw_mission_picture(
         interrupted=interrupted,
         dpi=dpi,
     )
+    png = io.BytesIO()
+    # "tight" keeps the legend and axis labels that sit outside the axes.
+    fig.savefig(png, format="png", bbox_inches="tight", pad_inches=0.15)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        os.chmod(tmp_name, _new_file_mode())
-        # "tight" keeps the legend and axis labels that sit outside the axes.
-        fig.savefig(tmp_name, format="png", bbox_inches="tight", pad_inches=0.15)
-        os.replace(tmp_name, path)
-    except BaseException:
-        Path(tmp_name).unlink(missing_ok=True)
-        raise
+    write_atomically(path, png.getvalue())
 
 
 def mission_figure(

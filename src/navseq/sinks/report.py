@@ -31,8 +31,6 @@ from __future__ import annotations
 import datetime
 import json
 import math
-import os
-import tempfile
 from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
@@ -41,6 +39,7 @@ from typing import Any
 from navseq import __version__
 from navseq.executor.events import WaypointOutcome
 from navseq.executor.result import MissionResult, WaypointResult
+from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 
@@ -126,14 +125,4 @@ def write_report(report: Mapping[str, Any], path: Path) -> None:
     """Write ``report`` as indented JSON, atomically (a temp file renamed into place)."""
     text = json.dumps(report, indent=2, ensure_ascii=False) + "\n"
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes 0600; a report is an ordinary file
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp_name, path)
-    except BaseException:
-        Path(tmp_name).unlink(missing_ok=True)
-        raise
+    write_atomically(path, text)
