@@ -5,6 +5,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from navseq.geometry import (
+    Pose2D,
+    compose,
+    inverse,
     normalize_angle,
     quaternion_to_yaw,
     yaw_degrees_to_quaternion,
@@ -42,3 +45,26 @@ def test_round_trip_is_exact_to_1e9(yaw):
 def test_normalize_angle_range():
     assert normalize_angle(math.pi) == pytest.approx(-math.pi)
     assert normalize_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
+
+
+def test_compose_places_a_pose_given_in_a_rotated_frame():
+    # A frame at (1, 2) turned 90 degrees left: its +x axis is the parent's +y.
+    frame = Pose2D(1.0, 2.0, math.pi / 2)
+    placed = compose(frame, Pose2D(3.0, 0.5, math.pi / 4))
+    assert (placed.x, placed.y, placed.yaw) == pytest.approx((0.5, 5.0, 3 * math.pi / 4))
+
+
+poses = st.builds(
+    Pose2D,
+    st.floats(min_value=-100, max_value=100),
+    st.floats(min_value=-100, max_value=100),
+    st.floats(min_value=-math.pi, max_value=math.pi),
+)
+
+
+@given(poses)
+def test_a_pose_composed_with_its_inverse_is_the_identity(pose):
+    for result in (compose(pose, inverse(pose)), compose(inverse(pose), pose)):
+        assert result.x == pytest.approx(0.0, abs=1e-9)
+        assert result.y == pytest.approx(0.0, abs=1e-9)
+        assert abs(normalize_angle(result.yaw)) < 1e-9

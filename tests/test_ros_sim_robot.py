@@ -1,4 +1,8 @@
-"""The sim robot node's body and its map messages, without a rosmaster (fast)."""
+"""The sim robot node's body and its map messages, without a rosmaster (fast).
+
+The body (:class:`navseq.sim.base.SimulatedBase`) is free of ROS, so its tests run
+everywhere; only the map message tests need rospy and carry the ``ros`` marker.
+"""
 
 from __future__ import annotations
 
@@ -7,13 +11,10 @@ import math
 import numpy as np
 import pytest
 
-from navseq.geometry import Pose2D
-
-pytestmark = pytest.mark.ros
-
-sim_robot_node = pytest.importorskip("navseq.ros.sim_robot_node", reason="rospy not importable")
-SimulatedBase = sim_robot_node.SimulatedBase
-OccupancyGrid = pytest.importorskip("navseq.sim.occupancy").OccupancyGrid
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D, compose
+from navseq.sim.base import SimulatedBase
+from navseq.sim.occupancy import OccupancyGrid
 
 
 def corridor() -> OccupancyGrid:
@@ -61,7 +62,7 @@ def test_teleport_moves_the_robot_and_keeps_odometry_continuous():
     assert base.odom_pose.y == pytest.approx(odom_before.y)
     assert base.odom_pose.yaw == pytest.approx(odom_before.yaw)
     # map -> odom -> base still composes to the true pose.
-    again = sim_robot_node.compose(base.map_to_odom, base.odom_pose)
+    again = compose(base.map_to_odom, base.odom_pose)
     assert (again.x, again.y, again.yaw) == pytest.approx((2.0, 0.5, math.pi / 2))
 
 
@@ -71,21 +72,30 @@ def test_teleport_into_the_wall_is_refused():
     assert base.pose == Pose2D(1.0, 1.0, 0.0)
 
 
+def ros_conversions():
+    """:mod:`navseq.ros.conversions`, or a skip where rospy cannot be imported."""
+    return pytest.importorskip("navseq.ros.conversions", reason="rospy not importable")
+
+
+@pytest.mark.ros
 def test_map_message_round_trip_keeps_cells_resolution_and_origin():
+    conversions = ros_conversions()
     grid = corridor()
     grid = OccupancyGrid(
         data=grid.data, resolution=0.05, origin=Pose2D(-1.0, 2.0, 0.3), source="test"
     )
-    msg = sim_robot_node.grid_to_msg(grid, "map", sim_robot_node.rospy.Time(0))
+    msg = conversions.grid_to_msg(grid, "map", conversions.rospy.Time(0))
     assert (msg.info.width, msg.info.height) == (80, 40)
-    back = sim_robot_node.grid_from_msg(msg, source="topic /map")
+    back = conversions.grid_from_msg(msg, source="topic /map")
     assert np.array_equal(back.data, grid.data)
     assert back.resolution == pytest.approx(0.05)
     assert (back.origin.x, back.origin.y, back.origin.yaw) == pytest.approx((-1.0, 2.0, 0.3))
 
 
+@pytest.mark.ros
 def test_a_truncated_map_message_is_a_clear_error():
-    msg = sim_robot_node.grid_to_msg(corridor(), "map", sim_robot_node.rospy.Time(0))
+    conversions = ros_conversions()
+    msg = conversions.grid_to_msg(corridor(), "map", conversions.rospy.Time(0))
     msg.data = msg.data[:-1]
-    with pytest.raises(sim_robot_node.NavseqError, match="80 x 40 cells but carries 3199"):
-        sim_robot_node.grid_from_msg(msg, source="topic /map")
+    with pytest.raises(NavseqError, match="80 x 40 cells but carries 3199"):
+        conversions.grid_from_msg(msg, source="topic /map")

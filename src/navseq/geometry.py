@@ -37,3 +37,27 @@ def quaternion_to_yaw(x: float, y: float, z: float, w: float) -> float:
 def yaw_degrees_to_quaternion(degrees: float) -> tuple[float, float, float, float]:
     """The tutorial's conversion: yaw in degrees to quaternion (x, y, z, w)."""
     return yaw_to_quaternion(math.radians(degrees))
+
+
+def compose(a: Pose2D, b: Pose2D) -> Pose2D:
+    """The pose ``b`` (expressed in frame ``a``) expressed in ``a``'s parent frame.
+
+    This is how TF chains planar transforms: ``compose(map_to_odom, odom_to_base)`` is
+    the robot's pose in the map.
+    """
+    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
+    return Pose2D(
+        a.x + cos_a * b.x - sin_a * b.y,
+        a.y + sin_a * b.x + cos_a * b.y,
+        normalize_angle(a.yaw + b.yaw),
+    )
+
+
+def inverse(a: Pose2D) -> Pose2D:
+    """The pose ``p`` with ``compose(a, p)`` = identity (the parent frame seen from ``a``)."""
+    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
+    return Pose2D(
+        -cos_a * a.x - sin_a * a.y,
+        sin_a * a.x - cos_a * a.y,
+        normalize_angle(-a.yaw),
+    )

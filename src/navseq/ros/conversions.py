@@ -9,13 +9,17 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import rospy
 from actionlib_msgs.msg import GoalStatus as GoalStatusMsg
 from geometry_msgs.msg import Pose, PoseStamped, Quaternion, TransformStamped
 from move_base_msgs.msg import MoveBaseGoal
+from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 
+from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, quaternion_to_yaw, yaw_to_quaternion
 from navseq.navigators.base import GoalStatus
+from navseq.sim.occupancy import OccupancyGrid
 
 # actionlib_msgs/GoalStatus values that end a goal, and what the executor calls them.
 TERMINAL_STATUSES: dict[int, GoalStatus] = {
@@ -47,10 +51,12 @@ def yaw_of(orientation: Any) -> float:
 
 
 def pose2d_from_pose(pose: Pose) -> Pose2D:
-    return Pose2D(pose.position.x, pose.position.y, yaw_of(pose.orientation))
+    """A planar pose from a ``geometry_msgs/Pose`` (z, roll and pitch are ignored)."""
+    return Pose2D(float(pose.position.x), float(pose.position.y), yaw_of(pose.orientation))
 
 
 def pose_from_pose2d(pose: Pose2D, z: float = 0.0) -> Pose:
+    """A ``geometry_msgs/Pose`` at ``pose`` (height ``z``), yaw as a quaternion."""
     message = Pose()
     message.position.x = pose.x
     message.position.y = pose.y
@@ -73,8 +79,9 @@ def move_base_goal(pose: Pose2D, frame: str, stamp: rospy.Time, z: float = 0.0) 
 
 
 def pose2d_from_transform(transform: TransformStamped) -> Pose2D:
+    """Where a planar ``TransformStamped`` puts its child frame in its parent frame."""
     t = transform.transform
-    return Pose2D(t.translation.x, t.translation.y, yaw_of(t.rotation))
+    return Pose2D(float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
 
 
 def transform_stamped(
@@ -90,3 +97,34 @@ def transform_stamped(
     message.transform.rotation = quaternion_msg(pose.yaw)
     return message
 
+
+
+def grid_to_msg(grid: OccupancyGrid, frame_id: str, stamp: rospy.Time) -> OccupancyGridMsg:
+    """A ``nav_msgs/OccupancyGrid`` with the same cells (both use row 0 = bottom)."""
+    msg = OccupancyGridMsg()
+    msg.header.frame_id = frame_id
+    msg.header.stamp = stamp
+    msg.info.map_load_time = stamp
+    msg.info.resolution = grid.resolution
+    msg.info.width = grid.width
+    msg.info.height = grid.height
+    msg.info.origin = pose_from_pose2d(grid.origin)
+    msg.data = grid.data.astype(np.int8).ravel().tolist()
+    return msg
+
+
+def grid_from_msg(msg: OccupancyGridMsg, source: str) -> OccupancyGrid:
+    """navseq's grid from a ``nav_msgs/OccupancyGrid``; ``source`` names it in messages."""
+    width, height = int(msg.info.width), int(msg.info.height)
+    if width <= 0 or height <= 0 or len(msg.data) != width * height:
+        raise NavseqError(
+            f"map message is {width} x {height} cells but carries {len(msg.data)} values",
+            source=source,
+        )
+    data = np.asarray(msg.data, dtype=np.int8).reshape(height, width)
+    return OccupancyGrid(
+        data=data,
+        resolution=float(msg.info.resolution),
+        origin=pose2d_from_pose(msg.info.origin),
+        source=source,
+    )

@@ -58,17 +58,15 @@ from nav_msgs.srv import GetPlan, GetPlanRequest, GetPlanResponse
 from std_srvs.srv import Empty, EmptyRequest, EmptyResponse
 
 from navseq.errors import NavseqError
-from navseq.geometry import Pose2D, quaternion_to_yaw
-from navseq.ros.sim_robot_node import (
-    bool_param,
-    compose,
-    fill_pose_msg,
-    float_param,
+from navseq.geometry import Pose2D, compose
+from navseq.ros.conversions import (
     grid_from_msg,
     grid_to_msg,
-    pose_from_msg,
-    str_param,
+    pose2d_from_pose,
+    pose2d_from_transform,
+    pose_from_pose2d,
 )
+from navseq.ros.params import bool_param, float_param, param_error, str_param
 from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap, CostmapParams
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid, load_map
@@ -114,7 +112,7 @@ def plan_to_path(plan: Plan | None, goal: Pose2D | None, frame: str, stamp: rosp
             yaw = 0.0
         pose = PoseStamped()
         pose.header = path.header
-        fill_pose_msg(pose.pose, Pose2D(float(x), float(y), yaw))
+        pose.pose = pose_from_pose2d(Pose2D(float(x), float(y), yaw))
         path.poses.append(pose)
     return path
 
@@ -162,10 +160,7 @@ class NavNodeConfig:
         )
         for name in ("controller_frequency", "feedback_rate", "pose_timeout"):
             if not getattr(config, name) > 0:
-                raise NavseqError(
-                    f"must be a positive number, got {getattr(config, name)}",
-                    source=f"param {rospy.resolve_name('~' + name)}",
-                )
+                raise param_error(name, f"must be a positive number, got {getattr(config, name)}")
         return config
 
 
@@ -243,8 +238,7 @@ class SimNavNode:
         age = (rospy.Time.now() - transform.header.stamp).to_sec()
         if age > self.config.transform_tolerance:
             return None
-        t, q = transform.transform.translation, transform.transform.rotation
-        return Pose2D(float(t.x), float(t.y), quaternion_to_yaw(q.x, q.y, q.z, q.w))
+        return pose2d_from_transform(transform)
 
     def _goal_pose(self, target: PoseStamped) -> Pose2D | str:
         """The goal in the global frame, or why it cannot be used."""
@@ -263,9 +257,7 @@ class SimNavNode:
                     f"goal frame {frame!r} cannot be transformed to "
                     f"{self.config.global_frame!r}: {error}"
                 )
-            t, q = transform.transform.translation, transform.transform.rotation
-            frame_pose = Pose2D(float(t.x), float(t.y), quaternion_to_yaw(q.x, q.y, q.z, q.w))
-            return compose(frame_pose, pose_from_msg(target.pose))
+            return compose(pose2d_from_transform(transform), pose2d_from_pose(target.pose))
         q = target.pose.orientation
         if not all(
             math.isfinite(v)
@@ -274,7 +266,7 @@ class SimNavNode:
             return "goal pose has non-finite numbers"
         if abs(q.x) + abs(q.y) + abs(q.z) + abs(q.w) == 0.0:
             return "goal orientation is the zero quaternion (set w = 1 for yaw 0)"
-        return pose_from_msg(target.pose)
+        return pose2d_from_pose(target.pose)
 
     # -- action server callbacks (called with the action server lock held) ---------------
 
@@ -396,7 +388,7 @@ class SimNavNode:
         feedback = MoveBaseFeedback()
         feedback.base_position.header.frame_id = self.config.global_frame
         feedback.base_position.header.stamp = now
-        fill_pose_msg(feedback.base_position.pose, pose)
+        feedback.base_position.pose = pose_from_pose2d(pose)
         self._as.publish_feedback(feedback)
 
     def _publish_plan_if_new(self, now: rospy.Time) -> None:

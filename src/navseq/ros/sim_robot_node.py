@@ -2,9 +2,10 @@
 
 This is the body half of navseq's embedded simulator (the navigation half is
 :mod:`navseq.ros.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
-physics beyond differential-drive kinematics: it integrates velocity commands with
-:class:`navseq.sim.robot.DiffDriveRobot` and refuses any step that would put its
-footprint on an occupied or unknown cell of the map (it stops as if it had hit a bumper).
+physics beyond differential-drive kinematics: the ROS-free body,
+:class:`navseq.sim.base.SimulatedBase`, integrates velocity commands and refuses any step
+that would put its footprint on an occupied or unknown cell of the map (it stops as if
+it had hit a bumper); this module speaks ROS around it.
 
 Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
 ``/robot1/cmd_vel`` ...):
@@ -32,228 +33,32 @@ odometry is continuous; a teleport moves the robot in the map and shifts the
 
 from __future__ import annotations
 
-import math
 import sys
 import threading
 import time
 from dataclasses import dataclass
 
-import numpy as np
 import rospy
 import tf2_ros
-from geometry_msgs.msg import (
-    Point32,
-    PolygonStamped,
-    PoseWithCovarianceStamped,
-    TransformStamped,
-    Twist,
-)
+from geometry_msgs.msg import Point32, PolygonStamped, PoseWithCovarianceStamped, Twist
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
 from navseq.errors import NavseqError
-from navseq.geometry import Pose2D, normalize_angle, quaternion_to_yaw, yaw_to_quaternion
-from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
-from navseq.sim.occupancy import OccupancyGrid, load_map
-from navseq.sim.robot import DiffDriveLimits, DiffDriveRobot
+from navseq.geometry import Pose2D
+from navseq.ros.conversions import (
+    grid_from_msg,
+    grid_to_msg,
+    pose2d_from_pose,
+    pose_from_pose2d,
+    transform_stamped,
+)
+from navseq.ros.params import bool_param, float_param, param_error, str_param
+from navseq.sim.base import SimulatedBase
+from navseq.sim.occupancy import load_map
 
 FOOTPRINT_RATE = 5.0  # Hz of sim time: enough for RViz, cheap at high speed factors
-
-# ---------------------------------------------------------------------------------------
-# Frame algebra and map <-> message conversion (shared with sim_nav_node)
-# ---------------------------------------------------------------------------------------
-
-
-def compose(a: Pose2D, b: Pose2D) -> Pose2D:
-    """The pose ``b`` (expressed in frame ``a``) expressed in ``a``'s parent frame."""
-    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
-    return Pose2D(
-        a.x + cos_a * b.x - sin_a * b.y,
-        a.y + sin_a * b.x + cos_a * b.y,
-        normalize_angle(a.yaw + b.yaw),
-    )
-
-
-def inverse(a: Pose2D) -> Pose2D:
-    """The pose ``p`` with ``compose(a, p)`` = identity."""
-    cos_a, sin_a = math.cos(a.yaw), math.sin(a.yaw)
-    return Pose2D(
-        -cos_a * a.x - sin_a * a.y,
-        sin_a * a.x - cos_a * a.y,
-        normalize_angle(-a.yaw),
-    )
-
-
-def pose_from_msg(pose: object) -> Pose2D:
-    """A planar pose from a ``geometry_msgs/Pose`` (roll and pitch are ignored)."""
-    q = pose.orientation  # type: ignore[attr-defined]
-    p = pose.position  # type: ignore[attr-defined]
-    return Pose2D(float(p.x), float(p.y), quaternion_to_yaw(q.x, q.y, q.z, q.w))
-
-
-def fill_pose_msg(target: object, pose: Pose2D) -> None:
-    """Write ``pose`` into a ``geometry_msgs/Pose`` (z = 0)."""
-    target.position.x, target.position.y, target.position.z = pose.x, pose.y, 0.0  # type: ignore[attr-defined]
-    q = target.orientation  # type: ignore[attr-defined]
-    q.x, q.y, q.z, q.w = yaw_to_quaternion(pose.yaw)
-
-
-def grid_to_msg(grid: OccupancyGrid, frame_id: str, stamp: rospy.Time) -> OccupancyGridMsg:
-    """A ``nav_msgs/OccupancyGrid`` with the same cells (both use row 0 = bottom)."""
-    msg = OccupancyGridMsg()
-    msg.header.frame_id = frame_id
-    msg.header.stamp = stamp
-    msg.info.map_load_time = stamp
-    msg.info.resolution = grid.resolution
-    msg.info.width = grid.width
-    msg.info.height = grid.height
-    fill_pose_msg(msg.info.origin, grid.origin)
-    msg.data = grid.data.astype(np.int8).ravel().tolist()
-    return msg
-
-
-def grid_from_msg(msg: OccupancyGridMsg, source: str) -> OccupancyGrid:
-    """navseq's grid from a ``nav_msgs/OccupancyGrid``; ``source`` names it in messages."""
-    width, height = int(msg.info.width), int(msg.info.height)
-    if width <= 0 or height <= 0 or len(msg.data) != width * height:
-        raise NavseqError(
-            f"map message is {width} x {height} cells but carries {len(msg.data)} values",
-            source=source,
-        )
-    data = np.asarray(msg.data, dtype=np.int8).reshape(height, width)
-    return OccupancyGrid(
-        data=data,
-        resolution=float(msg.info.resolution),
-        origin=pose_from_msg(msg.info.origin),
-        source=source,
-    )
-
-
-def make_transform(parent: str, child: str, pose: Pose2D, stamp: rospy.Time) -> TransformStamped:
-    """A planar ``TransformStamped`` placing ``child`` at ``pose`` in ``parent``."""
-    transform = TransformStamped()
-    transform.header.stamp = stamp
-    transform.header.frame_id = parent
-    transform.child_frame_id = child
-    transform.transform.translation.x = pose.x
-    transform.transform.translation.y = pose.y
-    rotation = transform.transform.rotation
-    rotation.x, rotation.y, rotation.z, rotation.w = yaw_to_quaternion(pose.yaw)
-    return transform
-
-
-def _param_error(name: str, message: str) -> NavseqError:
-    return NavseqError(message, source=f"param {rospy.resolve_name('~' + name)}")
-
-
-def float_param(name: str, default: float) -> float:
-    """``~name`` as a float; anything else is a NavseqError naming the parameter."""
-    value = rospy.get_param(f"~{name}", default)
-    if isinstance(value, bool):
-        raise _param_error(name, f"expected a number, got {value!r}")
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise _param_error(name, f"expected a number, got {value!r}") from None
-
-
-def str_param(name: str, default: str) -> str:
-    """``~name`` as a string (numbers are accepted and converted)."""
-    return str(rospy.get_param(f"~{name}", default))
-
-
-def bool_param(name: str, default: bool) -> bool:
-    """``~name`` as a boolean (``true``/``false`` strings from roslaunch are accepted)."""
-    value = rospy.get_param(f"~{name}", default)
-    if isinstance(value, bool):
-        return value
-    if isinstance(value, str) and value.lower() in ("true", "false"):
-        return value.lower() == "true"
-    raise _param_error(name, f"expected true or false, got {value!r}")
-
-
-# ---------------------------------------------------------------------------------------
-# The simulated base, free of ROS: what happens at each step
-# ---------------------------------------------------------------------------------------
-
-
-class SimulatedBase:
-    """A robot body on a map: commanded velocity in, pose (map and odom frames) out.
-
-    ``step`` moves the robot by one time step unless that would make its footprint touch
-    an obstacle, unknown space or the map edge, in which case the robot stops where it is
-    and ``refused_steps`` counts the bump. Without a grid nothing is refused.
-    """
-
-    def __init__(
-        self,
-        start: Pose2D,
-        grid: OccupancyGrid | None,
-        *,
-        footprint: Footprint = TURTLEBOT3_BURGER,
-        limits: DiffDriveLimits | None = None,
-        cmd_vel_timeout: float = 0.5,
-    ) -> None:
-        self.grid = grid
-        self.footprint = footprint
-        self.robot = DiffDriveRobot(start, limits)
-        # The odom frame is where the robot started: odometry reads (0, 0, 0) at start.
-        self.map_to_odom = Pose2D(start.x, start.y, start.yaw)
-        self.cmd_vel_timeout = cmd_vel_timeout
-        self.time = 0.0
-        self.refused_steps = 0
-        self._cmd = (0.0, 0.0)
-        self._cmd_time = -math.inf
-
-    def collides(self, pose: Pose2D) -> bool:
-        return self.grid is not None and footprint_collides(self.grid, self.footprint, pose)
-
-    def command(self, v: float, w: float) -> None:
-        """A new velocity command, valid for ``cmd_vel_timeout`` seconds of sim time."""
-        self._cmd = (v, w)
-        self._cmd_time = self.time
-
-    def step(self, dt: float) -> bool:
-        """Advance ``dt`` seconds; False when the move was refused (the robot bumped)."""
-        self.time += dt
-        fresh = self.time - self._cmd_time <= self.cmd_vel_timeout
-        cmd_v, cmd_w = self._cmd if fresh else (0.0, 0.0)
-        pose, v, w = self.robot.predict(cmd_v, cmd_w, dt)
-        if self.collides(pose):
-            self.robot.stop()
-            self.refused_steps += 1
-            return False
-        self.robot.pose, self.robot.v, self.robot.w = pose, v, w
-        return True
-
-    def teleport(self, pose: Pose2D) -> bool:
-        """Put the robot at ``pose`` (map frame), keeping odometry continuous.
-
-        Returns False (and leaves the robot alone) when ``pose`` is in collision.
-        """
-        if self.collides(pose):
-            return False
-        odom_pose = self.odom_pose
-        self.robot.teleport(pose)
-        self.map_to_odom = compose(pose, inverse(odom_pose))
-        self._cmd = (0.0, 0.0)
-        return True
-
-    @property
-    def pose(self) -> Pose2D:
-        """The robot's true pose in the map frame."""
-        return self.robot.pose
-
-    @property
-    def odom_pose(self) -> Pose2D:
-        """The robot's pose in the odom frame."""
-        return compose(inverse(self.map_to_odom), self.robot.pose)
-
-
-# ---------------------------------------------------------------------------------------
-# The ROS node
-# ---------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -289,7 +94,7 @@ class RobotNodeConfig:
         )
         for name, value in (("speed", config.speed), ("rate", config.rate)):
             if not value > 0:
-                raise _param_error(name, f"must be a positive number, got {value}")
+                raise param_error(name, f"must be a positive number, got {value}")
         return config
 
 
@@ -351,7 +156,7 @@ class SimRobotNode:
                 self.config.global_frame,
             )
             return
-        pose = pose_from_msg(msg.pose.pose)
+        pose = pose2d_from_pose(msg.pose.pose)
         with self._lock:
             moved = self.base.teleport(pose)
         if moved:
@@ -391,15 +196,15 @@ class SimRobotNode:
             self._clock_pub.publish(Clock(clock=stamp))
         self._tf.sendTransform(
             [
-                make_transform(config.global_frame, config.odom_frame, map_to_odom, stamp),
-                make_transform(config.odom_frame, config.base_frame, odom_pose, stamp),
+                transform_stamped(map_to_odom, config.global_frame, config.odom_frame, stamp),
+                transform_stamped(odom_pose, config.odom_frame, config.base_frame, stamp),
             ]
         )
         odom = Odometry()
         odom.header.stamp = stamp
         odom.header.frame_id = config.odom_frame
         odom.child_frame_id = config.base_frame
-        fill_pose_msg(odom.pose.pose, odom_pose)
+        odom.pose.pose = pose_from_pose2d(odom_pose)
         odom.twist.twist.linear.x = v
         odom.twist.twist.angular.z = w
         self._odom_pub.publish(odom)

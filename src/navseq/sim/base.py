@@ -1,0 +1,91 @@
+"""A simulated robot base: commanded velocity in, pose in the map and odom frames out.
+
+This is the body that navseq's sim robot ROS node (:mod:`navseq.ros.sim_robot_node`)
+wraps. It has no sensors and no physics beyond differential-drive kinematics
+(:class:`navseq.sim.robot.DiffDriveRobot`), and it behaves like a real base driver in the
+two ways a navigation stack notices: it stops when velocity commands stop coming, and
+its odometry is continuous even when the robot is teleported (the ``map -> odom``
+transform jumps instead, as after a localisation correction).
+"""
+
+from __future__ import annotations
+
+import math
+
+from navseq.geometry import Pose2D, compose, inverse
+from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
+from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.robot import DiffDriveLimits, DiffDriveRobot
+
+
+class SimulatedBase:
+    """A robot body on a map: commanded velocity in, pose (map and odom frames) out.
+
+    ``step`` moves the robot by one time step unless that would make its footprint touch
+    an obstacle, unknown space or the map edge, in which case the robot stops where it is
+    and ``refused_steps`` counts the bump. Without a grid nothing is refused.
+    """
+
+    def __init__(
+        self,
+        start: Pose2D,
+        grid: OccupancyGrid | None,
+        *,
+        footprint: Footprint = TURTLEBOT3_BURGER,
+        limits: DiffDriveLimits | None = None,
+        cmd_vel_timeout: float = 0.5,
+    ) -> None:
+        self.grid = grid
+        self.footprint = footprint
+        self.robot = DiffDriveRobot(start, limits)
+        # The odom frame is where the robot started: odometry reads (0, 0, 0) at start.
+        self.map_to_odom = Pose2D(start.x, start.y, start.yaw)
+        self.cmd_vel_timeout = cmd_vel_timeout
+        self.time = 0.0
+        self.refused_steps = 0
+        self._cmd = (0.0, 0.0)
+        self._cmd_time = -math.inf
+
+    def collides(self, pose: Pose2D) -> bool:
+        return self.grid is not None and footprint_collides(self.grid, self.footprint, pose)
+
+    def command(self, v: float, w: float) -> None:
+        """A new velocity command, valid for ``cmd_vel_timeout`` seconds of sim time."""
+        self._cmd = (v, w)
+        self._cmd_time = self.time
+
+    def step(self, dt: float) -> bool:
+        """Advance ``dt`` seconds; False when the move was refused (the robot bumped)."""
+        self.time += dt
+        fresh = self.time - self._cmd_time <= self.cmd_vel_timeout
+        cmd_v, cmd_w = self._cmd if fresh else (0.0, 0.0)
+        pose, v, w = self.robot.predict(cmd_v, cmd_w, dt)
+        if self.collides(pose):
+            self.robot.stop()
+            self.refused_steps += 1
+            return False
+        self.robot.pose, self.robot.v, self.robot.w = pose, v, w
+        return True
+
+    def teleport(self, pose: Pose2D) -> bool:
+        """Put the robot at ``pose`` (map frame), keeping odometry continuous.
+
+        Returns False (and leaves the robot alone) when ``pose`` is in collision.
+        """
+        if self.collides(pose):
+            return False
+        odom_pose = self.odom_pose
+        self.robot.teleport(pose)
+        self.map_to_odom = compose(pose, inverse(odom_pose))
+        self._cmd = (0.0, 0.0)
+        return True
+
+    @property
+    def pose(self) -> Pose2D:
+        """The robot's true pose in the map frame."""
+        return self.robot.pose
+
+    @property
+    def odom_pose(self) -> Pose2D:
+        """The robot's pose in the odom frame."""
+        return compose(inverse(self.map_to_odom), self.robot.pose)
