@@ -17,15 +17,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ros_clients import EXAMPLE_MISSION, SPEED, SUCCEEDED, goal, reports, start_client
 from ros_support import REPO_ROOT, RosMaster, RosProcess
-from test_ros_sim_nodes import (
-    EXAMPLE_MISSION,
-    SPEED,
-    SUCCEEDED,
-    goal,
-    reports,
-    start_client,
-)
 
 pytestmark = pytest.mark.ros
 

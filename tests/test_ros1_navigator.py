@@ -19,9 +19,7 @@ from typing import Any
 
 import pytest
 
-TESTS = Path(__file__).resolve().parent
 THIS = Path(__file__).resolve()
-SERVER = TESTS / "ros_scripted_server.py"
 
 
 # ---------------------------------------------------------------------------------------
@@ -176,6 +174,7 @@ if __name__ == "__main__":
 # Tests
 # ---------------------------------------------------------------------------------------
 
+from ros_clients import server_log, start_scripted_server  # noqa: E402
 from ros_support import RosMaster, RosProcess  # noqa: E402
 
 pytestmark = pytest.mark.ros
@@ -189,16 +188,8 @@ def events_of(process: RosProcess) -> list[dict[str, Any]]:
     ]
 
 
-def server_log(path: Path) -> list[dict[str, Any]]:
-    if not path.exists():
-        return []
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
-
-
 def start_server(master: RosMaster, log: Path, script: str = "", *extra: str) -> RosProcess:
-    server = master.start_python(SERVER, "--script", script, "--log", str(log), *extra)
-    server.wait_for_output("scripted move_base ready", timeout=20)
-    return server
+    return start_scripted_server(master, "--script", script, "--log", str(log), *extra)
 
 
 def drive(master: RosMaster, *args: str, timeout: float = 60.0) -> tuple[int, RosProcess]:

@@ -6,7 +6,6 @@ The node gets its mission exactly as the tutorial's launch file gives it (privat
 
 from __future__ import annotations
 
-import json
 import math
 import signal
 import time
@@ -15,20 +14,14 @@ from typing import Any
 
 import pytest
 
+from ros_clients import server_log, start_scripted_server
 from ros_support import RosMaster, RosProcess, wait_for
 
 pytestmark = pytest.mark.ros
 
-SERVER = Path(__file__).resolve().parent / "ros_scripted_server.py"
 # The tutorial's launch file contents.
 P_SEQ = [-1, -4, 0, 1, -4, 0, 1, -1, 0]
 YEA_SEQ = [90, 0, 180]
-
-
-def server_log(path: Path) -> list[dict[str, Any]]:
-    if not path.exists():
-        return []
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
 def events(path: Path, kind: str) -> list[dict[str, Any]]:
@@ -36,9 +29,7 @@ def events(path: Path, kind: str) -> list[dict[str, Any]]:
 
 
 def start_server(master: RosMaster, log: Path, script: str = "", then: str = "succeed:0.3"):
-    server = master.start_python(SERVER, "--script", script, "--then", then, "--log", str(log))
-    server.wait_for_output("scripted move_base ready", timeout=20)
-    return server
+    return start_scripted_server(master, "--script", script, "--then", then, "--log", str(log))
 
 
 def start_node(master: RosMaster, **params: Any) -> RosProcess:

@@ -11,92 +11,19 @@ clients below are written out to files and run as subprocesses.
 
 from __future__ import annotations
 
-import json
 import textwrap
 import time
 from pathlib import Path
 
 import pytest
 
+from ros_clients import TUTORIAL_DONE_CB_CLIENT, server_log, start_scripted_server
 from ros_support import RosMaster
 
 pytestmark = pytest.mark.ros
 
-SERVER = Path(__file__).resolve().parent / "ros_scripted_server.py"
 P_SEQ = [1.0, 0.0, 0.0, 2.0, 0.0, 0.0, 3.0, 1.0, 0.0, 1.0, 2.0, 0.0]
 YEA_SEQ = [0.0, 90.0, 180.0, -90.0]
-
-# The tutorial's node, trimmed of its logging, with its structure and callback logic kept.
-TUTORIAL_DONE_CB_CLIENT = textwrap.dedent(
-    """
-    import math
-    import actionlib
-    import rospy
-    from geometry_msgs.msg import Point, Pose, Quaternion
-    from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-
-
-    def quaternion_from_euler(roll, pitch, yaw, axes="sxyz"):
-        # Debian has no python3-tf; the tutorial only ever rotates about z.
-        return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
-
-
-    class MoveBaseSeq:
-        def __init__(self):
-            rospy.init_node("move_base_seq")
-            points_seq = rospy.get_param("move_base_seq/p_seq")
-            yaweulerangles_seq = rospy.get_param("move_base_seq/yea_seq")
-            quat_seq = [
-                Quaternion(*quaternion_from_euler(0, 0, yaw * math.pi / 180, axes="sxyz"))
-                for yaw in yaweulerangles_seq
-            ]
-            self.pose_seq = []
-            self.goal_cnt = 0
-            points = [points_seq[i:i + 3] for i in range(0, len(points_seq), 3)]
-            for n, point in enumerate(points):
-                self.pose_seq.append(Pose(Point(*point), quat_seq[n]))
-            self.client = actionlib.SimpleActionClient("move_base", MoveBaseAction)
-            if not self.client.wait_for_server(rospy.Duration(10.0)):
-                rospy.signal_shutdown("Action server not available!")
-                return
-            self.movebase_client()
-
-        def active_cb(self):
-            pass
-
-        def feedback_cb(self, feedback):
-            pass
-
-        def done_cb(self, status, result):
-            self.goal_cnt += 1
-            print("DONE %d status %d" % (self.goal_cnt, status), flush=True)
-            if status == 3:
-                if self.goal_cnt < len(self.pose_seq):
-                    next_goal = MoveBaseGoal()
-                    next_goal.target_pose.header.frame_id = "map"
-                    next_goal.target_pose.header.stamp = rospy.Time.now()
-                    next_goal.target_pose.pose = self.pose_seq[self.goal_cnt]
-                    self.client.send_goal(next_goal, self.done_cb, self.active_cb,
-                                          self.feedback_cb)
-                else:
-                    print("FINAL GOAL REACHED", flush=True)
-                    rospy.signal_shutdown("Final goal pose reached!")
-            else:
-                rospy.signal_shutdown("goal failed")
-
-        def movebase_client(self):
-            goal = MoveBaseGoal()
-            goal.target_pose.header.frame_id = "map"
-            goal.target_pose.header.stamp = rospy.Time.now()
-            goal.target_pose.pose = self.pose_seq[self.goal_cnt]
-            self.client.send_goal(goal, self.done_cb, self.active_cb, self.feedback_cb)
-            rospy.spin()
-
-
-    if __name__ == "__main__":
-        MoveBaseSeq()
-    """
-)
 
 # The same sequence done right: wait for each result on the main thread, then send.
 SEQUENCE_CLIENT = textwrap.dedent(
@@ -128,18 +55,16 @@ SEQUENCE_CLIENT = textwrap.dedent(
 
 
 def goals_received(log: Path) -> list[tuple[float, float]]:
-    records = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
-    return [(r["x"], r["y"]) for r in records if r["event"] == "goal"]
+    return [(r["x"], r["y"]) for r in server_log(log) if r["event"] == "goal"]
 
 
-def start_scripted_server(master: RosMaster, log: Path) -> None:
-    server = master.start_python(SERVER, "--then", "succeed:0.3", "--log", str(log))
-    server.wait_for_output("scripted move_base ready", timeout=20)
+def start_succeeding_server(master: RosMaster, log: Path) -> None:
+    start_scripted_server(master, "--then", "succeed:0.3", "--log", str(log))
 
 
 def test_plain_sequence_client_gets_every_goal_succeeded(ros_master: RosMaster, tmp_path):
     log = tmp_path / "server.jsonl"
-    start_scripted_server(ros_master, log)
+    start_succeeding_server(ros_master, log)
     script = tmp_path / "sequence_client.py"
     script.write_text(SEQUENCE_CLIENT)
     ros_master.set_param("/sequence_client/p_seq", P_SEQ)
@@ -152,7 +77,7 @@ def test_plain_sequence_client_gets_every_goal_succeeded(ros_master: RosMaster, 
 
 def test_tutorial_done_cb_client_stalls_after_its_second_goal(ros_master: RosMaster, tmp_path):
     log = tmp_path / "server.jsonl"
-    start_scripted_server(ros_master, log)
+    start_succeeding_server(ros_master, log)
     script = tmp_path / "move_base_seq.py"
     script.write_text(TUTORIAL_DONE_CB_CLIENT)
     ros_master.set_param("/move_base_seq/p_seq", P_SEQ)
@@ -162,8 +87,7 @@ def test_tutorial_done_cb_client_stalls_after_its_second_goal(ros_master: RosMas
     # Goal 2 is sent from inside done_cb and reaches SUCCEEDED on the server ...
     deadline = time.monotonic() + 20
     while time.monotonic() < deadline:
-        records = [json.loads(line) for line in log.read_text().splitlines() if line]
-        if [r["status"] for r in records if r["event"] == "done"] == ["SUCCEEDED"] * 2:
+        if [r["status"] for r in server_log(log) if r["event"] == "done"] == ["SUCCEEDED"] * 2:
             break
         time.sleep(0.1)
     else:
