@@ -218,22 +218,25 @@ def main() -> None:
     import rospy
 
     from navseq.navigators.ros1 import ensure_node
+    from navseq.ros.params import bool_param
 
     try:
         ensure_node(NODE_NAME, anonymous=False)
+        out = rospy.get_param("~out", "")
+        if not out:
+            raise NavseqError("give the mission file to write", source="param ~out")
+        # roslaunch passes <param value="false"/> as a string: bool("false") would be True.
+        overwrite = bool_param("overwrite", False)
+        from_tf = bool_param("from_tf", False)
     except NavseqError as error:
         print(f"navseq record: {error}", file=sys.stderr)
-        sys.exit(2)
-    out = rospy.get_param("~out", "")
-    if not out:
-        print("navseq record: param ~out: give the mission file to write", file=sys.stderr)
         sys.exit(2)
     sys.exit(
         record_main(
             Path(out),
             rospy.get_param("~topic", DEFAULT_TOPIC),
-            overwrite=bool(rospy.get_param("~overwrite", False)),
-            from_tf=bool(rospy.get_param("~from_tf", False)),
+            overwrite=overwrite,
+            from_tf=from_tf,
             base_frame=rospy.get_param("~base_frame", "base_footprint"),
             frame=rospy.get_param("~frame", "map"),
         )
