@@ -12,24 +12,10 @@ import signal
 
 import pytest
 
-from ros_support import REPO_ROOT, RosMaster, RosProcess
-from test_cli import NAVSEQ, journal_events, wait_for, write_mission
+from cli_support import NAVSEQ, journal_events, wait_for, write_mission
+from ros_clients import MAP, start_sim
 
 pytestmark = pytest.mark.ros
-
-MAP = REPO_ROOT / "maps" / "turtlebot3_world.yaml"
-SPEED = 8.0  # sim seconds per wall second
-
-
-def start_sim(master: RosMaster) -> RosProcess:
-    """The sim robot and navigation nodes; returns the navigation node (move_base)."""
-    master.set_param("/use_sim_time", True)
-    master.start([REPO_ROOT / "nodes" / "sim_robot_node", f"_map:={MAP}", "_x:=-2.0",
-                  "_y:=-0.5", "_yaw:=0.0", f"_speed:={SPEED}"], label="sim_robot")
-    nav = master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}"],
-                       label="move_base")
-    master.wait_for_action_server("/move_base", timeout=30)
-    return nav
 
 
 def mission(tmp_path):
@@ -56,7 +42,7 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
 
 
 def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
-    nav = start_sim(ros_master)
+    _robot, nav = start_sim(ros_master)
     out = tmp_path / "out"
     process = ros_master.start([NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1",
                                 "--out", out], cwd=tmp_path, label="navseq")

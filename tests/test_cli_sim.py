@@ -8,7 +8,7 @@ import signal
 import pytest
 from PIL import Image
 
-from test_cli import (
+from cli_support import (
     EXAMPLES,
     TURTLEBOT3_MAP,
     assert_clean_error,

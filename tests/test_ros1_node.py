@@ -202,3 +202,35 @@ def test_missing_action_server_is_a_clear_error(ros_master: RosMaster):
     assert node.wait(timeout=30) == 2
     assert "/move_base" in node.output() and ros_master.uri in node.output()
     assert "Traceback" not in node.output()
+
+
+def test_keep_alive_keeps_markers_and_status_up_after_the_mission_until_sigint(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = start_node(ros_master, keep_alive=True)
+    status = watch_status(ros_master)
+    wait_for(lambda: '\\"state\\": \\"succeeded\\"' in status.output(), 60, "mission end")
+    assert node.running(), node.output()
+    # A subscriber arriving after the mission still gets the final markers: all reached.
+    markers = ros_master.start(
+        ["rostopic", "echo", "-n", "1", "/navseq/waypoints/markers[0]/color"]
+    )
+    assert markers.wait(timeout=20) == 0, markers.output()
+    assert "g: 0.75" in markers.output(), markers.output()  # green: reached
+    late_status = ros_master.start(["rostopic", "echo", "-n", "1", "/navseq/status"])
+    assert late_status.wait(timeout=20) == 0, late_status.output()
+    assert '\\"state\\": \\"succeeded\\"' in late_status.output()
+    for service in ("cancel", "skip", "pause"):
+        response = ros_master.call_service(f"/navseq/{service}")
+        assert not response["success"] and "mission has ended" in response["message"], response
+    assert [d["status"] for d in events(log, "done")] == ["SUCCEEDED"] * 3
+    assert node.stop(signal.SIGINT) == 130
+    assert "Traceback" not in node.output()
+
+
+def test_keep_alive_that_is_not_a_boolean_is_a_bad_param(ros_master: RosMaster):
+    node = start_node(ros_master, keep_alive="sometimes")
+    assert node.wait(timeout=30) == 2
+    assert "keep_alive" in node.output() and "Traceback" not in node.output()

@@ -13,7 +13,8 @@ The node's own parameters: ``~action`` (default ``move_base``, resolved in the n
 namespace, so ``<group ns="robot1">`` drives ``/robot1/move_base``), ``~server_wait``
 (s, default 30), ``~stamp`` (``now`` or ``latest``), ``~status_timeout`` (s without
 action status before the server counts as lost, default 2), ``~base_frames``,
-``~plan_topic``, ``~use_tf``, ``~tick`` (s between executor looks, default 0.1).
+``~plan_topic``, ``~use_tf``, ``~tick`` (s between executor looks, default 0.1),
+``~keep_alive`` (default false: see below).
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
@@ -24,11 +25,19 @@ before the node exits, which logs ``interrupted (<signal or shutdown reason>)`` 
 publishes the state ``interrupted``. Exit status: 0 all waypoints reached, 1 not (also
 after ``rosnode kill``), 2 bad parameters or no action server, 130/143 interrupted by
 SIGINT/SIGTERM.
+
+With ``~keep_alive`` true the node does not exit when the mission ends (all waypoints
+done, or cancelled through ``~cancel``): it stays up until it is shut down, so RViz
+keeps showing the latched markers in their final colours and the final ``~status``.
+Meanwhile the services answer that the mission is over. The exit status is then
+130/143 for SIGINT/SIGTERM, otherwise (``rosnode kill``, roslaunch) the mission's own
+0 or 1. Bad parameters and a missing action server still exit at once with 2.
 """
 
 from __future__ import annotations
 
 import json
+import signal
 import sys
 import threading
 from dataclasses import asdict
@@ -55,6 +64,7 @@ from navseq.mission.params import mission_from_params
 from navseq.navigators.ros1 import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros.markers import MarkerStatus, waypoint_markers
 from navseq.ros.operator import NodeShutdown, OperatorCancel, OperatorNavigator
+from navseq.ros.params import bool_param
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -67,11 +77,13 @@ NODE_PARAMS: dict[str, Any] = {
     "plan_topic": "NavfnROS/plan",
     "use_tf": True,
     "tick": 0.1,
+    "keep_alive": False,
 }
 PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 # s to wait for rospy to name its shutdown reason: it does so only after the navigator's
 # shutdown hook has waited (up to CANCEL_FLUSH) for the goal's cancel to go out.
 SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
+KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a shutdown while kept alive
 
 _OUTCOME_MARKERS = {
     WaypointOutcome.REACHED: MarkerStatus.REACHED,
@@ -92,6 +104,8 @@ class MissionTopics:
         self._last_progress = float("-inf")
         self._lock = threading.Lock()
         self.active_waypoint: int | None = None  # 0-based index of the visit underway
+        # Set once the mission is over for good; the services then refuse with this reason.
+        self.over: str | None = None
         self.publish_markers()
         self.publish_status({"state": "waiting_for_server", "waypoints": len(mission)})
 
@@ -186,12 +200,16 @@ def read_params() -> tuple[Mission, dict[str, Any]]:
     """The mission and the node settings from the node's private parameters."""
     private: dict[str, Any] = rospy.get_param("~", {}) or {}
     settings = {key: private.get(key, default) for key, default in NODE_PARAMS.items()}
+    settings["keep_alive"] = bool_param("keep_alive", NODE_PARAMS["keep_alive"])
     mission = mission_from_params(private, "param ~", ignore=NODE_PARAMS.keys())
     return mission, settings
 
 
-def _trigger_service(name: str, operator: OperatorNavigator) -> None:
+def _trigger_service(name: str, operator: OperatorNavigator, topics: MissionTopics) -> None:
     def handle(_request: Any) -> TriggerResponse:
+        if topics.over is not None:
+            # Nobody polls the operator any more: a request would only time out.
+            return TriggerResponse(success=False, message=f"nothing to {name}: {topics.over}")
         ok, message = operator.request(name)
         return TriggerResponse(success=ok, message=message)
 
@@ -201,6 +219,8 @@ def _trigger_service(name: str, operator: OperatorNavigator) -> None:
 def _skip_service(topics: MissionTopics, control: MissionControl) -> None:
     def handle(_request: Any) -> TriggerResponse:
         index = topics.active_waypoint
+        if topics.over is not None:
+            return TriggerResponse(success=False, message=f"nothing to skip: {topics.over}")
         if index is None:
             # Filed now, the request would skip whichever waypoint comes next.
             return TriggerResponse(success=False, message="no waypoint is underway")
@@ -231,7 +251,7 @@ def run_node() -> int:
     topics = MissionTopics(mission)
     control = MissionControl()
     for name in ("pause", "resume", "cancel"):
-        _trigger_service(name, operator)
+        _trigger_service(name, operator, topics)
     _skip_service(topics, control)
     try:
         rospy.loginfo(
@@ -267,14 +287,50 @@ def run_node() -> int:
         return 1
     except OperatorCancel as cancelled:
         rospy.logwarn("navseq: %s", cancelled)
-        return 1
+        code, topics.over = 1, "the mission was cancelled"
+    else:
+        if result.success:
+            rospy.loginfo("navseq: mission succeeded (%s)", result.reason)
+            topics.over = "the mission has ended (succeeded)"
+        else:
+            rospy.logwarn(
+                "navseq: mission ended without reaching every waypoint (%s)", result.reason
+            )
+            topics.over = "the mission has ended (failed)"
+        code = result.exit_code
     finally:
         navigator.close()
-    if result.success:
-        rospy.loginfo("navseq: mission succeeded (%s)", result.reason)
-    else:
-        rospy.logwarn("navseq: mission ended without reaching every waypoint (%s)", result.reason)
-    return result.exit_code
+    if settings["keep_alive"]:
+        return stay_up(code)
+    return code
+
+
+def stay_up(mission_code: int) -> int:
+    """Keep the node (its latched topics and services) up until it is shut down.
+
+    Returns the exit status: 130/143 for SIGINT/SIGTERM, else ``mission_code``
+    (``rosnode kill``, a master or roslaunch shutdown).
+    """
+    rospy.loginfo("navseq: mission over; staying up (~keep_alive) until shut down")
+    # rospy's own signal handlers are off (see ensure_node); the node's are set here.
+    stop_signal: list[str] = []
+    stopping = threading.Event()
+
+    def on_signal(signum: int, _frame: Any) -> None:
+        stop_signal.append(signal.Signals(signum).name)
+        stopping.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        while not stopping.is_set() and not rospy.core.is_shutdown_requested():
+            stopping.wait(KEEP_ALIVE_POLL)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if stop_signal:
+        rospy.loginfo("navseq: %s; shutting down", stop_signal[0])
+        return SIGNAL_EXIT_CODES[stop_signal[0]]
+    return mission_code
 
 
 def _log_interrupted(cause: str) -> None:

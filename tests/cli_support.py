@@ -1,0 +1,68 @@
+"""Helpers for tests that run the ``navseq`` command as a subprocess, as a user runs it.
+
+Shared by the CLI test modules so that none imports another test module.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[1]
+NAVSEQ = str(Path(sys.executable).with_name("navseq"))
+EXAMPLES = REPO / "examples"
+TURTLEBOT3_MAP = REPO / "maps" / "turtlebot3_world.yaml"
+
+
+def navseq(*args: Any, cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
+    """Run ``navseq ARGS``; output is captured, so stdout is not a terminal."""
+    return subprocess.run([NAVSEQ, *map(str, args)], cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def start_navseq(*args: Any, cwd: Path) -> subprocess.Popen[str]:
+    """Start ``navseq ARGS`` in the background, stdout and stderr piped."""
+    return subprocess.Popen([NAVSEQ, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> None:
+    """Poll ``predicate`` until it is truthy; fail naming ``what`` after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.05)
+
+
+def journal_records(path: Path) -> list[dict[str, Any]]:
+    """The records of a run's ``journal.jsonl`` so far (none before it exists)."""
+    records = []
+    for line in path.read_text().splitlines() if path.exists() else []:
+        with contextlib.suppress(json.JSONDecodeError):  # a last line cut short by kill -9
+            records.append(json.loads(line))
+    return records
+
+
+def journal_events(path: Path, kind: str) -> list[dict[str, Any]]:
+    """The journal records of one event type (``MissionFinished`` ...)."""
+    return [r for r in journal_records(path) if r.get("type") == kind]
+
+
+def assert_clean_error(result: subprocess.CompletedProcess[str]) -> None:
+    """Bad input: exit 2, a message on stderr, never a traceback."""
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stdout + result.stderr
+    assert result.stderr.strip()
+
+
+def write_mission(path: Path, waypoints: str, header: str = "") -> Path:
+    """A navseq YAML mission at ``path``: ``header`` lines, then the ``waypoints`` list."""
+    path.write_text(f"navseq: 1\n{header}waypoints:\n{waypoints}")
+    return path
