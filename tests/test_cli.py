@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import signal
 import subprocess
@@ -365,6 +366,43 @@ def test_resume_after_kill_runs_only_what_is_left(tmp_path):
     report = json.loads((out / "report.json").read_text())
     assert report["success"] is True and report["totals"]["reached"] == 4
     assert any(r.get("kind") == "resumed" for r in journal_records(journal))
+
+
+def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkeypatch):
+    from navseq import cli
+    from navseq.sinks import picture
+    from navseq.sinks.journal import read_journal
+
+    mission = write_mission(tmp_path / "m.yaml", SQUARE)
+    out = tmp_path / "out"
+    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
+                           "--scripted-realtime", "4", cwd=tmp_path)
+    journal = out / "journal.jsonl"
+    wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60,
+             "two waypoints reached")
+    process.kill()
+    process.communicate(timeout=30)
+    before = read_journal(journal)
+    driven_before = [(e["x"], e["y"]) for e in journal_events(journal, "WaypointProgress")]
+    assert len(driven_before) >= 2  # the scripted robot drove 2 m, journaled once a second
+
+    drawn: dict[str, Any] = {}
+    real_draw = picture.draw_mission_picture
+    monkeypatch.setattr(picture, "draw_mission_picture",
+                        lambda path, *a, **kw: drawn.update(kw) or real_draw(path, *a, **kw))
+    assert cli.main(["run", "--resume", str(journal), "--navigator", "scripted"]) == 0
+
+    points = [tuple(p) for p in drawn["trajectory"]]
+    finite = [p for p in points if not any(map(math.isnan, p))]
+    # Everything driven before the crash is in the picture, then a break, then the rest.
+    assert [(x, y) for _, x, y in finite[: len(driven_before)]] == driven_before
+    assert math.isnan(points[len(driven_before)][0])
+    after = finite[len(driven_before):]
+    assert {(round(x, 3), round(y, 3)) for _, x, y in after} >= {(0.0, 1.0), (0.0, 0.0)}
+    # One mission clock: the resumed part is coloured after the part before the crash.
+    times = [t for t, _, _ in finite]
+    assert times == sorted(times)
+    assert after[0][0] >= before.previous_duration > 0
 
 
 def test_resume_refuses_a_changed_mission(tmp_path):

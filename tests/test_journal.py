@@ -6,6 +6,7 @@ import contextlib
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -16,12 +17,14 @@ from navseq.errors import NavseqError
 from navseq.executor import MissionExecutor, run_mission
 from navseq.executor.events import (
     MissionFinished,
+    MissionStarted,
     WaypointFinished,
     WaypointOutcome,
     WaypointPlan,
     WaypointProgress,
     WaypointStarted,
 )
+from navseq.executor.resume import ResumePoint
 from navseq.mission.model import FailureAction
 from navseq.navigators.base import GoalStatus
 from navseq.navigators.scripted import Finish, ScriptedNavigator
@@ -31,6 +34,7 @@ from navseq.sinks.journal import (
     read_journal,
     resume_point,
 )
+from navseq.sinks.recorder import RunRecorder
 
 
 @pytest.fixture
@@ -327,3 +331,50 @@ def test_wrongly_typed_event_fields_raise_only_navseq_errors(
     path = tmp_path / "typed.journal"
     path.write_text("\n".join(lines) + "\n")
     _read_and_resume(path)
+
+
+def test_recorder_from_journal_keeps_earlier_segments_on_one_mission_clock(
+    tmp_path: Path,
+) -> None:
+    def progress(t: float, x: float) -> WaypointProgress:
+        return WaypointProgress(t=t, index=0, x=x, y=0.0, yaw=0.0, distance_remaining=None,
+                                distance_driven=x)
+
+    path = tmp_path / "run.journal"
+    # The first segment runs on a clock that starts at 100 s (ROS time, say)...
+    with JournalWriter(path, "m.yaml", "digest") as journal:
+        for event in (
+            MissionStarted(t=100.0, waypoint_count=2, loops=1),
+            WaypointStarted(t=100.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0,
+                            yaw=0.0),
+            WaypointPlan(t=100.0, index=0, path=((0.0, 0.0), (2.0, 0.0))),
+            progress(100.5, 0.5),
+            progress(102.0, 1.0),
+        ):
+            journal(event)
+    state = read_journal(path)
+    recorder = RunRecorder.from_journal(state.events)
+    # ...the resumed one (appended to the same journal) on one that starts at 0.
+    with JournalWriter.resume(path, ResumePoint(loop=0, index=0)) as journal:
+        for event in (
+            MissionStarted(t=0.0, waypoint_count=2, loops=1, resumed_from=0),
+            WaypointStarted(t=0.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0, yaw=0.0),
+            WaypointPlan(t=0.0, index=0, path=((0.0, 0.0), (3.0, 0.0))),
+            progress(1.0, 0.7),
+        ):
+            journal(event)
+            recorder(event)
+
+    assert state.previous_duration == pytest.approx(2.0)
+    assert recorder.segments == 2
+    t, x, _ = zip(*recorder.trajectory(), strict=True)
+    assert x[:2] == (0.5, 1.0) and np.isnan(x[2]) and x[3] == 0.7
+    assert t[:2] == (0.5, 2.0) and t[3] == pytest.approx(3.0)  # 2 s before + 1 s after
+    assert recorder.earlier_trajectory()[:2] == [(0.5, 0.5, 0.0), (2.0, 1.0, 0.0)]
+    assert recorder.mission_time(4.0) == pytest.approx(6.0)
+    # The resumed visit shows both legs: the one planned before and the one after.
+    assert recorder.leg_plans() == [((0.0, 0.0), (2.0, 0.0)), ((0.0, 0.0), (3.0, 0.0))]
+    # Replaying the whole journal afterwards gives the same picture data.
+    replayed = RunRecorder.from_journal(read_journal(path).events)
+    assert replayed.leg_plans() == recorder.leg_plans()
+    assert np.allclose(replayed.trajectory(), recorder.trajectory(), equal_nan=True)

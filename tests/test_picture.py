@@ -159,3 +159,17 @@ def test_degenerate_missions_do_not_break_the_picture(tmp_path, count):
     mission = Mission((Waypoint(0.0, 0.0, 0.0),) * count, source="one.yaml")
     draw_mission_picture(tmp_path / "one.png", mission, MissionResult(True, "completed"))
     assert (tmp_path / "one.png").exists()
+
+
+def test_a_nan_row_breaks_the_driven_path_between_resumed_segments():
+    from matplotlib.collections import LineCollection
+
+    nan = math.nan
+    # Before the crash the robot got to (1, 0); the resumed run started again at (0, 0).
+    trajectory = [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (nan, nan, nan), (2.0, 0.0, 0.0),
+                  (3.0, 0.0, 1.0)]
+    fig = mission_figure(MISSION, result_of(WaypointOutcome.REACHED), trajectory=trajectory)
+    (driven,) = [c for c in fig.axes[0].collections if isinstance(c, LineCollection)]
+    segments = [tuple(map(tuple, s)) for s in driven.get_segments()]
+    assert segments == [((0.0, 0.0), (1.0, 0.0)), ((0.0, 0.0), (0.0, 1.0))]
+    assert list(driven.get_array()) == [0.0, 2.0]  # one mission clock across the break

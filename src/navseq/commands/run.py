@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
+    from navseq.sinks.journal import JournalState
     from navseq.sinks.progress import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
@@ -115,11 +116,14 @@ class RunSetup:
     map_path: Path | None = None
     resume: ResumePoint | None = None
     journal: Path | None = None  # the journal to append to when resuming
+    history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
 
 
-def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumePoint]:
-    """The mission file and resume point of a journal; the mission must be unchanged."""
+def _read_resume(
+    journal: Path, mission_arg: Path | None
+) -> tuple[Path, ResumePoint, JournalState]:
+    """The mission file, resume point and contents of a journal (mission unchanged)."""
     from navseq.commands.common import require_file
     from navseq.errors import NavseqError
     from navseq.sinks.journal import mission_digest, read_journal, resume_point
@@ -134,7 +138,8 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
             source=str(journal),
         )
     # resume_point refuses a mission whose digest differs from the journal's.
-    return mission_path, resume_point(state, mission_digest=mission_digest(mission_path))
+    point = resume_point(state, mission_digest=mission_digest(mission_path))
+    return mission_path, point, state
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
@@ -177,9 +182,9 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     from navseq.mission import load_mission
     from navseq.sinks.journal import mission_digest
 
-    resume = None
+    resume = history = None
     if args.resume is not None:
-        mission_path, resume = _read_resume(args.resume, args.mission)
+        mission_path, resume, history = _read_resume(args.resume, args.mission)
     elif args.mission is None:
         raise NavseqError("give a MISSION file (or --resume JOURNAL)", source="navseq run")
     else:
@@ -198,6 +203,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "digest": mission_digest(mission_path),
         "resume": resume,
         "journal": args.resume,
+        "history": history,
         "map_path": map_path,
         "start": start,
     }
@@ -353,11 +359,23 @@ def _discard_unused(journal: Path, folder: Path | None) -> None:
         pass  # tidying up only; the original error matters more
 
 
+def new_recorder(setup: RunSetup) -> RunRecorder:
+    """The run's recorder; a resumed run's starts with what its journal recorded.
+
+    So the picture of a resumed run shows the whole mission: the path driven and the
+    legs planned before the resume too, in one mission-time colouring.
+    """
+    from navseq.sinks.recorder import RunRecorder
+
+    if setup.history is None:
+        return RunRecorder()
+    return RunRecorder.from_journal(setup.history.events)
+
+
 def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Path) -> RunOutcome:
     from navseq.executor.runner import MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
     from navseq.sinks.progress import JsonProgress, make_progress
-    from navseq.sinks.recorder import RunRecorder
 
     navigator = setup.make_navigator()
     try:
@@ -367,7 +385,7 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
             # The absolute path, so that --resume works from any directory.
             source = str(setup.mission_path.resolve())
             journal = JournalWriter(journal_path, source, setup.digest)
-        recorder = RunRecorder()
+        recorder = new_recorder(setup)
         progress = make_progress(setup.mission, json_lines=args.json)
         with progress, journal:
             try:
@@ -448,8 +466,7 @@ def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) 
         files=files,
     )
     write_report(report, Path(files["report"]))
-    # The simulator records every step; other navigators only what feedback showed.
-    trajectory = getattr(outcome.navigator, "trajectory", None) or outcome.recorder.trajectory()
+    trajectory = picture_trajectory(outcome)
     draw_mission_picture(
         Path(files["picture"]),
         setup.mission,
@@ -460,6 +477,21 @@ def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) 
         trajectory=trajectory,
         interrupted=outcome.interrupted,
     )
+
+
+def picture_trajectory(outcome: RunOutcome) -> list[tuple[float, float, float]]:
+    """The driven path to draw, (mission time, x, y), NaN rows between run segments.
+
+    The simulator records every step of this run; other navigators give only what
+    their feedback showed (the recorder's progress events). Either way the segments
+    before a resume come from the journal, through the recorder.
+    """
+    recorder = outcome.recorder
+    stepped = getattr(outcome.navigator, "trajectory", None)
+    if not stepped:
+        return recorder.trajectory()
+    now = [(recorder.mission_time(t), x, y) for t, x, y in stepped]
+    return [*recorder.earlier_trajectory(), *now]
 
 
 def run(args: argparse.Namespace) -> int:

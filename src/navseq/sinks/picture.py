@@ -210,10 +210,15 @@ def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> object | None:
         return None
     points = trajectory[:, 1:3]
     segments = np.stack([points[:-1], points[1:]], axis=1)
+    times = trajectory[:-1, 0]
+    # A NaN row is a break (between the segments of a resumed run): no line across it.
+    drawn = np.isfinite(segments).all(axis=(1, 2)) & np.isfinite(times)
+    if not drawn.any():
+        return None
     lines = LineCollection(
-        segments, cmap="viridis", linewidths=2.4, capstyle="round", zorder=3
+        segments[drawn], cmap="viridis", linewidths=2.4, capstyle="round", zorder=3
     )
-    lines.set_array(trajectory[:-1, 0])
+    lines.set_array(times[drawn])
     ax.add_collection(lines)
     return lines
 
@@ -247,7 +252,8 @@ def draw_mission_picture(
     """Draw the run into a PNG at ``path`` (written atomically: temp file, then rename).
 
     ``plans`` are the legs' planned paths (x, y) and ``trajectory`` the driven
-    positions as (t, x, y) with t in mission-clock seconds.
+    positions as (t, x, y) with t in mission-clock seconds; a row of NaNs breaks the
+    line (a resumed run's segments: the robot may not have been where it stopped).
     """
     fig = mission_figure(
         mission,
@@ -286,7 +292,8 @@ def mission_figure(
     waypoints = mission.waypoints
     traj = np.asarray(trajectory, dtype=float).reshape(-1, 3)
     plan_arrays = [np.asarray(p, dtype=float).reshape(-1, 2) for p in plans if len(p) > 1]
-    point_sets = [np.array([[w.x, w.y] for w in waypoints]).reshape(-1, 2), traj[:, 1:3]]
+    driven = traj[np.isfinite(traj).all(axis=1), 1:3]
+    point_sets = [np.array([[w.x, w.y] for w in waypoints]).reshape(-1, 2), driven]
     point_sets += plan_arrays
     if start is not None:
         point_sets.append(np.array([[start.x, start.y]]))
