@@ -7,72 +7,35 @@ files, signals and resume. ``test_cli_sim.py`` runs the embedded simulator.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[1]
-NAVSEQ = str(Path(sys.executable).with_name("navseq"))
-EXAMPLES = REPO / "examples"
-TURTLEBOT3_MAP = REPO / "maps" / "turtlebot3_world.yaml"
-
-
-def navseq(*args: Any, cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
-    """Run ``navseq ARGS``; output is captured, so stdout is not a terminal."""
-    return subprocess.run([NAVSEQ, *map(str, args)], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout)
-
-
-def start_navseq(*args: Any, cwd: Path) -> subprocess.Popen[str]:
-    return subprocess.Popen([NAVSEQ, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-
-
-def wait_for(predicate, timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.05)
-
-
-def journal_records(path: Path) -> list[dict[str, Any]]:
-    records = []
-    for line in path.read_text().splitlines() if path.exists() else []:
-        with contextlib.suppress(json.JSONDecodeError):  # a last line cut short by kill -9
-            records.append(json.loads(line))
-    return records
-
-
-def journal_events(path: Path, kind: str) -> list[dict[str, Any]]:
-    return [r for r in journal_records(path) if r.get("type") == kind]
+from cli_support import (
+    EXAMPLES,
+    NAVSEQ,
+    TURTLEBOT3_MAP,
+    assert_clean_error,
+    journal_events,
+    journal_records,
+    navseq,
+    start_navseq,
+    wait_for,
+    write_mission,
+)
 
 
 def scripted_log(path: Path, call: str) -> list[dict[str, Any]]:
     if not path.exists():
         return []
     return [r for r in map(json.loads, path.read_text().splitlines()) if r["call"] == call]
-
-
-def assert_clean_error(result: subprocess.CompletedProcess[str]) -> None:
-    """Bad input: exit 2, a message on stderr, never a traceback."""
-    assert result.returncode == 2, result.stderr
-    assert "Traceback" not in result.stdout + result.stderr
-    assert result.stderr.strip()
-
-
-def write_mission(path: Path, waypoints: str, header: str = "") -> Path:
-    path.write_text(f"navseq: 1\n{header}waypoints:\n{waypoints}")
-    return path
 
 
 SQUARE = """\
