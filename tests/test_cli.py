@@ -154,6 +154,32 @@ def test_validate_against_a_map_finds_a_waypoint_in_a_pillar(tmp_path):
     assert "waypoint 1 'free'" not in result.stderr
 
 
+def test_validate_lists_file_and_map_problems_in_one_run(tmp_path):
+    """A typo in one waypoint does not hide that another one sits in a pillar."""
+    mission = write_mission(tmp_path / "m.yaml", (
+        "  - {name: free, x: 0.5, y: -1.6, yaw: 0}\n"
+        "  - {name: typo, x: 1.0, y: oops}\n"
+        "  - {name: pillar, x: 0.0, y: 0.0, yaw: 0}\n"
+        "  - {name: far, x: 1.6, y: 0.5, yaw: 90, goal_timeout: -1}\n"
+    ), header=f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2.0, y: -0.5, yaw: 0}}\n")
+    result = navseq("validate", mission, cwd=tmp_path)
+    assert_clean_error(result)
+    lines = [line for line in result.stderr.splitlines() if line.startswith("  - ")]
+    assert len(lines) == 3, result.stderr
+    assert "m.yaml:6, waypoint 2 'typo', field y" in lines[0]
+    assert "m.yaml:8, waypoint 4 'far', field goal_timeout" in lines[1]
+    # numbered as in the file, though waypoint 2 could not be read
+    assert "m.yaml:7, waypoint 3 'pillar'" in lines[2] and "nearest free spot" in lines[2]
+
+
+def test_validate_names_an_unreadable_map_next_to_the_file_problems(tmp_path):
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: 1.0, y: oops}\n  - {x: 0.5, y: 0.5}\n",
+                            header="map: missing_map.yaml\n")
+    result = navseq("validate", mission, cwd=tmp_path)
+    assert_clean_error(result)
+    assert "field y" in result.stderr and "missing_map.yaml" in result.stderr
+
+
 # ---------------------------------------------------------------------- convert
 
 

@@ -19,6 +19,7 @@ the message suggests the nearest free spot.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,14 +34,21 @@ _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 
 
 def check_mission(
-    mission: Mission, costmap: Costmap, start: Pose2D | None = None
+    mission: Mission,
+    costmap: Costmap,
+    start: Pose2D | None = None,
+    *,
+    numbers: Sequence[int] | None = None,
 ) -> list[NavseqError]:
     """Every problem that would stop the robot reaching the mission's waypoints.
 
     ``start`` defaults to ``mission.start``. An empty list means the mission is
-    feasible on this map (as far as a static map can tell).
+    feasible on this map (as far as a static map can tell). ``numbers`` are the
+    waypoints' indices in the file when ``mission`` is the readable part of a
+    faulty one, so that messages number them as the file does.
     """
     start = start if start is not None else mission.start
+    numbers = range(len(mission.waypoints)) if numbers is None else numbers
     free = _FreeRegions(costmap)
     problems: list[NavseqError] = []
 
@@ -58,7 +66,7 @@ def check_mission(
     # The reference for reachability: the last place the robot is known to get to.
     previous_label, previous_region = ("the start pose", start_region)
     regions: list[int | None] = []
-    for index, waypoint in enumerate(mission.waypoints):
+    for index, waypoint in zip(numbers, mission.waypoints, strict=True):
         source = waypoint.where or mission.source
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
@@ -85,17 +93,15 @@ def check_mission(
     if loops_again and len(mission.waypoints) > 1:
         first, last = regions[0], regions[-1]
         if first is not None and last is not None and first != last:
-            waypoint = mission.waypoints[0]
-            last_index = len(mission.waypoints) - 1
-            last_waypoint = mission.waypoints[last_index]
+            waypoint, last_waypoint = mission.waypoints[0], mission.waypoints[-1]
             problems.append(
                 NavseqError(
                     f"{_format_position(waypoint.x, waypoint.y)} cannot be reached from "
-                    f"{last_waypoint.label(last_index)} "
+                    f"{last_waypoint.label(numbers[-1])} "
                     f"{_format_position(last_waypoint.x, last_waypoint.y)} "
                     "to start the next loop: no free path connects them on the map",
                     source=waypoint.where or mission.source,
-                    subject=waypoint.label(0),
+                    subject=waypoint.label(numbers[0]),
                 )
             )
     return problems

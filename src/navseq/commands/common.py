@@ -11,6 +11,8 @@ from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from navseq.mission.model import Mission
     from navseq.sim.costmap import Costmap
 
@@ -54,12 +56,13 @@ def format_pose(pose: Pose2D) -> str:
 
 
 def preflight_errors(
-    mission: Mission, costmap: Costmap, start: Pose2D | None
+    mission: Mission, costmap: Costmap, start: Pose2D | None,
+    numbers: Sequence[int] | None = None,
 ) -> list[NavseqError]:
     """Every problem of ``mission`` against the map (empty when it is fine to run)."""
     from navseq.preflight import check_mission
 
-    return check_mission(mission, costmap, start)
+    return check_mission(mission, costmap, start, numbers=numbers)
 
 
 def costmap_for_map(map_path: Path) -> Costmap:

@@ -1,17 +1,24 @@
 """``navseq validate MISSION [--map MAP]``: every problem of a mission, all at once.
 
-First the mission file itself (syntax, values, names); then, when a map is known
-(``--map`` or the mission's ``map:`` key), the pre-flight check of every waypoint
-against that map. Exit 0 when there is nothing to report, 2 otherwise.
+The mission file itself (syntax, values, names) and, when a map is known (``--map``
+or the mission's ``map:`` key), the pre-flight check of every waypoint against that
+map, in one list: waypoints that read well are checked against the map even when
+others in the file have problems. Exit 0 when there is nothing to report, 2 otherwise.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from navseq.commands.common import parse_pose
+from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -31,25 +38,47 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.commands.common import costmap_for_map, preflight_errors, require_file
+    from navseq.commands.common import require_file
     from navseq.errors import MissionErrors
-    from navseq.mission import load_mission, validate_mission_file
+    from navseq.mission import inspect_mission_file
 
     if args.map is not None:
         require_file(args.map, "--map")
-    problems = validate_mission_file(args.mission)
-    if problems:
-        raise MissionErrors(problems)
-    mission = load_mission(args.mission)
-    map_path = args.map if args.map is not None else mission.map
-    start = args.start if args.start is not None else mission.start
-    if map_path is not None:
-        problems = preflight_errors(mission, costmap_for_map(map_path), start)
-        if problems:
-            raise MissionErrors(problems)
+    mission, problems = inspect_mission_file(args.mission)
+    errors = list(problems.errors)
+    if mission is None and problems.salvage is not None:
+        # Check the waypoints that did read against the map as well, so that one run
+        # of validate lists everything to fix.
+        errors += _map_problems(args, problems.salvage.mission, problems.salvage.numbers)
+    elif mission is not None:
+        errors += _map_problems(args, mission)
+    if errors:
+        raise MissionErrors(errors)
+    assert mission is not None
     count = len(mission.waypoints)
     loops = "forever" if mission.loops is None else str(mission.loops)
+    map_path = _map_path(args, mission)
     checked = f"checked against map {map_path}" if map_path is not None else "no map to check"
     print(f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
           f"loops {loops}, {checked}", file=sys.stdout)
     return 0
+
+
+def _map_path(args: argparse.Namespace, mission: Mission) -> Path | None:
+    return args.map if args.map is not None else mission.map
+
+
+def _map_problems(args: argparse.Namespace, mission: Mission,
+                  numbers: Sequence[int] | None = None) -> list[NavseqError]:
+    """The pre-flight problems of ``mission`` on the map given or named, if any."""
+    from navseq.commands.common import costmap_for_map, preflight_errors
+
+    map_path = _map_path(args, mission)
+    if map_path is None:
+        return []
+    try:
+        costmap = costmap_for_map(map_path)
+    except NavseqError as error:  # an unreadable map is one more problem to list
+        return [error]
+    start = args.start if args.start is not None else mission.start
+    return preflight_errors(mission, costmap, start, numbers)

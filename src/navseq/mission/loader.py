@@ -53,6 +53,15 @@ def validate_mission_file(path: str | os.PathLike[str]) -> list[NavseqError]:
     return _load(Path(path))[1].errors
 
 
+def inspect_mission_file(path: str | os.PathLike[str]) -> tuple[Mission | None, Problems]:
+    """The mission (None when it has problems) and every problem of a mission file.
+
+    When there are problems, ``Problems.salvage`` holds the waypoints that still
+    read well (navseq YAML only), so that they can be checked against the map too.
+    """
+    return _load(Path(path))
+
+
 def _load(path: Path) -> tuple[Mission | None, Problems]:
     problems = Problems()
     source = str(path)

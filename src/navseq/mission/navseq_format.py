@@ -31,7 +31,7 @@ from navseq.geometry import Pose2D, quaternion_to_yaw
 from navseq.mission import fields
 from navseq.mission.located import Located, describe
 from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
-from navseq.mission.problems import Problems
+from navseq.mission.problems import Problems, Salvage
 
 FORMAT_VERSION = 1
 FOREVER = "forever"
@@ -72,9 +72,13 @@ def mission_from_document(doc: Located | None, source: str, base_dir: Path | Non
             problems.add("has no 'waypoints' list; a mission needs at least one waypoint "
                          "(or p_seq/yea_seq, the tutorial's lists)", source=doc.where)
     else:
-        waypoints = read_waypoints(waypoints_node, problems)
+        waypoints, numbers = read_numbered_waypoints(waypoints_node, problems)
     settings = read_settings(doc, base_dir, problems)
     if len(problems) > before:
+        if waypoints:
+            problems.salvage = Salvage(
+                Mission(waypoints=waypoints, defaults=defaults, source=source, **settings),
+                numbers)
         return None
     return Mission(waypoints=waypoints, defaults=defaults, source=source, **settings)
 
@@ -167,16 +171,23 @@ def read_start(node: Located, subject: str) -> Pose2D:
 
 
 def read_waypoints(node: Located, problems: Problems) -> tuple[Waypoint, ...]:
+    return read_numbered_waypoints(node, problems)[0]
+
+
+def read_numbered_waypoints(node: Located, problems: Problems,
+                            ) -> tuple[tuple[Waypoint, ...], tuple[int, ...]]:
+    """The waypoints that read without a problem, and their indices in the list."""
     items = fields.attempt(problems, lambda: fields.sequence(node, "field waypoints"))
     if items is None:
-        return ()
+        return (), ()
     if not items:
         problems.add("the waypoint list is empty; a mission needs at least one waypoint",
                      source=node.where, subject="field waypoints")
-        return ()
-    waypoints = [read_waypoint(item, index, problems) for index, item in enumerate(items)]
+        return (), ()
+    read = [(index, read_waypoint(item, index, problems)) for index, item in enumerate(items)]
     check_unique_names(items, problems)
-    return tuple(w for w in waypoints if w is not None)
+    kept = [(index, waypoint) for index, waypoint in read if waypoint is not None]
+    return tuple(w for _, w in kept), tuple(i for i, _ in kept)
 
 
 def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | None:

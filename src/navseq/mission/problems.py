@@ -9,8 +9,23 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
+from dataclasses import dataclass
 
 from navseq.errors import MissionErrors, NavseqError
+from navseq.mission.model import Mission
+
+
+@dataclass(frozen=True)
+class Salvage:
+    """The part of a faulty mission that could still be read.
+
+    ``navseq validate`` checks it against the map too, so that one run lists the
+    file's problems and the map's. ``numbers`` gives each kept waypoint's index in
+    the file (0-based), so messages name waypoints as the user numbered them.
+    """
+
+    mission: Mission
+    numbers: tuple[int, ...]
 
 
 class Problems:
@@ -18,6 +33,7 @@ class Problems:
 
     def __init__(self) -> None:
         self.errors: list[NavseqError] = []
+        self.salvage: Salvage | None = None  # set by readers that can keep a partial mission
 
     def add(self, message: str, *, source: str | None, subject: str | None = None) -> None:
         self.errors.append(NavseqError(message, source=source, subject=subject))
