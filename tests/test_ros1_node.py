@@ -226,7 +226,8 @@ def test_keep_alive_keeps_markers_and_status_up_after_the_mission_until_sigint(
         response = ros_master.call_service(f"/navseq/{service}")
         assert not response["success"] and "mission has ended" in response["message"], response
     assert [d["status"] for d in events(log, "done")] == ["SUCCEEDED"] * 3
-    assert node.stop(signal.SIGINT) == 130
+    # The mission was over: roslaunch's SIGINT interrupts nothing, the exit says success.
+    assert node.stop(signal.SIGINT) == 0
     assert "Traceback" not in node.output()
 
 

@@ -29,9 +29,10 @@ SIGINT/SIGTERM.
 With ``~keep_alive`` true the node does not exit when the mission ends (all waypoints
 done, or cancelled through ``~cancel``): it stays up until it is shut down, so RViz
 keeps showing the latched markers in their final colours and the final ``~status``.
-Meanwhile the services answer that the mission is over. The exit status is then
-130/143 for SIGINT/SIGTERM, otherwise (``rosnode kill``, roslaunch) the mission's own
-0 or 1. Bad parameters and a missing action server still exit at once with 2.
+Meanwhile the services answer that the mission is over. Being stopped is then the
+expected end, not an interruption: whether by SIGINT/SIGTERM (roslaunch's shutdown),
+``rosnode kill`` or the master, the exit status is the mission's own 0 or 1. Bad
+parameters and a missing action server still exit at once with 2.
 """
 
 from __future__ import annotations
@@ -308,8 +309,9 @@ def run_node() -> int:
 def stay_up(mission_code: int) -> int:
     """Keep the node (its latched topics and services) up until it is shut down.
 
-    Returns the exit status: 130/143 for SIGINT/SIGTERM, else ``mission_code``
-    (``rosnode kill``, a master or roslaunch shutdown).
+    Returns ``mission_code`` however the node is stopped: the mission is over, so a
+    signal interrupts nothing, and roslaunch (which stops nodes with SIGINT) should
+    not see a finished mission as a failure.
     """
     rospy.loginfo("navseq: mission over; staying up (~keep_alive) until shut down")
     # rospy's own signal handlers are off (see ensure_node); the node's are set here.
@@ -329,7 +331,6 @@ def stay_up(mission_code: int) -> int:
             signal.signal(sig, handler)
     if stop_signal:
         rospy.loginfo("navseq: %s; shutting down", stop_signal[0])
-        return SIGNAL_EXIT_CODES[stop_signal[0]]
     return mission_code
 
 
