@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from navseq.geometry import Pose2D, compose, inverse
-from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
+from navseq.sim.footprint import TURTLEBOT3_BURGER, CollisionChecker, Footprint
 from navseq.sim.occupancy import OccupancyGrid
 from navseq.sim.robot import DiffDriveLimits, DiffDriveRobot
 
@@ -38,6 +38,7 @@ class SimulatedBase:
         self.grid = grid
         self.footprint = footprint
         self.robot = DiffDriveRobot(start, limits)
+        self._checker = CollisionChecker(grid, footprint) if grid is not None else None
         # The odom frame is where the robot started: odometry reads (0, 0, 0) at start.
         self.map_to_odom = Pose2D(start.x, start.y, start.yaw)
         self.cmd_vel_timeout = cmd_vel_timeout
@@ -47,7 +48,8 @@ class SimulatedBase:
         self._cmd_time = -math.inf
 
     def collides(self, pose: Pose2D) -> bool:
-        return self.grid is not None and footprint_collides(self.grid, self.footprint, pose)
+        """True when the footprint at ``pose`` overlaps an obstacle, unknown space or the edge."""
+        return self._checker is not None and self._checker.collides(pose)
 
     def command(self, v: float, w: float) -> None:
         """A new velocity command, valid for ``cmd_vel_timeout`` seconds of sim time."""
@@ -89,3 +91,4 @@ class SimulatedBase:
     def odom_pose(self) -> Pose2D:
         """The robot's pose in the odom frame."""
         return compose(inverse(self.map_to_odom), self.robot.pose)
+

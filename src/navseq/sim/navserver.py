@@ -31,13 +31,16 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from navseq.geometry import Pose2D
 from navseq.sim.controller import ControllerParams, RegulatedPurePursuit
 from navseq.sim.costmap import INSCRIBED, Costmap
-from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
-from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.footprint import (
+    TURTLEBOT3_BURGER,
+    Footprint,
+    clearance_map,
+    footprint_collides,
+)
 from navseq.sim.planner import Plan, plan_path
 from navseq.sim.robot import integrate_arc, next_velocity
 
@@ -298,18 +301,6 @@ class NavigationServer:
             if footprint_collides(grid, footprint, pose):
                 return False
         return True
-
-
-def clearance_map(grid: OccupancyGrid) -> np.ndarray:
-    """Metres from each cell centre to the nearest obstacle, unknown cell or map edge.
-
-    A footprint whose circumscribed circle, centred anywhere in a cell, stays more than
-    ``clearance - 2 * resolution`` away cannot overlap any blocked cell: the cheap test
-    that lets a caller skip the exact footprint test far from obstacles.
-    """
-    blocked = np.pad(grid.occupied_mask() | grid.unknown_mask(), 1, constant_values=True)
-    distance = ndimage.distance_transform_edt(~blocked)[1:-1, 1:-1]
-    return (distance * grid.resolution).astype(np.float32)
 
 
 def _with_exact_ends(plan: Plan, start: tuple[float, float], goal: tuple[float, float]) -> Plan:

@@ -1,9 +1,10 @@
 """One simulated robot with its navigation server on a map, and the clock that drives them.
 
 Each :meth:`SimWorld.step` advances simulated time by ``dt``: the navigation server turns
-the robot's pose and velocity into a command, and the robot body carries it out unless
-its footprint would then overlap an obstacle. In that case the body refuses the move
-and halts, like a bumper stop, and ``collisions`` counts it — with a correct server the
+the robot's pose and velocity into a command, and the robot body (the same
+:class:`navseq.sim.base.SimulatedBase` the ROS sim robot node wraps) carries it out
+unless its footprint would then overlap an obstacle. In that case the body refuses the
+move and halts, like a bumper stop, and ``collisions`` counts it — with a correct server the
 count stays zero, because the server aborts before a collision becomes unavoidable.
 """
 
@@ -13,9 +14,15 @@ import numpy as np
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.sim.base import SimulatedBase
 from navseq.sim.costmap import Costmap, CostmapParams
-from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_collides
-from navseq.sim.navserver import NavigationServer, NavParams, NavState, clearance_map
+from navseq.sim.footprint import (
+    TURTLEBOT3_BURGER,
+    Footprint,
+    clearance_map,
+    footprint_collides,
+)
+from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid
 from navseq.sim.robot import DiffDriveRobot
 
@@ -53,41 +60,34 @@ class SimWorld:
         self.footprint = footprint
         self.costmap = costmap if costmap is not None else Costmap.from_grid(grid, costmap_params)
         self.server = NavigationServer(self.costmap, nav_params, footprint)
-        self.robot = DiffDriveRobot(start, self.server.params.limits)
+        self._check_pose(grid, footprint, start, "start")
+        # A command arrives every step, so the body's command timeout (two steps, against
+        # rounding) never applies.
+        self.body = SimulatedBase(start, grid, footprint=footprint,
+                                  limits=self.server.params.limits, cmd_vel_timeout=2 * dt)
         self.time = 0.0
         self.steps = 0
-        self.collisions = 0
-        self._clearance = clearance_map(grid)
-        self._safe_clearance = footprint.circumscribed_radius + 2.0 * grid.resolution
-        self._check_pose(start, "start")
+
+    @property
+    def robot(self) -> DiffDriveRobot:
+        """The robot's kinematic state: pose (map frame) and velocities."""
+        return self.body.robot
+
+    @property
+    def collisions(self) -> int:
+        """Moves the body refused because the footprint would have touched something."""
+        return self.body.refused_steps
 
     def step(self) -> None:
         """Advance one ``dt``: the server commands, the robot moves unless it would collide."""
         robot = self.robot
-        dt = self.dt
-        cmd_v, cmd_w = self.server.compute_velocity(robot.pose, robot.v, robot.w, dt)
+        cmd_v, cmd_w = self.server.compute_velocity(robot.pose, robot.v, robot.w, self.dt)
         self.steps += 1
-        self.time = self.steps * dt  # no drift from adding dt thousands of times
+        self.time = self.steps * self.dt  # no drift from adding dt thousands of times
         if cmd_v == 0.0 and cmd_w == 0.0 and robot.v == 0.0 and robot.w == 0.0:
             return  # at rest and told to stay: nothing can change
-        pose, v, w = robot.predict(cmd_v, cmd_w, dt)
-        if self._may_collide(pose) and footprint_collides(self.grid, self.footprint, pose):
-            robot.stop()
-            self.collisions += 1
-            return
-        robot.pose, robot.v, robot.w = pose, v, w
-
-    def _may_collide(self, pose: Pose2D) -> bool:
-        """False when the pose is so far from everything that the footprint cannot touch it.
-
-        The exact footprint test costs far more than the rest of a step; the clearance
-        map answers for most of the map with one array lookup.
-        """
-        row, col = self.grid.world_to_cell(pose.x, pose.y)
-        clearance = self._clearance
-        if 0 <= row < clearance.shape[0] and 0 <= col < clearance.shape[1]:
-            return bool(clearance[row, col] <= self._safe_clearance)
-        return True
+        self.body.command(cmd_v, cmd_w)
+        self.body.step(self.dt)
 
     def run(self, seconds: float) -> None:
         """Step for ``seconds`` of simulated time."""
@@ -96,18 +96,19 @@ class SimWorld:
 
     def teleport(self, pose: Pose2D) -> None:
         """Move the robot to ``pose`` at rest (the server keeps its goal and replans)."""
-        self._check_pose(pose, "pose")
-        self.robot.teleport(pose)
+        self._check_pose(self.grid, self.footprint, pose, "pose")
+        self.body.teleport(pose)
         server = self.server
         if server.state is NavState.ACTIVE and server.goal is not None:
             server.set_goal(server.goal)  # replan from the new place
 
-    def _check_pose(self, pose: Pose2D, what: str) -> None:
-        if footprint_collides(self.grid, self.footprint, pose):
+    @staticmethod
+    def _check_pose(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D, what: str) -> None:
+        if footprint_collides(grid, footprint, pose):
             raise NavseqError(
                 f"the robot at ({pose.x:.2f}, {pose.y:.2f}) would overlap an obstacle, "
                 "unknown space or the map edge",
-                source=self.grid.source,
+                source=grid.source,
                 subject=what,
             )
 
