@@ -9,10 +9,18 @@
 
 The file is read with expat (line numbers for every element; DTDs and entity
 declarations refused, so no entity expansion attacks). The parameters that
-``<param>`` and ``<rosparam>`` set (in ``<group>``s and ``<node>``s, with namespaces
-resolved like roslaunch does) form a parameter tree; the mission is then read from
-it like from a rosparam file. Substitution args (``$(arg x)``, ``$(find pkg)``)
-cannot be resolved without ROS and are reported where they matter.
+``<param>`` and ``<rosparam>`` set (in ``<group>``s, ``<node>``s and ``<include>``d
+files, with namespaces resolved like roslaunch does) form a parameter tree; the
+mission is then read from it like from a rosparam file.
+
+Like roslaunch, the reader declares ``<arg>``s per file in document order, honours
+``if=``/``unless=``, and resolves substitution args (see :mod:`launch_subst`) in
+attributes and, with ``subst_value="true"``, in ``<rosparam>`` bodies and files.
+``<include>`` is followed (a relative path is relative to the including file, which
+roslaunch does not allow), with its ``ns=`` and the args it passes; cycles and
+runaway nesting are refused. What stays unresolved (``$(eval)``, ``$(anon)``, a
+package not on ``ROS_PACKAGE_PATH``) is reported where it matters, and the files it
+kept navseq from reading are named when no mission is found.
 """
 
 from __future__ import annotations
@@ -22,12 +30,23 @@ from pathlib import Path
 from xml.parsers import expat
 
 from navseq.errors import NavseqError
+from navseq.mission.launch_subst import (
+    LaunchArgs,
+    PackageFinder,
+    Substitution,
+    SubstitutionError,
+)
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.model import Mission
 from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
 from navseq.mission.yaml_doc import parse_yaml, parse_yaml_value
+
+# Real launch trees are a few includes deep; these bound a file that includes others
+# many times over (each of which includes more), not just cycles.
+MAX_INCLUDE_DEPTH = 16
+MAX_INCLUDED_FILES = 200
 
 
 @dataclass
@@ -49,8 +68,8 @@ def mission_from_launch(text: str, source: str, base_dir: Path | None,
         return None
     reader = _LaunchReader(source, base_dir, problems)
     before = len(problems)
-    reader.walk(root, "/", None)
-    if len(problems) > before:  # a broken <rosparam> body; what it set is unknown
+    reader.walk(root, "/", None, reader.top)
+    if len(problems) > before:  # e.g. a broken <rosparam> body: what it set is unknown
         return None
     return mission_from_tree(reader.tree.located(), source, base_dir, problems,
                              not_followed=reader.not_followed)
@@ -141,95 +160,247 @@ def _parts(name: str) -> list[str]:
     return [part for part in name.split("/") if part]
 
 
+@dataclass
+class _File:
+    """One launch file being read: how messages name it, and its substitution args."""
+
+    source: str
+    subst: Substitution
+
+    def where(self, line: int) -> str:
+        return f"{self.source}:{line}"
+
+
 class _LaunchReader:
-    """Walks <launch> collecting what <param> and <rosparam> set."""
+    """Walks <launch>, and the files it includes, collecting what <param> and <rosparam> set."""
 
     def __init__(self, source: str, base_dir: Path | None, problems: Problems):
-        self.source = source
-        self.base_dir = base_dir
         self.problems = problems
+        self.packages = PackageFinder()
         self.tree = _ParamTree(f"{source}:1")
         self.not_followed: list[str] = []
+        self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages))
+        self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
+        self.files_read = 1
 
-    def where(self, element: _Element) -> str:
-        return f"{self.source}:{element.line}"
-
-    def walk(self, element: _Element, namespace: str, private: str | None) -> None:
+    def walk(self, element: _Element, namespace: str, private: str | None, file: _File,
+             depth: int = 0) -> None:
+        if depth > MAX_DEPTH:
+            self.problems.add(f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
+                              source=file.where(element.line))
+            return
         for child in element.children:
-            if not _condition_holds(child):
-                continue
-            if child.tag == "group":
-                inner = _resolve(child.attrs.get("ns", ""), namespace, None)
-                self.walk(child, inner, None)
-            elif child.tag == "node":
-                node_namespace = _resolve(child.attrs.get("ns", ""), namespace, None)
-                node_name = _resolve(child.attrs.get("name", ""), node_namespace, None)
-                self.walk(child, node_namespace, node_name)
-            elif child.tag == "param":
-                self.param(child, namespace, private)
-            elif child.tag == "rosparam":
-                self.rosparam(child, namespace, private)
-            elif child.tag == "include":
-                self.not_followed.append(child.attrs.get("file", "<include>"))
+            try:
+                self.visit(child, namespace, private, file, depth)
+            except SubstitutionError as error:
+                self.problems.add(error.message, source=file.where(child.line))
 
-    def param(self, element: _Element, namespace: str, private: str | None) -> None:
-        name = element.attrs.get("name")
-        value = element.attrs.get("value")
+    def visit(self, element: _Element, namespace: str, private: str | None, file: _File,
+              depth: int) -> None:
+        if not self.condition_holds(element, file):
+            return
+        if element.tag == "arg":
+            self.arg(element, file)
+        elif element.tag == "group":
+            inner = _resolve(self.attr(element, "ns", file) or "", namespace, None)
+            self.walk(element, inner, None, file, depth + 1)
+        elif element.tag == "node":
+            node_namespace = _resolve(self.attr(element, "ns", file) or "", namespace, None)
+            node_name = _resolve(self.attr(element, "name", file) or "", node_namespace, None)
+            self.walk(element, node_namespace, node_name, file, depth + 1)
+        elif element.tag == "param":
+            self.param(element, namespace, private, file)
+        elif element.tag == "rosparam":
+            self.rosparam(element, namespace, private, file)
+        elif element.tag == "include":
+            self.include(element, namespace, file, depth)
+
+    @staticmethod
+    def attr(element: _Element, name: str, file: _File) -> str | None:
+        value = element.attrs.get(name)
+        return None if value is None else file.subst.resolve(value)
+
+    def condition_holds(self, element: _Element, file: _File) -> bool:
+        """roslaunch's if=/unless=; a substitution navseq cannot evaluate counts as true."""
+        for key, keep_when in (("if", True), ("unless", False)):
+            value = self.attr(element, key, file)
+            if value is None or "$(" in value:
+                continue
+            truth = _boolean(value)
+            if truth is None:
+                raise SubstitutionError(f"{key}=\"{value}\" is neither true nor false "
+                                        "(roslaunch accepts true, false, 1 and 0)")
+            if truth != keep_when:
+                return False
+        return True
+
+    def arg(self, element: _Element, file: _File) -> None:
+        name = self.attr(element, "name", file)
+        if not name:
+            self.problems.add("<arg> needs a name=", source=file.where(element.line))
+            return
+        file.subst.args.declare(name, value=self.attr(element, "value", file),
+                                default=self.attr(element, "default", file))
+
+    def param(self, element: _Element, namespace: str, private: str | None,
+              file: _File) -> None:
+        name = self.attr(element, "name", file)
+        value = self.attr(element, "value", file)
         if not name or value is None:  # textfile=, binfile=, command= need ROS
             return
-        where = self.where(element)
+        where = file.where(element.line)
         located = Located(value, where)
         if element.attrs.get("type", "auto") not in ("str", "string"):
             try:
-                parsed = parse_yaml_value(value, self.source, first_line=element.line)
+                parsed = parse_yaml_value(value, file.source, first_line=element.line)
             except NavseqError:
                 parsed = None  # plain text, as roslaunch would keep it
             if parsed is not None:
                 located = parsed
         self.tree.set(_parts(_resolve(name, namespace, private)), located)
 
-    def rosparam(self, element: _Element, namespace: str, private: str | None) -> None:
-        if element.attrs.get("command", "load") != "load":
+    def rosparam(self, element: _Element, namespace: str, private: str | None,
+                 file: _File) -> None:
+        if (self.attr(element, "command", file) or "load") != "load":
             return
-        target = _resolve(element.attrs.get("ns", ""), namespace, private)
-        param = element.attrs.get("param")
+        target = _resolve(self.attr(element, "ns", file) or "", namespace, private)
+        param = self.attr(element, "param", file)
         if param:
             target = _resolve(param, target, None)
-        value = self.rosparam_value(element)
+        value = self.rosparam_value(element, file)
         if value is not None:
             self.tree.set(_parts(target), value)
 
-    def rosparam_value(self, element: _Element) -> Located | None:
-        file_name = element.attrs.get("file")
+    def rosparam_value(self, element: _Element, file: _File) -> Located | None:
+        # As in roslaunch, a body or loaded file is substituted only when asked to.
+        substitute = _boolean(self.attr(element, "subst_value", file) or "false") is True
+        file_name = self.attr(element, "file", file)
         if file_name is not None:
-            return self.rosparam_file(file_name)
+            return self.rosparam_file(file_name, file, substitute)
         body = "".join(element.text)
+        first_line = element.text_line or element.line
+        if substitute:
+            try:
+                body = file.subst.resolve(body)
+            except SubstitutionError as error:
+                line = first_line + body[:error.offset].count("\n")
+                self.problems.add(error.message, source=file.where(line))
+                return None
         try:
-            return parse_yaml(body, self.source, self.problems,
-                              first_line=element.text_line or element.line)
+            return parse_yaml(body, file.source, self.problems, first_line=first_line)
         except NavseqError as error:
             self.problems.record(error)
             return None
 
-    def rosparam_file(self, file_name: str) -> Located | None:
+    def rosparam_file(self, file_name: str, file: _File, substitute: bool) -> Located | None:
         if "$(" in file_name:
+            self.not_followed.append(file.subst.explain(file_name))
+            return None
+        path = self.path(file_name, file)
+        try:
+            text = read_mission_text(path)
+        except NavseqError:
             self.not_followed.append(file_name)
             return None
-        path = Path(file_name)
-        if not path.is_absolute() and self.base_dir is not None:
-            path = self.base_dir / path
+        if substitute:
+            try:
+                text = file.subst.resolve(text)
+            except SubstitutionError as error:
+                line = 1 + text[:error.offset].count("\n")
+                self.problems.add(error.message, source=f"{path}:{line}")
+                return None
         try:
-            return parse_yaml(read_mission_text(path), str(path), self.problems)
+            return parse_yaml(text, str(path), self.problems)
         except NavseqError:
             self.not_followed.append(file_name)
             return None
 
+    def include(self, element: _Element, namespace: str, file: _File, depth: int) -> None:
+        here = file.where(element.line)
+        file_name = self.attr(element, "file", file)
+        if not file_name:
+            self.problems.add("<include> needs a file=", source=here)
+            return
+        inner = _resolve(self.attr(element, "ns", file) or "", namespace, None)
+        passed = self.passed_args(element, file)
+        if passed is None:
+            return
+        if "$(" in file_name:
+            self.not_followed.append(file.subst.explain(file_name))
+            return
+        path = self.path(file_name, file)
+        key = _file_key(path)
+        if key in self.reading:
+            chain = " -> ".join(str(p) for p in [*self.reading[self.reading.index(key):], key])
+            self.problems.add(f"includes {file_name}, which is already being read: an include "
+                              f"cycle ({chain})", source=here)
+            return
+        if len(self.reading) > MAX_INCLUDE_DEPTH or self.files_read >= MAX_INCLUDED_FILES:
+            self.problems.add(f"includes {file_name} beyond navseq's limits ({MAX_INCLUDE_DEPTH}"
+                              f" includes deep, {MAX_INCLUDED_FILES} files in all)", source=here)
+            return
+        try:
+            root = parse_xml(read_mission_text(path), str(path))
+        except NavseqError as error:
+            if error.source == str(path):  # the file itself is missing or unreadable
+                self.problems.add(f"includes {file_name}, which navseq cannot read: "
+                                  f"{error.message} ({path})", source=here)
+            else:
+                self.problems.record(error)
+            return
+        if root.tag != "launch":
+            self.problems.add(f"is included by {here} but is not a roslaunch file: its root "
+                              f"element is <{root.tag}>", source=f"{path}:{root.line}")
+            return
+        self.files_read += 1
+        included = _File(str(path), Substitution(LaunchArgs(passed), path.parent, self.packages))
+        self.reading.append(key)
+        try:
+            self.walk(root, inner, None, included, depth + 1)
+        finally:
+            self.reading.pop()
 
-def _condition_holds(element: _Element) -> bool:
-    """roslaunch's if=/unless=; a substitution it cannot evaluate counts as true."""
-    truthy, falsy = ("true", "1"), ("false", "0")
-    condition = element.attrs.get("if")
-    if condition is not None and condition.strip().lower() in falsy:
-        return False
-    condition = element.attrs.get("unless")
-    return not (condition is not None and condition.strip().lower() in truthy)
+    def passed_args(self, element: _Element, file: _File) -> dict[str, str] | None:
+        """The args an <include> gives the included file; None when one is wrong."""
+        all_args = _boolean(self.attr(element, "pass_all_args", file) or "false")
+        passed = file.subst.args.given() if all_args else {}
+        for child in element.children:
+            if child.tag != "arg":
+                continue
+            try:
+                if not self.condition_holds(child, file):
+                    continue
+                name = self.attr(child, "name", file)
+                value = self.attr(child, "value", file)
+                if value is None:
+                    value = self.attr(child, "default", file)
+            except SubstitutionError as error:
+                self.problems.add(error.message, source=file.where(child.line))
+                return None
+            if not name or value is None:
+                self.problems.add("<arg> in an <include> needs name= and value=",
+                                  source=file.where(child.line))
+                return None
+            passed[name] = value
+        return passed
+
+    @staticmethod
+    def path(file_name: str, file: _File) -> Path:
+        """A path from a launch file; relative ones are relative to that file's folder."""
+        path = Path(file_name)
+        if not path.is_absolute() and file.subst.folder is not None:
+            path = file.subst.folder / path
+        return path
+
+
+def _file_key(path: Path) -> Path:
+    """The same file under any of its names, to recognise an include cycle."""
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError, ValueError):
+        return path.absolute()
+
+
+def _boolean(value: str) -> bool | None:
+    text = value.strip().lower()
+    return True if text in ("true", "1") else False if text in ("false", "0") else None

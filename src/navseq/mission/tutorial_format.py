@@ -95,8 +95,11 @@ def _as_list(node: Located, key: str) -> Located:
     """The list itself; text holding a YAML list (``<param value="[1, 2]"/>``) is read too."""
     if isinstance(node.value, str):
         if "$(" in node.value:
-            raise NavseqError(f"uses a roslaunch substitution ({node.value.strip()[:40]}) that "
-                              "navseq cannot resolve here; write the numbers themselves",
+            raise NavseqError(f"holds a roslaunch substitution navseq left unresolved "
+                              f"({node.value.strip()[:40]}): navseq does not evaluate $(eval) "
+                              "or $(anon), finds only packages on ROS_PACKAGE_PATH, and (like "
+                              "roslaunch) substitutes in a <rosparam> body only with "
+                              'subst_value="true"; write the numbers themselves',
                               source=node.where, subject=f"field {key}")
         try:
             parsed = parse_yaml_value(node.value, node.where)

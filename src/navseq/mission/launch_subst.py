@@ -1,0 +1,235 @@
+"""roslaunch substitution args, resolved without ROS.
+
+Resolved like roslaunch does: ``$(arg NAME)`` (the args of the file being read),
+``$(dirname)`` (that file's folder), ``$(env NAME)``, ``$(optenv NAME [default words])``
+and ``$(find PKG)`` (the package on ``ROS_PACKAGE_PATH`` whose ``package.xml`` names
+it). What cannot be known without running roslaunch (``$(eval ...)``, ``$(anon ...)``,
+a ``$(find)`` of a package that is not on the path) stays in the text as written, so
+that whoever uses the value can say that it was not resolved. A substitution that
+roslaunch itself refuses (an undeclared or unset arg, an unset ``$(env)``, an unknown
+command) is a :class:`SubstitutionError`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from xml.parsers import expat
+
+from navseq.errors import NavseqError
+from navseq.mission.reading import read_mission_text
+
+COMMANDS = ("arg", "dirname", "env", "optenv", "find", "anon", "eval")
+# rospack crawls whole trees; navseq bounds the walk, since ROS_PACKAGE_PATH may name "/".
+MAX_SEARCH_DEPTH = 6
+MAX_SEARCHED_FOLDERS = 20_000
+
+
+class SubstitutionError(NavseqError):
+    """What roslaunch would refuse; ``offset`` is where in the text, for a line number."""
+
+    def __init__(self, message: str, offset: int = 0):
+        super().__init__(message)
+        self.offset = offset
+
+
+class LaunchArgs:
+    """The ``<arg>``s of one launch file: roslaunch scopes them per file, not per group.
+
+    ``passed`` are the values the including file gives (``<include><arg .../>``).
+    """
+
+    def __init__(self, passed: dict[str, str] | None = None):
+        self.passed = dict(passed or {})
+        self.values: dict[str, str | None] = {}  # None: declared, but no value anywhere
+
+    def declare(self, name: str, *, value: str | None, default: str | None) -> None:
+        if name in self.values:
+            raise SubstitutionError(f"declares arg '{name}' a second time")
+        if value is not None:
+            if name in self.passed:
+                raise SubstitutionError(
+                    f"arg '{name}' has a fixed value= here, so the including file cannot "
+                    "set it (roslaunch refuses this too); write default= to allow it")
+            self.values[name] = value
+        else:
+            self.values[name] = self.passed.get(name, default)
+
+    def value(self, name: str, offset: int) -> str:
+        if name not in self.values:
+            raise SubstitutionError(
+                f"$(arg {name}): no arg '{name}' is declared in this file before this line; "
+                f"declare it with <arg name=\"{name}\" default=\"...\"/>", offset)
+        value = self.values[name]
+        if value is None:
+            raise SubstitutionError(
+                f"$(arg {name}): arg '{name}' has neither a default nor a value and no "
+                f"including file passes it (roslaunch would need {name}:=... on its command "
+                "line); give it a default=", offset)
+        return value
+
+    def given(self) -> dict[str, str]:
+        """The args that have a value, for ``<include pass_all_args="true">``."""
+        return {name: value for name, value in self.values.items() if value is not None}
+
+
+class PackageFinder:
+    """``$(find PKG)`` without rospack: the folders of ``ROS_PACKAGE_PATH``, crawled once."""
+
+    def __init__(self, package_path: str | None = None):
+        if package_path is None:
+            package_path = os.environ.get("ROS_PACKAGE_PATH", "")
+        self.roots = [Path(part) for part in package_path.split(os.pathsep) if part]
+        self._index: dict[str, Path] | None = None
+
+    def find(self, name: str) -> Path | None:
+        if self._index is None:
+            self._index = self._crawl()
+        return self._index.get(name)
+
+    def why_missing(self, name: str) -> str:
+        if not self.roots:
+            return f"package '{name}' not found: ROS_PACKAGE_PATH is not set"
+        return f"package '{name}' is not on ROS_PACKAGE_PATH"
+
+    def _crawl(self) -> dict[str, Path]:
+        index: dict[str, Path] = {}
+        budget = MAX_SEARCHED_FOLDERS
+        for root in self.roots:  # earlier entries win, as in rospack
+            stack = [(root, 0)]
+            while stack and budget > 0:
+                folder, depth = stack.pop()
+                budget -= 1
+                try:
+                    entries = sorted(os.scandir(folder), key=lambda e: e.name, reverse=True)
+                except (OSError, ValueError):
+                    continue
+                names = {entry.name for entry in entries}
+                if "CATKIN_IGNORE" in names:
+                    continue
+                if "package.xml" in names:
+                    # A package's own subfolders hold no other packages worth finding.
+                    name = _package_name(folder / "package.xml")
+                    if name:
+                        index.setdefault(name, folder)
+                    continue
+                if depth < MAX_SEARCH_DEPTH:
+                    stack.extend((Path(entry.path), depth + 1) for entry in entries
+                                 if not entry.name.startswith(".") and _is_folder(entry))
+        return index
+
+
+def _is_folder(entry: os.DirEntry[str]) -> bool:
+    try:
+        return entry.is_dir()  # follows symbolic links, as workspaces often use them
+    except OSError:
+        return False
+
+
+def _package_name(path: Path) -> str | None:
+    """The ``<name>`` of a package.xml, or None when it cannot be read."""
+    try:
+        text = read_mission_text(path, max_bytes=1024 * 1024)
+    except NavseqError:
+        return None
+    parser = expat.ParserCreate()
+    depth = 0
+    inside_name = False
+    name: list[str] = []
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        nonlocal depth, inside_name
+        depth += 1
+        inside_name = depth == 2 and tag == "name"
+
+    def end(tag: str) -> None:
+        nonlocal depth, inside_name
+        depth -= 1
+        inside_name = False
+
+    def characters(data: str) -> None:
+        if inside_name:
+            name.append(data)
+
+    def refuse(*args: object) -> None:
+        raise ValueError("package.xml declares a DTD")  # no entity expansion, ever
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = characters
+    parser.StartDoctypeDeclHandler = refuse
+    parser.EntityDeclHandler = refuse
+    try:
+        parser.Parse(text, True)
+    except (expat.ExpatError, ValueError):
+        return None
+    return "".join(name).strip() or None
+
+
+class Substitution:
+    """Resolves the substitution args in the text of one launch file."""
+
+    def __init__(self, args: LaunchArgs, folder: Path | None, packages: PackageFinder):
+        self.args = args
+        self.folder = folder
+        self.packages = packages
+
+    def resolve(self, text: str) -> str:
+        if "$(" not in text:
+            return text
+        if text.startswith("$(eval ") and text.endswith(")"):
+            return text  # Python code; navseq never runs what a file says
+        parts = []
+        position = 0
+        while (start := text.find("$(", position)) != -1:
+            end = text.find(")", start)
+            if end == -1:
+                break  # roslaunch keeps an unclosed "$(" as text too
+            parts.append(text[position:start])
+            resolved = self._one(text[start + 2:end], start)
+            parts.append(text[start:end + 1] if resolved is None else resolved)
+            position = end + 1
+        parts.append(text[position:])
+        return "".join(parts)
+
+    def explain(self, text: str) -> str:
+        """``text``, plus why a ``$(find)`` in it stayed unresolved (for "not followed")."""
+        missing = [word.split(")")[0] for word in text.split("$(find ")[1:]]
+        reasons = [self.packages.why_missing(name.strip()) for name in missing if name.strip()]
+        return f"{text} ({'; '.join(reasons)})" if reasons else text
+
+    def _one(self, body: str, offset: int) -> str | None:
+        """The value of ``$(body)``; None when it stays as written."""
+        words = body.split()
+        if not words or words[0] not in COMMANDS:
+            known = ", ".join(f"$({command})" for command in COMMANDS)
+            raise SubstitutionError(f"$({body}) is not a roslaunch substitution (roslaunch "
+                                    f"knows {known})", offset)
+        command, rest = words[0], words[1:]
+        if command in ("anon", "eval"):
+            return None
+        if command == "dirname":
+            self._count(body, rest, 0, offset)
+            return None if self.folder is None else str(self.folder)
+        if command == "optenv":
+            if not rest:
+                raise SubstitutionError(f"$({body}) names no environment variable", offset)
+            return os.environ.get(rest[0], " ".join(rest[1:]))
+        self._count(body, rest, 1, offset)
+        if command == "arg":
+            return self.args.value(rest[0], offset)
+        if command == "env":
+            value = os.environ.get(rest[0])
+            if value is None:
+                raise SubstitutionError(
+                    f"$(env {rest[0]}): the environment variable {rest[0]} is not set "
+                    f"(write $(optenv {rest[0]} DEFAULT) for a default)", offset)
+            return value
+        package = self.packages.find(rest[0])
+        return None if package is None else str(package)
+
+    @staticmethod
+    def _count(body: str, rest: list[str], wanted: int, offset: int) -> None:
+        if len(rest) != wanted:
+            what = "no name" if wanted == 0 else "exactly one name"
+            raise SubstitutionError(f"$({body}) takes {what}, got {len(rest)}", offset)
