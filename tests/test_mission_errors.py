@@ -63,11 +63,12 @@ def test_missing_yea_seq_is_named(tmp_path):
     assert "yea_seq" in message and "missing" in message and ":2" in message
 
 
-def test_launch_substitution_args_are_reported_not_guessed(tmp_path):
+def test_unresolvable_launch_substitutions_are_reported_not_guessed(tmp_path):
+    # $(eval) needs roslaunch's Python evaluator, which navseq does not reimplement.
     path = write(tmp_path, "seq.launch", """<launch>
   <arg name="points" default="[1,2,0]"/>
   <node pkg="p" type="t" name="seq">
-    <param name="p_seq" value="$(arg points)"/>
+    <param name="p_seq" value="$(eval arg('points'))"/>
     <param name="yea_seq" value="[0]"/>
   </node>
 </launch>""")
