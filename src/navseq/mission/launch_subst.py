@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from xml.parsers import expat
 
 from navseq.errors import NavseqError
 from navseq.mission.reading import read_mission_text
+from navseq.mission.xml_tree import parse_xml
 
 COMMANDS = ("arg", "dirname", "env", "optenv", "find", "anon", "eval")
 # rospack crawls whole trees; navseq bounds the walk, since ROS_PACKAGE_PATH may name "/".
@@ -129,41 +129,11 @@ def _is_folder(entry: os.DirEntry[str]) -> bool:
 def _package_name(path: Path) -> str | None:
     """The ``<name>`` of a package.xml, or None when it cannot be read."""
     try:
-        text = read_mission_text(path, max_bytes=1024 * 1024)
+        root = parse_xml(read_mission_text(path, max_bytes=1024 * 1024), str(path))
     except NavseqError:
         return None
-    parser = expat.ParserCreate()
-    depth = 0
-    inside_name = False
-    name: list[str] = []
-
-    def start(tag: str, attrs: dict[str, str]) -> None:
-        nonlocal depth, inside_name
-        depth += 1
-        inside_name = depth == 2 and tag == "name"
-
-    def end(tag: str) -> None:
-        nonlocal depth, inside_name
-        depth -= 1
-        inside_name = False
-
-    def characters(data: str) -> None:
-        if inside_name:
-            name.append(data)
-
-    def refuse(*args: object) -> None:
-        raise ValueError("package.xml declares a DTD")  # no entity expansion, ever
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.CharacterDataHandler = characters
-    parser.StartDoctypeDeclHandler = refuse
-    parser.EntityDeclHandler = refuse
-    try:
-        parser.Parse(text, True)
-    except (expat.ExpatError, ValueError):
-        return None
-    return "".join(name).strip() or None
+    name = root.child("name") if root.tag == "package" else None
+    return (name.body.strip() or None) if name is not None else None
 
 
 class Substitution:

@@ -7,7 +7,7 @@
       </node>
     </launch>
 
-The file is read with expat (line numbers for every element; DTDs and entity
+The file is read by :mod:`xml_tree` (line numbers for every element; DTDs and entity
 declarations refused, so no entity expansion attacks). The parameters that
 ``<param>`` and ``<rosparam>`` set (in ``<group>``s, ``<node>``s and ``<include>``d
 files, with namespaces resolved like roslaunch does) form a parameter tree; the
@@ -25,9 +25,8 @@ kept navseq from reading are named when no mission is found.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from xml.parsers import expat
 
 from navseq.errors import NavseqError
 from navseq.mission.launch_subst import (
@@ -41,22 +40,13 @@ from navseq.mission.model import Mission
 from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
+from navseq.mission.xml_tree import XmlElement, parse_xml
 from navseq.mission.yaml_doc import parse_yaml, parse_yaml_value
 
 # Real launch trees are a few includes deep; these bound a file that includes others
 # many times over (each of which includes more), not just cycles.
 MAX_INCLUDE_DEPTH = 16
 MAX_INCLUDED_FILES = 200
-
-
-@dataclass
-class _Element:
-    tag: str
-    attrs: dict[str, str]
-    line: int
-    children: list[_Element] = field(default_factory=list)
-    text: list[str] = field(default_factory=list)
-    text_line: int | None = None  # file line of the first character of the body
 
 
 def mission_from_launch(text: str, source: str, base_dir: Path | None,
@@ -73,50 +63,6 @@ def mission_from_launch(text: str, source: str, base_dir: Path | None,
         return None
     return mission_from_tree(reader.tree.located(), source, base_dir, problems,
                              not_followed=reader.not_followed)
-
-
-def parse_xml(text: str, source: str) -> _Element:
-    """The element tree of an XML document, each element with its line number."""
-    parser = expat.ParserCreate()
-    stack: list[_Element] = []
-    roots: list[_Element] = []
-
-    def start(tag: str, attrs: dict[str, str]) -> None:
-        element = _Element(tag, attrs, parser.CurrentLineNumber)
-        (stack[-1].children if stack else roots).append(element)
-        stack.append(element)
-        if len(stack) > MAX_DEPTH:
-            raise NavseqError(f"nests elements more than {MAX_DEPTH} deep",
-                              source=f"{source}:{parser.CurrentLineNumber}")
-
-    def end(tag: str) -> None:
-        stack.pop()
-
-    def characters(data: str) -> None:
-        if stack:
-            if stack[-1].text_line is None:
-                stack[-1].text_line = parser.CurrentLineNumber
-            stack[-1].text.append(data)
-
-    def refuse_dtd(*args: object) -> None:
-        raise NavseqError("declares a DTD or entities; launch files have no use for them and "
-                          "navseq does not expand them",
-                          source=f"{source}:{parser.CurrentLineNumber}")
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.CharacterDataHandler = characters
-    parser.StartDoctypeDeclHandler = refuse_dtd
-    parser.EntityDeclHandler = refuse_dtd
-    try:
-        parser.Parse(text, True)
-    except expat.ExpatError as error:
-        message = expat.errors.messages[error.code]
-        raise NavseqError(f"is not well-formed XML: {message}",
-                          source=f"{source}:{error.lineno}") from None
-    if not roots:
-        raise NavseqError("has no XML element", source=source)
-    return roots[0]
 
 
 class _ParamTree:
@@ -183,7 +129,7 @@ class _LaunchReader:
         self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
         self.files_read = 1
 
-    def walk(self, element: _Element, namespace: str, private: str | None, file: _File,
+    def walk(self, element: XmlElement, namespace: str, private: str | None, file: _File,
              depth: int = 0) -> None:
         if depth > MAX_DEPTH:
             self.problems.add(f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
@@ -195,7 +141,7 @@ class _LaunchReader:
             except SubstitutionError as error:
                 self.problems.add(error.message, source=file.where(child.line))
 
-    def visit(self, element: _Element, namespace: str, private: str | None, file: _File,
+    def visit(self, element: XmlElement, namespace: str, private: str | None, file: _File,
               depth: int) -> None:
         if not self.condition_holds(element, file):
             return
@@ -216,11 +162,11 @@ class _LaunchReader:
             self.include(element, namespace, file, depth)
 
     @staticmethod
-    def attr(element: _Element, name: str, file: _File) -> str | None:
+    def attr(element: XmlElement, name: str, file: _File) -> str | None:
         value = element.attrs.get(name)
         return None if value is None else file.subst.resolve(value)
 
-    def condition_holds(self, element: _Element, file: _File) -> bool:
+    def condition_holds(self, element: XmlElement, file: _File) -> bool:
         """roslaunch's if=/unless=; a substitution navseq cannot evaluate counts as true."""
         for key, keep_when in (("if", True), ("unless", False)):
             value = self.attr(element, key, file)
@@ -234,7 +180,7 @@ class _LaunchReader:
                 return False
         return True
 
-    def arg(self, element: _Element, file: _File) -> None:
+    def arg(self, element: XmlElement, file: _File) -> None:
         name = self.attr(element, "name", file)
         if not name:
             self.problems.add("<arg> needs a name=", source=file.where(element.line))
@@ -242,7 +188,7 @@ class _LaunchReader:
         file.subst.args.declare(name, value=self.attr(element, "value", file),
                                 default=self.attr(element, "default", file))
 
-    def param(self, element: _Element, namespace: str, private: str | None,
+    def param(self, element: XmlElement, namespace: str, private: str | None,
               file: _File) -> None:
         name = self.attr(element, "name", file)
         value = self.attr(element, "value", file)
@@ -259,7 +205,7 @@ class _LaunchReader:
                 located = parsed
         self.tree.set(_parts(_resolve(name, namespace, private)), located)
 
-    def rosparam(self, element: _Element, namespace: str, private: str | None,
+    def rosparam(self, element: XmlElement, namespace: str, private: str | None,
                  file: _File) -> None:
         if (self.attr(element, "command", file) or "load") != "load":
             return
@@ -271,13 +217,13 @@ class _LaunchReader:
         if value is not None:
             self.tree.set(_parts(target), value)
 
-    def rosparam_value(self, element: _Element, file: _File) -> Located | None:
+    def rosparam_value(self, element: XmlElement, file: _File) -> Located | None:
         # As in roslaunch, a body or loaded file is substituted only when asked to.
         substitute = _boolean(self.attr(element, "subst_value", file) or "false") is True
         file_name = self.attr(element, "file", file)
         if file_name is not None:
             return self.rosparam_file(file_name, file, substitute)
-        body = "".join(element.text)
+        body = element.body
         first_line = element.text_line or element.line
         if substitute:
             try:
@@ -315,7 +261,7 @@ class _LaunchReader:
             self.not_followed.append(file_name)
             return None
 
-    def include(self, element: _Element, namespace: str, file: _File, depth: int) -> None:
+    def include(self, element: XmlElement, namespace: str, file: _File, depth: int) -> None:
         here = file.where(element.line)
         file_name = self.attr(element, "file", file)
         if not file_name:
@@ -360,7 +306,7 @@ class _LaunchReader:
         finally:
             self.reading.pop()
 
-    def passed_args(self, element: _Element, file: _File) -> dict[str, str] | None:
+    def passed_args(self, element: XmlElement, file: _File) -> dict[str, str] | None:
         """The args an <include> gives the included file; None when one is wrong."""
         all_args = _boolean(self.attr(element, "pass_all_args", file) or "false")
         passed = file.subst.args.given() if all_args else {}
