@@ -80,8 +80,6 @@ def test_navseq_launch_passes_the_tutorial_params_as_lists():
 
 
 def test_demo_launch_starts_the_robot_where_the_example_mission_starts():
-    if not EXAMPLE_MISSION.exists():
-        pytest.skip("examples/turtlebot3_world.yaml not written yet")
     from navseq.mission import load_mission
 
     start = load_mission(EXAMPLE_MISSION).start
@@ -146,8 +144,6 @@ def test_multi_robot_launch_drives_two_namespaced_robots_at_once(
 
 
 def test_demo_launch_completes_the_example_mission(ros_master: RosMaster):
-    if not EXAMPLE_MISSION.exists():
-        pytest.skip("examples/turtlebot3_world.yaml not written yet")
     demo = roslaunch(ros_master, "demo.launch", f"speed:={SPEED}")
     demo.wait(timeout=240)
     assert "mission succeeded" in demo.output(), demo.output()[-4000:]
