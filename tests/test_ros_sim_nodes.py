@@ -47,14 +47,12 @@ def yaw_error(a: float, b: float) -> float:
 
 def example_mission_goals() -> tuple[tuple[float, float, float], list[tuple[float, float, float]]]:
     """Start pose and (x, y, yaw radians) of every waypoint of the example mission."""
-    if not EXAMPLE_MISSION.exists():
-        pytest.skip(f"{EXAMPLE_MISSION.relative_to(REPO_ROOT)} not written yet")
     from navseq.mission import load_mission
 
     mission = load_mission(EXAMPLE_MISSION)
-    start = mission.start if getattr(mission, "start", None) is not None else None
-    start_pose = (start.x, start.y, start.yaw) if start is not None else START
-    return start_pose, [(w.x, w.y, w.yaw) for w in mission.waypoints]
+    start = mission.start
+    assert start is not None, "the example mission names its start pose"
+    return (start.x, start.y, start.yaw), [(w.x, w.y, w.yaw) for w in mission.waypoints]
 
 
 # -- move_base clients ------------------------------------------------------------------------
