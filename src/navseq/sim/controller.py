@@ -87,6 +87,11 @@ class RegulatedPurePursuit:
         self.goal_reached = False
         self.set_costmap(costmap)
 
+    @property
+    def closest_index(self) -> int:
+        """Index of the plan point nearest the robot at the last :meth:`compute`."""
+        return self._closest
+
     def set_costmap(self, costmap: Costmap) -> None:
         """Use ``costmap`` for the obstacle slowdown (after a costmap is rebuilt)."""
         self.costmap = costmap

@@ -15,10 +15,14 @@ Each cell gets a cost byte with costmap_2d's meanings:
 
 Distances are Euclidean between cell centres (``scipy.ndimage.distance_transform_edt``),
 as costmap_2d's inflation layer computes them.
+
+Obstacles that are not on the map (other robots) are added with
+:meth:`Costmap.with_obstacles`, like costmap_2d's obstacle layer over the static one.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,6 +92,30 @@ class Costmap:
     def free_mask(self) -> np.ndarray:
         """Cells where the robot centre may be."""
         return self.cost < INSCRIBED
+
+    def with_obstacles(self, rows: np.ndarray, cols: np.ndarray) -> Costmap:
+        """This costmap plus lethal cells at (``rows``, ``cols``), inflated as usual.
+
+        ``grid`` stays the map's: the extra obstacles live in ``cost`` only. The result
+        equals inflating the map with those cells occupied, but costs an EDT of a window
+        around them only: the cost falls with the distance to the nearest obstacle, so
+        the cost of the union is the larger of the two costs, and beyond
+        ``inflation_radius`` of the new cells nothing changes.
+        """
+        rows, cols = np.asarray(rows, dtype=np.intp), np.asarray(cols, dtype=np.intp)
+        if rows.size == 0:
+            return self
+        reach = math.ceil(self.params.inflation_radius / self.grid.resolution) + 1
+        height, width = self.cost.shape
+        top, bottom = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
+        left, right = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
+        free = np.ones((bottom - top, right - left), dtype=bool)
+        free[rows - top, cols - left] = False
+        distance = ndimage.distance_transform_edt(free) * self.grid.resolution
+        cost = self.cost.copy()
+        window = cost[top:bottom, left:right]
+        np.maximum(window, cost_of_distance(distance, self.params), out=window)
+        return Costmap(self.grid, self.params, cost)
 
 
 def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:

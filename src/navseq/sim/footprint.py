@@ -1,13 +1,14 @@
-"""The robot's footprint and an exact, fast test of whether it overlaps an obstacle.
+"""The robot's footprint and exact, fast tests of whether it overlaps an obstacle or a robot.
 
 A footprint is a polygon in the robot frame (x forward, y left), as costmap_2d's
 ``footprint`` parameter. ``footprint_collides`` asks whether any grid cell that the
 polygon overlaps (even partly) is occupied or unknown, or lies off the map. Overlap is
 decided exactly with the separating-axis theorem between the polygon and each cell
 square, so a footprint that only grazes the corner of an occupied cell collides, and
-one that merely touches a cell's edge does not.
+one that merely touches a cell's edge does not. ``footprints_overlap`` applies the same
+theorem, with the same convention for touching, to two placed footprints (robots).
 
-The test uses the convex hull of the polygon; for a non-convex footprint that is
+The tests use the convex hull of the polygon; for a non-convex footprint that is
 conservative (it may report a collision in a notch of the polygon).
 """
 
@@ -69,6 +70,12 @@ class Footprint:
         rotation = np.array([[c, s], [-s, c]])
         return self.polygon @ rotation + (pose.x, pose.y)
 
+    def _hull_at(self, pose: Pose2D) -> tuple[np.ndarray, np.ndarray]:
+        """(vertices, edge normals) of the convex hull placed at a pose, world frame."""
+        c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+        rotation = np.array([[c, s], [-s, c]])
+        return self._hull @ rotation + (pose.x, pose.y), self._normals @ rotation
+
 
 def footprint_collides(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) -> bool:
     """True if the footprint at ``pose`` overlaps an occupied or unknown cell or leaves the map.
@@ -86,6 +93,28 @@ def footprint_collides(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D) 
         return False
     rows, cols = np.nonzero(window)
     return bool(placed.overlaps(rows + row0, cols + col0).any())
+
+
+def footprints_overlap(
+    a: Footprint, pose_a: Pose2D, b: Footprint, pose_b: Pose2D, margin: float = 0.0
+) -> bool:
+    """True if footprint ``a`` at ``pose_a`` and ``b`` at ``pose_b`` overlap (two robots).
+
+    Exact for the convex hulls (separating axes: the edge normals of both); touching is
+    no overlap. With ``margin``, hulls less than ``margin`` apart along every axis also
+    count: that is ``b`` grown by at least ``margin`` all round (a little more at its
+    corners). Robots whose circumscribed circles are farther apart are rejected with a
+    few float operations, which is the usual answer.
+    """
+    reach = a.circumscribed_radius + b.circumscribed_radius + margin
+    dx, dy = pose_b.x - pose_a.x, pose_b.y - pose_a.y
+    if dx * dx + dy * dy >= reach * reach:
+        return False
+    vertices_a, normals_a = a._hull_at(pose_a)
+    vertices_b, normals_b = b._hull_at(pose_b)
+    axes = np.vstack((normals_a, normals_b))
+    min_b, max_b = _extent(vertices_b, axes)
+    return not _separated(*_extent(vertices_a, axes), min_b - margin, max_b + margin).any()
 
 
 def clearance_map(grid: OccupancyGrid) -> np.ndarray:
@@ -186,19 +215,31 @@ class _PlacedHull:
         projects to its centre's projection +- half the square's extent.
         """
         normals = self.footprint._normals @ self.rotation
-        vertices = np.column_stack((self.xs, self.ys))
-        hull_projection = vertices @ normals.T  # (vertices, edges)
-        hull_min, hull_max = hull_projection.min(axis=0), hull_projection.max(axis=0)
+        hull_min, hull_max = _extent(np.column_stack((self.xs, self.ys)), normals)
         half_extent = 0.5 * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
         centres = np.column_stack((cols + 0.5, rows + 0.5))
         centre_projection = centres @ normals.T  # (cells, edges)
-        separated = (centre_projection - half_extent >= hull_max - _EPSILON) | (
-            centre_projection + half_extent <= hull_min + _EPSILON
+        separated = _separated(
+            hull_min, hull_max, centre_projection - half_extent, centre_projection + half_extent
         )
         return ~separated.any(axis=1)
 
 
 _EPSILON = 1e-9
+
+
+def _extent(vertices: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) of the vertices' projections on each axis (the rows of ``axes``)."""
+    projection = vertices @ axes.T  # (vertices, axes)
+    return projection.min(axis=0), projection.max(axis=0)
+
+
+def _separated(
+    min_a: np.ndarray, max_a: np.ndarray, min_b: np.ndarray, max_b: np.ndarray
+) -> np.ndarray:
+    """Per axis, whether two projected intervals are apart; touching (within
+    ``_EPSILON``) counts as apart. The arguments broadcast (several shapes at once)."""
+    return (min_b >= max_a - _EPSILON) | (max_b <= min_a + _EPSILON)
 
 
 def _convex_hull(points: np.ndarray) -> np.ndarray:

@@ -8,9 +8,9 @@ Life of a goal (``state``): :meth:`set_goal` makes it ACTIVE (replacing any othe
 the first control step plans on the costmap. It ends
 
 - SUCCEEDED when the controller has the robot within the xy and yaw tolerances;
-- ABORTED when no plan exists (start or goal not free, goal unreachable) or when the
-  next step could not be taken without the footprint touching an obstacle and no
-  evasive move (turning the other way, creeping forward or back) is safe either, or
+- ABORTED when no plan exists on the map (start or goal not free, goal unreachable) or
+  when the next step could not be taken without the footprint touching an obstacle and
+  no evasive move (turning the other way, creeping forward or back) is safe either, or
   evading has not brought the robot 0.2 m closer within ``blocked_patience`` seconds —
   the command is then zero, so the robot stops rather than collides;
 - CANCELED on :meth:`cancel`.
@@ -22,27 +22,52 @@ Collision safety: every step, the footprint at the pose the next command leads t
 tested with :func:`footprint_collides`. Near obstacles the test is extended to the
 whole braking manoeuvre that would follow, so that when the server must stop, the
 robot can still come to rest without touching anything.
+
+Other robots (a fleet): the caller passes their poses and footprints every control
+step (:meth:`NavigationServer.set_other_robots`); with none, nothing above changes.
+
+- The safety test treats them as obstacles, exactly (:func:`footprints_overlap`), and
+  keeps ``robot_margin`` from them: their poses may be a step old (from ROS), and a
+  robot driving toward this one closes the gap while this one brakes. A robot that
+  is within the margin already may still move, so long as it does not close in.
+- Plans are made on ``planning_costmap``: the map's ``costmap`` plus the other robots'
+  footprints as lethal cells, inflated as usual. It is rebuilt only when planning, and
+  only once some robot has moved ``robot_moved`` since the last build. A robot that
+  moved and is now within ``robot_near_plan`` of the rest of the plan makes the server
+  replan around it.
+- When the other robots leave no way to the goal but the map has one (a robot parked
+  in the only door, or on the goal itself), or only robots block every move, the goal
+  stays ACTIVE and the robot waits at rest, replanning every ``robot_replan_period``.
+  It ends ABORTED, "blocked by another robot", when no way has opened and the robot
+  has not got 0.2 m closer within ``blocked_patience`` — move_base's planner_patience.
+  Two robots that need the same narrow passage at once may both wait and give up:
+  nothing here negotiates who goes first.
 """
 
 from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from navseq.geometry import Pose2D
+from navseq.geometry import Pose2D, normalize_angle
 from navseq.sim.controller import ControllerParams, RegulatedPurePursuit
 from navseq.sim.costmap import INSCRIBED, Costmap
 from navseq.sim.footprint import (
     TURTLEBOT3_BURGER,
     Footprint,
     clearance_map,
+    footprint_cells,
     footprint_collides,
+    footprints_overlap,
 )
 from navseq.sim.planner import Plan, plan_path
 from navseq.sim.robot import integrate_arc, next_velocity
+
+OtherRobots = Sequence[tuple[Pose2D, Footprint]]
 
 
 class NavState(enum.Enum):
@@ -68,6 +93,10 @@ class NavParams(ControllerParams):
     escape_speed: float = 0.05  # m/s, forward or back, when the controller's move is unsafe
     escape_distance: float = 0.1  # m crept before the controller gets another try
     blocked_patience: float = 10.0  # s blocked without 0.2 m of progress before ABORT
+    robot_near_plan: float = 0.5  # m: another robot's centre this close to the plan: replan
+    robot_moved: float = 0.1  # m a robot's outline moves before the costmap holding it is stale
+    robot_replan_period: float = 1.0  # s between replans while another robot blocks the way
+    robot_margin: float = 0.05  # m kept from other robots: they move while this one brakes
 
 
 class NavigationServer:
@@ -93,8 +122,16 @@ class NavigationServer:
         self._goal_time = 0.0
         self._blocked_since = None
         self._remaining_when_blocked = math.inf
+        self._blocked_by_robot = False
         self._escape_command = (0.0, 0.0)
         self._escape_time_left = 0.0
+        self._others: OtherRobots = ()
+        self._costmap_others: list[Pose2D] = []  # where planning_costmap has the others
+        self._plan_others: list[Pose2D] = []  # ... and where the current plan had them
+        self._waiting = False  # holding still until a replan finds a way past another robot
+        self._waiting_since: float | None = None
+        self._remaining_when_waiting = math.inf
+        self.costmap_version = 0
         self._use_costmap(costmap)
 
     # -- goal life cycle -------------------------------------------------------------
@@ -109,7 +146,19 @@ class NavigationServer:
         self._goal_time = 0.0
         self._blocked_since: float | None = None  # goal time the controller was first blocked
         self._remaining_when_blocked = math.inf
+        self._blocked_by_robot = False  # ... by another robot only, not by the map
         self._escape_time_left = 0.0
+        self._waiting = False
+        self._waiting_since: float | None = None  # goal time another robot first blocked the way
+        self._remaining_when_waiting = math.inf
+
+    def set_other_robots(self, others: Iterable[tuple[Pose2D, Footprint]]) -> None:
+        """The other robots' poses (map frame) and footprints now; call every control step.
+
+        Cheap: the costmap is rebuilt only when planning. A robot is expected to keep its
+        place in the sequence and its footprint from one call to the next.
+        """
+        self._others = others if isinstance(others, list | tuple) else list(others)
 
     def cancel(self) -> None:
         """Stop pursuing the active goal (state CANCELED); nothing happens when idle."""
@@ -124,11 +173,14 @@ class NavigationServer:
             return 0.0, 0.0
         controller = self.controller
         self._since_plan += dt
+        if self._waiting:
+            return self._keep_waiting(pose, dt)
         period = self.params.replan_period
         wants_plan = (
             self._needs_plan
             or controller.distance_to_path > self.params.stray_distance
             or (period is not None and self._since_plan >= period)
+            or (self._others and self._robot_near_plan())
         )
         if wants_plan and not self._replan(pose):
             return 0.0, 0.0
@@ -137,7 +189,8 @@ class NavigationServer:
         if self._blocked_since is not None and (
             self._goal_time - self._blocked_since > self.params.blocked_patience
         ):
-            self._finish(NavState.ABORTED, "stopped: blocked by an obstacle, no way around it")
+            blocker = "another robot" if self._blocked_by_robot else "an obstacle"
+            self._finish(NavState.ABORTED, f"stopped: blocked by {blocker}, no way around it")
             return 0.0, 0.0
 
         if self._escape_time_left > 0.0:
@@ -153,14 +206,23 @@ class NavigationServer:
             return 0.0, 0.0
         if self._blocked_since is not None and remaining < self._remaining_when_blocked - 0.2:
             self._blocked_since = None  # real progress since: the obstacle is behind us
+        if self._waiting_since is not None and remaining < self._remaining_when_waiting - 0.2:
+            self._waiting_since = None  # ... and the robot that blocked the way
         if self._command_is_safe(pose, v, w, cmd_v, cmd_w, dt):
             return cmd_v, cmd_w
 
+        robots_only = bool(self._others) and self._command_is_safe(
+            pose, v, w, cmd_v, cmd_w, dt, with_others=False
+        )
         if self._blocked_since is None:
             self._blocked_since = self._goal_time
             self._remaining_when_blocked = remaining
+            self._blocked_by_robot = robots_only
         evasion = self._evasive_command(pose, v, w, cmd_v, cmd_w, dt)
         if evasion is None:
+            if robots_only:
+                self._wait_for_robot()  # only robots are in the way, and robots move
+                return 0.0, 0.0
             self._finish(NavState.ABORTED, "stopped: the footprint would hit an obstacle")
             return 0.0, 0.0
         if evasion[0] != 0.0:  # creep on for a while, or the controller steers straight back
@@ -173,25 +235,113 @@ class NavigationServer:
     # -- services ------------------------------------------------------------------------
 
     def make_plan(self, start: Pose2D, goal: Pose2D) -> Plan | None:
-        """A plan from ``start`` to ``goal`` (exact end points), or None; no goal is started."""
-        from_x, from_y = self._planning_start(start)
-        plan = plan_path(self.costmap, (from_x, from_y), (goal.x, goal.y))
-        if plan is None:
-            return None
-        return _with_exact_ends(plan, (start.x, start.y), (goal.x, goal.y))
+        """A plan from ``start`` to ``goal`` (exact end points) around the other robots,
+        or None; no goal is started."""
+        self._refresh_planning_costmap()
+        return self._plan_on(self.planning_costmap, start, goal)
 
     def clear_costmaps(self) -> None:
-        """Rebuild the costmap from the map (drops anything transient) and replan."""
+        """Rebuild the costmap from the map and the other robots' present poses (drops
+        anything transient) and replan."""
         self._use_costmap(Costmap.from_grid(self.costmap.grid, self.costmap.params))
+        self._refresh_planning_costmap()
         if self.state is NavState.ACTIVE:
             self._needs_plan = True
 
     # -- internals -----------------------------------------------------------------------
 
     def _use_costmap(self, costmap: Costmap) -> None:
+        """``costmap`` is the map's; the planning costmap starts as that, without robots."""
         self.costmap = costmap
-        self.controller.set_costmap(costmap)
         self._clearance = clearance_map(costmap.grid)
+        self._costmap_others = []
+        self._use_planning_costmap(costmap)
+
+    def _use_planning_costmap(self, costmap: Costmap) -> None:
+        self.planning_costmap = costmap
+        self.controller.set_costmap(costmap)  # slows down near other robots as near walls
+        self.costmap_version += 1
+
+    def _refresh_planning_costmap(self) -> None:
+        """Put the other robots' present footprints in the planning costmap if it is stale."""
+        if not self._others_moved(self._costmap_others):
+            return
+        grid = self.costmap.grid
+        rows: list[np.ndarray] = []
+        cols: list[np.ndarray] = []
+        for at, footprint in self._others:
+            cells = footprint_cells(grid, footprint, at)
+            if cells is not None:  # None: partly off the map, where no plan goes anyway
+                rows.append(cells[0])
+                cols.append(cells[1])
+        costmap = self.costmap
+        if rows:
+            costmap = costmap.with_obstacles(np.concatenate(rows), np.concatenate(cols))
+        self._costmap_others = [at for at, _ in self._others]
+        self._use_planning_costmap(costmap)
+
+    def _others_moved(self, seen: list[Pose2D]) -> bool:
+        """True if the other robots are not (within ``robot_moved``) where ``seen`` has them."""
+        others = self._others
+        if len(others) != len(seen):
+            return True
+        return any(
+            self._robot_moved(before, at, footprint)
+            for before, (at, footprint) in zip(seen, others, strict=True)
+        )
+
+    def _robot_moved(self, before: Pose2D, at: Pose2D, footprint: Footprint) -> bool:
+        # How far its outline's farthest corner may have gone: travel plus turn.
+        turned = abs(normalize_angle(at.yaw - before.yaw)) * footprint.circumscribed_radius
+        return math.hypot(at.x - before.x, at.y - before.y) + turned > self.params.robot_moved
+
+    def _robot_near_plan(self) -> bool:
+        """True if a robot that moved since the plan was made is near the rest of the plan."""
+        plan = self.plan
+        if plan is None:
+            return False
+        seen = self._plan_others
+        ahead: np.ndarray | None = None
+        near_squared = self.params.robot_near_plan**2
+        for index, (at, footprint) in enumerate(self._others):
+            if index < len(seen) and not self._robot_moved(seen[index], at, footprint):
+                continue
+            if ahead is None:
+                ahead = plan.points[self.controller.closest_index :]
+            squared = (ahead[:, 0] - at.x) ** 2 + (ahead[:, 1] - at.y) ** 2
+            if squared.size and float(squared.min()) < near_squared:
+                return True
+        return False
+
+    def _wait_for_robot(self, remaining: float | None = None) -> None:
+        """Hold still: another robot blocks the way. Replan now and then; see _keep_waiting.
+
+        ``remaining``: the way left to the goal when the controller has not measured it.
+        """
+        if self._waiting_since is None:
+            self._waiting_since = self._goal_time
+            if self.distance_remaining is not None:
+                remaining = self.distance_remaining
+            self._remaining_when_waiting = math.inf if remaining is None else remaining
+        self._waiting = True
+        self._since_plan = 0.0
+        # Not an obstacle that evasion may get round: that patience starts afresh later.
+        self._blocked_since = None
+        self._escape_time_left = 0.0
+
+    def _keep_waiting(self, pose: Pose2D, dt: float) -> tuple[float, float]:
+        """One step of waiting for another robot: give up after the patience, or replan."""
+        assert self._waiting_since is not None
+        self._goal_time += dt
+        patience = self.params.blocked_patience
+        if self._goal_time - self._waiting_since > patience:
+            self._finish(
+                NavState.ABORTED,
+                f"no way to the goal: blocked by another robot for {patience:g} s",
+            )
+        elif self._since_plan >= self.params.robot_replan_period:
+            self._replan(pose)  # a way found: it is followed from the next step on
+        return 0.0, 0.0
 
     def _finish(self, state: NavState, text: str) -> None:
         self.state = state
@@ -206,12 +356,25 @@ class NavigationServer:
         self._since_plan = 0.0
         if plan is None:
             self.plan = None
+            on_the_map = self._plan_on(self.costmap, pose, goal) if self._others else None
+            if on_the_map is not None:  # the map has a way: robots block it, for now
+                self._wait_for_robot(on_the_map.length)
+                return False
             self._finish(NavState.ABORTED, self._why_no_plan(pose, goal))
             return False
         self.plan = plan
         self.plan_version += 1
+        self._plan_others = self._costmap_others
+        self._waiting = False
         self.controller.set_path(plan.points, goal)
         return True
+
+    def _plan_on(self, costmap: Costmap, start: Pose2D, goal: Pose2D) -> Plan | None:
+        from_x, from_y = self._planning_start(costmap, start)
+        plan = plan_path(costmap, (from_x, from_y), (goal.x, goal.y))
+        if plan is None:
+            return None
+        return _with_exact_ends(plan, (start.x, start.y), (goal.x, goal.y))
 
     def _why_no_plan(self, start: Pose2D, goal: Pose2D) -> str:
         costmap = self.costmap
@@ -222,14 +385,13 @@ class NavigationServer:
                 f"no plan: goal ({goal.x:.2f}, {goal.y:.2f}) is in an obstacle "
                 "or too close to one for the robot"
             )
-        from_x, from_y = self._planning_start(start)
+        from_x, from_y = self._planning_start(costmap, start)
         if not costmap.is_free(from_x, from_y):
             return f"no plan: the robot at ({start.x:.2f}, {start.y:.2f}) is in an obstacle"
         return f"no plan: goal ({goal.x:.2f}, {goal.y:.2f}) is unreachable"
 
-    def _planning_start(self, start: Pose2D) -> tuple[float, float]:
+    def _planning_start(self, costmap: Costmap, start: Pose2D) -> tuple[float, float]:
         """Where to plan from: the robot, or the nearest free point if it is not free."""
-        costmap = self.costmap
         if costmap.is_free(start.x, start.y):
             return start.x, start.y
         grid = costmap.grid
@@ -276,31 +438,78 @@ class NavigationServer:
         return None
 
     def _command_is_safe(
-        self, pose: Pose2D, v: float, w: float, cmd_v: float, cmd_w: float, dt: float
+        self,
+        pose: Pose2D,
+        v: float,
+        w: float,
+        cmd_v: float,
+        cmd_w: float,
+        dt: float,
+        *,
+        with_others: bool = True,
     ) -> bool:
         """True if the robot can take this command for one step and then still brake safely.
 
         The braking check repeats the robot model step by step (the server does not own
-        the robot, so it uses the same limits the body has). Far from obstacles it is
-        skipped: within the braking distance nothing can be reached there.
+        the robot, so it uses the same limits the body has). Far from obstacles and
+        other robots it is skipped: within the braking distance nothing can be reached
+        there. ``with_others=False`` leaves the other robots out.
         """
         limits = self.params.limits
         grid = self.costmap.grid
         footprint = self.footprint
+        others = self._others if with_others else ()
+        start = pose
         v, w = next_velocity(limits, v, w, cmd_v, cmd_w, dt)
         pose = integrate_arc(pose.x, pose.y, pose.yaw, v, w, dt)
-        if footprint_collides(grid, footprint, pose):
+        if footprint_collides(grid, footprint, pose) or (
+            others and self._too_close_to_robot(start, pose, others)
+        ):
             return False
         travel = abs(v) * dt + v * v / (2.0 * limits.acc_v)
         margin = footprint.circumscribed_radius + travel + 2.0 * grid.resolution
-        if self._clearance_at(pose.x, pose.y) > margin:
+        if self._clearance_at(pose.x, pose.y) > margin and not (
+            others and self._other_robot_within(pose, others, travel)
+        ):
             return True
         while v != 0.0 or w != 0.0:
             v, w = next_velocity(limits, v, w, 0.0, 0.0, dt)
             pose = integrate_arc(pose.x, pose.y, pose.yaw, v, w, dt)
-            if footprint_collides(grid, footprint, pose):
+            if footprint_collides(grid, footprint, pose) or (
+                others and self._too_close_to_robot(start, pose, others)
+            ):
                 return False
         return True
+
+    def _too_close_to_robot(self, start: Pose2D, pose: Pose2D, others: OtherRobots) -> bool:
+        """True if the robot, moving on from ``start``, may not be at ``pose``.
+
+        It must stay ``robot_margin`` away from the other robots, as their last known
+        poses may already be out of date. Within the margin already (another robot came
+        that close), it may still move so long as it does not close in or overlap.
+        """
+        footprint = self.footprint
+        margin = self.params.robot_margin
+        for at, other in others:
+            if not footprints_overlap(footprint, pose, other, at, margin):
+                continue
+            if footprints_overlap(footprint, pose, other, at) or not footprints_overlap(
+                footprint, start, other, at, margin
+            ):
+                return True
+            closer = math.hypot(pose.x - at.x, pose.y - at.y)
+            if closer < math.hypot(start.x - at.x, start.y - at.y):
+                return True
+        return False
+
+    def _other_robot_within(self, pose: Pose2D, others: OtherRobots, travel: float) -> bool:
+        """True if some other robot (or its margin) could be reached after the robot centre
+        moves ``travel``."""
+        own = self.footprint.circumscribed_radius + travel + self.params.robot_margin + 1e-6
+        return any(
+            math.hypot(at.x - pose.x, at.y - pose.y) < own + fp.circumscribed_radius
+            for at, fp in others
+        )
 
 
 def _with_exact_ends(plan: Plan, start: tuple[float, float], goal: tuple[float, float]) -> Plan:

@@ -6,9 +6,14 @@ the robot's pose and velocity into a command, and the robot body (the same
 unless its footprint would then overlap an obstacle. In that case the body refuses the
 move and halts, like a bumper stop, and ``collisions`` counts it — with a correct server the
 count stays zero, because the server aborts before a collision becomes unavoidable.
+
+The world holds one robot. Other robots, moved by the caller, are made known to the
+body and the server alike with :meth:`SimWorld.set_other_robots`.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -88,6 +93,14 @@ class SimWorld:
             return  # at rest and told to stay: nothing can change
         self.body.command(cmd_v, cmd_w)
         self.body.step(self.dt)
+
+    def set_other_robots(self, others: Sequence[tuple[Pose2D, Footprint]]) -> None:
+        """Other robots (poses in the map frame, footprints) for the body and the server.
+
+        The world does not move them: the caller sets them again whenever they move.
+        """
+        self.body.set_other_robots(others)
+        self.server.set_other_robots(others)
 
     def run(self, seconds: float) -> None:
         """Step for ``seconds`` of simulated time."""
