@@ -232,6 +232,14 @@ def test_costmap_with_obstacles_equals_inflating_them_with_the_map() -> None:
     assert np.array_equal(with_robots.cost, reference.cost)
     assert with_robots.grid is grid  # the map itself is untouched
     assert costmap.with_obstacles(np.array([], int), np.array([], int)) is costmap
+    # Padding grows them: cells within it are lethal too, and the inflation starts there.
+    padded = costmap.with_obstacles(rows, cols, padding=0.1)
+    near = np.zeros(grid.data.shape, bool)
+    near[rows, cols] = True
+    assert (padded.cost[near] == LETHAL).all()
+    row, col = rows[0], cols[0]
+    assert (padded.cost >= with_robots.cost).all()
+    assert padded.cost[row, col - 2] == LETHAL or padded.cost[row, col + 2] == LETHAL
 
 
 # -- the navigation server --------------------------------------------------------------------
@@ -255,6 +263,16 @@ def test_plans_around_a_robot_parked_on_the_straight_way_and_never_touches_it() 
     # The map's own costmap is untouched; the planning one has the robot in it.
     assert world.server.costmap.cost_at(other.x, other.y) == 0
     assert world.server.planning_costmap.cost_at(other.x, other.y) == LETHAL
+
+
+def test_gets_past_a_robot_parked_between_two_pillars_of_the_arena() -> None:
+    """The plan keeps the margin the safety test wants, so the robot can drive it."""
+    world = SimWorld(load_map(MAP), Pose2D(-2.0, -0.5, 0.0))
+    goal = Pose2D(0.5, -0.5, 0.0)
+    world.server.set_goal(goal)
+    drive_among(world, parked(Pose2D(-1.0, -0.5, math.pi / 2)))
+    assert world.server.state is NavState.SUCCEEDED, world.server.status_text
+    assert world.collisions == 0
 
 
 def test_replans_around_a_robot_that_stops_on_the_plan_ahead() -> None:

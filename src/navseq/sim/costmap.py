@@ -93,25 +93,30 @@ class Costmap:
         """Cells where the robot centre may be."""
         return self.cost < INSCRIBED
 
-    def with_obstacles(self, rows: np.ndarray, cols: np.ndarray) -> Costmap:
+    def with_obstacles(
+        self, rows: np.ndarray, cols: np.ndarray, *, padding: float = 0.0
+    ) -> Costmap:
         """This costmap plus lethal cells at (``rows``, ``cols``), inflated as usual.
 
         ``grid`` stays the map's: the extra obstacles live in ``cost`` only. The result
         equals inflating the map with those cells occupied, but costs an EDT of a window
         around them only: the cost falls with the distance to the nearest obstacle, so
         the cost of the union is the larger of the two costs, and beyond
-        ``inflation_radius`` of the new cells nothing changes.
+        ``inflation_radius`` of the new cells nothing changes. ``padding`` (m) grows the
+        new obstacles all round before they are inflated.
         """
         rows, cols = np.asarray(rows, dtype=np.intp), np.asarray(cols, dtype=np.intp)
         if rows.size == 0:
             return self
-        reach = math.ceil(self.params.inflation_radius / self.grid.resolution) + 1
+        reach = math.ceil((self.params.inflation_radius + padding) / self.grid.resolution) + 1
         height, width = self.cost.shape
         top, bottom = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
         left, right = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
         free = np.ones((bottom - top, right - left), dtype=bool)
         free[rows - top, cols - left] = False
         distance = ndimage.distance_transform_edt(free) * self.grid.resolution
+        if padding > 0.0:
+            distance = np.maximum(distance - padding, 0.0)
         cost = self.cost.copy()
         window = cost[top:bottom, left:right]
         np.maximum(window, cost_of_distance(distance, self.params), out=window)

@@ -31,10 +31,10 @@ step (:meth:`NavigationServer.set_other_robots`); with none, nothing above chang
   robot driving toward this one closes the gap while this one brakes. A robot that
   is within the margin already may still move, so long as it does not close in.
 - Plans are made on ``planning_costmap``: the map's ``costmap`` plus the other robots'
-  footprints as lethal cells, inflated as usual. It is rebuilt only when planning, and
-  only once some robot has moved ``robot_moved`` since the last build. A robot that
-  moved and is now within ``robot_near_plan`` of the rest of the plan makes the server
-  replan around it.
+  footprints, grown by ``robot_margin``, as lethal cells, inflated as usual. It is
+  rebuilt only when planning, and only once some robot has moved ``robot_moved`` since
+  the last build. A robot that moved and is now within ``robot_near_plan`` of the rest
+  of the plan makes the server replan around it.
 - When the other robots leave no way to the goal but the map has one (a robot parked
   in the only door, or on the goal itself), or only robots block every move, the goal
   stays ACTIVE and the robot waits at rest, replanning every ``robot_replan_period``.
@@ -276,7 +276,11 @@ class NavigationServer:
                 cols.append(cells[1])
         costmap = self.costmap
         if rows:
-            costmap = costmap.with_obstacles(np.concatenate(rows), np.concatenate(cols))
+            # Grown by the margin the safety test keeps, or plans squeeze through gaps
+            # the robot then may not drive.
+            costmap = costmap.with_obstacles(
+                np.concatenate(rows), np.concatenate(cols), padding=self.params.robot_margin
+            )
         self._costmap_others = [at for at, _ in self._others]
         self._use_planning_costmap(costmap)
 
