@@ -6,6 +6,7 @@
 - :mod:`navseq.ros.operator`: pause/resume/cancel on top of any navigator (no ROS);
 - :mod:`navseq.ros.conversions`: navseq types <-> ROS messages, shared by all nodes;
 - :mod:`navseq.ros.params`: typed private parameters with errors naming the parameter;
+- :mod:`navseq.ros.fleet`: the other robots of a simulated fleet, their poses from TF;
 - ``sim_robot_node`` / ``sim_nav_node``: the embedded simulator served as ROS nodes.
 
 Importing this package imports nothing from ROS; each module does so itself.

@@ -8,6 +8,8 @@ log one clear line and exit instead of failing later with a traceback.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import rospy
 
 from navseq.errors import NavseqError
@@ -42,3 +44,19 @@ def bool_param(name: str, default: bool) -> bool:
     if isinstance(value, str) and value.lower() in ("true", "false"):
         return value.lower() == "true"
     raise param_error(name, f"expected true or false, got {value!r}")
+
+
+def str_list_param(name: str, default: Sequence[str]) -> tuple[str, ...]:
+    """``~name`` as a list of non-empty strings (a YAML list: ``[a, b]``)."""
+    value = rospy.get_param(f"~{name}", list(default))
+    if not isinstance(value, list) or not all(
+        isinstance(item, str) and item.strip() for item in value
+    ):
+        hint = (
+            f' (a string: in a launch file, <rosparam param="{name}">[a, b]</rosparam> '
+            "gives a list)"
+            if isinstance(value, str)
+            else ""
+        )
+        raise param_error(name, f"expected a list of non-empty strings, got {value!r}{hint}")
+    return tuple(item.strip() for item in value)

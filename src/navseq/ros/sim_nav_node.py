@@ -17,7 +17,8 @@ Interface (names relative to the node's namespace, as with move_base):
 - ``move_base/NavfnROS/plan`` (``nav_msgs/Path``): the global plan, published whenever
   it changes (the topic move_base publishes with its default navfn planner);
 - ``move_base/global_costmap/costmap`` (``nav_msgs/OccupancyGrid``, latched): the
-  inflated costmap in costmap_2d's 0..100 scale, for RViz;
+  inflated costmap in costmap_2d's 0..100 scale, for RViz; with other robots, the
+  planning costmap that holds them, republished (at most once a second) when it changes;
 - services ``move_base/make_plan`` (``nav_msgs/GetPlan``; an empty start frame means
   "from the robot's pose", as in move_base) and ``move_base/clear_costmaps``
   (``std_srvs/Empty``);
@@ -27,6 +28,11 @@ It knows the robot only through ROS: its pose from TF (``~global_frame`` ->
 ``~base_frame``) and its velocity from ``odom``, so it drives navseq's sim robot node,
 or a real base, alike. The map comes from ``~map`` (a map_server YAML) or, when that is
 empty, from the first message on the ``map`` topic.
+
+In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
+``[robot2/base_footprint]``); their poses come from TF every control step and the
+server plans around them, stops short of them, and waits for one that blocks the only
+way (see :mod:`navseq.sim.navserver` and :mod:`navseq.ros.fleet`).
 
 Control runs at ``~controller_frequency`` Hz of ROS time, so under ``use_sim_time`` the
 whole stack follows the simulated clock and its speed factor.
@@ -66,6 +72,7 @@ from navseq.ros.conversions import (
     pose2d_from_transform,
     pose_from_pose2d,
 )
+from navseq.ros.fleet import OtherRobots, other_robots_param
 from navseq.ros.params import bool_param, float_param, param_error, str_param
 from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap, CostmapParams
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
@@ -75,6 +82,7 @@ from navseq.sim.planner import Plan
 ACTION = "move_base"
 PLAN_TOPIC = f"{ACTION}/NavfnROS/plan"
 COSTMAP_TOPIC = f"{ACTION}/global_costmap/costmap"
+COSTMAP_PERIOD = 1.0  # s of ROS time at least between two costmap messages (they are big)
 
 
 def costmap_to_occupancy_values(cost: np.ndarray) -> np.ndarray:
@@ -131,15 +139,17 @@ class NavNodeConfig:
     publish_costmap: bool
     costmap: CostmapParams
     nav: NavParams
+    other_robots: tuple[str, ...]
 
     @classmethod
     def from_params(cls) -> NavNodeConfig:
         costmap_defaults = CostmapParams()
         nav_defaults = NavParams()
+        base_frame = str_param("base_frame", "base_footprint")
         config = cls(
             map_yaml=str_param("map", ""),
             global_frame=str_param("global_frame", "map"),
-            base_frame=str_param("base_frame", "base_footprint"),
+            base_frame=base_frame,
             controller_frequency=float_param("controller_frequency", 20.0),
             feedback_rate=float_param("feedback_rate", 5.0),
             pose_timeout=float_param("pose_timeout", 2.0),
@@ -157,6 +167,7 @@ class NavNodeConfig:
                 xy_tolerance=float_param("xy_goal_tolerance", nav_defaults.xy_tolerance),
                 yaw_tolerance=float_param("yaw_goal_tolerance", nav_defaults.yaw_tolerance),
             ),
+            other_robots=other_robots_param(base_frame),
         )
         for name in ("controller_frequency", "feedback_rate", "pose_timeout"):
             if not getattr(config, name) > 0:
@@ -198,15 +209,28 @@ class SimNavNode:
 
         self._tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(10.0))
         self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        self._others = (
+            OtherRobots(
+                self._tf_buffer,
+                config.global_frame,
+                config.other_robots,
+                tolerance=config.transform_tolerance,
+            )
+            if config.other_robots
+            else None
+        )
         self._cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=10)
         self._plan_pub = rospy.Publisher(PLAN_TOPIC, Path, queue_size=1, latch=True)
         self._simple_goal_pub = rospy.Publisher(f"{ACTION}/goal", MoveBaseActionGoal, queue_size=10)
         self._goal_ids = actionlib.GoalIDGenerator()
+        self._costmap_pub = None
+        self._published_costmap_version = self.server.costmap_version
+        self._last_costmap_stamp = rospy.Time(0)
         if config.publish_costmap:
-            costmap_pub = rospy.Publisher(COSTMAP_TOPIC, OccupancyGridMsg, queue_size=1, latch=True)
-            msg = grid_to_msg(grid, config.global_frame, rospy.Time.now())
-            msg.data = costmap_to_occupancy_values(self.costmap.cost).ravel().tolist()
-            costmap_pub.publish(msg)
+            self._costmap_pub = rospy.Publisher(
+                COSTMAP_TOPIC, OccupancyGridMsg, queue_size=1, latch=True
+            )
+            self._publish_costmap(self.costmap, rospy.Time.now())
         rospy.Subscriber("odom", Odometry, self._on_odom, queue_size=10)
         rospy.Subscriber("move_base_simple/goal", PoseStamped, self._on_simple_goal, queue_size=10)
 
@@ -336,11 +360,35 @@ class SimNavNode:
 
     # -- control loop ----------------------------------------------------------------------
 
-    def control_step(self) -> None:
-        """One controller cycle: read the pose, ask the server for a command, report."""
-        pose = self.robot_pose()
-        now = rospy.Time.now()
+    def _publish_costmap(self, costmap: Costmap, now: rospy.Time) -> None:
+        if self._costmap_pub is None:
+            return
+        msg = grid_to_msg(costmap.grid, self.config.global_frame, now)
+        msg.data = costmap_to_occupancy_values(costmap.cost).ravel().tolist()
+        self._costmap_pub.publish(msg)
+        self._last_costmap_stamp = now
+
+    def _publish_costmap_if_new(self, now: rospy.Time) -> None:
+        """The planning costmap, once the other robots in it have moved; not too often."""
+        server = self.server
+        if server.costmap_version == self._published_costmap_version:
+            return
+        if self._costmap_pub is None or (now - self._last_costmap_stamp).to_sec() < COSTMAP_PERIOD:
+            return
         with self._lock:
+            version, costmap = server.costmap_version, server.planning_costmap
+        self._published_costmap_version = version
+        self._publish_costmap(costmap, now)
+
+    def control_step(self) -> None:
+        """One controller cycle: read the poses, ask the server for a command, report."""
+        pose = self.robot_pose()
+        others = self._others.poses() if self._others is not None else None
+        now = rospy.Time.now()
+        self._publish_costmap_if_new(now)
+        with self._lock:
+            if others is not None:
+                self.server.set_other_robots(others)
             if not self._as.is_active() or self._goal is None:
                 return
             if pose is None:
@@ -407,6 +455,7 @@ class SimNavNode:
                 rate.sleep()
             except rospy.ROSTimeMovedBackwardsException:
                 self._last_step = None
+                self._last_costmap_stamp = rospy.Time(0)
             except rospy.ROSInterruptException:
                 break
 

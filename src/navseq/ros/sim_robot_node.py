@@ -26,6 +26,11 @@ Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
   map_server YAML) when ``~publish_map`` is true. Without ``~map`` the node takes the
   map for its collision checks from the ``map`` topic instead (e.g. a real map_server).
 
+In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
+``[robot2/base_footprint]``): their poses come from TF in ``~global_frame`` every
+step, and the body refuses to overlap them as it refuses to overlap walls (see
+:mod:`navseq.ros.fleet`).
+
 Odometry behaves like a real robot's: the ``odom`` frame starts at the start pose and
 odometry is continuous; a teleport moves the robot in the map and shifts the
 ``map -> odom`` transform, as a localisation jump would.
@@ -54,11 +59,13 @@ from navseq.ros.conversions import (
     pose_from_pose2d,
     transform_stamped,
 )
+from navseq.ros.fleet import OtherRobots, other_robots_param
 from navseq.ros.params import bool_param, float_param, param_error, str_param
 from navseq.sim.base import SimulatedBase
 from navseq.sim.occupancy import load_map
 
 FOOTPRINT_RATE = 5.0  # Hz of sim time: enough for RViz, cheap at high speed factors
+OTHER_POSE_TOLERANCE = 1.0  # s of ROS time: an older pose of another robot is not used
 
 
 @dataclass(frozen=True)
@@ -76,9 +83,11 @@ class RobotNodeConfig:
     publish_map: bool
     publish_clock: bool
     use_sim_time: bool
+    other_robots: tuple[str, ...]
 
     @classmethod
     def from_params(cls) -> RobotNodeConfig:
+        base_frame = str_param("base_frame", "base_footprint")
         config = cls(
             map_yaml=str_param("map", ""),
             start=Pose2D(float_param("x", 0.0), float_param("y", 0.0), float_param("yaw", 0.0)),
@@ -87,10 +96,11 @@ class RobotNodeConfig:
             cmd_vel_timeout=float_param("cmd_vel_timeout", 0.5),
             global_frame=str_param("global_frame", "map"),
             odom_frame=str_param("odom_frame", "odom"),
-            base_frame=str_param("base_frame", "base_footprint"),
+            base_frame=base_frame,
             publish_map=bool_param("publish_map", True),
             publish_clock=bool_param("publish_clock", True),
             use_sim_time=bool(rospy.get_param("/use_sim_time", False)),
+            other_robots=other_robots_param(base_frame),
         )
         for name, value in (("speed", config.speed), ("rate", config.rate)):
             if not value > 0:
@@ -140,6 +150,16 @@ class SimRobotNode:
         rospy.Subscriber(
             "initialpose", PoseWithCovarianceStamped, self._on_initial_pose, queue_size=10
         )
+        self._others: OtherRobots | None = None
+        if config.other_robots:
+            tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(10.0))
+            self._tf_listener = tf2_ros.TransformListener(tf_buffer)
+            self._others = OtherRobots(
+                tf_buffer,
+                config.global_frame,
+                config.other_robots,
+                tolerance=OTHER_POSE_TOLERANCE,
+            )
 
     # -- callbacks (rospy threads) -------------------------------------------------------
 
@@ -163,7 +183,8 @@ class SimRobotNode:
             rospy.loginfo("teleported to (%.2f, %.2f, %.2f rad)", pose.x, pose.y, pose.yaw)
         else:
             rospy.logwarn(
-                "initialpose (%.2f, %.2f) refused: the robot would be on an obstacle",
+                "initialpose (%.2f, %.2f) refused: the robot would be on an obstacle "
+                "or another robot",
                 pose.x,
                 pose.y,
             )
@@ -223,12 +244,16 @@ class SimRobotNode:
         self._footprint_pub.publish(polygon)
 
     def step(self, dt: float | None = None) -> None:
+        others = self._others.poses() if self._others is not None else None
         with self._lock:
+            if others is not None:
+                self.base.set_other_robots(others)
             moved = self.base.step(self.dt if dt is None else dt)
         if not moved:
             rospy.logwarn_throttle(
                 1.0,
-                "cmd_vel refused: the robot would hit an obstacle (bumped %d times)",
+                "cmd_vel refused: the robot would hit an obstacle or another robot "
+                "(bumped %d times)",
                 self.base.refused_steps,
             )
         self.publish_state()
@@ -285,12 +310,15 @@ def main(argv: list[str] | None = None) -> int:
         rospy.logfatal("%s", error)
         return 2
     rospy.loginfo(
-        "sim robot at (%.2f, %.2f, %.2f rad), %s, speed x%.1f",
+        "sim robot at (%.2f, %.2f, %.2f rad), %s, speed x%.1f%s",
         node.base.pose.x,
         node.base.pose.y,
         node.base.pose.yaw,
         f"map {node.config.map_yaml}" if node.config.map_yaml else "map from topic",
         node.speed,
+        f", other robots {', '.join(node.config.other_robots)}"
+        if node.config.other_robots
+        else "",
     )
     node.spin()
     return 0

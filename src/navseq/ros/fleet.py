@@ -1,0 +1,83 @@
+"""The other robots of a simulated fleet, as the sim nodes see them: poses from TF.
+
+Each sim node of a robot can be given the base frames of the other robots (private
+param ``~other_robots``, e.g. ``[robot2/base_footprint]``). Their poses are looked up in
+the global frame every step; a robot whose pose is not (yet) in TF, or too old, is left
+out — with a throttled warning — rather than guessed. Every other robot is taken to
+have the TurtleBot3 burger footprint, the simulator's only robot.
+"""
+
+from __future__ import annotations
+
+import rospy
+import tf2_ros
+
+from navseq.geometry import Pose2D
+from navseq.ros.conversions import pose2d_from_transform
+from navseq.ros.params import param_error, str_list_param
+from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
+
+WARN_PERIOD = 10.0  # s between two warnings about other robots without a pose
+
+
+def other_robots_param(own_base_frame: str) -> tuple[str, ...]:
+    """``~other_robots``: the other robots' base frames (leading ``/`` dropped, as tf2
+    wants). This robot's own base frame among them is an error: it would bump into
+    itself."""
+    frames = tuple(frame.lstrip("/") for frame in str_list_param("other_robots", ()))
+    if any(not frame for frame in frames):
+        raise param_error("other_robots", f"a frame name is empty: {list(frames)!r}")
+    if own_base_frame.lstrip("/") in frames:
+        raise param_error(
+            "other_robots",
+            f"lists this robot's own base frame {own_base_frame!r}; "
+            "name only the other robots' base frames",
+        )
+    return frames
+
+
+class OtherRobots:
+    """Looks up the other robots' poses in TF (``global_frame`` -> each base frame)."""
+
+    def __init__(
+        self,
+        buffer: tf2_ros.Buffer,
+        global_frame: str,
+        frames: tuple[str, ...],
+        *,
+        tolerance: float,
+        footprint: Footprint = TURTLEBOT3_BURGER,
+    ) -> None:
+        self.buffer = buffer
+        self.global_frame = global_frame
+        self.frames = frames
+        self.tolerance = tolerance
+        self.footprint = footprint
+
+    def poses(self) -> list[tuple[Pose2D, Footprint]]:
+        """(pose, footprint) of every other robot with a recent pose in TF."""
+        found: list[tuple[Pose2D, Footprint]] = []
+        missing: list[str] = []
+        now = rospy.Time.now()
+        for frame in self.frames:
+            try:
+                transform = self.buffer.lookup_transform(self.global_frame, frame, rospy.Time(0))
+            except (
+                tf2_ros.LookupException,
+                tf2_ros.ConnectivityException,
+                tf2_ros.ExtrapolationException,
+            ):
+                missing.append(frame)
+                continue
+            if (now - transform.header.stamp).to_sec() > self.tolerance:
+                missing.append(frame)  # its node is gone, most likely: so is the robot
+                continue
+            found.append((pose2d_from_transform(transform), self.footprint))
+        if missing:
+            rospy.logwarn_throttle(
+                WARN_PERIOD,
+                "other robot(s) %s: no recent pose %s -> frame in TF; not avoided until there is",
+                ", ".join(missing),
+                self.global_frame,
+            )
+        return found
