@@ -15,10 +15,6 @@ from dataclasses import dataclass
 
 from navseq.geometry import Pose2D, normalize_angle
 
-# Below this turn rate the arc formulas divide by almost zero; a straight segment is
-# then exact to far better than a micrometre over any sensible time step.
-_STRAIGHT_W = 1e-9
-
 
 @dataclass(frozen=True)
 class DiffDriveLimits:
@@ -63,17 +59,20 @@ def wrap_angle(angle: float) -> float:
 
 
 def integrate_arc(x: float, y: float, yaw: float, v: float, w: float, dt: float) -> Pose2D:
-    """The pose reached from ``(x, y, yaw)`` moving at constant ``(v, w)`` for ``dt`` seconds."""
-    if abs(w) < _STRAIGHT_W:
-        distance = v * dt
-        return Pose2D(x + distance * math.cos(yaw), y + distance * math.sin(yaw), yaw)
-    new_yaw = yaw + w * dt
-    radius = v / w
-    return Pose2D(
-        x + radius * (math.sin(new_yaw) - math.sin(yaw)),
-        y - radius * (math.cos(new_yaw) - math.cos(yaw)),
-        wrap_angle(new_yaw),
-    )
+    """The pose reached from ``(x, y, yaw)`` moving at constant ``(v, w)`` for ``dt`` seconds.
+
+    The arc's chord has length ``v * dt * sinc(w * dt / 2)`` and points along the mean
+    heading. Written this way instead of ``v / w * (sin(yaw + w dt) - sin(yaw))`` it stays
+    exact for turn rates near zero, where the radius explodes and the difference of sines
+    cancels catastrophically.
+    """
+    turn = w * dt
+    half = 0.5 * turn
+    sinc = math.sin(half) / half if half != 0.0 else 1.0
+    chord = v * dt * sinc
+    heading = yaw + half
+    return Pose2D(x + chord * math.cos(heading), y + chord * math.sin(heading),
+                  wrap_angle(yaw + turn))
 
 
 class DiffDriveRobot:
