@@ -75,10 +75,13 @@ class SimulatedBase:
     def collides(self, pose: Pose2D) -> bool:
         """True when the footprint at ``pose`` overlaps an obstacle, unknown space, the edge,
         or another robot."""
-        if self._checker is not None and self._checker.collides(pose):
-            return True
         footprint = self.footprint
-        return any(footprints_overlap(footprint, pose, other, at) for at, other in self._others)
+        return self._hits_map(pose) or any(
+            footprints_overlap(footprint, pose, other, at) for at, other in self._others
+        )
+
+    def _hits_map(self, pose: Pose2D) -> bool:
+        return self._checker is not None and self._checker.collides(pose)
 
     def command(self, v: float, w: float) -> None:
         """A new velocity command, valid for ``cmd_vel_timeout`` seconds of sim time."""
@@ -91,10 +94,7 @@ class SimulatedBase:
         fresh = self.time - self._cmd_time <= self.cmd_vel_timeout
         cmd_v, cmd_w = self._cmd if fresh else (0.0, 0.0)
         pose, v, w = self.robot.predict(cmd_v, cmd_w, dt)
-        checker = self._checker
-        if (checker is not None and checker.collides(pose)) or (
-            self._others and self._bumps_other_robot(pose)
-        ):
+        if self._hits_map(pose) or (self._others and self._bumps_other_robot(pose)):
             self.robot.stop()
             self.refused_steps += 1
             return False
@@ -142,4 +142,3 @@ class SimulatedBase:
     def odom_pose(self) -> Pose2D:
         """The robot's pose in the odom frame."""
         return compose(inverse(self.map_to_odom), self.robot.pose)
-

@@ -25,7 +25,6 @@ from navseq.sim.footprint import (
     TURTLEBOT3_BURGER,
     Footprint,
     clearance_map,
-    footprint_collides,
 )
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid
@@ -65,11 +64,12 @@ class SimWorld:
         self.footprint = footprint
         self.costmap = costmap if costmap is not None else Costmap.from_grid(grid, costmap_params)
         self.server = NavigationServer(self.costmap, nav_params, footprint)
-        self._check_pose(grid, footprint, start, "start")
         # A command arrives every step, so the body's command timeout (two steps, against
         # rounding) never applies.
         self.body = SimulatedBase(start, grid, footprint=footprint,
                                   limits=self.server.params.limits, cmd_vel_timeout=2 * dt)
+        if self.body.collides(start):
+            raise self._collision_error(start, "start")
         self.time = 0.0
         self.steps = 0
 
@@ -109,21 +109,19 @@ class SimWorld:
 
     def teleport(self, pose: Pose2D) -> None:
         """Move the robot to ``pose`` at rest (the server keeps its goal and replans)."""
-        self._check_pose(self.grid, self.footprint, pose, "pose")
-        self.body.teleport(pose)
+        if not self.body.teleport(pose):
+            raise self._collision_error(pose, "pose")
         server = self.server
         if server.state is NavState.ACTIVE and server.goal is not None:
             server.set_goal(server.goal)  # replan from the new place
 
-    @staticmethod
-    def _check_pose(grid: OccupancyGrid, footprint: Footprint, pose: Pose2D, what: str) -> None:
-        if footprint_collides(grid, footprint, pose):
-            raise NavseqError(
-                f"the robot at ({pose.x:.2f}, {pose.y:.2f}) would overlap an obstacle, "
-                "unknown space or the map edge",
-                source=grid.source,
-                subject=what,
-            )
+    def _collision_error(self, pose: Pose2D, what: str) -> NavseqError:
+        return NavseqError(
+            f"the robot at ({pose.x:.2f}, {pose.y:.2f}) would overlap an obstacle, "
+            "unknown space, the map edge or another robot",
+            source=self.grid.source,
+            subject=what,
+        )
 
 
 def default_start(grid: OccupancyGrid, footprint: Footprint = TURTLEBOT3_BURGER) -> Pose2D:
