@@ -142,6 +142,19 @@ def _positive_seconds(node: Located, subject: str) -> float:
     return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s")
 
 
+def _positive_metres(node: Located, subject: str) -> float:
+    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" m")
+
+
+def _angle_degrees_as_radians(node: Located, subject: str) -> float:
+    """An angular tolerance written in degrees (like yaw), kept in radians."""
+    degrees = bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" degrees")
+    if degrees > 180.0:
+        raise NavseqError(f"must be <= 180 degrees, got {degrees:g}", source=node.where,
+                          subject=subject)
+    return math.radians(degrees)
+
+
 def _failure_action(node: Located, subject: str) -> FailureAction:
     return FailureAction(choice(node, subject, [a.value for a in FailureAction]))
 
@@ -157,6 +170,8 @@ POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
                                              unit=" m")),
     "dwell": lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
                                                   unit=" s"),
+    "xy_tolerance": _optional(_positive_metres),
+    "yaw_tolerance": _optional(_angle_degrees_as_radians),
 }
 
 

@@ -16,6 +16,7 @@ from types import MappingProxyType
 from typing import Any
 
 from navseq.geometry import Pose2D
+from navseq.mission.robot import RobotProfile
 
 
 class FailureAction(str, enum.Enum):
@@ -40,6 +41,9 @@ class Policy:
     on_failure: FailureAction = FailureAction.STOP
     pass_through: float | None = None
     dwell: float = 0.0
+    # Arrival check on SUCCEEDED: None takes the robot profile's goal tolerance.
+    xy_tolerance: float | None = None  # m
+    yaw_tolerance: float | None = None  # rad (files say degrees)
 
     def with_overrides(self, overrides: Mapping[str, Any]) -> Policy:
         return dataclasses.replace(self, **dict(overrides)) if overrides else self
@@ -85,6 +89,7 @@ class Mission:
     map: Path | None = None
     start: Pose2D | None = None
     server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
+    robot: RobotProfile | None = None  # the mission's robot: section; None: not said
     source: str = field(default="<memory>", compare=False)  # where it was read from
 
     def policy_for(self, index: int) -> Policy:

@@ -162,6 +162,8 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
 
 def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
     values = {key: getattr(policy, key) for key in keys}
+    if values.get("yaw_tolerance") is not None:
+        values["yaw_tolerance"] = round(math.degrees(values["yaw_tolerance"]), 6)
     return {key: value.value if isinstance(value, FailureAction) else value
             for key, value in values.items()}
 
