@@ -69,7 +69,7 @@ def test_header_then_one_event_per_line(tmp_path: Path, mission_file: Path) -> N
     path = journal_of_run(tmp_path, mission_file)
     header, *events = records(path)
     assert header["kind"] == "header" and header["format"] == "navseq-journal"
-    assert header["version"] == 1 and header["mission_source"] == str(mission_file)
+    assert header["version"] == 2 and header["mission_source"] == str(mission_file)
     assert header["mission_digest"] == mission_digest(mission_file)
     assert len(header["mission_digest"]) == 64
     assert events[0]["type"] == "MissionStarted" and events[-1]["type"] == "MissionFinished"

@@ -48,7 +48,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--navigator",
         choices=NAVIGATORS + TEST_NAVIGATORS,
-        default="sim",
+        default=None,  # None: sim, or the journal's when resuming
         metavar="{sim,ros1}",
         help="sim: the embedded simulator (default); ros1: move_base over actionlib",
     )
@@ -91,10 +91,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     ros1 = parser.add_argument_group("ros1 navigator")
     ros1.add_argument(
-        "--action", default="move_base", help="MoveBaseAction server name (default: move_base)"
+        "--action", default=None, help="MoveBaseAction server name (default: move_base)"
     )
     ros1.add_argument("--frame", help="goal frame (default: the mission's frame:, usually map)")
-    ros1.add_argument("--ns", default="", help="robot namespace, e.g. robot1 (default: none)")
+    ros1.add_argument("--ns", default=None, help="robot namespace, e.g. robot1 (default: none)")
     # Options of the scripted test navigator, hidden from --help.
     parser.add_argument("--scripted-speed", type=float, default=0.5, help=argparse.SUPPRESS)
     parser.add_argument("--scripted-realtime", type=float, default=None, help=argparse.SUPPRESS)
@@ -118,11 +118,10 @@ class RunSetup:
     journal: Path | None = None  # the journal to append to when resuming
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
+    run_options: dict[str, Any] = field(default_factory=dict)  # journaled for a resume
 
 
-def _read_resume(
-    journal: Path, mission_arg: Path | None
-) -> tuple[Path, ResumePoint, JournalState]:
+def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumePoint, JournalState]:
     """The mission file, resume point and contents of a journal (mission unchanged)."""
     from navseq.commands.common import require_file
     from navseq.errors import NavseqError
@@ -183,8 +182,10 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     from navseq.sinks.journal import mission_digest
 
     resume = history = None
+    notes: list[str] = []
     if args.resume is not None:
         mission_path, resume, history = _read_resume(args.resume, args.mission)
+        notes = continue_as_journaled(args, history)
     elif args.mission is None:
         raise NavseqError("give a MISSION file (or --resume JOURNAL)", source="navseq run")
     else:
@@ -192,9 +193,15 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         require_file(mission_path, "MISSION")
     if args.map is not None:
         require_file(args.map, "--map")
+    apply_run_defaults(args)
     mission = load_mission(mission_path)
     if "loops" in vars(args):  # given on the command line (None = forever)
         mission = dataclasses.replace(mission, loops=args.loops)
+    if resume is not None:
+        # Refuse a journal the mission cannot continue before anything is appended to it.
+        from navseq.executor.machine import MissionExecutor
+
+        MissionExecutor(mission, resume=resume)
     map_path = args.map if args.map is not None else mission.map
     start = args.start if args.start is not None else mission.start
     setup_kwargs: dict[str, Any] = {
@@ -208,10 +215,103 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "start": start,
     }
     if args.navigator == "sim":
-        return _prepare_sim(args, setup_kwargs)
-    if args.navigator == "ros1":
-        return _prepare_ros1(args, setup_kwargs)
-    return _prepare_scripted(args, setup_kwargs)
+        setup = _prepare_sim(args, setup_kwargs)
+    elif args.navigator == "ros1":
+        setup = _prepare_ros1(args, setup_kwargs)
+    else:
+        setup = _prepare_scripted(args, setup_kwargs)
+    setup.notes[:0] = notes
+    setup.run_options = run_options(args, setup)
+    return setup
+
+
+#: Options a run records in its journal, with their defaults; a resume continues with
+#: the recorded value of each one the command line does not give again.
+RUN_OPTION_DEFAULTS: dict[str, Any] = {
+    "navigator": "sim",
+    "action": "move_base",
+    "ns": "",
+    "frame": None,
+}
+
+
+def apply_run_defaults(args: argparse.Namespace) -> None:
+    """Fill the options left out (None) with their defaults."""
+    for name, default in RUN_OPTION_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, default)
+
+
+def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> list[str]:
+    """Take the journaled run's options the command line leaves out; notes on overrides.
+
+    A resume continues the mission as it was started: its loop count, navigator and
+    navigator settings, map and start pose. An option given again with another value
+    wins, and is said, so an operator never changes a patrol by accident.
+    """
+    from navseq.commands.common import parse_loops, parse_pose
+    from navseq.errors import NavseqError
+
+    recorded = dict(history.run_options)
+    started = history.mission_started
+    if "loops" not in recorded and started is not None:
+        recorded["loops"] = started.loops  # journals written before run options existed
+    notes: list[str] = []
+
+    def given(name: str) -> bool:
+        if name == "loops":
+            return "loops" in vars(args)
+        return getattr(args, name, None) is not None
+
+    for name, value in recorded.items():
+        if name not in (*RUN_OPTION_DEFAULTS, "loops", "map", "start"):
+            continue
+        try:
+            if name == "loops":
+                value = None if value in (None, "forever") else parse_loops(str(value))
+            elif name == "map":
+                value = None if value is None else Path(str(value))
+            elif name == "start":
+                value = None if value is None else parse_pose(",".join(map(str, value)))
+        except (argparse.ArgumentTypeError, TypeError) as error:
+            raise NavseqError(
+                f"the journal's run option {name} is not valid: {error}",
+                source=f"{history.path}:1",
+            ) from None
+        if not given(name):
+            setattr(args, name, value)
+        elif getattr(args, name) != value:
+            notes.append(
+                f"resuming with --{name} {_option_text(getattr(args, name))} instead of the "
+                f"journal's {_option_text(value)}"
+            )
+    return notes
+
+
+def _option_text(value: Any) -> str:
+    if value is None:
+        return "none (forever for loops)"
+    if hasattr(value, "yaw"):
+        return format_pose(value)
+    return str(value)
+
+
+def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
+    """What the journal's header records so that a resume continues the same run."""
+    import math
+
+    start = setup.start
+    return {
+        "navigator": args.navigator,
+        "action": args.action,
+        "ns": args.ns,
+        "frame": args.frame,
+        "loops": setup.mission.loops,
+        "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
+        "start": None
+        if start is None
+        else [round(start.x, 6), round(start.y, 6), round(math.degrees(start.yaw), 6)],
+    }
 
 
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
@@ -348,15 +448,25 @@ def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, boo
     return create_run_folder(default_run_folder(setup.mission_path.stem), fresh=True), True
 
 
-def _discard_unused(journal: Path, folder: Path | None) -> None:
-    """Remove a journal that holds only its header (and the folder, if ours and empty)."""
+def _discard_unused(journal: Path) -> None:
+    """Remove a journal that holds only its header."""
     try:
         if journal.exists() and len(journal.read_bytes().splitlines()) <= 1:
             journal.unlink()
-        if folder is not None and not any(folder.iterdir()):
-            folder.rmdir()
     except OSError:
         pass  # tidying up only; the original error matters more
+
+
+def _remove_if_unused(folder: Path) -> None:
+    """Remove a folder this run created if nothing but its released lock is in it."""
+    from navseq.runlock import LOCK_NAME
+
+    try:
+        if {entry.name for entry in folder.iterdir()} <= {LOCK_NAME}:
+            (folder / LOCK_NAME).unlink(missing_ok=True)
+            folder.rmdir()
+    except OSError:
+        pass  # tidying up only
 
 
 def new_recorder(setup: RunSetup) -> RunRecorder:
@@ -384,7 +494,9 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
         else:
             # The absolute path, so that --resume works from any directory.
             source = str(setup.mission_path.resolve())
-            journal = JournalWriter(journal_path, source, setup.digest)
+            journal = JournalWriter(
+                journal_path, source, setup.digest, run_options=setup.run_options
+            )
         recorder = new_recorder(setup)
         progress = make_progress(setup.mission, json_lines=args.json)
         with progress, journal:
@@ -403,9 +515,30 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
-    from navseq.commands.output import reserve_file
+
+    from navseq.runlock import RunLock
 
     folder, created = _output_folder(setup, args)
+    # One live run per folder: a second --resume of the same journal is refused here,
+    # before it writes anything or moves the robot.
+    lock = RunLock(folder).acquire()
+    try:
+        return _execute_locked(setup, args, folder, created, lock)
+    finally:
+        lock.release()
+        if created:
+            _remove_if_unused(folder)
+
+
+def _execute_locked(
+    setup: RunSetup, args: argparse.Namespace, folder: Path, created: bool, lock: Any
+) -> int:
+    from navseq.commands.output import reserve_file
+
+    if lock.took_over is not None:
+        setup.notes.append(
+            f"took over the lock of process {lock.took_over}, which is no longer running"
+        )
     # Resuming appends to the run's own journal; a new run starts a new one.
     journal_path = setup.journal or reserve_file(folder, "journal.jsonl")
     for note in setup.notes:
@@ -415,7 +548,7 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     except BaseException:
         # No result to report (e.g. no navigation server): leave no empty files behind.
         if setup.journal is None:
-            _discard_unused(journal_path, folder if created else None)
+            _discard_unused(journal_path)
         raise
     # Reserved only now, so that a run killed with -9 leaves no empty report behind.
     files = {
@@ -437,8 +570,13 @@ def _print_end(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) -> N
     if outcome.json_lines is not None:
         outcome.json_lines.emit(
             "RunFinished",
-            {"success": result.success, "reason": result.reason,
-             "exit_code": outcome.exit_code, "interrupted": outcome.interrupted, **files},
+            {
+                "success": result.success,
+                "reason": result.reason,
+                "exit_code": outcome.exit_code,
+                "interrupted": outcome.interrupted,
+                **files,
+            },
         )
         return
     console = Console()
@@ -497,4 +635,3 @@ def picture_trajectory(outcome: RunOutcome) -> list[tuple[float, float, float]]:
 def run(args: argparse.Namespace) -> int:
     setup = prepare(args)
     return execute(setup, args)
-

@@ -19,6 +19,13 @@ with a single ``write`` call on a file opened in append mode, so a crash (even
 ``kill -9``) leaves at most one truncated last line; the reader tolerates it, and a
 resumed run starts a fresh line after it. ``WaypointProgress`` events are thinned out
 to at most one per second of mission time; everything else is kept.
+
+Every line ends with ``"chain"``: the first 16 hex digits of the sha256 of the previous
+line's chain and this line's record. A journal whose lines were edited, deleted or
+reordered by hand no longer chains, and is refused with the line number where the
+chain breaks: resuming from it could re-run reached waypoints or skip unreached ones.
+The header records the run's options (``run``: loops, navigator, ...), so that a resume
+continues the mission as it was started.
 """
 
 from __future__ import annotations
@@ -42,7 +49,12 @@ from navseq.executor.result import WaypointResult
 from navseq.executor.resume import ResumePoint
 
 JOURNAL_FORMAT = "navseq-journal"
-JOURNAL_VERSION = 1
+JOURNAL_VERSION = 2
+#: From this version on every line carries a chain digest.
+_CHAINED_SINCE = 2
+_CHAIN_KEY = b', "chain": "'
+_CHAIN_DIGITS = 16
+_CHAIN_SUFFIX_LENGTH = len(_CHAIN_KEY) + _CHAIN_DIGITS + 2  # digits, closing quote and brace
 #: Mission time between two journaled WaypointProgress events (s).
 PROGRESS_INTERVAL = 1.0
 _MAX_HEADER_BYTES = 64 * 1024
@@ -91,8 +103,10 @@ class JournalWriter:
         *,
         overwrite: bool = False,
         fsync: bool = False,
+        run_options: Mapping[str, Any] | None = None,
     ):
         self.path = Path(path)
+        self._chain = ""
         if not overwrite and self.path.exists() and self.path.stat().st_size > 0:
             raise NavseqError(
                 "a journal already exists here; resume it, or choose another journal path",
@@ -107,6 +121,7 @@ class JournalWriter:
                 "mission_source": mission_source,
                 "mission_digest": mission_digest,
                 "started": _wall_clock(),
+                "run": dict(run_options or {}),
             }
         )
 
@@ -117,7 +132,8 @@ class JournalWriter:
         """Continue an existing journal: append a ``resumed`` record, then the new events."""
         writer = cls.__new__(cls)  # skip __init__: no new header
         writer.path = Path(path)
-        read_journal(writer.path)  # refuse to append to something that is not a journal
+        # Refuse to append to something that is not an intact journal; go on with its chain.
+        writer._chain = read_journal(writer.path).chain
         writer._open(0, fsync)
         if not _ends_with_newline(writer.path):
             os.write(writer._fd, b"\n")  # end the line a crash cut short
@@ -155,7 +171,8 @@ class JournalWriter:
     def _write(self, record: Mapping[str, Any]) -> None:
         if self._fd is None:
             raise ValueError(f"journal {self.path} is closed")
-        data = (json.dumps(record, default=_json_default) + "\n").encode()
+        data = _sealed(json.dumps(record, default=_json_default).encode(), self._chain)
+        self._chain = data[-_CHAIN_DIGITS - 3 : -3].decode()
         view = memoryview(data)
         while view:  # one write call in practice; loop only if the OS writes less
             written = os.write(self._fd, view)
@@ -190,6 +207,8 @@ class JournalState:
     visits: dict[tuple[int, int], WaypointResult] = field(default_factory=dict)
     previous_duration: float = 0.0  # mission time covered by all segments (s)
     finish_reason: str | None = None  # of the last segment, if it finished
+    run_options: dict[str, Any] = field(default_factory=dict)  # the header's "run"
+    chain: str = ""  # digest of the last intact line: a resumed run chains on from it
 
     @property
     def mission_started(self) -> ev.MissionStarted | None:
@@ -210,8 +229,12 @@ def read_journal(path: str | os.PathLike[str]) -> JournalState:
         mission_source=str(header.get("mission_source", "")),
         mission_digest=str(header.get("mission_digest", "")),
         started=str(header.get("started", "")),
+        run_options=dict(header["run"]) if isinstance(header.get("run"), dict) else {},
     )
-    _replay(state, records)
+    _replay(state, records)  # first: its messages about damaged lines are the more precise
+    if "_lines" in header:
+        first, lines = header["_lines"]
+        state.chain = _check_chain(path, first, lines, records)
     return state
 
 
@@ -220,7 +243,8 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
     try:
         with path.open("rb") as handle:
             # Check the header before reading on, so a huge wrong file fails fast.
-            header = _parse_line(handle.readline(_MAX_HEADER_BYTES))
+            first = handle.readline(_MAX_HEADER_BYTES).rstrip(b"\n")
+            header = _parse_line(first)
             if header is None or header.get("kind") != "header":
                 raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
             rest = handle.read()
@@ -243,7 +267,60 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
     records = [
         (number, _parse_line(line)) for number, line in enumerate(lines, start=2) if line.strip()
     ]
+    if version >= _CHAINED_SINCE:
+        header["_lines"] = (first, lines)
     return header, records
+
+
+def _sealed(record: bytes, previous_chain: str) -> bytes:
+    """The journal line for a JSON object: the record plus its chain digest, and a newline."""
+    digest = hashlib.sha256(previous_chain.encode() + record).hexdigest()[:_CHAIN_DIGITS]
+    return record[:-1] + _CHAIN_KEY + digest.encode() + b'"}\n'
+
+
+def _unsealed(line: bytes) -> tuple[bytes, str] | None:
+    """(the record as it was hashed, its chain digest), or None if the line has no chain."""
+    suffix = line[-_CHAIN_SUFFIX_LENGTH:]
+    if len(line) <= _CHAIN_SUFFIX_LENGTH or not (
+        suffix.startswith(_CHAIN_KEY) and suffix.endswith(b'"}')
+    ):
+        return None
+    return line[:-_CHAIN_SUFFIX_LENGTH] + b"}", suffix[len(_CHAIN_KEY) : -2].decode(
+        "ascii", "replace"
+    )
+
+
+def _check_chain(
+    path: Path,
+    header_line: bytes,
+    lines: list[bytes],
+    records: list[tuple[int, dict[str, Any] | None]],
+) -> str:
+    """The chain digest of the last intact line; NavseqError where the chain breaks.
+
+    Unreadable lines are left to the replay, which tolerates a line a crash cut short
+    (they never joined the chain: the run that resumed chained on from the line before).
+    """
+    chain = ""
+    readable = {number for number, record in records if record is not None}
+    numbered = [(1, header_line)] + [
+        (number, line) for number, line in enumerate(lines, start=2) if number in readable
+    ]
+    for number, line in numbered:
+        parts = _unsealed(line)
+        expected = None
+        if parts is not None:
+            expected = hashlib.sha256(chain.encode() + parts[0]).hexdigest()[:_CHAIN_DIGITS]
+        if parts is None or parts[1] != expected:
+            raise NavseqError(
+                "the journal was altered here (a line edited, removed or moved: its chain "
+                "digest does not follow from the lines before); navseq does not resume "
+                "from an altered journal, which could re-run reached waypoints or skip "
+                "others. Start a new run, or restore the original journal",
+                source=f"{path}:{number}",
+            )
+        chain = parts[1]
+    return chain
 
 
 def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]]) -> None:

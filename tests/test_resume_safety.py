@@ -1,0 +1,161 @@
+"""A resume continues the run as journaled, alone, and refuses before it writes or moves."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from cli_support import (
+    assert_clean_error,
+    journal_events,
+    journal_records,
+    navseq,
+    start_navseq,
+    wait_for,
+    write_mission,
+)
+
+PATROL = """\
+  - {name: a, x: 1.0, y: 0.0, yaw: 90}
+  - {name: b, x: 1.0, y: 1.0, yaw: 180}
+  - {name: c, x: 0.0, y: 1.0, yaw: -90}
+"""
+
+
+def goals_sent(log: Path) -> list[dict[str, Any]]:
+    if not log.exists():
+        return []
+    return [r for r in map(json.loads, log.read_text().splitlines()) if r["call"] == "send_goal"]
+
+
+def killed_run(tmp_path: Path, *extra: Any, visits: int = 2) -> tuple[Path, Path, int]:
+    """A patrol run killed with -9 after ``visits`` finished visits: (mission, journal, pid)."""
+    mission = write_mission(tmp_path / "patrol.yaml", PATROL, header="loops: forever\n")
+    out = tmp_path / "out"
+    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
+                           "--scripted-realtime", "4", *extra, cwd=tmp_path)
+    journal = out / "journal.jsonl"
+    try:
+        wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= visits, 60,
+                 f"{visits} visits finished")
+    finally:
+        process.kill()
+        process.communicate(timeout=30)
+    return mission, journal, process.pid
+
+
+def test_resume_keeps_the_journaled_loop_count_instead_of_patrolling_forever(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=4)
+    result = navseq("run", "--resume", journal, "--scripted-log", tmp_path / "nav.log",
+                    cwd=tmp_path, timeout=120)
+    assert result.returncode == 0, result.stderr
+    report = json.loads((journal.parent / "report.json").read_text())
+    assert report["success"] is True
+    assert report["totals"]["reached"] == 6  # 2 loops of 3 waypoints, not a patrol
+    assert "instead of the journal's" not in result.stderr
+
+
+def test_an_option_given_again_overrides_the_journal_and_says_so(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=1)
+    result = navseq("run", "--resume", journal, "--loops", "1", "--scripted-log",
+                    tmp_path / "nav.log", cwd=tmp_path, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "resuming with --loops 1 instead of the journal's 2" in result.stderr
+    report = json.loads((journal.parent / "report.json").read_text())
+    assert report["totals"]["reached"] == 3
+
+
+def test_a_second_resume_of_a_live_run_is_refused_and_moves_nothing(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "3")
+    first = start_navseq("run", "--resume", journal, "--scripted-realtime", "0.5",
+                         cwd=tmp_path)
+    try:
+        wait_for(lambda: any(r.get("kind") == "resumed" for r in journal_records(journal)),
+                 30, "the first resume to start")
+        before = journal.read_bytes()
+        log = tmp_path / "second.log"
+        second = navseq("run", "--resume", journal, "--scripted-log", log, cwd=tmp_path)
+        assert_clean_error(second)
+        assert f"another navseq run (process {first.pid})" in second.stderr
+        assert goals_sent(log) == []
+        # The live run may append meanwhile; the refused one added no 'resumed' record.
+        records = journal_records(journal)
+        assert sum(r.get("kind") == "resumed" for r in records) == 1
+        assert journal.read_bytes().startswith(before)
+    finally:
+        first.send_signal(signal.SIGTERM)
+        first.communicate(timeout=30)
+    assert first.returncode == 143
+
+
+def test_the_lock_of_a_killed_run_is_taken_over_and_said(tmp_path):
+    _, journal, pid = killed_run(tmp_path, "--loops", "1")
+    result = navseq("run", "--resume", journal, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert f"took over the lock of process {pid}" in result.stderr
+    assert not (journal.parent / ".navseq.lock").exists()  # a clean end removes it
+
+
+def test_a_refused_resume_writes_nothing_to_the_journal(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=4)  # in the second loop
+    before = journal.read_bytes()
+    log = tmp_path / "nav.log"
+    result = navseq("run", "--resume", journal, "--loops", "1", "--scripted-log", log,
+                    cwd=tmp_path)
+    assert_clean_error(result)
+    assert "loop 2" in result.stderr
+    assert journal.read_bytes() == before
+    assert goals_sent(log) == []
+
+
+def test_a_hand_edited_journal_is_refused_with_the_line(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=3)
+    lines = journal.read_bytes().splitlines(keepends=True)
+    finished = [n for n, line in enumerate(lines) if b'"WaypointFinished"' in line]
+    del lines[finished[0]]  # "forget" that the first waypoint was reached
+    journal.write_bytes(b"".join(lines))
+    log = tmp_path / "nav.log"
+    result = navseq("run", "--resume", journal, "--scripted-log", log, cwd=tmp_path)
+    assert_clean_error(result)
+    assert f"journal.jsonl:{finished[0] + 1}: the journal was altered" in result.stderr
+    assert goals_sent(log) == []
+
+
+def test_a_changed_outcome_in_a_journal_line_is_refused(tmp_path):
+    _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=3)
+    text = journal.read_text()
+    journal.write_text(text.replace('"outcome": "reached"', '"outcome": "skipped"', 1))
+    result = navseq("run", "--resume", journal, cwd=tmp_path)
+    assert_clean_error(result)
+    assert "the journal was altered" in result.stderr
+
+
+def test_lock_refusal_names_the_holder(tmp_path):
+    from navseq.errors import NavseqError
+    from navseq.runlock import RunLock
+
+    holder = subprocess.Popen(
+        [os.sys.executable, "-c",
+         "import sys, time; from pathlib import Path; from navseq.runlock import RunLock; "
+         "RunLock(Path(sys.argv[1])).acquire(); print('held', flush=True); time.sleep(30)",
+         str(tmp_path)],
+        stdout=subprocess.PIPE, text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        try:
+            RunLock(tmp_path).acquire()
+        except NavseqError as error:
+            assert f"process {holder.pid}" in str(error)
+        else:
+            raise AssertionError("a held lock was acquired twice")
+    finally:
+        holder.kill()
+        holder.communicate(timeout=10)
+    lock = RunLock(tmp_path).acquire()  # the kernel dropped the dead holder's lock
+    assert lock.took_over == holder.pid
+    lock.release()
