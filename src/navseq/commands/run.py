@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
+    from navseq.signals import DeferredSignals
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
@@ -482,7 +483,11 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
     return RunRecorder.from_journal(setup.history.events)
 
 
-def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Path) -> RunOutcome:
+def _run_with_sinks(
+    setup: RunSetup, args: argparse.Namespace, journal_path: Path, deferred: DeferredSignals
+) -> RunOutcome:
+    """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
     from navseq.sinks.progress import JsonProgress, make_progress
@@ -502,12 +507,20 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
         with progress, journal:
             try:
                 result = run_mission(
-                    setup.mission, navigator, [journal, recorder, progress], resume=setup.resume
+                    setup.mission,
+                    navigator,
+                    [journal, recorder, StdoutGuard(progress)],
+                    resume=setup.resume,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
                 result, exit_code, interrupted = stop.result, stop.exit_code, stop.signal_name
+            finally:
+                # The goal is reached or cancelled: nothing left is worth losing the
+                # report for.
+                deferred.start()
     finally:
+        deferred.start()
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
     return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines)
@@ -515,25 +528,44 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
-
     from navseq.runlock import RunLock
+    from navseq.signals import DeferredSignals
 
     folder, created = _output_folder(setup, args)
     # One live run per folder: a second --resume of the same journal is refused here,
     # before it writes anything or moves the robot.
     lock = RunLock(folder).acquire()
+    deferred = DeferredSignals()
     try:
-        return _execute_locked(setup, args, folder, created, lock)
+        return _execute_locked(setup, args, folder, lock, deferred)
     finally:
         lock.release()
         if created:
             _remove_if_unused(folder)
+        deferred.stop()
+        if deferred.received:
+            print(
+                f"navseq run: {', '.join(deferred.received)} received after the robot was "
+                "stopped; the outputs were finished first",
+                file=sys.stderr,
+            )
 
 
 def _execute_locked(
-    setup: RunSetup, args: argparse.Namespace, folder: Path, created: bool, lock: Any
+    setup: RunSetup,
+    args: argparse.Namespace,
+    folder: Path,
+    lock: Any,
+    deferred: DeferredSignals,
 ) -> int:
     from navseq.commands.output import reserve_file
+    from navseq.commands.run_outputs import (
+        RunFiles,
+        print_summary,
+        report_failures,
+        silence_stdout,
+        write_outputs,
+    )
 
     if lock.took_over is not None:
         setup.notes.append(
@@ -544,55 +576,54 @@ def _execute_locked(
     for note in setup.notes:
         print(f"navseq run: {note}", file=sys.stderr)
     try:
-        outcome = _run_with_sinks(setup, args, journal_path)
+        outcome = _run_with_sinks(setup, args, journal_path, deferred)
     except BaseException:
         # No result to report (e.g. no navigation server): leave no empty files behind.
         if setup.journal is None:
             _discard_unused(journal_path)
         raise
-    # Reserved only now, so that a run killed with -9 leaves no empty report behind.
-    files = {
-        "journal": str(journal_path),
-        "report": str(reserve_file(folder, "report.json")),
-        "picture": str(reserve_file(folder, "mission.png")),
-    }
-    _write_outputs(setup, outcome, files)
-    _print_end(setup, outcome, files)
+    files = RunFiles(paths={"journal": str(journal_path)})
+    write_outputs(
+        folder,
+        files,
+        lambda paths: _report(setup, outcome, paths),
+        lambda: _picture_png(setup, outcome),
+        deferred,
+    )
+    if outcome.json_lines is not None:
+        try:
+            outcome.json_lines.emit(
+                "RunFinished",
+                {
+                    "success": outcome.result.success,
+                    "reason": outcome.result.reason,
+                    "exit_code": outcome.exit_code,
+                    "interrupted": outcome.interrupted,
+                    **files.paths,
+                },
+            )
+        except BrokenPipeError:
+            silence_stdout()
+    else:
+        print_summary(setup.mission, outcome.result, files)
+    report_failures(files)
+    if "report" in files.failed:
+        from navseq.errors import NavseqError
+
+        raise NavseqError(
+            f"the report could not be written ({files.failed['report']}); the journal "
+            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it",
+            source="navseq run",
+        )
     return outcome.exit_code
 
 
-def _print_end(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) -> None:
-    from rich.console import Console
+def _report(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) -> dict[str, Any]:
+    from navseq.sinks.report import build_report
 
-    from navseq.sinks.progress import summary_table
-
-    result = outcome.result
-    if outcome.json_lines is not None:
-        outcome.json_lines.emit(
-            "RunFinished",
-            {
-                "success": result.success,
-                "reason": result.reason,
-                "exit_code": outcome.exit_code,
-                "interrupted": outcome.interrupted,
-                **files,
-            },
-        )
-        return
-    console = Console()
-    console.print(summary_table(setup.mission, result))
-    for role, path in files.items():
-        console.print(f"{role:>8}: {path}", highlight=False)
-
-
-def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) -> None:
-    from navseq.sinks.picture import draw_mission_picture
-    from navseq.sinks.report import build_report, write_report
-
-    result = outcome.result
-    report = build_report(
+    return build_report(
         setup.mission,
-        result,
+        outcome.result,
         exit_code=outcome.exit_code,
         navigator=setup.navigator_info,
         interrupted=outcome.interrupted,
@@ -603,16 +634,18 @@ def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) 
         start=setup.start,
         files=files,
     )
-    write_report(report, Path(files["report"]))
-    trajectory = picture_trajectory(outcome)
-    draw_mission_picture(
-        Path(files["picture"]),
+
+
+def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:
+    from navseq.sinks.picture import mission_picture_png
+
+    return mission_picture_png(
         setup.mission,
-        result,
+        outcome.result,
         grid=setup.grid,
         start=setup.start,
         plans=outcome.recorder.leg_plans(),
-        trajectory=trajectory,
+        trajectory=picture_trajectory(outcome),
         interrupted=outcome.interrupted,
     )
 

@@ -255,6 +255,32 @@ def draw_mission_picture(
     positions as (t, x, y) with t in mission-clock seconds; a row of NaNs breaks the
     line (a resumed run's segments: the robot may not have been where it stopped).
     """
+    png = mission_picture_png(
+        mission,
+        result,
+        grid=grid,
+        start=start,
+        plans=plans,
+        trajectory=trajectory,
+        interrupted=interrupted,
+        dpi=dpi,
+    )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomically(path, png)
+
+
+def mission_picture_png(
+    mission: Mission,
+    result: MissionResult,
+    *,
+    grid: OccupancyGrid | None = None,
+    start: Pose2D | None = None,
+    plans: Sequence[Path2D] = (),
+    trajectory: Sequence[tuple[float, float, float]] = (),
+    interrupted: str | None = None,
+    dpi: int = 150,
+) -> bytes:
+    """The picture of the run as PNG bytes (see :func:`draw_mission_picture`)."""
     fig = mission_figure(
         mission,
         result,
@@ -268,8 +294,7 @@ def draw_mission_picture(
     png = io.BytesIO()
     # "tight" keeps the legend and axis labels that sit outside the axes.
     fig.savefig(png, format="png", bbox_inches="tight", pad_inches=0.15)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_atomically(path, png.getvalue())
+    return png.getvalue()
 
 
 def mission_figure(

@@ -1,0 +1,198 @@
+"""What ``navseq run`` leaves behind once the robot is stopped: report, picture, summary.
+
+The order is the promise: the report first, then the picture, then the terminal
+summary. Each file is written complete under a name nothing else has (``report.json``,
+else ``report-2.json`` ...) through a temporary file, so no empty or half file is ever
+seen, and nothing the user has is replaced. Shutdown signals that arrive meanwhile are
+counted by :class:`~navseq.signals.DeferredSignals`, not obeyed: the report is always
+written, and states exactly the exit status the process returns. Only an operator who
+signals twice more while the picture is drawn gives the picture up.
+"""
+
+from __future__ import annotations
+
+import errno
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from navseq.executor.result import MissionResult
+    from navseq.mission.model import Mission
+    from navseq.signals import DeferredSignals
+
+#: Attempts at a free name (``report-2.json`` ...) before giving up.
+MAX_NAME_ATTEMPTS = 1000
+
+
+@dataclass
+class RunFiles:
+    """The files of one run: role -> path, and the roles that could not be written."""
+
+    paths: dict[str, str] = field(default_factory=dict)
+    failed: dict[str, str] = field(default_factory=dict)  # role -> why
+
+
+def free_name(folder: Path, name: str, start: int = 1) -> Path:
+    """``folder/name``, or ``stem-N.ext`` for the first N from ``start`` not taken."""
+    stem, dot, suffix = name.rpartition(".")
+    if not dot:
+        stem, suffix = name, ""
+    for number in range(start, start + MAX_NAME_ATTEMPTS):
+        candidate = folder / (name if number == 1 else f"{stem}-{number}{dot}{suffix}")
+        if not candidate.exists() and not candidate.is_symlink():
+            return candidate
+    raise NavseqError(f"no free name for {name} in {MAX_NAME_ATTEMPTS} tries", source=str(folder))
+
+
+def write_new_file(folder: Path, name: str, render: Callable[[Path], bytes]) -> Path:
+    """Write ``render(path)`` to a free name in ``folder``; never replaces a file.
+
+    ``render`` gets the path the file will have (a report names its own path). OSError
+    (disk full, permissions) becomes a :class:`NavseqError` naming the file.
+    """
+    from navseq.files import write_atomically
+
+    number = 1
+    while True:
+        path = free_name(folder, name, number)
+        data = render(path)
+        try:
+            write_atomically(path, data, replace=False)
+            return path
+        except FileExistsError:
+            number = _number_of(path, name) + 1  # someone took it meanwhile: the next one
+        except OSError as error:
+            raise output_error(path, error) from None
+
+
+def output_error(path: Path, error: OSError) -> NavseqError:
+    """A clear message for a file that could not be written (disk full, permissions)."""
+    why = error.strerror or str(error)
+    if error.errno == errno.ENOSPC:
+        why = "the disk is full"
+    return NavseqError(f"cannot write it: {why}", source=str(path))
+
+
+def _number_of(path: Path, name: str) -> int:
+    stem = name.rpartition(".")[0] or name
+    tail = path.name[len(stem) :].lstrip("-").split(".")[0]
+    return int(tail) if tail.isdigit() else 1
+
+
+def write_outputs(
+    folder: Path,
+    files: RunFiles,
+    build_report: Callable[[dict[str, str]], dict[str, Any]],
+    render_picture: Callable[[], bytes],
+    deferred: DeferredSignals | None,
+) -> None:
+    """The report, then the picture; a failure of either is recorded, the other still made.
+
+    ``build_report(paths)`` makes the report given every file's path (the picture's
+    name is chosen first so the report can name it); ``render_picture()`` the PNG.
+    """
+    import json
+
+    from navseq.signals import StepAbandoned
+
+    picture_path = free_name(folder, "mission.png")
+    files.paths["picture"] = str(picture_path)
+
+    def report_bytes(path: Path) -> bytes:
+        files.paths["report"] = str(path)
+        report = build_report(dict(files.paths))
+        return (json.dumps(report, indent=2, ensure_ascii=False) + "\n").encode()
+
+    try:
+        write_new_file(folder, "report.json", report_bytes)
+    except NavseqError as error:
+        files.failed["report"] = str(error)
+    try:
+        if deferred is not None:
+            with deferred.abortable():
+                png = render_picture()
+        else:
+            png = render_picture()
+        files.paths["picture"] = str(write_new_file(folder, picture_path.name, lambda _: png))
+    except StepAbandoned as stop:
+        files.failed["picture"] = f"not drawn: given up on {stop} while drawing"
+    except NavseqError as error:
+        files.failed["picture"] = str(error)
+
+
+def print_summary(mission: Mission, result: MissionResult, files: RunFiles) -> None:
+    """The final table and the files, on stdout; a reader gone away is not an error."""
+    from rich.console import Console
+
+    from navseq.sinks.progress import summary_table
+
+    try:
+        console = Console()
+        console.print(summary_table(mission, result))
+        for role, path in files.paths.items():
+            if role not in files.failed:
+                console.print(f"{role:>8}: {path}", highlight=False)
+    except BrokenPipeError:
+        silence_stdout()
+
+
+def report_failures(files: RunFiles) -> None:
+    for role, why in files.failed.items():
+        print(f"navseq run: {role}: {why}", file=sys.stderr)
+
+
+def silence_stdout() -> None:
+    """Point stdout at /dev/null: its reader went away, and Python must not complain at exit."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
+
+
+class StdoutGuard:
+    """A listener wrapper: when stdout's reader goes away, the mission goes on silently.
+
+    ``navseq run --json | head -1`` closes the pipe after one line. That is not a reason
+    to stop a robot mid-mission or lose its report: output is dropped from then on
+    (said once on stderr), and the run, the journal and the report carry on.
+    """
+
+    def __init__(self, listener: Callable[[Any], None]) -> None:
+        self._listener = listener
+        self.closed = False
+
+    def __call__(self, event: Any) -> None:
+        if self.closed:
+            return
+        try:
+            self._listener(event)
+        except BrokenPipeError:
+            self.closed = True
+            silence_stdout()
+            print(
+                "navseq run: standard output was closed; the mission goes on and the "
+                "report is written as usual",
+                file=sys.stderr,
+            )
+
+
+__all__ = [
+    "RunFiles",
+    "StdoutGuard",
+    "free_name",
+    "output_error",
+    "print_summary",
+    "report_failures",
+    "silence_stdout",
+    "write_new_file",
+    "write_outputs",
+]
