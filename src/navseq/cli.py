@@ -6,7 +6,8 @@ Exit statuses (the same for every subcommand):
 - 0: done (for ``run``: every waypoint reached);
 - 1: ``run`` finished but not every waypoint was reached;
 - 2: bad input (mission, map, arguments) — a readable message, never a traceback;
-- 130 / 143: interrupted by SIGINT / SIGTERM (``run`` cancels the active goal first).
+- 130 / 143 / 129: interrupted by SIGINT / SIGTERM / SIGHUP (``run`` cancels the active
+  goal first).
 
 Anything else that goes wrong is a bug: one line "internal error" on stderr, and
 ``--debug`` shows the traceback.
@@ -26,6 +27,7 @@ from types import FrameType
 from navseq import __version__
 from navseq.commands import SUBCOMMANDS
 from navseq.errors import NavseqError
+from navseq.signals import Terminated
 
 EXIT_OK = 0
 EXIT_NOT_ALL_REACHED = 1
@@ -36,12 +38,12 @@ EXIT_SIGTERM = 128 + signal.SIGTERM
 EXIT_SIGPIPE = 128 + signal.SIGPIPE
 
 
-class Terminated(BaseException):
-    """SIGTERM arrived outside a mission run (the runner handles it during a run)."""
+#: Ending the process like SIGTERM: a closed terminal (SIGHUP) included.
+_TERMINATING = (signal.SIGTERM, signal.SIGHUP)
 
 
 def _raise_terminated(signum: int, frame: FrameType | None) -> None:
-    raise Terminated()
+    raise Terminated(signal.Signals(signum).name)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -114,6 +116,16 @@ def _configure_logging(debug: bool) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        # Ctrl-C before the command took over (while Python imports what it needs):
+        # nothing has moved yet, and a traceback would tell the user nothing.
+        print("navseq: interrupted", file=sys.stderr)
+        return EXIT_SIGINT
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(_attach_negative_values(sys.argv[1:] if argv is None else argv))
     if getattr(args, "command_module", None) is None:
@@ -121,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     debug = getattr(args, "debug", False)
     _configure_logging(debug)
-    previous_sigterm = signal.signal(signal.SIGTERM, _raise_terminated)
+    previous = {signum: signal.signal(signum, _raise_terminated) for signum in _TERMINATING}
     try:
         return args.command_module.run(args)
     except NavseqError as error:
@@ -131,9 +143,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"navseq {args.command}: interrupted", file=sys.stderr)
         return EXIT_SIGINT
-    except Terminated:
-        print(f"navseq {args.command}: terminated", file=sys.stderr)
-        return EXIT_SIGTERM
+    except Terminated as terminated:
+        print(f"navseq {args.command}: terminated ({terminated.signal_name})", file=sys.stderr)
+        return 128 + signal.Signals[terminated.signal_name].value
     except BrokenPipeError:
         # The reader of our output went away (`navseq run ... | head`): stop quietly,
         # as a process killed by SIGPIPE would, and keep Python from complaining
@@ -150,7 +162,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return EXIT_INTERNAL_ERROR
     finally:
-        signal.signal(signal.SIGTERM, previous_sigterm)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 if __name__ == "__main__":

@@ -1,12 +1,19 @@
-"""Shutdown signals while a finished run writes its outputs: counted, not obeyed.
+"""Shutdown signals during a run: the first one stops the robot, later ones are counted.
 
-Once the active goal is cancelled, nothing a signal could still stop is worth losing
-the report for: an impatient second Ctrl-C, a SIGTERM from a supervisor, or SIGHUP from
-a closing terminal must not leave ``report.json`` missing or disagreeing with the exit
-status. :class:`DeferredSignals` replaces the handlers of SIGINT, SIGTERM and SIGHUP
-with one that only counts; the caller decides what the signals mean afterwards. An
-operator who insists (``abort_after`` signals) may abandon a step that may be given up,
-such as drawing the picture, never the report: :meth:`DeferredSignals.abortable`.
+navseq drives a robot, so SIGINT, SIGTERM and SIGHUP (a closed terminal, a dropped ssh)
+must all reach the run and cancel its goal — even where the process was started with
+SIGINT ignored, as a background job of a shell script is. But once the run is being
+stopped, nothing a signal could still stop is worth losing the report for: an impatient
+second Ctrl-C, a supervisor's SIGTERM after a SIGINT, must neither cut the cancel short
+nor leave ``report.json`` missing or disagreeing with the exit status.
+
+:class:`SignalGuard` has two phases. *Armed*: SIGINT raises KeyboardInterrupt, SIGTERM
+and SIGHUP raise :class:`Terminated`; the handler switches the guard to *deferring*
+before it raises, so a second signal that follows at once finds no gap. *Deferring*:
+signals are only counted; an operator who insists (signals twice more) may give up a
+step that may be given up, such as drawing the picture (:meth:`SignalGuard.abortable`),
+never the report. :meth:`SignalGuard.restore` puts the original handlers back.
+Handlers can only be set in the main thread; elsewhere the guard does nothing.
 """
 
 from __future__ import annotations
@@ -21,32 +28,53 @@ from typing import Any
 SHUTDOWN_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP ended the run; a BaseException so no ``except Exception`` in a
+    sink or navigator swallows it."""
+
+    def __init__(self, signal_name: str = "SIGTERM"):
+        super().__init__(signal_name)
+        self.signal_name = signal_name
+
+
 class StepAbandoned(Exception):
     """The operator insisted (signalled again) while an abortable step ran."""
 
 
-class DeferredSignals:
-    """Count shutdown signals instead of acting on them, between start() and stop().
+class SignalGuard:
+    """The run's handling of SIGINT, SIGTERM and SIGHUP; see the module docstring.
 
-    Signal handlers can only be set in the main thread; elsewhere this does nothing
-    (and counts nothing). ``received`` lists the signal names in arrival order.
+    ``received`` lists the names of the signals that arrived, in order.
     """
 
     def __init__(self) -> None:
         self.received: list[str] = []
-        self._previous: dict[int, Any] = {}
+        self._original: dict[int, Any] = {}
         self._abort_at: int | None = None
 
-    def start(self) -> DeferredSignals:
-        if threading.current_thread() is threading.main_thread() and not self._previous:
+    @property
+    def deferring(self) -> bool:
+        return bool(self._original) and signal.getsignal(signal.SIGINT) == self._count
+
+    def arm(self) -> SignalGuard:
+        """From now on a shutdown signal raises (and defers the ones after it)."""
+        if self._save_originals():
             for signum in SHUTDOWN_SIGNALS:
-                self._previous[signum] = signal.signal(signum, self._count)
+                signal.signal(signum, self._raise)
         return self
 
-    def stop(self) -> None:
-        for signum, handler in self._previous.items():
+    def defer(self) -> SignalGuard:
+        """From now on shutdown signals are only counted."""
+        if self._save_originals():
+            for signum in SHUTDOWN_SIGNALS:
+                signal.signal(signum, self._count)
+        return self
+
+    def restore(self) -> None:
+        """Put back the handlers the process had before the guard."""
+        for signum, handler in self._original.items():
             signal.signal(signum, handler)
-        self._previous.clear()
+        self._original.clear()
 
     @contextlib.contextmanager
     def abortable(self, after: int = 2) -> Iterator[None]:
@@ -57,17 +85,26 @@ class DeferredSignals:
         finally:
             self._abort_at = None
 
+    def _save_originals(self) -> bool:
+        if threading.current_thread() is not threading.main_thread():
+            return False
+        if not self._original:
+            self._original = {signum: signal.getsignal(signum) for signum in SHUTDOWN_SIGNALS}
+        return True
+
+    def _raise(self, signum: int, frame: FrameType | None) -> None:
+        name = signal.Signals(signum).name
+        self.received.append(name)
+        self.defer()  # first: a signal right behind this one must not interrupt the stop
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Terminated(name)
+
     def _count(self, signum: int, frame: FrameType | None) -> None:
         self.received.append(signal.Signals(signum).name)
         if self._abort_at is not None and len(self.received) >= self._abort_at:
             self._abort_at = None
             raise StepAbandoned(signal.Signals(signum).name)
 
-    def __enter__(self) -> DeferredSignals:
-        return self.start()
 
-    def __exit__(self, *exc_info: object) -> None:
-        self.stop()
-
-
-__all__ = ["SHUTDOWN_SIGNALS", "DeferredSignals", "StepAbandoned"]
+__all__ = ["SHUTDOWN_SIGNALS", "SignalGuard", "StepAbandoned", "Terminated"]

@@ -45,6 +45,11 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "navseq.commands.validate",
     ),
     Subcommand(
+        "report",
+        "rebuild a run's report and picture from its journal",
+        "navseq.commands.report",
+    ),
+    Subcommand(
         "convert",
         "write any supported mission format as navseq YAML",
         "navseq.commands.convert",

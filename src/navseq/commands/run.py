@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
-    from navseq.signals import DeferredSignals
+    from navseq.signals import SignalGuard
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
@@ -484,7 +484,7 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
 
 
 def _run_with_sinks(
-    setup: RunSetup, args: argparse.Namespace, journal_path: Path, deferred: DeferredSignals
+    setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
 ) -> RunOutcome:
     """Run the mission; from the moment it ends, shutdown signals are only counted."""
     from navseq.commands.run_outputs import StdoutGuard
@@ -511,16 +511,13 @@ def _run_with_sinks(
                     navigator,
                     [journal, recorder, StdoutGuard(progress)],
                     resume=setup.resume,
+                    signals=signals,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
                 result, exit_code, interrupted = stop.result, stop.exit_code, stop.signal_name
-            finally:
-                # The goal is reached or cancelled: nothing left is worth losing the
-                # report for.
-                deferred.start()
     finally:
-        deferred.start()
+        signals.defer()  # the goal is reached or cancelled: the report comes first now
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
     return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines)
@@ -529,24 +526,24 @@ def _run_with_sinks(
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
     from navseq.runlock import RunLock
-    from navseq.signals import DeferredSignals
+    from navseq.signals import SignalGuard
 
     folder, created = _output_folder(setup, args)
     # One live run per folder: a second --resume of the same journal is refused here,
     # before it writes anything or moves the robot.
     lock = RunLock(folder).acquire()
-    deferred = DeferredSignals()
+    signals = SignalGuard()
     try:
-        return _execute_locked(setup, args, folder, lock, deferred)
+        return _execute_locked(setup, args, folder, lock, signals)
     finally:
         lock.release()
         if created:
             _remove_if_unused(folder)
-        deferred.stop()
-        if deferred.received:
+        signals.restore()
+        if len(signals.received) > 1:  # the first one is the interruption itself
             print(
-                f"navseq run: {', '.join(deferred.received)} received after the robot was "
-                "stopped; the outputs were finished first",
+                f"navseq run: {', '.join(signals.received)} received; the robot was stopped "
+                "and the outputs were finished first",
                 file=sys.stderr,
             )
 
@@ -556,7 +553,7 @@ def _execute_locked(
     args: argparse.Namespace,
     folder: Path,
     lock: Any,
-    deferred: DeferredSignals,
+    signals: SignalGuard,
 ) -> int:
     from navseq.commands.output import reserve_file
     from navseq.commands.run_outputs import (
@@ -576,7 +573,7 @@ def _execute_locked(
     for note in setup.notes:
         print(f"navseq run: {note}", file=sys.stderr)
     try:
-        outcome = _run_with_sinks(setup, args, journal_path, deferred)
+        outcome = _run_with_sinks(setup, args, journal_path, signals)
     except BaseException:
         # No result to report (e.g. no navigation server): leave no empty files behind.
         if setup.journal is None:
@@ -588,7 +585,7 @@ def _execute_locked(
         files,
         lambda paths: _report(setup, outcome, paths),
         lambda: _picture_png(setup, outcome),
-        deferred,
+        signals,
     )
     if outcome.json_lines is not None:
         try:
@@ -666,5 +663,37 @@ def picture_trajectory(outcome: RunOutcome) -> list[tuple[float, float, float]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    setup = prepare(args)
+    from navseq.sinks.journal import NothingToResume
+
+    try:
+        setup = prepare(args)
+    except NothingToResume:
+        # A finished run: all a resume can still do is finish its outputs.
+        code = _rebuild_finished(args.resume)
+        if code is None:
+            raise
+        return code
     return execute(setup, args)
+
+
+def _rebuild_finished(journal: Path) -> int | None:
+    """Rebuild a finished run's missing report/picture; its exit status, or None if complete."""
+    from navseq.commands.report import (
+        exit_code_of,
+        journaled_mission,
+        rebuild_outputs,
+        result_from_journal,
+    )
+    from navseq.runlock import RunLock
+    from navseq.sinks.journal import read_journal
+
+    with RunLock(journal.parent):
+        written = rebuild_outputs(journal)
+    if not written:
+        return None
+    for role, path in written.items():
+        print(f"navseq run: nothing left to run; rebuilt the {role}: {path}", file=sys.stderr)
+    state = read_journal(journal)
+    result = result_from_journal(state, journaled_mission(state))
+    code = exit_code_of(result, state.finish_reason is not None)
+    return 1 if code is None else code

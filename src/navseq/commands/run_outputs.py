@@ -4,7 +4,7 @@ The order is the promise: the report first, then the picture, then the terminal
 summary. Each file is written complete under a name nothing else has (``report.json``,
 else ``report-2.json`` ...) through a temporary file, so no empty or half file is ever
 seen, and nothing the user has is replaced. Shutdown signals that arrive meanwhile are
-counted by :class:`~navseq.signals.DeferredSignals`, not obeyed: the report is always
+counted by :class:`~navseq.signals.SignalGuard` (deferring), not obeyed: the report is always
 written, and states exactly the exit status the process returns. Only an operator who
 signals twice more while the picture is drawn gives the picture up.
 """
@@ -23,7 +23,7 @@ from navseq.errors import NavseqError
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
     from navseq.mission.model import Mission
-    from navseq.signals import DeferredSignals
+    from navseq.signals import SignalGuard
 
 #: Attempts at a free name (``report-2.json`` ...) before giving up.
 MAX_NAME_ATTEMPTS = 1000
@@ -89,7 +89,7 @@ def write_outputs(
     files: RunFiles,
     build_report: Callable[[dict[str, str]], dict[str, Any]],
     render_picture: Callable[[], bytes],
-    deferred: DeferredSignals | None,
+    signals: SignalGuard | None,
 ) -> None:
     """The report, then the picture; a failure of either is recorded, the other still made.
 
@@ -113,8 +113,8 @@ def write_outputs(
     except NavseqError as error:
         files.failed["report"] = str(error)
     try:
-        if deferred is not None:
-            with deferred.abortable():
+        if signals is not None:
+            with signals.abortable():
                 png = render_picture()
         else:
             png = render_picture()

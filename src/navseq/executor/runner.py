@@ -9,12 +9,8 @@ to a goal nobody watches.
 
 from __future__ import annotations
 
-import contextlib
 import logging
-import signal
-import threading
-from collections.abc import Iterable, Iterator
-from types import FrameType
+from collections.abc import Iterable
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
@@ -24,11 +20,12 @@ from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
 from navseq.mission.model import Mission
 from navseq.navigators.base import Navigator
+from navseq.signals import SignalGuard, Terminated
 
 _log = logging.getLogger(__name__)
 
 #: Exit status of a process ended by each signal, as shells report it (128 + number).
-SIGNAL_EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
+SIGNAL_EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}
 
 
 class MissionInterrupted(Exception):
@@ -45,11 +42,6 @@ class MissionInterrupted(Exception):
         super().__init__(f"mission interrupted by {signal_name}")
 
 
-class _Terminated(BaseException):
-    """Raised by the temporary SIGTERM handler; a BaseException so no ``except
-    Exception`` in a sink or navigator swallows it."""
-
-
 def run_mission(
     mission: Mission,
     navigator: Navigator,
@@ -59,6 +51,7 @@ def run_mission(
     tick: float = 0.1,
     server_wait: float = 10.0,
     control: MissionControl | None = None,
+    signals: SignalGuard | None = None,
 ) -> MissionResult:
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
@@ -67,6 +60,11 @@ def run_mission(
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
     ``control`` lets other threads file operator requests (skip the current waypoint).
+    ``signals`` is the run's :class:`~navseq.signals.SignalGuard`: armed for the run
+    (SIGINT, SIGTERM and SIGHUP end it, also where SIGINT was ignored), deferring from
+    the moment the run is stopped or ends, so that the caller can finish its outputs
+    before it restores the handlers. Without one, a guard of the run's own is restored
+    on return.
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
     :class:`MissionInterrupted` on SIGINT/SIGTERM, and re-raises any other exception;
@@ -77,20 +75,29 @@ def run_mission(
     executor = MissionExecutor(mission, resume=resume)
     for listener in listeners:
         executor.add_listener(listener)
-    with _sigterm_raises():
-        try:
-            server_up = navigator.wait_for_server(server_wait)
-            if server_up:
-                _drive(executor, navigator, tick, control)
-        except KeyboardInterrupt:
-            result = _abort(executor, navigator, "interrupted: SIGINT")
-            raise MissionInterrupted("SIGINT", result) from None
-        except _Terminated:
-            result = _abort(executor, navigator, "interrupted: SIGTERM")
-            raise MissionInterrupted("SIGTERM", result) from None
-        except BaseException as error:
-            _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
-            raise
+    guard = signals if signals is not None else SignalGuard()
+    guard.arm()
+    try:
+        server_up = navigator.wait_for_server(server_wait)
+        if server_up:
+            _drive(executor, navigator, tick, control)
+    except KeyboardInterrupt:
+        guard.defer()  # also for a KeyboardInterrupt not raised by the guard
+        result = _abort(executor, navigator, "interrupted: SIGINT")
+        raise MissionInterrupted("SIGINT", result) from None
+    except Terminated as signalled:
+        name = signalled.signal_name
+        result = _abort(executor, navigator, f"interrupted: {name}")
+        raise MissionInterrupted(name, result) from None
+    except BaseException as error:
+        guard.defer()
+        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+        raise
+    finally:
+        if signals is None:
+            guard.restore()
+        else:
+            guard.defer()  # the caller's outputs come next
     if not server_up:
         raise NavseqError(
             f"no navigation server answered within {server_wait:g} s; is the navigation "
@@ -127,7 +134,10 @@ def _apply(navigator: Navigator, commands: list[Command]) -> None:
 
 
 def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> MissionResult:
-    """Stop the robot first, then close the books; never raise from here."""
+    """Stop the robot first, then close the books; never raise from here.
+
+    Called with the run's signal guard deferring: a second Ctrl-C cannot cut it short.
+    """
     try:
         navigator.cancel_goal()
     except Exception:
@@ -141,24 +151,3 @@ def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> Miss
     except Exception:
         _log.exception("a mission listener failed while the mission was interrupted")
     return executor.result
-
-
-@contextlib.contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """While inside, SIGTERM raises :class:`_Terminated` like SIGINT raises KeyboardInterrupt.
-
-    Signal handlers can only be set from the main thread; elsewhere (a ROS node's
-    worker thread, say) the process's own handling stays in place.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def raise_terminated(signum: int, frame: FrameType | None) -> None:
-        raise _Terminated()
-
-    previous = signal.signal(signal.SIGTERM, raise_terminated)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)

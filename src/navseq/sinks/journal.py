@@ -87,6 +87,10 @@ def mission_digest(path: str | os.PathLike[str]) -> str:
         ) from None
 
 
+class NothingToResume(NavseqError):
+    """The journal records every visit of the mission as finished."""
+
+
 class JournalWriter:
     """A mission listener that appends every event to a journal file, one JSON per line.
 
@@ -412,7 +416,7 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
         if index == count:
             loop, index = loop + 1, 0
         if loops is not None and loop >= loops:
-            raise NavseqError(
+            raise NothingToResume(
                 "nothing to resume: the journal records every waypoint of the mission "
                 f"as finished ({state.finish_reason or 'completed'})",
                 source=source,
@@ -509,6 +513,7 @@ __all__ = [
     "PROGRESS_INTERVAL",
     "JournalState",
     "JournalWriter",
+    "NothingToResume",
     "mission_digest",
     "read_journal",
     "resume_point",

@@ -1,0 +1,250 @@
+"""``navseq report RUN``: rebuild a run's report and picture from its journal.
+
+A run killed with ``kill -9`` (or on a full disk) after its last journal line but
+before its report leaves no report; the journal still holds everything the report
+says. This command reads the journal (refusing one that was altered, see
+:mod:`navseq.sinks.journal`), checks the mission file is the one the run used, and
+writes whatever of ``report.json`` / ``mission.png`` is missing, empty or unreadable.
+A complete report is left as it is. ``navseq run --resume`` of a journal with nothing
+left to run does the same.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from navseq.executor.result import MissionResult
+    from navseq.mission.model import Mission
+    from navseq.sinks.journal import JournalState
+
+JOURNAL_NAME = "journal.jsonl"
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+#: Exit statuses of runs that ended by a signal, by the reason the journal gives.
+SIGNAL_EXITS = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}
+UNFINISHED_REASON = "ended without finishing: the process stopped before the mission did"
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "run",
+        type=Path,
+        metavar="RUN",
+        help="a run's output folder (navseq-out/...) or its journal.jsonl",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    from navseq.commands.common import require_file
+    from navseq.errors import NavseqError
+    from navseq.runlock import RunLock
+
+    journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
+    require_file(journal, "RUN")
+    with RunLock(journal.parent):  # not while a live run writes them
+        written = rebuild_outputs(journal)
+    if not written:
+        print(f"navseq report: the report in {journal.parent} is complete; nothing to rebuild")
+        return 0
+    for role, path in written.items():
+        print(f"{role:>8}: {path}")
+    if "report" not in written and "picture" not in written:
+        raise NavseqError("nothing could be rebuilt", source=str(journal))
+    return 0
+
+
+def rebuild_outputs(journal: Path) -> dict[str, str]:
+    """Write the missing or broken report / picture of the run in ``journal``; role -> path."""
+    from navseq.commands.run_outputs import output_error
+    from navseq.files import write_atomically
+    from navseq.sinks.journal import read_journal
+
+    state = read_journal(journal)
+    mission = journaled_mission(state)
+    result = result_from_journal(state, mission)
+    folder = journal.parent
+    report_path, picture_path = folder / "report.json", folder / "mission.png"
+    written: dict[str, str] = {}
+    if not _complete_report(report_path):
+        report = _report(state, mission, result, report_path, picture_path, journal)
+        text = json.dumps(report, indent=2, ensure_ascii=False) + "\n"
+        try:
+            write_atomically(report_path, text)
+        except OSError as error:
+            raise output_error(report_path, error) from None
+        written["report"] = str(report_path)
+    if not _complete_picture(picture_path):
+        png = _picture(state, mission, result)
+        try:
+            write_atomically(picture_path, png)
+        except OSError as error:
+            raise output_error(picture_path, error) from None
+        written["picture"] = str(picture_path)
+    return written
+
+
+def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
+    """The run's result as its journal tells it (visits not finished are not run)."""
+    from dataclasses import replace
+
+    from navseq.executor.events import WaypointOutcome
+    from navseq.executor.result import MissionResult, WaypointResult
+
+    def visit(loop: int, index: int) -> WaypointResult:
+        waypoint = mission.waypoints[index]
+        known = state.visits.get((loop, index))
+        details = {"name": waypoint.name, "x": waypoint.x, "y": waypoint.y, "yaw": waypoint.yaw}
+        if known is not None:
+            return replace(known, **details)
+        return WaypointResult(index=index, loop=loop, **details)
+
+    count = len(mission.waypoints)
+    started = state.mission_started
+    loops = started.loops if started is not None else mission.loops
+    if loops is None:
+        keys = sorted(key for key in state.visits if 0 <= key[1] < count)
+    else:
+        keys = [(loop, index) for loop in range(loops) for index in range(count)]
+    visits = [visit(loop, index) for loop, index in keys]
+    success = bool(visits) and all(v.outcome is WaypointOutcome.REACHED for v in visits)
+    loops_completed = sum(
+        all(
+            state.visits.get((loop, index)) is not None
+            and state.visits[(loop, index)].outcome is not WaypointOutcome.NOT_RUN
+            for index in range(count)
+        )
+        for loop in range(max((key[0] for key in state.visits), default=-1) + 1)
+    )
+    return MissionResult(
+        success=success and state.finish_reason is not None,
+        reason=state.finish_reason or UNFINISHED_REASON,
+        visits=visits,
+        duration=state.previous_duration,
+        distance_driven=sum(v.distance_driven for v in visits),
+        loops_completed=loops_completed,
+    )
+
+
+def exit_code_of(result: MissionResult, finished: bool) -> int | None:
+    """The exit status the run had, from its journal; None if it never finished."""
+    if not finished:
+        return None
+    for name, code in SIGNAL_EXITS.items():
+        if result.reason.startswith(f"interrupted: {name}"):
+            return code
+    return result.exit_code
+
+
+def journaled_mission(state: JournalState) -> Mission:
+    import dataclasses
+
+    from navseq.commands.common import require_file
+    from navseq.errors import NavseqError
+    from navseq.mission import load_mission
+    from navseq.sinks.journal import mission_digest
+
+    source = Path(state.mission_source)
+    require_file(source, f"the journal's mission file ({state.path})")
+    if mission_digest(source) != state.mission_digest:
+        raise NavseqError(
+            "the mission file changed since the run; the report would describe other "
+            "waypoints. Restore the original mission file",
+            source=str(source),
+        )
+    mission = load_mission(source)
+    started = state.mission_started
+    if started is not None:
+        mission = dataclasses.replace(mission, loops=started.loops)
+    return mission
+
+
+def _report(
+    state: JournalState,
+    mission: Mission,
+    result: MissionResult,
+    report_path: Path,
+    picture_path: Path,
+    journal: Path,
+) -> dict[str, Any]:
+    from navseq.sinks.report import build_report
+
+    options = state.run_options
+    interrupted = next(
+        (name for name in SIGNAL_EXITS if result.reason.startswith(f"interrupted: {name}")), None
+    )
+    report = build_report(
+        mission,
+        result,
+        exit_code=exit_code_of(result, state.finish_reason is not None),  # type: ignore[arg-type]
+        navigator={"kind": options.get("navigator", "unknown")},
+        interrupted=interrupted,
+        mission_digest=state.mission_digest,
+        start=_start_of(options),
+        files={
+            "journal": str(journal),
+            "report": str(report_path),
+            "picture": str(picture_path),
+        },
+    )
+    report["rebuilt_from_journal"] = True
+    return report
+
+
+def _start_of(options: dict[str, Any]) -> Any:
+    import math
+
+    from navseq.geometry import Pose2D
+
+    start = options.get("start")
+    if (
+        isinstance(start, list)
+        and len(start) == 3
+        and all(isinstance(v, int | float) and math.isfinite(v) for v in start)
+    ):
+        return Pose2D(float(start[0]), float(start[1]), math.radians(start[2]))
+    return None
+
+
+def _picture(state: JournalState, mission: Mission, result: MissionResult) -> bytes:
+    from navseq.errors import NavseqError
+    from navseq.sim.occupancy import load_map
+    from navseq.sinks.picture import mission_picture_png
+    from navseq.sinks.recorder import RunRecorder
+
+    grid = None
+    map_path = state.run_options.get("map") or mission.map
+    if map_path:
+        try:
+            grid = load_map(map_path)
+        except NavseqError as error:
+            print(f"navseq report: drawing without the map ({error})", file=sys.stderr)
+    recorder = RunRecorder.from_journal(state.events)
+    return mission_picture_png(
+        mission,
+        result,
+        grid=grid,
+        start=_start_of(state.run_options),
+        plans=recorder.leg_plans(),
+        trajectory=recorder.trajectory(),
+        interrupted=None if state.finish_reason else "unfinished",
+    )
+
+
+def _complete_report(path: Path) -> bool:
+    try:
+        report = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(report, dict) and "visits" in report and "exit_code" in report
+
+
+def _complete_picture(path: Path) -> bool:
+    try:
+        with path.open("rb") as handle:
+            return handle.read(len(PNG_SIGNATURE)) == PNG_SIGNATURE
+    except OSError:
+        return False

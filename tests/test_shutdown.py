@@ -1,0 +1,181 @@
+"""However a run is ended, its report exists, parses and agrees with the exit status."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cli_support import (
+    NAVSEQ,
+    assert_clean_error,
+    journal_events,
+    journal_records,
+    navseq,
+    start_navseq,
+    wait_for,
+    write_mission,
+)
+
+SQUARE = """\
+  - {name: a, x: 1.0, y: 0.0, yaw: 90}
+  - {name: b, x: 1.0, y: 1.0, yaw: 180}
+  - {name: c, x: 0.0, y: 1.0, yaw: -90}
+  - {name: d, x: 0.0, y: 0.0, yaw: 0}
+"""
+EXIT = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}
+
+
+def calls(log: Path, call: str) -> list[dict[str, Any]]:
+    if not log.exists():
+        return []
+    return [r for r in map(json.loads, log.read_text().splitlines()) if r["call"] == call]
+
+
+def start_run(tmp_path: Path, *extra: Any, **popen: Any) -> tuple[subprocess.Popen[str], Path]:
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    log = tmp_path / "nav.log"
+    args = [NAVSEQ, "run", str(mission), "--navigator", "scripted", "--out",
+            str(tmp_path / "out"), "--scripted-realtime", "1", "--scripted-log", str(log),
+            *map(str, extra)]
+    process = subprocess.Popen(args, cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, **popen)
+    wait_for(lambda: calls(log, "send_goal"), 30, "the first goal")
+    return process, log
+
+
+def assert_report_agrees(out: Path, returncode: int) -> dict[str, Any]:
+    report = json.loads((out / "report.json").read_text())
+    assert report["exit_code"] == returncode
+    assert (out / "mission.png").stat().st_size > 0 or "picture" not in report["files"]
+    assert not [p for p in out.iterdir() if p.stat().st_size == 0]  # never an empty file
+    assert not list(out.glob(".*.tmp"))
+    return report
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [("SIGINT", "SIGINT"), ("SIGTERM", "SIGTERM"), ("SIGINT", "SIGTERM"), ("SIGHUP", "SIGINT")],
+)
+def test_two_quick_signals_still_write_a_report_that_agrees_with_the_exit(
+    tmp_path: Path, first: str, second: str
+) -> None:
+    process, log = start_run(tmp_path)
+    process.send_signal(signal.Signals[first])
+    time.sleep(0.005)
+    process.send_signal(signal.Signals[second])
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == EXIT[first], stderr
+    assert "Traceback" not in stderr
+    report = assert_report_agrees(tmp_path / "out", process.returncode)
+    assert report["interrupted"] == first
+    assert calls(log, "cancel_goal")  # the robot was stopped
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.02, 0.1, 0.3])
+def test_signals_at_the_end_of_a_run_never_lose_the_report(tmp_path: Path, delay: float) -> None:
+    """Signals around the moment the mission finishes (while outputs are written)."""
+    out = tmp_path / "out"
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
+                           "--scripted-realtime", "8", cwd=tmp_path)
+    journal = out / "journal.jsonl"
+    wait_for(lambda: journal_events(journal, "MissionFinished"), 60, "the mission to finish")
+    time.sleep(delay)
+    for _ in range(2):
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert "Traceback" not in stderr
+    # The mission was over: the run exits with the mission's own status, which the
+    # report states.
+    assert process.returncode == 0, stderr
+    report = assert_report_agrees(out, 0)
+    assert report["success"] is True
+
+
+def test_sighup_cancels_the_goal_like_sigterm(tmp_path: Path) -> None:
+    process, log = start_run(tmp_path)
+    process.send_signal(signal.SIGHUP)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 129, stderr
+    assert calls(log, "cancel_goal")
+    report = assert_report_agrees(tmp_path / "out", 129)
+    assert report["reason"] == "interrupted: SIGHUP"
+
+
+def test_sigint_cancels_the_goal_even_when_started_with_sigint_ignored(tmp_path: Path) -> None:
+    """A background job of a shell script inherits SIGINT as ignored."""
+    process, log = start_run(
+        tmp_path, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)
+    )
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert calls(log, "cancel_goal")
+    assert_report_agrees(tmp_path / "out", 130)
+
+
+def test_kill_9_after_the_last_journal_line_then_report_rebuilds_it(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    first = navseq("run", mission, "--navigator", "scripted", "--out", out, cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    original = json.loads((out / "report.json").read_text())
+    # What a kill -9 between MissionFinished and the report leaves: no report, no picture.
+    (out / "report.json").unlink()
+    (out / "mission.png").write_bytes(b"")
+    rebuilt = navseq("report", out, cwd=tmp_path)
+    assert rebuilt.returncode == 0, rebuilt.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["rebuilt_from_journal"] is True
+    assert report["exit_code"] == 0 and report["success"] is True
+    assert [v["outcome"] for v in report["visits"]] == [
+        v["outcome"] for v in original["visits"]
+    ]
+    assert (out / "mission.png").read_bytes().startswith(b"\x89PNG")
+    again = navseq("report", out, cwd=tmp_path)
+    assert again.returncode == 0 and "complete" in again.stdout
+
+
+def test_resume_of_a_finished_journal_rebuilds_a_missing_report(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    assert navseq("run", mission, "--navigator", "scripted", "--out", out,
+                  cwd=tmp_path).returncode == 0
+    (out / "report.json").unlink()
+    result = navseq("run", "--resume", out / "journal.jsonl", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "rebuilt the report" in result.stderr
+    assert json.loads((out / "report.json").read_text())["success"] is True
+    # With the report complete, a resume of a finished run is refused as before.
+    refused = navseq("run", "--resume", out / "journal.jsonl", cwd=tmp_path)
+    assert_clean_error(refused)
+    assert "nothing to resume" in refused.stderr
+
+
+@pytest.mark.parametrize("cut", [3, 5, 8])
+def test_kill_9_at_any_journal_line_then_resume_finishes_with_a_true_report(
+    tmp_path: Path, cut: int
+) -> None:
+    out = tmp_path / "out"
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
+                           "--scripted-realtime", "4", cwd=tmp_path)
+    journal = out / "journal.jsonl"
+    try:
+        wait_for(lambda: len(journal_records(journal)) >= cut or process.poll() is not None,
+                 120, f"{cut} journal lines")
+    finally:
+        process.kill()
+        _, stderr = process.communicate(timeout=30)
+    assert process.returncode == -signal.SIGKILL, stderr  # killed mid-run, not finished
+    resumed = navseq("run", "--resume", journal, cwd=tmp_path)
+    assert resumed.returncode == 0, resumed.stderr
+    report = assert_report_agrees(out, 0)
+    assert report["totals"]["reached"] == 4
