@@ -179,3 +179,63 @@ def test_kill_9_at_any_journal_line_then_resume_finishes_with_a_true_report(
     assert resumed.returncode == 0, resumed.stderr
     report = assert_report_agrees(out, 0)
     assert report["totals"]["reached"] == 4
+
+
+def test_a_full_disk_under_the_journal_stops_the_robot_and_exits_2(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import errno
+    import os
+
+    from navseq import cli
+    from navseq.sinks import journal as journal_module
+
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    log = tmp_path / "nav.log"
+    real_write = os.write
+    writes = {"count": 0}
+
+    def write_until_full(fd: int, data: Any) -> int:
+        writes["count"] += 1
+        if writes["count"] > 8:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(fd, data)
+
+    monkeypatch.setattr(journal_module.os, "write", write_until_full)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out),
+                     "--scripted-log", str(log)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    assert f"{out / 'journal.jsonl'}: cannot write the journal: the disk is full" in stderr
+    assert "Traceback" not in stderr
+    assert calls(log, "cancel_goal")  # the robot was stopped first
+    report = json.loads((out / "report.json").read_text())  # what could be written, was
+    assert report["exit_code"] == 2 and report["reason"].startswith("stopped:")
+
+
+def test_a_picture_that_cannot_be_written_exits_2_and_the_report_says_so(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import errno
+
+    from navseq import cli, files
+
+    real = files.write_atomically
+
+    def no_room_for_pictures(path: Path, data: Any, **kwargs: Any) -> None:
+        if path.suffix == ".png":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(path, data, **kwargs)
+
+    monkeypatch.setattr(files, "write_atomically", no_room_for_pictures)
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    assert f"{out / 'mission.png'}: cannot write it: the disk is full" in stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["exit_code"] == 2 and report["success"] is True
+    assert "picture" in report["files_not_written"]
+    assert not (out / "mission.png").exists()

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from navseq.commands.common import format_pose, parse_loops, parse_pose
 
 if TYPE_CHECKING:
+    from navseq.errors import NavseqError
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
@@ -435,6 +436,7 @@ class RunOutcome:
     navigator: Navigator
     recorder: RunRecorder
     json_lines: JsonProgress | None
+    error: NavseqError | None = None  # what stopped the run, if an output failed
 
 
 def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, bool]:
@@ -488,11 +490,12 @@ def _run_with_sinks(
 ) -> RunOutcome:
     """Run the mission; from the moment it ends, shutdown signals are only counted."""
     from navseq.commands.run_outputs import StdoutGuard
-    from navseq.executor.runner import MissionInterrupted, run_mission
+    from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
     from navseq.sinks.progress import JsonProgress, make_progress
 
     navigator = setup.make_navigator()
+    error: NavseqError | None = None
     try:
         if setup.resume is not None:
             journal = JournalWriter.resume(journal_path, setup.resume)
@@ -516,11 +519,15 @@ def _run_with_sinks(
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
                 result, exit_code, interrupted = stop.result, stop.exit_code, stop.signal_name
+            except MissionAborted as aborted:
+                # Stopped by an output that failed: report what happened, then exit 2.
+                result, exit_code, interrupted = aborted.result, 2, None
+                error = aborted
     finally:
         signals.defer()  # the goal is reached or cancelled: the report comes first now
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
-    return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines)
+    return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines, error)
 
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
@@ -580,12 +587,13 @@ def _execute_locked(
             _discard_unused(journal_path)
         raise
     files = RunFiles(paths={"journal": str(journal_path)})
-    write_outputs(
+    exit_code = write_outputs(
         folder,
         files,
-        lambda paths: _report(setup, outcome, paths),
+        lambda paths, code: _report(setup, outcome, paths, code),
         lambda: _picture_png(setup, outcome),
         signals,
+        outcome.exit_code,
     )
     if outcome.json_lines is not None:
         try:
@@ -594,7 +602,7 @@ def _execute_locked(
                 {
                     "success": outcome.result.success,
                     "reason": outcome.result.reason,
-                    "exit_code": outcome.exit_code,
+                    "exit_code": exit_code,
                     "interrupted": outcome.interrupted,
                     **files.paths,
                 },
@@ -604,6 +612,8 @@ def _execute_locked(
     else:
         print_summary(setup.mission, outcome.result, files)
     report_failures(files)
+    if outcome.error is not None:
+        raise outcome.error
     if "report" in files.failed:
         from navseq.errors import NavseqError
 
@@ -612,16 +622,22 @@ def _execute_locked(
             f"{journal_path} holds the run: `navseq report {folder}` rebuilds it",
             source="navseq run",
         )
-    return outcome.exit_code
+    if exit_code == 2:
+        from navseq.errors import NavseqError
+
+        raise NavseqError(files.failed["picture"], source="navseq run")
+    return exit_code
 
 
-def _report(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) -> dict[str, Any]:
+def _report(
+    setup: RunSetup, outcome: RunOutcome, files: dict[str, str], exit_code: int
+) -> dict[str, Any]:
     from navseq.sinks.report import build_report
 
     return build_report(
         setup.mission,
         outcome.result,
-        exit_code=outcome.exit_code,
+        exit_code=exit_code,
         navigator=setup.navigator_info,
         interrupted=outcome.interrupted,
         mission_digest=setup.digest,

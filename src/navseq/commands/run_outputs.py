@@ -87,14 +87,18 @@ def _number_of(path: Path, name: str) -> int:
 def write_outputs(
     folder: Path,
     files: RunFiles,
-    build_report: Callable[[dict[str, str]], dict[str, Any]],
+    build_report: Callable[[dict[str, str], int], dict[str, Any]],
     render_picture: Callable[[], bytes],
     signals: SignalGuard | None,
-) -> None:
-    """The report, then the picture; a failure of either is recorded, the other still made.
+    exit_code: int,
+) -> int:
+    """The report, then the picture; returns the exit status the report states.
 
-    ``build_report(paths)`` makes the report given every file's path (the picture's
-    name is chosen first so the report can name it); ``render_picture()`` the PNG.
+    ``build_report(paths, exit_code)`` makes the report given every file's path (the
+    picture's name is chosen first so that the report can name it); ``render_picture()``
+    the PNG. A picture given up by the operator is only noted. A picture that cannot be
+    written (disk full) makes the run's status 2, and the report is written again to say
+    so, if it can be.
     """
     import json
 
@@ -105,12 +109,15 @@ def write_outputs(
 
     def report_bytes(path: Path) -> bytes:
         files.paths["report"] = str(path)
-        report = build_report(dict(files.paths))
+        report = build_report(dict(files.paths), exit_code)
+        if files.failed:
+            report["files_not_written"] = dict(files.failed)
         return (json.dumps(report, indent=2, ensure_ascii=False) + "\n").encode()
 
     try:
-        write_new_file(folder, "report.json", report_bytes)
+        report_path: Path | None = write_new_file(folder, "report.json", report_bytes)
     except NavseqError as error:
+        report_path = None
         files.failed["report"] = str(error)
     try:
         if signals is not None:
@@ -123,6 +130,15 @@ def write_outputs(
         files.failed["picture"] = f"not drawn: given up on {stop} while drawing"
     except NavseqError as error:
         files.failed["picture"] = str(error)
+        exit_code = 2
+        if report_path is not None:
+            from navseq.files import write_atomically
+
+            try:
+                write_atomically(report_path, report_bytes(report_path))
+            except OSError as again:
+                files.failed["report"] = str(output_error(report_path, again))
+    return exit_code
 
 
 def print_summary(mission: Mission, result: MissionResult, files: RunFiles) -> None:

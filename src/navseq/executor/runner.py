@@ -42,6 +42,18 @@ class MissionInterrupted(Exception):
         super().__init__(f"mission interrupted by {signal_name}")
 
 
+class MissionAborted(NavseqError):
+    """Bad input or a failing output stopped the run mid-way; the goal was cancelled.
+
+    The error's own message, plus ``result``: what the run did until then, so the
+    caller can still report it.
+    """
+
+    def __init__(self, error: NavseqError, result: MissionResult):
+        super().__init__(error.message, source=error.source, subject=error.subject)
+        self.result = result
+
+
 def run_mission(
     mission: Mission,
     navigator: Navigator,
@@ -67,7 +79,9 @@ def run_mission(
     on return.
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
-    :class:`MissionInterrupted` on SIGINT/SIGTERM, and re-raises any other exception;
+    :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP, :class:`MissionAborted` when
+    a NavseqError (a sink that cannot write) stops the run, and re-raises any other
+    exception;
     in the last two cases only after cancelling the active goal and telling the
     listeners that the mission finished (``MissionFinished``, reason
     ``"interrupted: SIGINT"`` and so on).
@@ -89,6 +103,11 @@ def run_mission(
         name = signalled.signal_name
         result = _abort(executor, navigator, f"interrupted: {name}")
         raise MissionInterrupted(name, result) from None
+    except NavseqError as error:
+        # A sink could not do its job (the journal on a full disk): stop, then say why.
+        guard.defer()
+        result = _abort(executor, navigator, f"stopped: {error}")
+        raise MissionAborted(error, result) from None
     except BaseException as error:
         guard.defer()
         _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")

@@ -34,6 +34,7 @@ import contextlib
 import dataclasses
 import datetime
 import enum
+import errno
 import hashlib
 import json
 import os
@@ -160,9 +161,12 @@ class JournalWriter:
                 f"cannot write the journal: {error.strerror}", source=str(self.path)
             ) from None
         self._fsync = fsync
+        self._failed = False
         self._last_progress_t: float | None = None
 
     def __call__(self, event: ev.MissionEvent) -> None:
+        if self._failed:
+            return  # said once, when it failed; the run is being stopped
         if isinstance(event, ev.WaypointProgress):
             last = self._last_progress_t
             # A resumed run's clock may start again from zero: t < last also passes.
@@ -178,11 +182,20 @@ class JournalWriter:
         data = _sealed(json.dumps(record, default=_json_default).encode(), self._chain)
         self._chain = data[-_CHAIN_DIGITS - 3 : -3].decode()
         view = memoryview(data)
-        while view:  # one write call in practice; loop only if the OS writes less
-            written = os.write(self._fd, view)
-            view = view[written:]
-        if self._fsync:
-            os.fsync(self._fd)
+        try:
+            while view:  # one write call in practice; loop only if the OS writes less
+                written = os.write(self._fd, view)
+                view = view[written:]
+            if self._fsync:
+                os.fsync(self._fd)
+        except OSError as error:
+            self._failed = True
+            why = "the disk is full" if error.errno == errno.ENOSPC else error.strerror
+            raise NavseqError(
+                f"cannot write the journal: {why}; the run was stopped, since a run that "
+                "cannot be journaled cannot be resumed",
+                source=str(self.path),
+            ) from None
 
     def close(self) -> None:
         if self._fd is not None:
