@@ -18,7 +18,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -241,33 +241,13 @@ def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> 
 
 
 def draw_mission_picture(
-    path: Path,
-    mission: Mission,
-    result: MissionResult,
-    *,
-    grid: OccupancyGrid | None = None,
-    start: Pose2D | None = None,
-    plans: Sequence[Path2D] = (),
-    trajectory: Sequence[tuple[float, float, float]] = (),
-    interrupted: str | None = None,
-    dpi: int = 150,
+    path: Path, mission: Mission, result: MissionResult, **drawing: Any
 ) -> None:
     """Draw the run into a PNG at ``path`` (written atomically: temp file, then rename).
 
-    ``plans`` are the legs' planned paths (x, y) and ``trajectory`` the driven
-    positions as (t, x, y) with t in mission-clock seconds; a row of NaNs breaks the
-    line (a resumed run's segments: the robot may not have been where it stopped).
+    ``drawing`` takes the keyword arguments of :func:`mission_picture_png`.
     """
-    png = mission_picture_png(
-        mission,
-        result,
-        grid=grid,
-        start=start,
-        plans=plans,
-        trajectory=trajectory,
-        interrupted=interrupted,
-        dpi=dpi,
-    )
+    png = mission_picture_png(mission, result, **drawing)
     path.parent.mkdir(parents=True, exist_ok=True)
     write_atomically(path, png)
 
@@ -283,7 +263,12 @@ def mission_picture_png(
     interrupted: str | None = None,
     dpi: int = 150,
 ) -> bytes:
-    """The picture of the run as PNG bytes (see :func:`draw_mission_picture`)."""
+    """The picture of the run as PNG bytes.
+
+    ``plans`` are the legs' planned paths (x, y) and ``trajectory`` the driven
+    positions as (t, x, y) with t in mission-clock seconds; a row of NaNs breaks the
+    line (a resumed run's segments: the robot may not have been where it stopped).
+    """
     fig = mission_figure(
         mission,
         result,
