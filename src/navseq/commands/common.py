@@ -56,9 +56,7 @@ def format_pose(pose: Pose2D) -> str:
 
 
 def preflight_errors(
-    mission: Mission,
-    costmap: Costmap,
-    start: Pose2D | None,
+    mission: Mission, costmap: Costmap, start: Pose2D | None,
     numbers: Sequence[int] | None = None,
 ) -> list[NavseqError]:
     """Every problem of ``mission`` against the map (empty when it is fine to run)."""

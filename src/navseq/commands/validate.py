@@ -59,11 +59,8 @@ def run(args: argparse.Namespace) -> int:
     loops = "forever" if mission.loops is None else str(mission.loops)
     map_path = _map_path(args, mission)
     checked = f"checked against map {map_path}" if map_path is not None else "no map to check"
-    print(
-        f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
-        f"loops {loops}, {checked}",
-        file=sys.stdout,
-    )
+    print(f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
+          f"loops {loops}, {checked}", file=sys.stdout)
     return 0
 
 
@@ -71,9 +68,8 @@ def _map_path(args: argparse.Namespace, mission: Mission) -> Path | None:
     return args.map if args.map is not None else mission.map
 
 
-def _map_problems(
-    args: argparse.Namespace, mission: Mission, numbers: Sequence[int] | None = None
-) -> list[NavseqError]:
+def _map_problems(args: argparse.Namespace, mission: Mission,
+                  numbers: Sequence[int] | None = None) -> list[NavseqError]:
     """The pre-flight problems of ``mission`` on the map given or named, if any."""
     from navseq.commands.common import costmap_for_map, preflight_errors
 

@@ -28,34 +28,27 @@ def number(node: Located, subject: str) -> float:
     """A finite real number. Booleans and text are refused, not coerced."""
     value = node.value
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise NavseqError(
-            f"must be a number, got {describe(value)}", source=node.where, subject=subject
-        )
+        raise NavseqError(f"must be a number, got {describe(value)}", source=node.where,
+                          subject=subject)
     try:
         result = float(value)
     except OverflowError:
-        raise NavseqError(
-            "is too large to be a coordinate or a time", source=node.where, subject=subject
-        ) from None
+        raise NavseqError("is too large to be a coordinate or a time", source=node.where,
+                          subject=subject) from None
     if not math.isfinite(result):
-        raise NavseqError(
-            f"must be a finite number, got {value!r}", source=node.where, subject=subject
-        )
+        raise NavseqError(f"must be a finite number, got {value!r}", source=node.where,
+                          subject=subject)
     return result
 
 
-def bounded_number(
-    node: Located, subject: str, *, minimum: float, inclusive: bool, unit: str = ""
-) -> float:
+def bounded_number(node: Located, subject: str, *, minimum: float, inclusive: bool,
+                   unit: str = "") -> float:
     """A finite number ``>= minimum`` (or ``> minimum`` when not inclusive)."""
     result = number(node, subject)
     if result < minimum or (not inclusive and result == minimum):
         relation = ">=" if inclusive else ">"
-        raise NavseqError(
-            f"must be {relation} {minimum:g}{unit}, got {result:g}",
-            source=node.where,
-            subject=subject,
-        )
+        raise NavseqError(f"must be {relation} {minimum:g}{unit}, got {result:g}",
+                          source=node.where, subject=subject)
     return result
 
 
@@ -65,21 +58,18 @@ def integer(node: Located, subject: str, *, minimum: int) -> int:
     if isinstance(value, float) and math.isfinite(value) and value.is_integer():
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, int):
-        raise NavseqError(
-            f"must be a whole number, got {describe(node.value)}",
-            source=node.where,
-            subject=subject,
-        )
+        raise NavseqError(f"must be a whole number, got {describe(node.value)}",
+                          source=node.where, subject=subject)
     if value < minimum:
-        raise NavseqError(f"must be >= {minimum}, got {value}", source=node.where, subject=subject)
+        raise NavseqError(f"must be >= {minimum}, got {value}", source=node.where,
+                          subject=subject)
     return value
 
 
 def boolean(node: Located, subject: str) -> bool:
     if not isinstance(node.value, bool):
-        raise NavseqError(
-            f"must be true or false, got {describe(node.value)}", source=node.where, subject=subject
-        )
+        raise NavseqError(f"must be true or false, got {describe(node.value)}",
+                          source=node.where, subject=subject)
     return node.value
 
 
@@ -89,11 +79,8 @@ def text(node: Located, subject: str, *, allow_numbers: bool = False) -> str:
     if allow_numbers and isinstance(value, int | float) and not isinstance(value, bool):
         value = str(value)
     if not isinstance(value, str) or not value.strip():
-        raise NavseqError(
-            f"must be non-empty text, got {describe(node.value)}",
-            source=node.where,
-            subject=subject,
-        )
+        raise NavseqError(f"must be non-empty text, got {describe(node.value)}",
+                          source=node.where, subject=subject)
     return value
 
 
@@ -102,43 +89,32 @@ def choice(node: Located, subject: str, options: Collection[str]) -> str:
     if not isinstance(value, str) or value not in options:
         hint = closest_hint(value, options) if isinstance(value, str) else ""
         listed = " | ".join(options)
-        raise NavseqError(
-            f"must be one of {listed}, got {describe(value)}{hint}",
-            source=node.where,
-            subject=subject,
-        )
+        raise NavseqError(f"must be one of {listed}, got {describe(value)}{hint}",
+                          source=node.where, subject=subject)
     return value
 
 
 def mapping(node: Located, subject: str) -> Located:
     if not node.is_mapping:
-        raise NavseqError(
-            f"must be a mapping of keys to values, got {describe(node.value)}",
-            source=node.where,
-            subject=subject,
-        )
+        raise NavseqError(f"must be a mapping of keys to values, got {describe(node.value)}",
+                          source=node.where, subject=subject)
     return node
 
 
 def sequence(node: Located, subject: str) -> list[Located]:
     if not node.is_list:
-        raise NavseqError(
-            f"must be a list, got {describe(node.value)}", source=node.where, subject=subject
-        )
+        raise NavseqError(f"must be a list, got {describe(node.value)}", source=node.where,
+                          subject=subject)
     return node.value
 
 
-def check_keys(
-    node: Located, known: Collection[str], owner: str | None, problems: Problems
-) -> None:
+def check_keys(node: Located, known: Collection[str], owner: str | None,
+               problems: Problems) -> None:
     """Report every key of a mapping that navseq does not know, with the closest known one."""
     for key in node.value:
         if key not in known:
-            problems.add(
-                f"unknown key{closest_hint(key, known)}",
-                source=node.where_key(key),
-                subject=field_subject(owner, key),
-            )
+            problems.add(f"unknown key{closest_hint(key, known)}", source=node.where_key(key),
+                         subject=field_subject(owner, key))
 
 
 def attempt(problems: Problems, read: Callable[[], T]) -> T | None:
@@ -174,9 +150,8 @@ def _angle_degrees_as_radians(node: Located, subject: str) -> float:
     """An angular tolerance written in degrees (like yaw), kept in radians."""
     degrees = bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" degrees")
     if degrees > 180.0:
-        raise NavseqError(
-            f"must be <= 180 degrees, got {degrees:g}", source=node.where, subject=subject
-        )
+        raise NavseqError(f"must be <= 180 degrees, got {degrees:g}", source=node.where,
+                          subject=subject)
     return math.radians(degrees)
 
 
@@ -191,11 +166,10 @@ POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
     "clear_costmaps_on_retry": boolean,
     "on_failure": _failure_action,
     "pass_through": _optional(
-        lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True, unit=" m")
-    ),
-    "dwell": lambda node, subject: bounded_number(
-        node, subject, minimum=0.0, inclusive=True, unit=" s"
-    ),
+        lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
+                                             unit=" m")),
+    "dwell": lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
+                                                  unit=" s"),
     "xy_tolerance": _optional(_positive_metres),
     "yaw_tolerance": _optional(_angle_degrees_as_radians),
 }

@@ -50,8 +50,7 @@ class LaunchArgs:
             if name in self.passed:
                 raise SubstitutionError(
                     f"arg '{name}' has a fixed value= here, so the including file cannot "
-                    "set it (roslaunch refuses this too); write default= to allow it"
-                )
+                    "set it (roslaunch refuses this too); write default= to allow it")
             self.values[name] = value
         else:
             self.values[name] = self.passed.get(name, default)
@@ -60,17 +59,13 @@ class LaunchArgs:
         if name not in self.values:
             raise SubstitutionError(
                 f"$(arg {name}): no arg '{name}' is declared in this file before this line; "
-                f'declare it with <arg name="{name}" default="..."/>',
-                offset,
-            )
+                f"declare it with <arg name=\"{name}\" default=\"...\"/>", offset)
         value = self.values[name]
         if value is None:
             raise SubstitutionError(
                 f"$(arg {name}): arg '{name}' has neither a default nor a value and no "
                 f"including file passes it (roslaunch would need {name}:=... on its command "
-                "line); give it a default=",
-                offset,
-            )
+                "line); give it a default=", offset)
         return value
 
     def given(self) -> dict[str, str]:
@@ -119,11 +114,8 @@ class PackageFinder:
                         index.setdefault(name, folder)
                     continue
                 if depth < MAX_SEARCH_DEPTH:
-                    stack.extend(
-                        (Path(entry.path), depth + 1)
-                        for entry in entries
-                        if not entry.name.startswith(".") and _is_folder(entry)
-                    )
+                    stack.extend((Path(entry.path), depth + 1) for entry in entries
+                                 if not entry.name.startswith(".") and _is_folder(entry))
         return index
 
 
@@ -164,8 +156,8 @@ class Substitution:
             if end == -1:
                 break  # roslaunch keeps an unclosed "$(" as text too
             parts.append(text[position:start])
-            resolved = self._one(text[start + 2 : end], start)
-            parts.append(text[start : end + 1] if resolved is None else resolved)
+            resolved = self._one(text[start + 2:end], start)
+            parts.append(text[start:end + 1] if resolved is None else resolved)
             position = end + 1
         parts.append(text[position:])
         return "".join(parts)
@@ -181,9 +173,8 @@ class Substitution:
         words = body.split()
         if not words or words[0] not in COMMANDS:
             known = ", ".join(f"$({command})" for command in COMMANDS)
-            raise SubstitutionError(
-                f"$({body}) is not a roslaunch substitution (roslaunch knows {known})", offset
-            )
+            raise SubstitutionError(f"$({body}) is not a roslaunch substitution (roslaunch "
+                                    f"knows {known})", offset)
         command, rest = words[0], words[1:]
         if command in ("anon", "eval"):
             return None
@@ -202,9 +193,7 @@ class Substitution:
             if value is None:
                 raise SubstitutionError(
                     f"$(env {rest[0]}): the environment variable {rest[0]} is not set "
-                    f"(write $(optenv {rest[0]} DEFAULT) for a default)",
-                    offset,
-                )
+                    f"(write $(optenv {rest[0]} DEFAULT) for a default)", offset)
             return value
         package = self.packages.find(rest[0])
         return None if package is None else str(package)

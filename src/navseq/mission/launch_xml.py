@@ -49,24 +49,20 @@ MAX_INCLUDE_DEPTH = 16
 MAX_INCLUDED_FILES = 200
 
 
-def mission_from_launch(
-    text: str, source: str, base_dir: Path | None, problems: Problems
-) -> Mission | None:
+def mission_from_launch(text: str, source: str, base_dir: Path | None,
+                        problems: Problems) -> Mission | None:
     root = parse_xml(text, source)
     if root.tag != "launch":
-        problems.add(
-            f"is XML but not a roslaunch file: its root element is <{root.tag}>, expected <launch>",
-            source=f"{source}:{root.line}",
-        )
+        problems.add(f"is XML but not a roslaunch file: its root element is <{root.tag}>, "
+                     "expected <launch>", source=f"{source}:{root.line}")
         return None
     reader = _LaunchReader(source, base_dir, problems)
     before = len(problems)
     reader.walk(root, "/", None, reader.top)
     if len(problems) > before:  # e.g. a broken <rosparam> body: what it set is unknown
         return None
-    return mission_from_tree(
-        reader.tree.located(), source, base_dir, problems, not_followed=reader.not_followed
-    )
+    return mission_from_tree(reader.tree.located(), source, base_dir, problems,
+                             not_followed=reader.not_followed)
 
 
 class _ParamTree:
@@ -92,10 +88,8 @@ class _ParamTree:
         child.set(rest, value)
 
     def located(self) -> Located:
-        values = {
-            key: entry.located() if isinstance(entry, _ParamTree) else entry
-            for key, entry in self.entries.items()
-        }
+        values = {key: entry.located() if isinstance(entry, _ParamTree) else entry
+                  for key, entry in self.entries.items()}
         return Located(values, self.where, {key: v.where for key, v in values.items()})
 
 
@@ -135,14 +129,11 @@ class _LaunchReader:
         self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
         self.files_read = 1
 
-    def walk(
-        self, element: XmlElement, namespace: str, private: str | None, file: _File, depth: int = 0
-    ) -> None:
+    def walk(self, element: XmlElement, namespace: str, private: str | None, file: _File,
+             depth: int = 0) -> None:
         if depth > MAX_DEPTH:
-            self.problems.add(
-                f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
-                source=file.where(element.line),
-            )
+            self.problems.add(f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
+                              source=file.where(element.line))
             return
         for child in element.children:
             try:
@@ -150,9 +141,8 @@ class _LaunchReader:
             except SubstitutionError as error:
                 self.problems.add(error.message, source=file.where(child.line))
 
-    def visit(
-        self, element: XmlElement, namespace: str, private: str | None, file: _File, depth: int
-    ) -> None:
+    def visit(self, element: XmlElement, namespace: str, private: str | None, file: _File,
+              depth: int) -> None:
         if not self.condition_holds(element, file):
             return
         if element.tag == "arg":
@@ -184,10 +174,8 @@ class _LaunchReader:
                 continue
             truth = _boolean(value)
             if truth is None:
-                raise SubstitutionError(
-                    f'{key}="{value}" is neither true nor false '
-                    "(roslaunch accepts true, false, 1 and 0)"
-                )
+                raise SubstitutionError(f"{key}=\"{value}\" is neither true nor false "
+                                        "(roslaunch accepts true, false, 1 and 0)")
             if truth != keep_when:
                 return False
         return True
@@ -197,13 +185,11 @@ class _LaunchReader:
         if not name:
             self.problems.add("<arg> needs a name=", source=file.where(element.line))
             return
-        file.subst.args.declare(
-            name,
-            value=self.attr(element, "value", file),
-            default=self.attr(element, "default", file),
-        )
+        file.subst.args.declare(name, value=self.attr(element, "value", file),
+                                default=self.attr(element, "default", file))
 
-    def param(self, element: XmlElement, namespace: str, private: str | None, file: _File) -> None:
+    def param(self, element: XmlElement, namespace: str, private: str | None,
+              file: _File) -> None:
         name = self.attr(element, "name", file)
         value = self.attr(element, "value", file)
         if not name or value is None:  # textfile=, binfile=, command= need ROS
@@ -219,9 +205,8 @@ class _LaunchReader:
                 located = parsed
         self.tree.set(_parts(_resolve(name, namespace, private)), located)
 
-    def rosparam(
-        self, element: XmlElement, namespace: str, private: str | None, file: _File
-    ) -> None:
+    def rosparam(self, element: XmlElement, namespace: str, private: str | None,
+                 file: _File) -> None:
         if (self.attr(element, "command", file) or "load") != "load":
             return
         target = _resolve(self.attr(element, "ns", file) or "", namespace, private)
@@ -244,7 +229,7 @@ class _LaunchReader:
             try:
                 body = file.subst.resolve(body)
             except SubstitutionError as error:
-                line = first_line + body[: error.offset].count("\n")
+                line = first_line + body[:error.offset].count("\n")
                 self.problems.add(error.message, source=file.where(line))
                 return None
         try:
@@ -267,7 +252,7 @@ class _LaunchReader:
             try:
                 text = file.subst.resolve(text)
             except SubstitutionError as error:
-                line = 1 + text[: error.offset].count("\n")
+                line = 1 + text[:error.offset].count("\n")
                 self.problems.add(error.message, source=f"{path}:{line}")
                 return None
         try:
@@ -292,36 +277,26 @@ class _LaunchReader:
         path = self.path(file_name, file)
         key = _file_key(path)
         if key in self.reading:
-            chain = " -> ".join(str(p) for p in [*self.reading[self.reading.index(key) :], key])
-            self.problems.add(
-                f"includes {file_name}, which is already being read: an include cycle ({chain})",
-                source=here,
-            )
+            chain = " -> ".join(str(p) for p in [*self.reading[self.reading.index(key):], key])
+            self.problems.add(f"includes {file_name}, which is already being read: an include "
+                              f"cycle ({chain})", source=here)
             return
         if len(self.reading) > MAX_INCLUDE_DEPTH or self.files_read >= MAX_INCLUDED_FILES:
-            self.problems.add(
-                f"includes {file_name} beyond navseq's limits ({MAX_INCLUDE_DEPTH}"
-                f" includes deep, {MAX_INCLUDED_FILES} files in all)",
-                source=here,
-            )
+            self.problems.add(f"includes {file_name} beyond navseq's limits ({MAX_INCLUDE_DEPTH}"
+                              f" includes deep, {MAX_INCLUDED_FILES} files in all)", source=here)
             return
         try:
             root = parse_xml(read_mission_text(path), str(path))
         except NavseqError as error:
             if error.source == str(path):  # the file itself is missing or unreadable
-                self.problems.add(
-                    f"includes {file_name}, which navseq cannot read: {error.message} ({path})",
-                    source=here,
-                )
+                self.problems.add(f"includes {file_name}, which navseq cannot read: "
+                                  f"{error.message} ({path})", source=here)
             else:
                 self.problems.record(error)
             return
         if root.tag != "launch":
-            self.problems.add(
-                f"is included by {here} but is not a roslaunch file: its root "
-                f"element is <{root.tag}>",
-                source=f"{path}:{root.line}",
-            )
+            self.problems.add(f"is included by {here} but is not a roslaunch file: its root "
+                              f"element is <{root.tag}>", source=f"{path}:{root.line}")
             return
         self.files_read += 1
         included = _File(str(path), Substitution(LaunchArgs(passed), path.parent, self.packages))
@@ -349,9 +324,8 @@ class _LaunchReader:
                 self.problems.add(error.message, source=file.where(child.line))
                 return None
             if not name or value is None:
-                self.problems.add(
-                    "<arg> in an <include> needs name= and value=", source=file.where(child.line)
-                )
+                self.problems.add("<arg> in an <include> needs name= and value=",
+                                  source=file.where(child.line))
                 return None
             passed[name] = value
         return passed

@@ -47,27 +47,26 @@ def read_mission_text(path: Path, *, max_bytes: int = MAX_MISSION_BYTES) -> str:
 def decode_text(data: bytes, source: str) -> str:
     """UTF-8 text, refusing binary data with a message that says so."""
     if b"\x00" in data:
-        raise NavseqError("is a binary file (it contains NUL bytes), not a mission", source=source)
+        raise NavseqError("is a binary file (it contains NUL bytes), not a mission",
+                          source=source)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise NavseqError(
-            f"is not UTF-8 text (invalid byte 0x{data[error.start]:02x}); is it a binary file?",
+            f"is not UTF-8 text (invalid byte 0x{data[error.start]:02x}); "
+            "is it a binary file?",
             source=f"{source}:{line}",
         ) from None
     bad = _CONTROL_CHARACTER.search(text)
     if bad is not None:
         line = text[: bad.start()].count("\n") + 1
-        raise NavseqError(
-            f"contains the control character U+{ord(bad.group()):04X}; is it a binary file?",
-            source=f"{source}:{line}",
-        )
+        raise NavseqError(f"contains the control character U+{ord(bad.group()):04X}; "
+                          "is it a binary file?", source=f"{source}:{line}")
     return text
 
 
 def _too_big(size: int, limit: int) -> str:
-    return (
-        f"is {size / 2**20:.1f} MiB; navseq refuses mission files over "
-        f"{limit / 2**20:g} MiB (is this really a mission?)"
-    )
+    return (f"is {size / 2**20:.1f} MiB; navseq refuses mission files over "
+            f"{limit / 2**20:g} MiB (is this really a mission?)")
+

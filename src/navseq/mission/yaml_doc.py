@@ -32,9 +32,8 @@ _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 EXPONENT_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
 
 
-def parse_yaml(
-    text: str, source: str, problems: Problems, *, first_line: int = 1
-) -> Located | None:
+def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1
+               ) -> Located | None:
     """Parse one YAML document. Syntax errors raise; duplicate keys are recorded.
 
     ``first_line`` is the file line of the text's first line (YAML inside a launch
@@ -87,13 +86,11 @@ class _Walker:
             if key in sizes:
                 return sizes[key]
             if key in in_progress:
-                raise NavseqError(
-                    "an alias refers to a value that contains it (a loop)", source=self.where(node)
-                )
+                raise NavseqError("an alias refers to a value that contains it (a loop)",
+                                  source=self.where(node))
             if depth > MAX_DEPTH:
-                raise NavseqError(
-                    f"is nested more than {MAX_DEPTH} levels deep", source=self.where(node)
-                )
+                raise NavseqError(f"is nested more than {MAX_DEPTH} levels deep",
+                                  source=self.where(node))
             in_progress.add(key)
             if isinstance(node, SequenceNode):
                 children: list[Node] = node.value
@@ -108,11 +105,8 @@ class _Walker:
 
         total = expanded_size(root, 0)
         if total > len(sizes) + MAX_ALIAS_EXPANSION:
-            raise NavseqError(
-                f"has aliases that expand {len(sizes)} written values to {total}; "
-                "refusing it (an alias bomb?)",
-                source=self.where(root),
-            )
+            raise NavseqError(f"has aliases that expand {len(sizes)} written values to {total}; "
+                              "refusing it (an alias bomb?)", source=self.where(root))
 
     def where(self, node: Node) -> str:
         return f"{self.source}:{node.start_mark.line + 1 + self.line_offset}"
@@ -137,37 +131,32 @@ class _Walker:
     def require_tag(self, node: Node, tag: str) -> None:
         if node.tag != tag:
             kind = str(node.tag).removeprefix(_TAG)
-            raise NavseqError(
-                f"uses the YAML type '{kind}', which navseq does not accept",
-                source=self.where(node),
-            )
+            raise NavseqError(f"uses the YAML type '{kind}', which navseq does not accept",
+                              source=self.where(node))
 
     def scalar(self, node: ScalarNode) -> Any:
         if node.tag not in _SCALAR_TAGS:
             kind = node.tag.removeprefix(_TAG)
-            raise NavseqError(
-                f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
-                "navseq does not accept (quote it if it is text)",
-                source=self.where(node),
-            )
-        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(node.value):
+            raise NavseqError(f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
+                              "navseq does not accept (quote it if it is text)",
+                              source=self.where(node))
+        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(
+            node.value
+        ):
             return float(node.value)
         try:
             return self.constructor.construct_object(node)
         except (yaml.YAMLError, ValueError, OverflowError) as error:
-            raise NavseqError(
-                f"cannot read the value {node.value!r}: {error}", source=self.where(node)
-            ) from None
+            raise NavseqError(f"cannot read the value {node.value!r}: {error}",
+                              source=self.where(node)) from None
 
     def mapping(self, node: MappingNode, depth: int) -> Located:
         values: dict[str, Located] = {}
         key_where: dict[str, str] = {}
         for key_node, value_node in self.entries(node, depth):
             if not isinstance(key_node, ScalarNode):
-                raise NavseqError(
-                    "has a key that is a list or mapping; keys must be names",
-                    source=self.where(key_node),
-                )
+                raise NavseqError("has a key that is a list or mapping; keys must be names",
+                                  source=self.where(key_node))
             key = key_node.value
             if key in values:
                 first_line = key_where[key].rsplit(":", 1)[1]
@@ -192,9 +181,8 @@ class _Walker:
             sources = value_node.value if isinstance(value_node, SequenceNode) else [value_node]
             for source in sources:
                 if not isinstance(source, MappingNode):
-                    raise NavseqError(
-                        "a merge key (<<) must refer to a mapping", source=self.where(source)
-                    )
+                    raise NavseqError("a merge key (<<) must refer to a mapping",
+                                      source=self.where(source))
                 merged.extend(self.entries(source, depth + 1))
         names = {k.value for k, _ in explicit if isinstance(k, ScalarNode)}
         kept: list[tuple[Node, Node]] = []

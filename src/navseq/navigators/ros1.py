@@ -179,9 +179,7 @@ class Ros1Navigator:
         self._plan_sub = None
         if plan_topic:
             self._plan_sub = rospy.Subscriber(
-                rosgraph.names.ns_join(self.action, plan_topic),
-                PathMsg,
-                self._on_plan,
+                rosgraph.names.ns_join(self.action, plan_topic), PathMsg, self._on_plan,
                 queue_size=1,
             )
         self._tf_buffer = None
@@ -360,7 +358,9 @@ class Ros1Navigator:
                 self._handle = None
                 self._goal_id = None
             return [
-                ServerLost(f"no status from {self.resolved_action} for {self.status_timeout:g} s")
+                ServerLost(
+                    f"no status from {self.resolved_action} for {self.status_timeout:g} s"
+                )
             ]
         if not self._server_up and self._server_ready():
             self._server_up = True

@@ -257,9 +257,7 @@ def run_node() -> int:
     try:
         rospy.loginfo(
             "navseq: %d waypoints from %s; waiting for %s",
-            len(mission),
-            mission.source,
-            navigator.resolved_action,
+            len(mission), mission.source, navigator.resolved_action,
         )
         navigator.require_server(float(settings["server_wait"]))
         result = run_mission(

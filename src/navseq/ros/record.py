@@ -71,7 +71,9 @@ class WaypointRecorder:
                 )
             self._frame = frame
             self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw=pose.yaw, z=z))
-            mission = Mission(waypoints=tuple(self._waypoints), frame=frame, source=str(self.out))
+            mission = Mission(
+                waypoints=tuple(self._waypoints), frame=frame, source=str(self.out)
+            )
             # The first write may replace a user's file only when asked; later ones
             # replace the file we wrote ourselves.
             write_mission(mission, self.out, overwrite=self._may_replace)
@@ -132,8 +134,8 @@ def record_main(
         pose = message.pose.pose if hasattr(message.pose, "covariance") else message.pose
         record(pose2d_from_pose(pose), message.header.frame_id, pose.position.z, topic)
 
-    message_type = (
-        PoseWithCovarianceStamped if topic.rstrip("/").endswith("initialpose") else (PoseStamped)
+    message_type = PoseWithCovarianceStamped if topic.rstrip("/").endswith("initialpose") else (
+        PoseStamped
     )
     rospy.Subscriber(topic, message_type, on_pose, queue_size=10)
 
@@ -157,9 +159,7 @@ def record_main(
 
     rospy.loginfo(
         "navseq record: recording %s%s into %s; Ctrl-C to stop",
-        topic,
-        " and ~record (TF)" if from_tf else "",
-        recorder.out,
+        topic, " and ~record (TF)" if from_tf else "", recorder.out,
     )
     print("navseq record: ready", flush=True)
 
@@ -190,15 +190,13 @@ def record_main(
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("out", type=Path, help="mission file to write (navseq YAML)")
     parser.add_argument(
-        "--topic",
-        default=DEFAULT_TOPIC,
+        "--topic", default=DEFAULT_TOPIC,
         help="pose topic: PoseStamped, or PoseWithCovarianceStamped for */initialpose "
         f"(default {DEFAULT_TOPIC})",
     )
     parser.add_argument("--force", action="store_true", help="replace an existing file")
     parser.add_argument(
-        "--from-tf",
-        action="store_true",
+        "--from-tf", action="store_true",
         help="also offer the ~record service that records the robot's current TF pose",
     )
     parser.add_argument("--base-frame", default="base_footprint")
@@ -207,12 +205,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     return record_main(
-        args.out,
-        args.topic,
-        overwrite=args.force,
-        from_tf=args.from_tf,
-        base_frame=args.base_frame,
-        frame=args.frame,
+        args.out, args.topic, overwrite=args.force, from_tf=args.from_tf,
+        base_frame=args.base_frame, frame=args.frame,
     )
 
 

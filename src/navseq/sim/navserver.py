@@ -165,7 +165,9 @@ class NavigationServer:
         if self.state is NavState.ACTIVE:
             self._finish(NavState.CANCELED, "canceled")
 
-    def compute_velocity(self, pose: Pose2D, v: float, w: float, dt: float) -> tuple[float, float]:
+    def compute_velocity(
+        self, pose: Pose2D, v: float, w: float, dt: float
+    ) -> tuple[float, float]:
         """Velocity command for the next ``dt`` seconds; (0, 0) unless a goal is ACTIVE."""
         if self.state is not NavState.ACTIVE or self.goal is None:
             return 0.0, 0.0
