@@ -34,8 +34,12 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
     assert process.wait(timeout=120) == 0, process.output()
     report = json.loads((out / "report.json").read_text())
     assert report["success"] is True
-    assert report["navigator"] == {"kind": "ros1", "action": "move_base", "frame": "map",
-                                   "ns": ""}
+    navigator = report["navigator"]
+    assert {k: navigator[k] for k in ("kind", "action", "frame", "ns")} == {
+        "kind": "ros1", "action": "move_base", "frame": "map", "ns": ""}
+    # The sim's move_base sets no footprint or local planner: navseq says it assumes the burger.
+    assert navigator["robot"] == "turtlebot3_burger"
+    assert "assuming turtlebot3_burger" in navigator["robot_source"]
     assert [v["outcome"] for v in report["visits"]] == ["reached", "reached"]
     assert report["visits"][1]["distance_m"] > 0.5
     assert (out / "mission.png").exists()

@@ -95,6 +95,14 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     ros1.add_argument("--frame", help="goal frame (default: the mission's frame:, usually map)")
     ros1.add_argument("--ns", default="", help="robot namespace, e.g. robot1 (default: none)")
+    ros1.add_argument(
+        "--settle",
+        type=float,
+        default=0.05,
+        metavar="S",
+        help="wall seconds between a goal's result and the next goal, against move_base's "
+        "SUCCEEDED race (navigation #949); 0: off (default 0.05)",
+    )
     # Options of the scripted test navigator, hidden from --help.
     parser.add_argument("--scripted-speed", type=float, default=0.5, help=argparse.SUPPRESS)
     parser.add_argument("--scripted-realtime", type=float, default=None, help=argparse.SUPPRESS)
@@ -118,6 +126,8 @@ class RunSetup:
     journal: Path | None = None  # the journal to append to when resuming
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
+    # Extra mission listeners the navigator's setup made (ROS markers and status).
+    listeners: list[Any] = field(default_factory=list)
 
 
 def _read_resume(
@@ -255,29 +265,43 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
 
 def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
+    from navseq.errors import NavseqError
+
     mission: Mission = setup["mission"]
     frame = args.frame or mission.frame
     grid = _optional_map(args, setup)
-
-    def make_navigator() -> Navigator:
-        from navseq.errors import NavseqError
-
-        try:
-            from navseq.navigators.ros1 import Ros1Navigator
-        except ImportError as error:
-            raise NavseqError(
-                f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
-                f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
-                "from the project's venv",
-                source="--navigator ros1",
-            ) from None
-        return Ros1Navigator(args.action, frame, namespace=args.ns)
-
+    try:
+        from navseq.ros.run_setup import connect_for_run
+    except ImportError as error:
+        raise NavseqError(
+            f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
+            f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
+            "from the project's venv",
+            source="--navigator ros1",
+        ) from None
+    # Before anything is written: the server must answer and its clock run; the robot
+    # comes from move_base's parameters unless the user named one.
+    connection = connect_for_run(
+        mission,
+        action=args.action,
+        frame=frame,
+        namespace=args.ns,
+        settle=args.settle,
+        read_robot=getattr(args, "robot", None) is None,
+    )
+    info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
+    notes = []
+    if connection.robot is not None:
+        info["robot"] = connection.robot.name
+        info["robot_source"] = connection.robot_note
+        notes.append(connection.robot_note)
     return RunSetup(
         **setup,
         grid=grid,
-        make_navigator=make_navigator,
-        navigator_info={"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns},
+        make_navigator=lambda: connection.navigator,
+        navigator_info=info,
+        notes=notes,
+        listeners=[connection.topics],
     )
 
 
@@ -390,7 +414,10 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
         with progress, journal:
             try:
                 result = run_mission(
-                    setup.mission, navigator, [journal, recorder, progress], resume=setup.resume
+                    setup.mission,
+                    navigator,
+                    [journal, recorder, progress, *setup.listeners],
+                    resume=setup.resume,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
