@@ -18,7 +18,7 @@ from navseq.navigators.ros1 import DEFAULT_SETTLE, Ros1Navigator
 from navseq.ros.mission_topics import MissionTopics, run_topics_namespace
 from navseq.ros.navstack_params import read_navstack_profile
 
-SERVER_WAIT = 10.0  # s of wall time for the action server, as run_mission waits
+SERVER_WAIT = 30.0  # s of wall time for the action server, as the navseq node waits
 
 
 @dataclass
