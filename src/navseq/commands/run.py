@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from navseq.commands.common import format_pose, parse_loops, parse_pose
 
 if TYPE_CHECKING:
+    from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
@@ -127,7 +128,7 @@ class RunSetup:
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
     # Extra mission listeners the navigator's setup made (ROS markers and status).
-    listeners: list[Any] = field(default_factory=list)
+    listeners: list[MissionListener] = field(default_factory=list)
 
 
 def _read_resume(
@@ -291,7 +292,7 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     )
     info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
     notes = []
-    if connection.robot is not None:
+    if connection.robot is not None and connection.robot_note is not None:
         info["robot"] = connection.robot.name
         info["robot_source"] = connection.robot_note
         notes.append(connection.robot_note)
