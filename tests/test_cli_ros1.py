@@ -12,7 +12,7 @@ import signal
 
 import pytest
 
-from cli_support import NAVSEQ, journal_events, wait_for, write_mission
+from cli_support import NAVSEQ, assert_clean_error, journal_events, navseq, wait_for, write_mission
 from ros_clients import MAP, start_sim
 
 pytestmark = pytest.mark.ros
@@ -58,3 +58,11 @@ def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
     assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130
     assert "Traceback" not in process.output()
     nav.wait_for_output("goal canceled", timeout=10)  # the robot was not left driving
+
+
+def test_a_negative_settle_is_a_clean_error(tmp_path):
+    result = navseq("run", mission(tmp_path), "--navigator", "ros1", "--settle", "-1",
+                    "--out", tmp_path / "out", cwd=tmp_path, timeout=60)
+    assert_clean_error(result)
+    assert "settle" in result.stderr and ">= 0" in result.stderr
+    assert not (tmp_path / "out").exists()

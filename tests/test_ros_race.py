@@ -26,7 +26,7 @@ from ros_clients import (
     start_result_watcher,
     start_sim,
 )
-from ros_support import RosMaster, RosProcess
+from ros_support import REPO_ROOT, RosMaster, RosProcess
 
 pytestmark = pytest.mark.ros
 
@@ -108,3 +108,15 @@ def test_without_the_settle_the_executor_reports_a_far_succeeded(
     report = json.loads((out / "report.json").read_text())
     reasons = [attempt["reason"] for visit in report["visits"] for attempt in visit["attempts"]]
     assert any(reason.startswith("succeeded far from goal") for reason in reasons), reasons
+
+
+@pytest.mark.parametrize(
+    ("param", "complaint"),
+    [("_race_window:=-0.1", "race_window"), ("_race_probability:=1.5", "race_probability")],
+)
+def test_a_bad_race_option_stops_the_node_naming_it(ros_master: RosMaster, param, complaint):
+    ros_master.set_param("/use_sim_time", False)
+    nav = ros_master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}", param],
+                           label="move_base")
+    assert nav.wait(timeout=60) == 2, nav.output()
+    assert f"/move_base/{complaint}" in nav.output() and "Traceback" not in nav.output()
