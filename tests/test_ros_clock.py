@@ -21,7 +21,7 @@ import pytest
 
 from cli_support import NAVSEQ, journal_events, write_mission
 from ros_clients import start_scripted_server, start_sim
-from ros_support import REPO_ROOT, RosMaster, wait_for
+from ros_support import REPO_ROOT, RosMaster
 
 pytestmark = pytest.mark.ros
 
@@ -36,10 +36,6 @@ def mission(tmp_path: Path) -> Path:
     )
 
 
-def navseq_node_registered(master: RosMaster) -> bool:
-    return any(name.startswith("/navseq_") for name in master.node_names())
-
-
 def test_navseq_started_before_a_5x_sim_runs_on_the_sims_clock(
     ros_master: RosMaster, tmp_path: Path
 ):
@@ -49,7 +45,8 @@ def test_navseq_started_before_a_5x_sim_runs_on_the_sims_clock(
         [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", out],
         cwd=tmp_path, label="navseq",
     )
-    wait_for(lambda: navseq_node_registered(ros_master), 30, "navseq's node")
+    # Its action client subscribes only once init_node (which reads /use_sim_time) is done.
+    ros_master.wait_for_subscriber("/move_base/status", timeout=30)
     start_sim(ros_master, speed=5.0)  # sets /use_sim_time true, drives /clock at 5x
     assert navseq.wait(timeout=120) == 0, navseq.output()[-4000:]
     assert "taking time from /clock" in navseq.output()
@@ -68,7 +65,7 @@ def test_sim_time_without_a_clock_is_a_clear_error_naming_clock(
         [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", tmp_path / "out"],
         cwd=tmp_path, label="navseq",
     )
-    wait_for(lambda: navseq_node_registered(ros_master), 30, "navseq's node")
+    ros_master.wait_for_subscriber("/move_base/status", timeout=30)  # init_node done
     # The server comes up on wall time (no /clock ever): navseq's rospy stays at time 0.
     ros_master.set_param("/use_sim_time", False)
     start_scripted_server(ros_master)
