@@ -14,7 +14,9 @@ subprocess (this same script in a ``--role``), and all of them are stopped at th
 
    - navseq: :class:`~navseq.navigators.ros1.Ros1Navigator` +
      :func:`~navseq.executor.runner.run_mission`, with the executor tick the CLI and the
-     node use (0.1 s) and with a 10x shorter one;
+     node use (0.1 s) and with a 10x shorter one; with its default ``settle`` (0.05 s of
+     wall time after a result before the next goal, which keeps clear of move_base's
+     SUCCEEDED race, navigation #949) and, side by side, with it off (what it costs);
    - baseline: a plain ``SimpleActionClient`` loop (send_goal, wait_for_result, next).
 
 2. **Mission time vs its lower bound**: the simulator's ROS nodes (``sim_robot_node``
@@ -70,6 +72,7 @@ EXAMPLE = REPO_ROOT / "examples" / "turtlebot3_world.yaml"
 NAVSEQ = Path(sys.executable).parent / "navseq"
 ACTION = "move_base"
 DEFAULT_TICK = 0.1  # s: what `navseq run` and the navseq node use
+DEFAULT_SETTLE = 0.05  # s: navseq's wait after a result (Ros1Navigator's default)
 RANDOM_DELAY = 0.2  # s: longest wait of the server that succeeds goals at a random moment
 PASS_THROUGH = 0.3  # m, as in bench_sim.py
 CLIENT_TIMEOUT = 120.0  # s of wall time for one client run; nothing waits unbounded
@@ -130,7 +133,7 @@ def bench_goals(count: int) -> list[tuple[float, float, float]]:
     ]
 
 
-def role_navseq_client(goals: int, tick: float) -> None:
+def role_navseq_client(goals: int, tick: float, settle: float) -> None:
     """navseq's sequencer (Ros1Navigator + run_mission) sending ``goals`` goals in a row."""
     from navseq.executor.runner import run_mission
     from navseq.navigators.ros1 import Ros1Navigator
@@ -140,7 +143,7 @@ def role_navseq_client(goals: int, tick: float) -> None:
         defaults=Policy(goal_timeout=10.0, on_failure=FailureAction.STOP),
         source="<bench_ros1>",
     )
-    navigator = Ros1Navigator(ACTION, node_name="bench_navseq")
+    navigator = Ros1Navigator(ACTION, node_name="bench_navseq", settle=settle)
     try:
         result = run_mission(mission, navigator, tick=tick, server_wait=30.0)
     finally:
@@ -209,7 +212,7 @@ def run_role(args: argparse.Namespace) -> None:
     if args.role == "server":
         role_server(Path(args.log), args.delay_max)
     elif args.role == "navseq":
-        role_navseq_client(args.goals, args.tick)
+        role_navseq_client(args.goals, args.tick, args.settle)
     elif args.role == "baseline":
         role_baseline_client(args.goals)
     elif args.role == "plan":
@@ -284,9 +287,16 @@ def measure_turnaround(
 def turnaround_rows(goals: int) -> list[tuple[Turnaround, Turnaround]]:
     """Each measurement paired with the baseline measured against the same server."""
     n = ["--goals", str(goals)]
+
+    def navseq_client(tick: float, settle: float) -> tuple[str, list[str]]:
+        name = f"navseq, tick {tick:g} s, settle " + (f"{settle:g} s" if settle else "off")
+        return name, ["--role", "navseq", *n, "--tick", str(tick), "--settle", str(settle)]
+
+    # Before/after the settle that keeps clear of move_base's SUCCEEDED race (#949).
     navseq = [
-        (f"navseq, tick {tick:g} s", ["--role", "navseq", *n, "--tick", str(tick)])
-        for tick in (DEFAULT_TICK, DEFAULT_TICK / 10)
+        navseq_client(DEFAULT_TICK, 0.0),
+        navseq_client(DEFAULT_TICK, DEFAULT_SETTLE),
+        navseq_client(DEFAULT_TICK / 10, DEFAULT_SETTLE),
     ]
     baseline = ("SimpleActionClient loop", ["--role", "baseline", *n])
     servers = [("at once", 0.0), (f"after U(0, {RANDOM_DELAY:g}) s", RANDOM_DELAY)]
@@ -294,7 +304,7 @@ def turnaround_rows(goals: int) -> list[tuple[Turnaround, Turnaround]]:
     with running_master() as master:
         for server in servers:
             # The 10x shorter tick only matters for the first server: skip it for the second.
-            clients = navseq if server[1] == 0 else navseq[:1]
+            clients = navseq if server[1] == 0 else navseq[:2]
             base = measure_turnaround(master, server, baseline)
             rows += [(measure_turnaround(master, server, client), base) for client in clients]
             rows.append((base, base))
@@ -442,6 +452,7 @@ def main() -> None:
     parser.add_argument("--log", help=argparse.SUPPRESS)
     parser.add_argument("--delay-max", type=float, default=0.0, help=argparse.SUPPRESS)
     parser.add_argument("--tick", type=float, default=DEFAULT_TICK, help=argparse.SUPPRESS)
+    parser.add_argument("--settle", type=float, default=DEFAULT_SETTLE, help=argparse.SUPPRESS)
     parser.add_argument("--legs", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.role:

@@ -174,10 +174,19 @@ SIM_CLIENT = textwrap.dedent(
 
 
 def start_sim(
-    master: RosMaster, start: tuple[float, float, float] = START, speed: float = SPEED
+    master: RosMaster,
+    start: tuple[float, float, float] = START,
+    speed: float = SPEED,
+    nav_params: tuple[str, ...] = (),
+    *,
+    set_sim_time: bool = True,
 ) -> tuple[RosProcess, RosProcess]:
-    """Robot node + navigation node on the TurtleBot3 world, ROS time driven by the robot."""
-    master.set_param("/use_sim_time", True)
+    """Robot node + navigation node on the TurtleBot3 world, ROS time driven by the robot.
+
+    ``nav_params`` are extra ``_name:=value`` arguments of the navigation node.
+    """
+    if set_sim_time:
+        master.set_param("/use_sim_time", True)
     x, y, yaw = start
     robot = master.start(
         [
@@ -190,7 +199,9 @@ def start_sim(
         ],
         label="sim_robot",
     )
-    nav = master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}"], label="move_base")
+    nav = master.start(
+        [REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}", *nav_params], label="move_base"
+    )
     master.wait_for_action_server("/move_base", timeout=30)
     return robot, nav
 
@@ -227,6 +238,50 @@ def run_client(
 
 def goal(x: float, y: float, yaw: float = 0.0, op: str = "goal") -> dict[str, Any]:
     return {"op": op, "x": x, "y": y, "yaw": yaw}
+
+
+# -- observers of a running stack -----------------------------------------------------------
+
+# Prints one JSON line per move_base result: its status, the goal it ended, and where the
+# robot really is then (TF map -> base_footprint): the truth a SUCCEEDED should match.
+RESULT_WATCHER = textwrap.dedent(
+    """
+    import json, math
+    import rospy, tf2_ros
+    from move_base_msgs.msg import MoveBaseActionGoal, MoveBaseActionResult
+
+    rospy.init_node("result_watcher", anonymous=True)
+    buffer = tf2_ros.Buffer()
+    listener = tf2_ros.TransformListener(buffer)
+    goals = {}
+
+    def on_goal(msg):
+        p = msg.goal.target_pose.pose.position
+        goals[msg.goal_id.id] = [p.x, p.y]
+
+    def on_result(msg):
+        t = buffer.lookup_transform("map", "base_footprint", rospy.Time(0), rospy.Duration(2))
+        robot = [t.transform.translation.x, t.transform.translation.y]
+        goal = goals.get(msg.status.goal_id.id)
+        away = math.dist(goal, robot) if goal else None
+        print(json.dumps({"status": msg.status.status, "goal": goal, "robot": robot,
+                          "distance": away}), flush=True)
+
+    rospy.Subscriber("move_base/goal", MoveBaseActionGoal, on_goal, queue_size=100)
+    rospy.Subscriber("move_base/result", MoveBaseActionResult, on_result, queue_size=100)
+    print("watching", flush=True)
+    rospy.spin()
+    """
+)
+
+
+def start_result_watcher(master: RosMaster, tmp_path: Path) -> RosProcess:
+    script = tmp_path / "result_watcher.py"
+    script.write_text(RESULT_WATCHER)
+    watcher = master.start_python(script, label="result_watcher")
+    watcher.wait_for_output("watching", timeout=30)
+    master.wait_for_subscriber("/move_base/result", timeout=30)
+    return watcher
 
 
 # -- the tutorial's move_base_seq node --------------------------------------------------------

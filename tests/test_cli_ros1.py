@@ -12,7 +12,7 @@ import signal
 
 import pytest
 
-from cli_support import NAVSEQ, journal_events, wait_for, write_mission
+from cli_support import NAVSEQ, assert_clean_error, journal_events, navseq, wait_for, write_mission
 from ros_clients import MAP, start_sim
 
 pytestmark = pytest.mark.ros
@@ -34,8 +34,12 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
     assert process.wait(timeout=120) == 0, process.output()
     report = json.loads((out / "report.json").read_text())
     assert report["success"] is True
-    assert report["navigator"] == {"kind": "ros1", "action": "move_base", "frame": "map",
-                                   "ns": ""}
+    navigator = report["navigator"]
+    assert {k: navigator[k] for k in ("kind", "action", "frame", "ns")} == {
+        "kind": "ros1", "action": "move_base", "frame": "map", "ns": ""}
+    # The sim's move_base sets no footprint or local planner: navseq says it assumes the burger.
+    assert navigator["robot"] == "turtlebot3_burger"
+    assert "assuming turtlebot3_burger" in navigator["robot_source"]
     assert [v["outcome"] for v in report["visits"]] == ["reached", "reached"]
     assert report["visits"][1]["distance_m"] > 0.5
     assert (out / "mission.png").exists()
@@ -54,3 +58,11 @@ def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
     assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130
     assert "Traceback" not in process.output()
     nav.wait_for_output("goal canceled", timeout=10)  # the robot was not left driving
+
+
+def test_a_negative_settle_is_a_clean_error(tmp_path):
+    result = navseq("run", mission(tmp_path), "--navigator", "ros1", "--settle", "-1",
+                    "--out", tmp_path / "out", cwd=tmp_path, timeout=60)
+    assert_clean_error(result)
+    assert "settle" in result.stderr and ">= 0" in result.stderr
+    assert not (tmp_path / "out").exists()

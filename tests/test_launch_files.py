@@ -96,7 +96,7 @@ def test_rviz_config_shows_map_plan_robot_and_waypoints():
     assert {
         "/map",
         "/move_base/NavfnROS/plan",
-        "/footprint",
+        "/move_base/local_costmap/footprint",
         "/navseq/waypoints",
     } <= topics
     assert config["Visualization Manager"]["Global Options"]["Fixed Frame"] == "map"

@@ -129,3 +129,17 @@ def test_markers_show_every_waypoint_with_heading_number_and_status_colour():
     colours = [c for m in arrows for c in (m.color.r, m.color.g, m.color.b, m.color.a)]
     expected = [MarkerStatus.REACHED, MarkerStatus.ACTIVE, MarkerStatus.PENDING]
     assert colours == pytest.approx([c for s in expected for c in STATUS_COLOURS[s]])
+
+
+def test_the_odometry_pose_passes_through_when_the_inner_navigator_has_one():
+    class WithOdometry(ScriptedNavigator):
+        def odometry_pose(self) -> Pose2D | None:
+            return Pose2D(0.5, 0.0, 0.1)
+
+    assert OperatorNavigator(WithOdometry([Hang()])).odometry_pose() == Pose2D(0.5, 0.0, 0.1)
+
+    class WithoutOdometry:  # only what the operator layer touches here
+        pass
+
+    # A navigator that has no odometry pose: None, no error.
+    assert OperatorNavigator(WithoutOdometry()).odometry_pose() is None  # type: ignore[arg-type]

@@ -148,3 +148,20 @@ def test_record_service_takes_the_robot_pose_from_tf(ros_master: RosMaster, tmp_
     waypoint = load_mission(out).waypoints[0]
     assert (waypoint.x, waypoint.y) == pytest.approx((0.75, -1.25))
     assert math.degrees(waypoint.yaw) == pytest.approx(30)
+
+
+def test_tf_poses_are_recorded_to_the_millimetre_and_the_tenth_of_a_degree(
+    ros_master: RosMaster, tmp_path: Path
+):
+    out = tmp_path / "recorded.yaml"
+    recorder = start_recorder(ros_master, out, from_tf=True)
+    recorder.wait_for_output("navseq record: ready", timeout=20)
+    tf = publish(ros_master, tmp_path, "unused", "-1.8739253890256067,0.4995812,33.333333", "--tf")
+    tf.wait_for_output("tf sent", timeout=20)
+    assert ros_master.call_service("/navseq_record/record")["success"]
+    text = out.read_text()
+    assert "x: -1.874," in text and "y: 0.5," in text and "yaw: 33.3" in text, text
+    assert "-1.8739" not in text and "33.333" not in text
+    waypoint = load_mission(out).waypoints[0]
+    assert (waypoint.x, waypoint.y) == (-1.874, 0.5)
+    assert math.degrees(waypoint.yaw) == pytest.approx(33.3, abs=1e-9)

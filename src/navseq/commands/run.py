@@ -22,6 +22,7 @@ from navseq.commands.common import format_pose, parse_loops, parse_pose
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
+    from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
@@ -97,6 +98,14 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     ros1.add_argument("--frame", help="goal frame (default: the mission's frame:, usually map)")
     ros1.add_argument("--ns", default=None, help="robot namespace, e.g. robot1 (default: none)")
+    ros1.add_argument(
+        "--settle",
+        type=float,
+        default=None,  # 0.05, or the journal's when resuming
+        metavar="S",
+        help="wall seconds between a goal's result and the next goal, against move_base's "
+        "SUCCEEDED race (navigation #949); 0: off (default 0.05)",
+    )
     # Options of the scripted test navigator, hidden from --help.
     parser.add_argument("--scripted-speed", type=float, default=0.5, help=argparse.SUPPRESS)
     parser.add_argument("--scripted-realtime", type=float, default=None, help=argparse.SUPPRESS)
@@ -121,6 +130,8 @@ class RunSetup:
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
     run_options: dict[str, Any] = field(default_factory=dict)  # journaled for a resume
+    # Extra mission listeners the navigator's setup made (ROS markers and status).
+    listeners: list[MissionListener] = field(default_factory=list)
 
 
 def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumePoint, JournalState]:
@@ -234,6 +245,7 @@ RUN_OPTION_DEFAULTS: dict[str, Any] = {
     "action": "move_base",
     "ns": "",
     "frame": None,
+    "settle": 0.05,
 }
 
 
@@ -308,6 +320,7 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
         "action": args.action,
         "ns": args.ns,
         "frame": args.frame,
+        "settle": args.settle,
         "loops": setup.mission.loops,
         "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
         "start": None
@@ -357,29 +370,43 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
 
 def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
+    from navseq.errors import NavseqError
+
     mission: Mission = setup["mission"]
     frame = args.frame or mission.frame
     grid = _optional_map(args, setup)
-
-    def make_navigator() -> Navigator:
-        from navseq.errors import NavseqError
-
-        try:
-            from navseq.navigators.ros1 import Ros1Navigator
-        except ImportError as error:
-            raise NavseqError(
-                f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
-                f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
-                "from the project's venv",
-                source="--navigator ros1",
-            ) from None
-        return Ros1Navigator(args.action, frame, namespace=args.ns)
-
+    try:
+        from navseq.ros.run_setup import connect_for_run
+    except ImportError as error:
+        raise NavseqError(
+            f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
+            f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
+            "from the project's venv",
+            source="--navigator ros1",
+        ) from None
+    # Before anything is written: the server must answer and its clock run; the robot
+    # comes from move_base's parameters unless the user named one.
+    connection = connect_for_run(
+        mission,
+        action=args.action,
+        frame=frame,
+        namespace=args.ns,
+        settle=args.settle,
+        read_robot=getattr(args, "robot", None) is None,
+    )
+    info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
+    notes = []
+    if connection.robot is not None and connection.robot_note is not None:
+        info["robot"] = connection.robot.name
+        info["robot_source"] = connection.robot_note
+        notes.append(connection.robot_note)
     return RunSetup(
         **setup,
         grid=grid,
-        make_navigator=make_navigator,
-        navigator_info={"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns},
+        make_navigator=lambda: connection.navigator,
+        navigator_info=info,
+        notes=notes,
+        listeners=[connection.topics],
     )
 
 
@@ -512,7 +539,7 @@ def _run_with_sinks(
                 result = run_mission(
                     setup.mission,
                     navigator,
-                    [journal, recorder, StdoutGuard(progress)],
+                    [journal, recorder, StdoutGuard(progress), *setup.listeners],
                     resume=setup.resume,
                     signals=signals,
                 )

@@ -16,10 +16,26 @@ How it stays out of actionlib's traps:
   publishes again *and* has connected to our goal and cancel topics (so the resent goal
   cannot vanish in transit).
 
-Time: :meth:`now` is ROS time and :meth:`spin` waits on ROS time, so under
-``use_sim_time`` the executor's timeouts run on the simulation clock. :meth:`spin`
-returns early as soon as a callback queues an event (or the server is lost or back):
-the executor answers a result with the next goal at once, not at the end of its tick.
+Time: :meth:`now` is the navigation stack's clock and :meth:`spin` waits on it, so
+under ``use_sim_time`` the executor's timeouts run on the simulation clock. Which clock
+that is gets settled once the server is found (:meth:`wait_for_server`): rospy reads
+``/use_sim_time`` only once, in ``init_node``, so a navseq started at the same moment as
+a simulator may have come up on wall time before the simulator set the parameter. If
+``/use_sim_time`` is true by then while rospy runs on wall time, the navigator takes
+its time from ``/clock`` itself (goal stamps included). Either way it then waits, on
+wall time and bounded, for a valid (non-zero) clock, so no timeout or journal time is
+counted from time 0 before the first ``/clock`` (actionlib #137); none is a
+:class:`NavseqError` naming ``/clock`` and ``use_sim_time``. The server wait itself is
+on wall time and needs no clock. :meth:`spin` returns early as soon as a callback
+queues an event (or the server is lost or back).
+
+move_base's SUCCEEDED race (ros-planning/navigation #949): a goal sent a few
+milliseconds after the previous goal's result can inherit the plan still being computed
+for the old one and end SUCCEEDED at once, metres from its pose. :meth:`send_goal`
+therefore sends a goal that follows a result only once ``settle`` seconds (wall time,
+default 0.05) have passed since that result *and* the server's status array lists the
+previous goal as terminal (waited for up to 0.5 s). A goal that replaces an active one
+(pass-through) goes out at once. ``settle=0`` turns the precaution off.
 
 Goals are stamped with ``rospy.Time.now()`` (``stamp="now"``, what RViz does);
 ``stamp="latest"`` stamps them with time zero, which tells move_base to use the latest
@@ -28,7 +44,9 @@ the clock (it avoids "extrapolation into the future" errors). Before ``/clock`` 
 ROS time is zero and both are the same.
 
 Robot pose: from TF (``frame`` -> the first of ``base_frames`` that resolves) when
-available, else from the goal feedback's ``base_position``.
+available, else from the goal feedback's ``base_position``. :meth:`odometry_pose` is the
+pose in the odometry frame (``odom_frame`` -> base frame, from TF): it drifts but never
+jumps, unlike the map pose when localisation corrects itself.
 """
 
 from __future__ import annotations
@@ -70,6 +88,12 @@ MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up
 CANCEL_FLUSH = 1.0  # s of wall time to let a cancel reach the server when closing
 # Longest wall-time wait in spin() between looks at the clock, the server and shutdown.
 SPIN_SLICE = 0.1
+DEFAULT_SETTLE = 0.05  # s of wall time between a result and the next goal (race #949)
+# Longest wall-time wait for the server's status array to list a finished goal as such.
+STATUS_LISTING_WAIT = 0.5
+CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
+# actionlib_msgs/GoalStatus codes of a finished goal.
+_TERMINAL_CODES = frozenset({2, 3, 4, 5, 8, 9})
 
 
 def ensure_node(name: str = DEFAULT_NODE_NAME, *, anonymous: bool = True) -> None:
@@ -147,11 +171,16 @@ class Ros1Navigator:
         plan_topic: str | None = "NavfnROS/plan",
         use_tf: bool = True,
         node_name: str = DEFAULT_NODE_NAME,
+        settle: float = DEFAULT_SETTLE,
+        odom_frame: str = "odom",
+        clock_wait: float = CLOCK_WAIT,
     ):
         if stamp not in ("now", "latest"):
             raise NavseqError(f"stamp must be 'now' or 'latest', not {stamp!r}", subject="stamp")
         if status_timeout <= 0:
             raise NavseqError("must be > 0 s", subject="status_timeout")
+        if not settle >= 0:
+            raise NavseqError(f"must be >= 0 s (0: off), not {settle!r}", subject="settle")
         ensure_node(node_name)
         self.action = rosgraph.names.ns_join(namespace, action) if namespace else action
         self.resolved_action = rospy.resolve_name(self.action)
@@ -159,6 +188,14 @@ class Ros1Navigator:
         self.base_frames = tuple(base_frames)
         self.stamp = stamp
         self.status_timeout = status_timeout
+        self.settle = settle
+        self.odom_frame = odom_frame
+        self.clock_wait = clock_wait
+        # Set when the navigation stack runs on /clock but rospy came up on wall time:
+        # the latest /clock time, read instead of rospy's (None: rospy's time is right).
+        self._clock_time: float | None = None
+        # (wall time, actionlib goal id) of the last result of a goal we tracked.
+        self._last_result: tuple[float, str] | None = None
 
         self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
         # Set after an event is queued (and on anything else spin() must look at); the
@@ -179,7 +216,9 @@ class Ros1Navigator:
         self._plan_sub = None
         if plan_topic:
             self._plan_sub = rospy.Subscriber(
-                rosgraph.names.ns_join(self.action, plan_topic), PathMsg, self._on_plan,
+                rosgraph.names.ns_join(self.action, plan_topic),
+                PathMsg,
+                self._on_plan,
                 queue_size=1,
             )
         self._tf_buffer = None
@@ -198,7 +237,17 @@ class Ros1Navigator:
     # -- Navigator protocol -----------------------------------------------------------
 
     def now(self) -> float:
+        if self._clock_time is not None:
+            return self._clock_time
         return rospy.get_time()
+
+    @property
+    def follows_clock_topic(self) -> bool:
+        """Time comes from ``/clock`` read by this navigator, not from rospy."""
+        return self._clock_time is not None
+
+    def _stamp_now(self) -> rospy.Time:
+        return rospy.Time.from_sec(self.now()) if self._clock_time is not None else rospy.Time.now()
 
     def spin(self, seconds: float) -> None:
         """Wait until ``seconds`` of ROS time have passed or :meth:`poll` has news.
@@ -209,9 +258,9 @@ class Ros1Navigator:
         it starts; raises ``rospy.ROSInterruptException`` on ROS shutdown and
         ``ROSTimeMovedBackwardsException`` when ROS time jumps back.
         """
-        start = rospy.get_time()
+        start = self.now()
         while not self._has_news():
-            now = rospy.get_time()
+            now = self.now()
             if start == 0.0:
                 start = now  # the simulation clock has not started: wait from when it does
             elif now < start:
@@ -229,13 +278,52 @@ class Ros1Navigator:
             self._wake.clear()
 
     def wait_for_server(self, timeout: float) -> bool:
+        """Wait (wall time) for the server, then settle the clock (see the module doc).
+
+        Raises :class:`NavseqError` when the server is there but no valid ROS time
+        comes within ``clock_wait`` seconds.
+        """
         deadline = time.monotonic() + timeout
         while not self._server_ready():
             if time.monotonic() >= deadline or rospy.is_shutdown():
                 return False
             time.sleep(0.02)
         self._server_up = True
+        self._follow_the_stacks_clock()
+        self._wait_for_valid_time()
         return True
+
+    def _follow_the_stacks_clock(self) -> None:
+        """Take time from /clock if the stack set /use_sim_time after rospy started."""
+        if self._clock_time is not None or not rospy.rostime.is_wallclock():
+            return
+        try:
+            sim_time = rospy.get_param("/use_sim_time", False)
+        except (rospy.ROSException, OSError):
+            return
+        if sim_time not in (True, "true", "True"):
+            return
+        rospy.logwarn(
+            "navseq: /use_sim_time became true after this node started on wall time; "
+            "taking time from /clock"
+        )
+        self._clock_time = 0.0
+        self._clock_sub = rospy.Subscriber("/clock", Clock, self._on_clock, queue_size=1)
+
+    def _wait_for_valid_time(self) -> None:
+        deadline = time.monotonic() + self.clock_wait
+        while self.now() <= 0.0:
+            if time.monotonic() >= deadline:
+                raise NavseqError(
+                    f"ROS time is still 0 after {self.clock_wait:g} s: /use_sim_time is true "
+                    "but nothing publishes /clock. Start the simulator that drives /clock, "
+                    "or set /use_sim_time false (rosparam set /use_sim_time false) for a "
+                    "robot on wall time",
+                    source="/clock",
+                )
+            if rospy.is_shutdown():
+                raise rospy.ROSInterruptException("ROS shutdown request")
+            time.sleep(0.02)
 
     def require_server(self, timeout: float) -> None:
         """Like :meth:`wait_for_server`, but a missing server is a clear :class:`NavseqError`."""
@@ -249,8 +337,9 @@ class Ros1Navigator:
             )
 
     def send_goal(self, goal: Goal) -> None:
+        self._settle_after_result()
         frame = self.frame or goal.frame or "map"
-        stamp = rospy.Time.now() if self.stamp == "now" else rospy.Time(0)
+        stamp = self._stamp_now() if self.stamp == "now" else rospy.Time(0)
         message = move_base_goal(goal.pose, frame, stamp, goal.z)
         with self._lock:
             # The previous goal is simply no longer tracked: like move_base's own
@@ -273,6 +362,35 @@ class Ros1Navigator:
             # actionlib only keeps a weak reference: this one keeps the goal's callbacks alive.
             if seq == self._send_seq and handle.get_comm_state() != CommState.DONE:
                 self._handle = handle
+
+    def _settle_after_result(self) -> None:
+        """Keep a goal that follows a result out of move_base's race (module doc)."""
+        if self.settle <= 0:
+            return
+        with self._lock:
+            replacing = self._handle is not None  # an active goal: no result to race with
+            last = self._last_result
+        if replacing or last is None:
+            return
+        result_at, previous_id = last
+        settled_at = result_at + self.settle
+        give_up_listing_at = result_at + max(self.settle, STATUS_LISTING_WAIT)
+        while not rospy.is_shutdown():
+            now = time.monotonic()
+            if now >= settled_at and (
+                now >= give_up_listing_at or self._status_lists_as_terminal(previous_id)
+            ):
+                return
+            time.sleep(min(0.005, max(settled_at - now, 0.001)))
+
+    def _status_lists_as_terminal(self, goal_id: str) -> bool:
+        status = self._client.last_status_msg
+        if status is None:
+            return False
+        return any(
+            entry.goal_id.id == goal_id and entry.status in _TERMINAL_CODES
+            for entry in status.status_list
+        )
 
     def cancel_goal(self) -> None:
         with self._lock:
@@ -304,6 +422,22 @@ class Ros1Navigator:
                     continue
                 return pose2d_from_transform(transform)
         return self._feedback_pose
+
+    def odometry_pose(self) -> Pose2D | None:
+        """The robot pose in ``odom_frame`` from TF; None when TF has none (or is off).
+
+        Continuous, unlike the map pose that localisation may shift at any time: what
+        to measure a short movement with (how far the robot really drove for a goal).
+        """
+        if self._tf_buffer is None:
+            return None
+        for base in self.base_frames:
+            try:
+                transform = self._tf_buffer.lookup_transform(self.odom_frame, base, rospy.Time(0))
+            except Exception:  # tf2 raises several unrelated types; any means "not now"
+                continue
+            return pose2d_from_transform(transform)
+        return None
 
     def poll(self) -> list[NavEvent]:
         events: list[NavEvent] = []
@@ -358,9 +492,7 @@ class Ros1Navigator:
                 self._handle = None
                 self._goal_id = None
             return [
-                ServerLost(
-                    f"no status from {self.resolved_action} for {self.status_timeout:g} s"
-                )
+                ServerLost(f"no status from {self.resolved_action} for {self.status_timeout:g} s")
             ]
         if not self._server_up and self._server_ready():
             self._server_up = True
@@ -385,6 +517,10 @@ class Ros1Navigator:
                     # announce ServerBack once it is ready, so the executor resends.
                     self._server_up = False
                 self._queue(GoalDone(goal_id, status, handle.get_goal_status_text()))
+                self._last_result = (
+                    time.monotonic(),
+                    handle.comm_state_machine.action_goal.goal_id.id,
+                )
                 self._handle = None
                 self._goal_id = None
 
@@ -405,7 +541,9 @@ class Ros1Navigator:
         if self._server_up is False:
             self._wake.set()  # the server may be back: let spin() check
 
-    def _on_clock(self, _clock: Any) -> None:
+    def _on_clock(self, clock: Any) -> None:
+        if self._clock_time is not None:
+            self._clock_time = clock.clock.to_sec()
         self._wake.set()  # ROS time moved: let spin() check its deadline
 
     def _on_rospy_shutdown(self) -> None:

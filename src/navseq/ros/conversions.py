@@ -84,9 +84,7 @@ def pose2d_from_transform(transform: TransformStamped) -> Pose2D:
     return Pose2D(float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
 
 
-def transform_stamped(
-    pose: Pose2D, parent: str, child: str, stamp: rospy.Time
-) -> TransformStamped:
+def transform_stamped(pose: Pose2D, parent: str, child: str, stamp: rospy.Time) -> TransformStamped:
     """A planar TF transform ``parent`` -> ``child`` placing the child at ``pose``."""
     message = TransformStamped()
     message.header.frame_id = parent
@@ -96,7 +94,6 @@ def transform_stamped(
     message.transform.translation.y = pose.y
     message.transform.rotation = quaternion_msg(pose.yaw)
     return message
-
 
 
 def grid_to_msg(grid: OccupancyGrid, frame_id: str, stamp: rospy.Time) -> OccupancyGridMsg:

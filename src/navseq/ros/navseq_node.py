@@ -14,7 +14,9 @@ namespace, so ``<group ns="robot1">`` drives ``/robot1/move_base``), ``~server_w
 (s, default 30), ``~stamp`` (``now`` or ``latest``), ``~status_timeout`` (s without
 action status before the server counts as lost, default 2), ``~base_frames``,
 ``~plan_topic``, ``~use_tf``, ``~tick`` (s between executor looks, default 0.1),
-``~keep_alive`` (default false: see below).
+``~keep_alive`` (default false: see below), ``~settle`` (s of wall time between a
+result and the next goal, against move_base's SUCCEEDED race; default 0.05, 0 = off),
+``~odom_frame`` (default ``odom``).
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
@@ -37,33 +39,26 @@ parameters and a missing action server still exit at once with 2.
 
 from __future__ import annotations
 
-import json
 import signal
 import sys
 import threading
-from dataclasses import asdict
 from typing import Any
 
 import rospy
-from std_msgs.msg import String
 from std_srvs.srv import Trigger, TriggerResponse
-from visualization_msgs.msg import MarkerArray
 
 from navseq.errors import NavseqError
 from navseq.executor.control import MissionControl
 from navseq.executor.events import (
     MissionEvent,
-    MissionFinished,
     WaypointFinished,
     WaypointOutcome,
-    WaypointProgress,
-    WaypointStarted,
 )
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
 from navseq.navigators.ros1 import CANCEL_FLUSH, Ros1Navigator, ensure_node
-from navseq.ros.markers import MarkerStatus, waypoint_markers
+from navseq.ros.mission_topics import MissionTopics
 from navseq.ros.operator import NodeShutdown, OperatorCancel, OperatorNavigator
 from navseq.ros.params import bool_param
 
@@ -79,76 +74,13 @@ NODE_PARAMS: dict[str, Any] = {
     "use_tf": True,
     "tick": 0.1,
     "keep_alive": False,
+    "settle": 0.05,
+    "odom_frame": "odom",
 }
-PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 # s to wait for rospy to name its shutdown reason: it does so only after the navigator's
 # shutdown hook has waited (up to CANCEL_FLUSH) for the goal's cancel to go out.
 SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
 KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a shutdown while kept alive
-
-_OUTCOME_MARKERS = {
-    WaypointOutcome.REACHED: MarkerStatus.REACHED,
-    WaypointOutcome.SKIPPED: MarkerStatus.SKIPPED,
-    WaypointOutcome.FAILED: MarkerStatus.FAILED,
-    WaypointOutcome.NOT_RUN: MarkerStatus.PENDING,
-}
-
-
-class MissionTopics:
-    """A mission listener publishing the ``~status`` JSON and the ``~waypoints`` markers."""
-
-    def __init__(self, mission: Mission):
-        self.mission = mission
-        self.statuses: dict[int, MarkerStatus] = {}
-        self._status_pub = rospy.Publisher("~status", String, queue_size=10, latch=True)
-        self._marker_pub = rospy.Publisher("~waypoints", MarkerArray, queue_size=2, latch=True)
-        self._last_progress = float("-inf")
-        self._lock = threading.Lock()
-        self.active_waypoint: int | None = None  # 0-based index of the visit underway
-        # Set once the mission is over for good; the services then refuse with this reason.
-        self.over: str | None = None
-        self.publish_markers()
-        self.publish_status({"state": "waiting_for_server", "waypoints": len(mission)})
-
-    def publish_markers(self) -> None:
-        self._marker_pub.publish(waypoint_markers(self.mission, self.statuses))
-
-    def publish_status(self, fields: dict[str, Any]) -> None:
-        self._status_pub.publish(String(data=json.dumps(fields, default=str)))
-
-    def __call__(self, event: MissionEvent) -> None:
-        with self._lock:
-            if isinstance(event, WaypointProgress):
-                if event.t - self._last_progress < PROGRESS_PERIOD:
-                    return
-                self._last_progress = event.t
-            if isinstance(event, WaypointStarted):
-                if event.index == 0 and event.attempt == 1:
-                    # A new loop of a patrol: every waypoint is to come again.
-                    self.statuses.clear()
-                self.statuses[event.index] = MarkerStatus.ACTIVE
-                self.active_waypoint = event.index
-                self.publish_markers()
-            elif isinstance(event, WaypointFinished):
-                self.statuses[event.index] = _OUTCOME_MARKERS[event.outcome]
-                self.active_waypoint = None
-                self.publish_markers()
-            elif isinstance(event, MissionFinished):
-                self.active_waypoint = None
-            fields = {"event": type(event).__name__, **asdict(event)}
-            fields["state"] = _state(event)
-            fields["waypoints"] = len(self.mission)
-            self.publish_status(fields)
-
-
-def _state(event: MissionEvent) -> str:
-    """The ``state`` field of a status message: running, succeeded, failed or interrupted."""
-    if not isinstance(event, MissionFinished):
-        return "running"
-    if event.success:
-        return "succeeded"
-    # The runner's reason for a run ended from outside ("interrupted: SIGINT" ...).
-    return "interrupted" if event.reason.startswith("interrupted") else "failed"
 
 
 def log_waypoint_outcome(event: MissionEvent) -> None:
@@ -240,14 +172,20 @@ def run_node() -> int:
     except NavseqError as error:
         rospy.logerr("navseq: %s", error)
         return 2
-    navigator = Ros1Navigator(
-        action=str(settings["action"]),
-        base_frames=tuple(settings["base_frames"]),
-        stamp=settings["stamp"],
-        status_timeout=float(settings["status_timeout"]),
-        plan_topic=settings["plan_topic"] or None,
-        use_tf=bool(settings["use_tf"]),
-    )
+    try:
+        navigator = Ros1Navigator(
+            action=str(settings["action"]),
+            base_frames=tuple(settings["base_frames"]),
+            stamp=settings["stamp"],
+            status_timeout=float(settings["status_timeout"]),
+            plan_topic=settings["plan_topic"] or None,
+            use_tf=bool(settings["use_tf"]),
+            settle=float(settings["settle"]),
+            odom_frame=str(settings["odom_frame"]),
+        )
+    except (NavseqError, TypeError, ValueError) as error:
+        rospy.logerr("navseq: bad node parameter (param ~): %s", error)
+        return 2
     operator = OperatorNavigator(navigator, stop_reason=ShutdownWatch())
     topics = MissionTopics(mission)
     control = MissionControl()
@@ -257,7 +195,9 @@ def run_node() -> int:
     try:
         rospy.loginfo(
             "navseq: %d waypoints from %s; waiting for %s",
-            len(mission), mission.source, navigator.resolved_action,
+            len(mission),
+            mission.source,
+            navigator.resolved_action,
         )
         navigator.require_server(float(settings["server_wait"]))
         result = run_mission(

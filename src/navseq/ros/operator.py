@@ -148,6 +148,11 @@ class OperatorNavigator:
     def robot_pose(self) -> Pose2D | None:
         return self.inner.robot_pose()
 
+    def odometry_pose(self) -> Pose2D | None:
+        """The inner navigator's odometry-frame pose; None where it has no such thing."""
+        odometry = getattr(self.inner, "odometry_pose", None)
+        return odometry() if callable(odometry) else None
+
     def poll(self) -> list[NavEvent]:
         while True:
             try:

@@ -3,7 +3,8 @@
 Click RViz's "2D Nav Goal" (``/move_base_simple/goal``, geometry_msgs/PoseStamped) or
 "2D Pose Estimate" (``/initialpose``, geometry_msgs/PoseWithCovarianceStamped) where the
 robot should go, or drive the robot there and call the ``~record`` service (with
-``from_tf``) to take its current TF pose. After **every** waypoint the whole mission is
+``from_tf``) to take its current TF pose. Positions are recorded to the millimetre and
+yaws to the tenth of a degree. After **every** waypoint the whole mission is
 written again (atomically: temporary file + rename), so Ctrl-C, a crash or a power cut
 never loses what was recorded, and the file is always a valid navseq mission.
 
@@ -31,6 +32,16 @@ from navseq.geometry import Pose2D
 
 DEFAULT_TOPIC = "/move_base_simple/goal"
 NODE_NAME = "navseq_record"
+
+
+def rounded_pose(pose: Pose2D) -> Pose2D:
+    """A recorded pose to the millimetre and the tenth of a degree.
+
+    TF and clicked poses carry noise far below what a robot reaches
+    (``x: -1.8739253890256067``); the file should read like one a person wrote.
+    """
+    yaw = math.radians(round(math.degrees(pose.yaw), 1))
+    return Pose2D(round(pose.x, 3) + 0.0, round(pose.y, 3) + 0.0, yaw + 0.0)  # no -0.0
 
 
 class WaypointRecorder:
@@ -71,9 +82,7 @@ class WaypointRecorder:
                 )
             self._frame = frame
             self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw=pose.yaw, z=z))
-            mission = Mission(
-                waypoints=tuple(self._waypoints), frame=frame, source=str(self.out)
-            )
+            mission = Mission(waypoints=tuple(self._waypoints), frame=frame, source=str(self.out))
             # The first write may replace a user's file only when asked; later ones
             # replace the file we wrote ourselves.
             write_mission(mission, self.out, overwrite=self._may_replace)
@@ -118,6 +127,7 @@ def record_main(
         return 2
 
     def record(pose: Pose2D, pose_frame: str, z: float, origin: str) -> str:
+        pose, z = rounded_pose(pose), round(z, 3)
         try:
             count = recorder.add(pose, pose_frame, z)
         except NavseqError as error:
@@ -134,8 +144,8 @@ def record_main(
         pose = message.pose.pose if hasattr(message.pose, "covariance") else message.pose
         record(pose2d_from_pose(pose), message.header.frame_id, pose.position.z, topic)
 
-    message_type = PoseWithCovarianceStamped if topic.rstrip("/").endswith("initialpose") else (
-        PoseStamped
+    message_type = (
+        PoseWithCovarianceStamped if topic.rstrip("/").endswith("initialpose") else (PoseStamped)
     )
     rospy.Subscriber(topic, message_type, on_pose, queue_size=10)
 
@@ -159,7 +169,9 @@ def record_main(
 
     rospy.loginfo(
         "navseq record: recording %s%s into %s; Ctrl-C to stop",
-        topic, " and ~record (TF)" if from_tf else "", recorder.out,
+        topic,
+        " and ~record (TF)" if from_tf else "",
+        recorder.out,
     )
     print("navseq record: ready", flush=True)
 
@@ -190,13 +202,15 @@ def record_main(
 def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("out", type=Path, help="mission file to write (navseq YAML)")
     parser.add_argument(
-        "--topic", default=DEFAULT_TOPIC,
+        "--topic",
+        default=DEFAULT_TOPIC,
         help="pose topic: PoseStamped, or PoseWithCovarianceStamped for */initialpose "
         f"(default {DEFAULT_TOPIC})",
     )
     parser.add_argument("--force", action="store_true", help="replace an existing file")
     parser.add_argument(
-        "--from-tf", action="store_true",
+        "--from-tf",
+        action="store_true",
         help="also offer the ~record service that records the robot's current TF pose",
     )
     parser.add_argument("--base-frame", default="base_footprint")
@@ -205,8 +219,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     return record_main(
-        args.out, args.topic, overwrite=args.force, from_tf=args.from_tf,
-        base_frame=args.base_frame, frame=args.frame,
+        args.out,
+        args.topic,
+        overwrite=args.force,
+        from_tf=args.from_tf,
+        base_frame=args.base_frame,
+        frame=args.frame,
     )
 
 

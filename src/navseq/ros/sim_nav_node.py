@@ -22,7 +22,17 @@ Interface (names relative to the node's namespace, as with move_base):
 - services ``move_base/make_plan`` (``nav_msgs/GetPlan``; an empty start frame means
   "from the robot's pose", as in move_base) and ``move_base/clear_costmaps``
   (``std_srvs/Empty``);
+- ``move_base/local_costmap/footprint`` (``geometry_msgs/PolygonStamped``): the robot's
+  outline placed at its pose in the global frame, as costmap_2d publishes it, so one
+  RViz config shows the footprint on this stand-in and on a real move_base;
 - publishes ``cmd_vel`` (``geometry_msgs/Twist``) for the robot, zero when a goal ends.
+
+For tests, ``~race_window`` (s of wall time, default 0 = off) reproduces move_base's
+SUCCEEDED race (ros-planning/navigation #949): a goal that arrives within that window
+after the previous goal's result ends SUCCEEDED at once, with the robot wherever it is
+(with probability ``~race_probability``, default 1). move_base applies a plan still
+being computed for the previous goal to the new one; a client that sends its next goal
+a few milliseconds after a result triggers it.
 
 It knows the robot only through ROS: its pose from TF (``~global_frame`` ->
 ``~base_frame``) and its velocity from ``odom``, so it drives navseq's sim robot node,
@@ -43,14 +53,16 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import random
 import sys
+import time
 from collections.abc import Callable
 
 import actionlib
 import numpy as np
 import rospy
 import tf2_ros
-from geometry_msgs.msg import PoseStamped, Twist
+from geometry_msgs.msg import Point32, PolygonStamped, PoseStamped, Twist
 from move_base_msgs.msg import (
     MoveBaseAction,
     MoveBaseActionGoal,
@@ -82,6 +94,8 @@ from navseq.sim.planner import Plan
 ACTION = "move_base"
 PLAN_TOPIC = f"{ACTION}/NavfnROS/plan"
 COSTMAP_TOPIC = f"{ACTION}/global_costmap/costmap"
+FOOTPRINT_TOPIC = f"{ACTION}/local_costmap/footprint"
+FOOTPRINT_PERIOD = 0.2  # s of ROS time between two footprint messages (RViz needs no more)
 COSTMAP_PERIOD = 1.0  # s of ROS time at least between two costmap messages (they are big)
 
 
@@ -140,6 +154,8 @@ class NavNodeConfig:
     costmap: CostmapParams
     nav: NavParams
     other_robots: tuple[str, ...]
+    race_window: float = 0.0
+    race_probability: float = 1.0
 
     @classmethod
     def from_params(cls) -> NavNodeConfig:
@@ -168,10 +184,18 @@ class NavNodeConfig:
                 yaw_tolerance=float_param("yaw_goal_tolerance", nav_defaults.yaw_tolerance),
             ),
             other_robots=other_robots_param(base_frame),
+            race_window=float_param("race_window", 0.0),
+            race_probability=float_param("race_probability", 1.0),
         )
         for name in ("controller_frequency", "feedback_rate", "pose_timeout"):
             if not getattr(config, name) > 0:
                 raise param_error(name, f"must be a positive number, got {getattr(config, name)}")
+        if not config.race_window >= 0:
+            raise param_error("race_window", f"must be >= 0 s, got {config.race_window}")
+        if not 0.0 <= config.race_probability <= 1.0:
+            raise param_error(
+                "race_probability", f"must be between 0 and 1, got {config.race_probability}"
+            )
         return config
 
 
@@ -206,6 +230,8 @@ class SimNavNode:
         self._last_step: rospy.Time | None = None
         self._last_feedback = rospy.Time(0)
         self._pose_missing_since: rospy.Time | None = None
+        self._last_result_wall: float | None = None  # when the last goal ended (race option)
+        self._last_footprint = rospy.Time(0)
 
         self._tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(10.0))
         self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
@@ -221,6 +247,7 @@ class SimNavNode:
         )
         self._cmd_pub = rospy.Publisher("cmd_vel", Twist, queue_size=10)
         self._plan_pub = rospy.Publisher(PLAN_TOPIC, Path, queue_size=1, latch=True)
+        self._footprint_pub = rospy.Publisher(FOOTPRINT_TOPIC, PolygonStamped, queue_size=1)
         self._simple_goal_pub = rospy.Publisher(f"{ACTION}/goal", MoveBaseActionGoal, queue_size=10)
         self._goal_ids = actionlib.GoalIDGenerator()
         self._costmap_pub = None
@@ -295,6 +322,7 @@ class SimNavNode:
     # -- action server callbacks (called with the action server lock held) ---------------
 
     def _on_goal(self) -> None:
+        idle = self._goal is None  # no goal was active: this one follows a result
         goal: MoveBaseGoal | None = self._as.accept_new_goal()
         if goal is None:
             return
@@ -305,6 +333,17 @@ class SimNavNode:
             return
         if self._as.is_preempt_requested():
             self._finish(lambda: self._as.set_preempted(MoveBaseResult(), "canceled at once"))
+            return
+        if idle and self._race_strikes():
+            pose = self.robot_pose()
+            away = math.hypot(target.x - pose.x, target.y - pose.y) if pose else float("nan")
+            rospy.logwarn(
+                "race (~race_window): goal (%.2f, %.2f) SUCCEEDED at once, robot %.2f m away",
+                target.x,
+                target.y,
+                away,
+            )
+            self._finish(lambda: self._as.set_succeeded(MoveBaseResult(), "goal reached"))
             return
         rospy.loginfo("new goal (%.2f, %.2f, %.2f rad)", target.x, target.y, target.yaw)
         self._goal = target
@@ -318,12 +357,21 @@ class SimNavNode:
         rospy.loginfo("goal canceled")
         self._finish(lambda: self._as.set_preempted(MoveBaseResult(), "canceled by the client"))
 
+    def _race_strikes(self) -> bool:
+        """The test option ``~race_window`` makes this goal inherit the last one's success."""
+        window = self.config.race_window
+        last = self._last_result_wall
+        if window <= 0 or last is None or time.monotonic() - last > window:
+            return False
+        return random.random() < self.config.race_probability
+
     def _finish(self, report: Callable[[], None]) -> None:
         """End the active goal: stop the server and the robot, then tell the client."""
         self.server.cancel()
         self._goal = None
         self._cmd_pub.publish(Twist())
         report()
+        self._last_result_wall = time.monotonic()
 
     # -- topics and services ----------------------------------------------------------------
 
@@ -386,6 +434,8 @@ class SimNavNode:
         others = self._others.poses() if self._others is not None else None
         now = rospy.Time.now()
         self._publish_costmap_if_new(now)
+        if pose is not None:
+            self._publish_footprint(pose, now)
         with self._lock:
             if others is not None:
                 self.server.set_other_robots(others)
@@ -438,6 +488,19 @@ class SimNavNode:
         feedback.base_position.header.stamp = now
         feedback.base_position.pose = pose_from_pose2d(pose)
         self._as.publish_feedback(feedback)
+
+    def _publish_footprint(self, pose: Pose2D, now: rospy.Time) -> None:
+        """The outline at the robot's pose, global frame: what costmap_2d publishes."""
+        if now >= self._last_footprint and (now - self._last_footprint).to_sec() < FOOTPRINT_PERIOD:
+            return
+        self._last_footprint = now
+        polygon = PolygonStamped()
+        polygon.header.frame_id = self.config.global_frame
+        polygon.header.stamp = now
+        polygon.polygon.points = [
+            Point32(x=float(x), y=float(y), z=0.0) for x, y in self.server.footprint.at(pose)
+        ]
+        self._footprint_pub.publish(polygon)
 
     def _publish_plan_if_new(self, now: rospy.Time) -> None:
         if self.server.plan_version == self._published_plan_version:

@@ -316,9 +316,7 @@ def main(argv: list[str] | None = None) -> int:
         node.base.pose.yaw,
         f"map {node.config.map_yaml}" if node.config.map_yaml else "map from topic",
         node.speed,
-        f", other robots {', '.join(node.config.other_robots)}"
-        if node.config.other_robots
-        else "",
+        f", other robots {', '.join(node.config.other_robots)}" if node.config.other_robots else "",
     )
     node.spin()
     return 0

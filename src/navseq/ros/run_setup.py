@@ -1,0 +1,60 @@
+"""``navseq run --navigator ros1``: connect to the navigation stack before the mission.
+
+Everything that needs the running stack is done here, before the robot moves and before
+any file is written, so a problem is one clear :class:`NavseqError` (exit 2): the
+action server must answer, the stack's clock must run (see
+:meth:`Ros1Navigator.wait_for_server`), and, unless the user named a robot, the robot
+profile is read from move_base's parameters (:func:`navstack_robot`). The mission's
+markers and status topics are set up as the navseq node's are (:class:`MissionTopics`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from navseq.mission.model import Mission
+from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.navigators.ros1 import DEFAULT_SETTLE, Ros1Navigator
+from navseq.ros.mission_topics import MissionTopics, run_topics_namespace
+from navseq.ros.navstack_params import read_navstack_profile
+
+SERVER_WAIT = 30.0  # s of wall time for the action server, as the navseq node waits
+
+
+@dataclass
+class Ros1Connection:
+    """A navigator whose server answered, the robot it drives, and the mission's topics."""
+
+    navigator: Ros1Navigator
+    topics: MissionTopics
+    robot: RobotProfile | None  # None: the user named the robot; nothing was read
+    robot_note: str | None  # what was read from the stack, one line, for stderr
+
+
+def navstack_robot(
+    navigator: Ros1Navigator, base: RobotProfile = DEFAULT_PROFILE
+) -> tuple[RobotProfile, str]:
+    """The robot profile the running move_base is configured for, and a note saying so."""
+    return read_navstack_profile(navigator.resolved_action, base)
+
+
+def connect_for_run(
+    mission: Mission,
+    *,
+    action: str,
+    frame: str | None,
+    namespace: str,
+    settle: float = DEFAULT_SETTLE,
+    read_robot: bool = True,
+    server_wait: float = SERVER_WAIT,
+) -> Ros1Connection:
+    """Find the server (and its clock), read the robot, set up markers; or NavseqError."""
+    navigator = Ros1Navigator(action, frame, namespace=namespace, settle=settle)
+    try:
+        navigator.require_server(server_wait)
+        robot, note = navstack_robot(navigator) if read_robot else (None, None)
+        topics = MissionTopics(mission, run_topics_namespace(namespace))
+    except BaseException:
+        navigator.close()
+        raise
+    return Ros1Connection(navigator, topics, robot, note)
