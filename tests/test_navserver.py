@@ -12,7 +12,14 @@ import pytest
 from navseq.geometry import Pose2D, normalize_angle
 from navseq.sim.costmap import Costmap, CostmapParams
 from navseq.sim.footprint import TURTLEBOT3_BURGER, footprint_collides
-from navseq.sim.navserver import NavigationServer, NavParams, NavState
+from navseq.sim.navserver import (
+    CONTROL_FAILED,
+    PLAN_FAILED,
+    RECOVERY_BEHAVIOURS,
+    NavigationServer,
+    NavParams,
+    NavState,
+)
 from navseq.sim.occupancy import OccupancyGrid, load_map
 from navseq.sim.robot import DiffDriveRobot
 
@@ -33,9 +40,7 @@ def boxed_grid(size_m: float = 4.0) -> OccupancyGrid:
     return OccupancyGrid(data, 0.05, Pose2D(-size_m / 2, -size_m / 2))
 
 
-def run(
-    server: NavigationServer, robot: DiffDriveRobot, seconds: float = 120.0
-) -> list[Pose2D]:
+def run(server: NavigationServer, robot: DiffDriveRobot, seconds: float = 120.0) -> list[Pose2D]:
     """Drive until the goal is no longer ACTIVE; the poses visited. Fails if it never ends."""
     poses = [robot.pose]
     for _ in range(round(seconds / DT)):
@@ -109,20 +114,26 @@ def test_goal_that_cannot_be_planned_to_aborts_at_once(
     assert server.make_plan(Pose2D(-2.0, -0.5, 0.0), goal) is None
 
 
-def test_unreachable_goal_aborts() -> None:
+def test_unreachable_goal_aborts_after_the_recovery_behaviours() -> None:
     grid = boxed_grid()
     grid.data[:, 40] = 100  # a wall splitting the room in two
     server = NavigationServer(Costmap.from_grid(grid))
     server.set_goal(Pose2D(1.0, 0.0))
-    assert server.compute_velocity(Pose2D(-1.0, 0.0, 0.0), 0.0, 0.0, DT) == (0.0, 0.0)
+    robot = DiffDriveRobot(Pose2D(-1.0, 0.0, 0.0))
+    poses = run(server, robot, seconds=30.0)
     assert server.state is NavState.ABORTED
+    # move_base's words, then why.
+    assert server.status_text.startswith(PLAN_FAILED)
     assert "unreachable" in server.status_text
+    assert server.recoveries_run == len(RECOVERY_BEHAVIOURS)
+    assert poses[-1].distance_to(poses[0]) < 0.3  # it only turned and backed up a little
 
 
 def test_aborts_rather_than_turn_its_corners_into_a_wall() -> None:
     """Facing along a wall 12 cm away, a half turn would swing the rear corners into it.
 
-    The server tries the long way round and creeping along the wall, then gives up.
+    The server tries the long way round, creeping along the wall and its recovery
+    behaviours, then gives up with move_base's text.
     """
     grid = boxed_grid()
     wall_row, _ = grid.world_to_cell(0.0, 0.2)
@@ -131,10 +142,11 @@ def test_aborts_rather_than_turn_its_corners_into_a_wall() -> None:
     robot = DiffDriveRobot(Pose2D(0.0, 0.08, 0.0))
     assert not footprint_collides(grid, TURTLEBOT3_BURGER, robot.pose)
     server = NavigationServer(costmap)
-    server.set_goal(Pose2D(-1.5, 0.08, math.pi))
+    server.set_goal(Pose2D(-1.5, -0.5, math.pi))
     poses = run(server, robot)
     assert server.state is NavState.ABORTED
-    assert server.status_text.startswith("stopped:")
+    assert server.status_text.startswith(CONTROL_FAILED)
+    assert server.recoveries_run >= len(RECOVERY_BEHAVIOURS)
     # The robot stopped short of the wall: every pose it passed through, and the pose
     # where it comes to rest after the abort, are collision free.
     for _ in range(40):
