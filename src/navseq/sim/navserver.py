@@ -8,9 +8,10 @@ Life of a goal (``state``): :meth:`set_goal` makes it ACTIVE (replacing any othe
 the first control step plans on the costmap. It ends
 
 - SUCCEEDED when the controller has the robot within the xy and yaw tolerances;
-- ABORTED at once when the goal is off the map or not free (nothing the robot does
-  changes that);
-- otherwise, when no plan exists from where the robot is, or the next step could not
+- ABORTED at once when the goal is off the map or not free, or no way on the map leads
+  there from a robot that stands where it can turn (nothing the robot does changes that);
+- otherwise, when no plan exists from where the robot is (it stopped where it cannot
+  turn, and no free cell is near), or the next step could not
   be taken without the footprint touching an obstacle and no evasive move (turning the
   other way, creeping forward or back) is safe either, or evading has not brought the
   robot 0.2 m closer within ``blocked_patience`` seconds, the server runs move_base's
@@ -111,7 +112,7 @@ class NavParams(ControllerParams):
     robot_replan_period: float = 1.0  # s between replans while another robot blocks the way
     robot_margin: float = 0.05  # m kept from other robots: they move while this one brakes
     recovery_rotation: float = 2.0 * math.pi  # rad turned in place by the rotate recovery
-    recovery_backup: float = 0.15  # m driven back (or forward) by the back-up recovery
+    recovery_backup: float = 0.3  # m driven back (or forward) by the back-up recovery (Nav2's)
     recovery_rounds: int = 3  # times per goal the behaviours re-arm after real progress
 
 
@@ -397,7 +398,9 @@ class NavigationServer:
                 self._wait_for_robot(on_the_map.length)
                 return False
             why = self._why_no_plan(pose, goal)
-            if self._goal_is_hopeless(goal):
+            if self._goal_is_hopeless(goal) or self.costmap.is_free(pose.x, pose.y):
+                # Nothing the robot can do changes the answer: the goal is ruled out, or
+                # the robot stands where it can turn and the map has no way from there.
                 self._finish(NavState.ABORTED, why)
             else:
                 self._stuck(PLAN_FAILED, why)
@@ -454,6 +457,8 @@ class NavigationServer:
         self._goal_time += dt
         recovery.elapsed += dt
         command: tuple[float, float] | None = None
+        if recovery.kind == "rotate" and recovery.elapsed == dt and not self._can_turn_round(pose):
+            recovery.left = 0.0  # as move_base's rotate recovery: only a turn that is clear
         if recovery.kind == "rotate":
             speed = min(self.params.rotate_speed, self.params.limits.max_w)
             recovery.left -= abs(w) * dt
@@ -470,10 +475,23 @@ class NavigationServer:
             self.clear_costmaps()
         if command is not None:
             return command
+        if v != 0.0 or w != 0.0:
+            recovery.left = 0.0
+            return 0.0, 0.0  # done: come to rest before planning again
         self._recovery = None
         self._needs_plan = True
         self._blocked_since = None
         return 0.0, 0.0
+
+    def _can_turn_round(self, pose: Pose2D) -> bool:
+        """True if the footprint clears the map at every heading, turning in place here."""
+        if self._clearance_at(pose.x, pose.y) > self.footprint.circumscribed_radius + 0.1:
+            return True
+        grid, footprint = self.costmap.grid, self.footprint
+        return not any(
+            footprint_collides(grid, footprint, Pose2D(pose.x, pose.y, pose.yaw + k * math.pi / 16))
+            for k in range(1, 32)
+        )
 
     def _first_safe(
         self,
