@@ -23,8 +23,9 @@ Columns:
   executor's stall measure compared a straight-line distance with one along the plan;
 - trapped: missions after which the robot, sent back to its start, cannot get there;
 - collisions: moves the simulated body refused (should be 0: the server stops first);
-- efficiency: distance driven / length of the plan from where the leg began (1 = the
-  plan exactly; median and max over reached waypoints with a plan over 0.5 m).
+- efficiency: time to reach a waypoint / (length of the plan from where the leg began
+  / top speed), as in bench_sim.py (1 = driving the plan at top speed all the way;
+  median and max over reached waypoints with a plan over 0.5 m).
 
 Targets: no false stall, no trapped robot, every accepted waypoint reached.
 """
@@ -169,7 +170,8 @@ def run_one(
             if leg_start is not None:
                 plan = plan_path(costmap, (leg_start.x, leg_start.y), (goal.x, goal.y))
                 if plan is not None and plan.length > 0.5:
-                    stats.efficiency.append(visit.distance_driven / plan.length)
+                    bound = plan.length / sim.profile.max_linear_speed
+                    stats.efficiency.append(visit.duration / bound)
             leg_start = goal
         else:
             failed = True

@@ -57,8 +57,8 @@ class _Canvas:
 def office_map(seed: int) -> OccupancyGrid:
     """About 16 m x 12 m: a corridor across the middle, rooms above and below it.
 
-    Door widths are drawn from 0.2 .. 1.0 m, so some rooms can only be entered by a
-    robot that does not need to turn in the doorway, and some by none; passages
+    Door widths are drawn from 0.25 .. 1.0 m (one in four narrower than a TurtleBot3
+    burger's turning circle, 0.3 m), so some rooms are out of reach; passages
     between neighbouring rooms are 0.2 .. 0.6 m wide.
     """
     rng = np.random.default_rng(seed)
@@ -77,7 +77,7 @@ def office_map(seed: int) -> OccupancyGrid:
             room = float(rng.uniform(2.5, 4.5))
             room = min(room, width - x)
             walls.append(x + room)
-            door = float(rng.choice([0.2, 0.25, 0.3, 0.45, 0.6, 0.8, 1.0]))
+            door = float(rng.choice([0.25, 0.3, 0.45, 0.6, 0.7, 0.8, 0.9, 1.0]))
             door_at = x + float(rng.uniform(0.4, max(room - door - 0.4, 0.5)))
             canvas.clear(door_at, y_wall, door_at + door, y_wall + WALL)
             # Furniture: a desk somewhere in the room, away from the door.
