@@ -212,7 +212,8 @@ def _distances(blocked: np.ndarray, resolution: float) -> tuple[np.ndarray, np.n
         infinite = np.full(blocked.shape, np.inf)
         return infinite, infinite
     distance, (near_rows, near_cols) = ndimage.distance_transform_edt(~blocked, return_indices=True)
-    rows, cols = np.indices(blocked.shape)
+    rows = np.arange(blocked.shape[0])[:, np.newaxis]  # broadcast: no full index arrays
+    cols = np.arange(blocked.shape[1])[np.newaxis, :]
     d_row = np.maximum(np.abs(near_rows - rows) - 0.5, 0.0)
     d_col = np.maximum(np.abs(near_cols - cols) - 0.5, 0.0)
     to_square = np.hypot(d_row, d_col)
