@@ -73,7 +73,7 @@ def mission_of(points: list[tuple[float, float]], start: Pose2D | None = None) -
 
 # -- the planner, pre-flight and the simulator use the real footprint --------------------
 
-NARROW = (0.35, 0.60)  # 0.25 m: wider than the burger (0.21 m) but not its turning circle
+NARROW = (0.85, 1.10)  # 0.25 m: wider than the burger (0.21 m) but not its turning circle
 
 
 def test_a_gap_the_robot_cannot_turn_in_is_planned_around_and_never_traps_it() -> None:
@@ -81,7 +81,7 @@ def test_a_gap_the_robot_cannot_turn_in_is_planned_around_and_never_traps_it() -
     through it would leave the robot unable to turn (move_base on Nav2's maps got stuck
     for good). The plan takes the 1 m door, and the robot gets there."""
     grid = wall_with_gaps([NARROW, (2.0, 2.9)])
-    start, goal = Pose2D(1.0, 0.5, 0.0), Pose2D(5.0, 0.5, 0.0)
+    start, goal = Pose2D(1.0, 0.975, 0.0), Pose2D(5.0, 0.975, 0.0)
     world = world_for(grid, start, TURTLEBOT3_BURGER)
     plan = world.server.make_plan(start, goal)
     assert plan is not None
@@ -94,7 +94,7 @@ def test_a_gap_the_robot_cannot_turn_in_is_planned_around_and_never_traps_it() -
 
 def test_with_only_a_narrow_gap_preflight_says_unreachable_and_the_robot_is_not_stuck() -> None:
     grid = wall_with_gaps([NARROW])
-    start, goal = Pose2D(1.0, 0.5, 0.0), Pose2D(5.0, 0.5, 0.0)
+    start, goal = Pose2D(1.0, 0.975, 0.0), Pose2D(5.0, 0.975, 0.0)
     world = world_for(grid, start, TURTLEBOT3_BURGER)
     (problem,) = check_mission(mission_of([(goal.x, goal.y)], start), world.costmap)
     assert "cannot be reached from the start pose" in str(problem)
@@ -111,7 +111,7 @@ def test_with_only_a_narrow_gap_preflight_says_unreachable_and_the_robot_is_not_
 
 def test_a_waffle_refuses_a_gap_the_burger_passes() -> None:
     grid = wall_with_gaps([(0.3, 0.75)])  # 0.45 m
-    start, goal = Pose2D(1.0, 0.5, 0.0), Pose2D(5.0, 0.5, 0.0)
+    start, goal = Pose2D(1.0, 0.975, 0.0), Pose2D(5.0, 0.975, 0.0)
     mission = mission_of([(goal.x, goal.y)], start)
     burger = world_for(grid, start, TURTLEBOT3_BURGER)
     assert check_mission(mission, burger.costmap, robot=TURTLEBOT3_BURGER) == []
