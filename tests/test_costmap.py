@@ -73,7 +73,10 @@ def test_bands_lethal_inscribed_decay_free() -> None:
     assert costs[-1] > FREE  # exactly 1.0 m away: still inflated
     assert costmap.cost_at(x0 + 1.05, y0) == FREE
     assert not costmap.is_free(x0 + 0.10, y0)
-    assert costmap.is_free(x0 + 0.15, y0)
+    # Traversable only where the burger's corners (0.148 m out) clear the obstacle's
+    # square: 0.15 m from its centre is 0.125 m from its edge, 0.20 m is 0.175 m.
+    assert not costmap.is_free(x0 + 0.15, y0)
+    assert costmap.is_free(x0 + 0.20, y0)
 
 
 def test_unknown_is_lethal_by_default() -> None:

@@ -12,7 +12,13 @@ import pytest
 from navseq.geometry import Pose2D, normalize_angle
 from navseq.sim.costmap import Costmap, CostmapParams
 from navseq.sim.footprint import TURTLEBOT3_BURGER, footprint_collides
-from navseq.sim.navserver import NavigationServer, NavParams, NavState
+from navseq.sim.navserver import (
+    PLAN_FAILED,
+    RECOVERY_BEHAVIOURS,
+    NavigationServer,
+    NavParams,
+    NavState,
+)
 from navseq.sim.occupancy import OccupancyGrid, load_map
 from navseq.sim.robot import DiffDriveRobot
 
@@ -33,9 +39,7 @@ def boxed_grid(size_m: float = 4.0) -> OccupancyGrid:
     return OccupancyGrid(data, 0.05, Pose2D(-size_m / 2, -size_m / 2))
 
 
-def run(
-    server: NavigationServer, robot: DiffDriveRobot, seconds: float = 120.0
-) -> list[Pose2D]:
+def run(server: NavigationServer, robot: DiffDriveRobot, seconds: float = 120.0) -> list[Pose2D]:
     """Drive until the goal is no longer ACTIVE; the poses visited. Fails if it never ends."""
     poses = [robot.pose]
     for _ in range(round(seconds / DT)):
@@ -109,7 +113,7 @@ def test_goal_that_cannot_be_planned_to_aborts_at_once(
     assert server.make_plan(Pose2D(-2.0, -0.5, 0.0), goal) is None
 
 
-def test_unreachable_goal_aborts() -> None:
+def test_unreachable_goal_aborts_at_once() -> None:
     grid = boxed_grid()
     grid.data[:, 40] = 100  # a wall splitting the room in two
     server = NavigationServer(Costmap.from_grid(grid))
@@ -117,13 +121,52 @@ def test_unreachable_goal_aborts() -> None:
     assert server.compute_velocity(Pose2D(-1.0, 0.0, 0.0), 0.0, 0.0, DT) == (0.0, 0.0)
     assert server.state is NavState.ABORTED
     assert "unreachable" in server.status_text
+    assert server.recoveries_run == 0  # no move of the robot can open a way
 
 
-def test_aborts_rather_than_turn_its_corners_into_a_wall() -> None:
-    """Facing along a wall 12 cm away, a half turn would swing the rear corners into it.
+def test_backs_out_of_a_dead_end_it_cannot_turn_in() -> None:
+    """A burger 0.3 m deep in a 0.25 m wide dead end, facing its end: it can drive but
+    not turn there, and no cell near it is one to plan from. Like move_base's recovery
+    behaviours, the server backs up, plans, and gets out."""
+    grid = boxed_grid()  # cell (row, col) spans x in [-2 + col / 20, ...), y likewise
+    grid.data[36, 60:] = 100  # a niche from x = 1.0 m to the east wall, y in [-0.15, 0.1)
+    grid.data[42, 60:] = 100
+    costmap = Costmap.from_grid(grid)
+    start = Pose2D(1.3, -0.025, 0.0)
+    assert not footprint_collides(grid, TURTLEBOT3_BURGER, start)
+    assert not costmap.is_free(start.x, start.y)
+    server = NavigationServer(costmap)
+    robot = DiffDriveRobot(start)
+    goal = Pose2D(-1.0, 0.0, math.pi)
+    server.set_goal(goal)
+    poses = run(server, robot)
+    assert server.state is NavState.SUCCEEDED, server.status_text
+    assert server.recoveries_run >= 1
+    assert not any(footprint_collides(grid, TURTLEBOT3_BURGER, p) for p in poses)
 
-    The server tries the long way round and creeping along the wall, then gives up.
-    """
+
+def test_boxed_in_robot_gives_up_after_the_recovery_behaviours() -> None:
+    """Shut in a box it fits in but cannot turn in: the server tries clearing the
+    costmap, turning (not possible) and backing up, then aborts with move_base's text."""
+    grid = boxed_grid()
+    grid.data[36, 40:49] = grid.data[42, 40:49] = 100  # y in [-0.15, 0.1)
+    grid.data[36:43, 40] = grid.data[36:43, 48] = 100  # x in [0.05, 0.4)
+    start = Pose2D(0.225, -0.025, 0.0)
+    assert not footprint_collides(grid, TURTLEBOT3_BURGER, start)
+    server = NavigationServer(Costmap.from_grid(grid))
+    robot = DiffDriveRobot(start)
+    server.set_goal(Pose2D(-1.0, -1.0, 0.0))
+    poses = run(server, robot, seconds=60.0)
+    assert server.state is NavState.ABORTED
+    assert server.status_text.startswith(PLAN_FAILED)
+    assert server.recoveries_run == len(RECOVERY_BEHAVIOURS)
+    assert not any(footprint_collides(grid, TURTLEBOT3_BURGER, p) for p in poses)
+
+
+def test_never_turns_its_corners_into_a_wall() -> None:
+    """Facing along a wall 12 cm away, a half turn in place would swing the rear corners
+    into it. The server tries the long way round, creeping along the wall and its
+    recovery behaviours, and gets away from the wall without touching it."""
     grid = boxed_grid()
     wall_row, _ = grid.world_to_cell(0.0, 0.2)
     grid.data[wall_row, :] = 100  # wall cells span y in [0.2, 0.25)
@@ -131,16 +174,15 @@ def test_aborts_rather_than_turn_its_corners_into_a_wall() -> None:
     robot = DiffDriveRobot(Pose2D(0.0, 0.08, 0.0))
     assert not footprint_collides(grid, TURTLEBOT3_BURGER, robot.pose)
     server = NavigationServer(costmap)
-    server.set_goal(Pose2D(-1.5, 0.08, math.pi))
+    goal = Pose2D(-1.5, -0.5, math.pi)
+    server.set_goal(goal)
     poses = run(server, robot)
-    assert server.state is NavState.ABORTED
-    assert server.status_text.startswith("stopped:")
-    # The robot stopped short of the wall: every pose it passed through, and the pose
-    # where it comes to rest after the abort, are collision free.
+    assert server.state is NavState.SUCCEEDED, server.status_text
+    assert robot.pose.distance_to(goal) <= 0.05
+    # Every pose it passed through, and where it comes to rest, are collision free.
     for _ in range(40):
         poses.append(robot.step(0.0, 0.0, DT))
     assert not any(footprint_collides(grid, TURTLEBOT3_BURGER, p) for p in poses)
-    assert len(poses) > 41  # it did try to turn before giving up
 
 
 def test_cancel_stops_the_robot() -> None:

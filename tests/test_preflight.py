@@ -10,6 +10,7 @@ import pytest
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Waypoint
+from navseq.mission.robot import TURTLEBOT3_BURGER
 from navseq.preflight import check_mission
 from navseq.sim.costmap import Costmap
 from navseq.sim.occupancy import OccupancyGrid, load_map
@@ -67,7 +68,7 @@ def test_all_problems_are_reported_at_once(arena: Costmap) -> None:
     text = messages(problems)
     assert "inside an obstacle" in text[0] and "(0.20, 0.00)" in text[0]
     assert "outside the map" in text[1] and "(50.00, 3.00)" in text[1]
-    assert "inscribed radius" in text[2] and "(0.27, 0.00)" in text[2]
+    assert "circumscribed radius (0.148 m" in text[2] and "(0.27, 0.00)" in text[2]
     assert "unmapped space" in text[3]
     # Each names the line the user wrote the waypoint on.
     assert [p.source for p in problems] == [
@@ -81,10 +82,16 @@ def test_all_problems_are_reported_at_once(arena: Costmap) -> None:
 def test_too_close_to_a_wall_suggests_a_free_spot(arena: Costmap) -> None:
     problems = check_mission(mission_of([(0.27, 0.0)]), arena)
     assert len(problems) == 1
-    suggestion = str(problems[0]).split("nearest free spot is at ")[1]
-    x, y = (float(v) for v in suggestion.strip("()").split(","))
+    x, y = suggested_spot(problems[0])
     assert arena.is_free(x, y)
-    assert abs(x - 0.27) + abs(y) < 0.1
+    assert arena.clearance_at(x, y) >= TURTLEBOT3_BURGER.circumscribed_radius + 0.02
+    assert abs(x - 0.27) + abs(y) < 0.2
+
+
+def suggested_spot(problem: NavseqError) -> tuple[float, float]:
+    suggestion = str(problem).split("nearest free spot is at ")[1]
+    x, y = (float(v) for v in suggestion.strip("()").split(","))
+    return x, y
 
 
 def test_outside_the_map_says_where_the_map_is(arena: Costmap) -> None:

@@ -4,17 +4,21 @@
 
 - a waypoint off the map;
 - a waypoint inside an obstacle, or in unmapped (unknown) space;
-- a waypoint in the inflated footprint: closer to an obstacle than the robot's
-  inscribed radius (cost ``INSCRIBED``), where the robot centre cannot be;
+- a waypoint where the robot cannot turn: closer to an obstacle, unknown space or the
+  map edge than the footprint's circumscribed radius (the robot stops and turns to the
+  goal's heading at every waypoint, and at the start it turns toward the first one);
 - a waypoint that no path connects to the one before it (or to the start pose, for
   the first waypoint; or to the last waypoint, for the first one of the next round
   when the mission loops);
-- a start pose off the map, in an obstacle or in the inflated footprint.
+- a start pose off the map, where the footprint overlaps something (the exact test the
+  simulated body uses), or where the robot cannot turn.
 
-Reachability uses the connected components of the free region (the cells where the
-robot centre may be, 8-connected as the planner moves), so it costs one labelling of
-the map instead of one plan per leg. Where a waypoint is merely too close to a wall
-the message suggests the nearest free spot.
+Reachability uses the connected components of the cells the planner may cross (those
+that clear every obstacle by the circumscribed radius, 8-connected as the planner
+moves), so it costs one labelling of the map instead of one plan per leg, and agrees
+with the planner on narrow gaps. Where a waypoint is merely too close to a wall the
+message suggests the nearest spot where the robot fits with ``clearance_margin_m`` to
+spare and that is reachable from the place the robot comes from.
 """
 
 from __future__ import annotations
@@ -28,7 +32,10 @@ from scipy import ndimage
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
-from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap
+from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.sim.costmap import LETHAL, NO_INFORMATION, Costmap
+from navseq.sim.footprint import Footprint, footprint_collides
+from navseq.sim.occupancy import OCCUPIED, UNKNOWN, blocked_values
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
 
@@ -39,22 +46,26 @@ def check_mission(
     start: Pose2D | None = None,
     *,
     numbers: Sequence[int] | None = None,
+    robot: RobotProfile | None = None,
 ) -> list[NavseqError]:
     """Every problem that would stop the robot reaching the mission's waypoints.
 
     ``start`` defaults to ``mission.start``. An empty list means the mission is
     feasible on this map (as far as a static map can tell). ``numbers`` are the
     waypoints' indices in the file when ``mission`` is the readable part of a
-    faulty one, so that messages number them as the file does.
+    faulty one, so that messages number them as the file does. ``robot`` (default:
+    the mission's, else the default profile) gives the outline tested at the start and
+    the margin of suggested spots; ``costmap`` must have been built for that robot.
     """
     start = start if start is not None else mission.start
     numbers = range(len(mission.waypoints)) if numbers is None else numbers
-    free = _FreeRegions(costmap)
+    robot = robot or mission.robot or DEFAULT_PROFILE
+    free = _FreeRegions(costmap, robot)
     problems: list[NavseqError] = []
 
     start_region: int | None = None
     if start is not None:
-        problem = _placement_problem(free, start.x, start.y, "the robot cannot start there")
+        problem = _start_problem(free, start)
         if problem:
             position = _format_position(start.x, start.y)
             problems.append(
@@ -70,7 +81,9 @@ def check_mission(
         source = waypoint.where or mission.source
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
-        problem = _placement_problem(free, waypoint.x, waypoint.y, "the robot cannot stop there")
+        problem = _placement_problem(
+            free, waypoint.x, waypoint.y, "the robot cannot turn there", previous_region
+        )
         if problem:
             problems.append(NavseqError(f"{position} {problem}", source=source, subject=subject))
             regions.append(None)
@@ -107,8 +120,27 @@ def check_mission(
     return problems
 
 
-def _placement_problem(free: _FreeRegions, x: float, y: float, consequence: str) -> str | None:
-    """Why the robot centre cannot be at (x, y), or None if it can."""
+def _start_problem(free: _FreeRegions, start: Pose2D) -> str | None:
+    """Why the robot cannot start at ``start``, or None if it can."""
+    problem = _placement_problem(free, start.x, start.y, "the robot cannot turn there", None)
+    costmap = free.costmap
+    if problem is None or costmap.cost_at(start.x, start.y) in (LETHAL, NO_INFORMATION):
+        return problem  # off the map, in an obstacle or in unknown space: said so already
+    if footprint_collides(costmap.grid, free.footprint, start):
+        return (
+            "puts the robot's footprint over an obstacle, unknown space or the map edge: "
+            "the robot cannot be there" + free.nearest_hint(start.x, start.y, None)
+        )
+    return problem
+
+
+def _placement_problem(
+    free: _FreeRegions, x: float, y: float, consequence: str, from_region: int | None
+) -> str | None:
+    """Why the robot centre cannot be at (x, y) and turn there, or None if it can.
+
+    ``from_region``: where the robot comes from, so that a suggested spot is reachable.
+    """
     costmap = free.costmap
     if not costmap.grid.contains(x, y):
         xmin, ymin, xmax, ymax = costmap.grid.bounds
@@ -118,14 +150,16 @@ def _placement_problem(free: _FreeRegions, x: float, y: float, consequence: str)
         )
     cost = costmap.cost_at(x, y)
     if cost == LETHAL:
-        return "is inside an obstacle" + free.nearest_hint(x, y)
+        return "is inside an obstacle" + free.nearest_hint(x, y, from_region)
     if cost == NO_INFORMATION:
-        return "is in unmapped space (unknown cells)" + free.nearest_hint(x, y)
-    if cost >= INSCRIBED:
-        radius = costmap.params.inscribed_radius
+        return "is in unmapped space (unknown cells)" + free.nearest_hint(x, y, from_region)
+    clearance = free.clearance_at(x, y)
+    radius = costmap.params.circumscribed_radius
+    if clearance < radius or not costmap.is_free(x, y):
         return (
-            f"is within the robot's inscribed radius ({radius:.3f} m) of an obstacle: "
-            f"{consequence}" + free.nearest_hint(x, y)
+            f"is {clearance:.3f} m from an obstacle, unknown space or the map edge, within "
+            f"the robot's circumscribed radius ({radius:.3f} m, {free.robot.name}): "
+            f"{consequence}" + free.nearest_hint(x, y, from_region)
         )
     return None
 
@@ -136,26 +170,67 @@ def _format_position(x: float, y: float) -> str:
 
 @dataclass
 class _FreeRegions:
-    """Connected components of the cells where the robot centre may be."""
+    """Connected components of the cells the planner may cross, and the robot's room."""
 
     costmap: Costmap
+    robot: RobotProfile
 
     def __post_init__(self) -> None:
         self.free = self.costmap.free_mask()
         self.labels, _ = ndimage.label(self.free, structure=_EIGHT_CONNECTED)
-        self._free_cells: np.ndarray | None = None
+        self.footprint = Footprint(np.array(self.robot.footprint, dtype=float))
+        # Where a suggested spot may be: room to turn, with the margin to spare.
+        roomy = self.costmap.params.circumscribed_radius + self.robot.clearance_margin_m
+        self._roomy_cells = np.argwhere(self.free & (self.costmap.clearance >= roomy))
 
     def region_at(self, x: float, y: float) -> int:
         row, col = self.costmap.world_to_cell(x, y)
         return int(self.labels[row, col])
 
-    def nearest_hint(self, x: float, y: float) -> str:
-        """``"; the nearest free spot is at (x, y)"`` or an empty string."""
-        if self._free_cells is None:
-            self._free_cells = np.argwhere(self.free)
-        if len(self._free_cells) == 0:
-            return "; the map has no free space at all"
+    def clearance_at(self, x: float, y: float) -> float:
+        """Metres from (x, y) to the nearest blocked cell or the map edge: the smaller of
+        the exact distance from the point and its cell's (the planner's) clearance."""
+        costmap = self.costmap
+        grid = costmap.grid
+        resolution = grid.resolution
+        reach = costmap.params.circumscribed_radius + resolution
+        cell_clearance = costmap.clearance_at(x, y)
+        if cell_clearance > reach + resolution:
+            return cell_clearance  # the point is within half a diagonal of its cell centre
+        gx, gy = grid.world_to_grid(x, y)  # grid units: cell (r, c) spans [c, c+1] x [r, r+1]
+        span = int(np.ceil(reach / resolution)) + 1
+        row, col = int(np.floor(gy)), int(np.floor(gx))
+        top, left = max(row - span, 0), max(col - span, 0)
+        values = grid.data[top : row + span + 1, left : col + span + 1]
+        if costmap.params.unknown_is_lethal:
+            window = blocked_values(values)
+            edge = min(gx, gy, grid.width - gx, grid.height - gy)
+        else:
+            window = (values >= OCCUPIED) | (values < UNKNOWN)
+            edge = np.inf
+        rows, cols = np.nonzero(window)
+        nearest = edge
+        if rows.size:
+            rows, cols = rows + top, cols + left
+            d_col = np.maximum(np.maximum(cols - gx, gx - (cols + 1)), 0.0)
+            d_row = np.maximum(np.maximum(rows - gy, gy - (rows + 1)), 0.0)
+            nearest = min(nearest, float(np.hypot(d_col, d_row).min()))
+        return min(cell_clearance, float(nearest) * resolution)
+
+    def nearest_hint(self, x: float, y: float, from_region: int | None) -> str:
+        """``"; the nearest free spot is at (x, y)"`` or an explanation why there is none.
+
+        The spot leaves the robot room to turn with its clearance margin to spare and,
+        when ``from_region`` is known, is reachable from where the robot comes from.
+        """
+        cells = self._roomy_cells
+        if from_region is not None and len(cells):
+            cells = cells[self.labels[cells[:, 0], cells[:, 1]] == from_region]
+        if len(cells) == 0:
+            if from_region is not None:
+                return "; no spot reachable from the previous pose leaves the robot room to turn"
+            return "; the map has no spot where the robot has room to turn"
         row, col = self.costmap.world_to_cell(x, y)
-        nearest = np.argmin(((self._free_cells - (row, col)) ** 2).sum(axis=1))
-        free_x, free_y = self.costmap.cell_to_world(*self._free_cells[nearest])
+        nearest = np.argmin(((cells - (row, col)) ** 2).sum(axis=1))
+        free_x, free_y = self.costmap.cell_to_world(*cells[nearest])
         return f"; the nearest free spot is {_format_position(free_x, free_y)}"

@@ -14,7 +14,9 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
+    from navseq.sim.occupancy import OccupancyGrid
 
 
 def parse_pose(text: str) -> Pose2D:
@@ -56,21 +58,61 @@ def format_pose(pose: Pose2D) -> str:
 
 
 def preflight_errors(
-    mission: Mission, costmap: Costmap, start: Pose2D | None,
+    mission: Mission,
+    costmap: Costmap,
+    start: Pose2D | None,
     numbers: Sequence[int] | None = None,
+    robot: RobotProfile | None = None,
 ) -> list[NavseqError]:
-    """Every problem of ``mission`` against the map (empty when it is fine to run)."""
+    """Every problem of ``mission`` against the map (empty when it is fine to run).
+
+    ``costmap`` must have been built for ``robot`` (:func:`costmap_for_map`).
+    """
     from navseq.preflight import check_mission
 
-    return check_mission(mission, costmap, start, numbers=numbers)
+    return check_mission(mission, costmap, start, numbers=numbers, robot=robot)
 
 
-def costmap_for_map(map_path: Path) -> Costmap:
-    """The default (TurtleBot3 burger) costmap of a map_server YAML file."""
-    from navseq.sim.costmap import Costmap
+def costmap_for_map(map_path: Path, robot: RobotProfile | None = None) -> Costmap:
+    """The costmap of a map_server YAML file for ``robot`` (default: the default profile)."""
     from navseq.sim.occupancy import load_map
 
-    return Costmap.from_grid(load_map(map_path))
+    return costmap_for_robot(load_map(map_path), robot)
+
+
+def costmap_for_robot(grid: OccupancyGrid, robot: RobotProfile | None = None) -> Costmap:
+    """The grid inflated for ``robot``'s outline and inflation settings."""
+    from navseq.mission.robot import DEFAULT_PROFILE
+    from navseq.sim.costmap import Costmap
+    from navseq.sim.profile import costmap_params_of
+
+    return Costmap.from_grid(grid, costmap_params_of(robot or DEFAULT_PROFILE))
+
+
+def add_robot_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--robot",
+        metavar="NAME|FILE",
+        help="robot profile: a built-in name (turtlebot3_burger, turtlebot3_waffle, "
+        "turtlebot3_waffle_pi) or a YAML file like a mission's robot: section "
+        "(default: the mission's robot:, else turtlebot3_burger)",
+    )
+
+
+def choose_robot(option: str | None, mission: Mission | None) -> RobotProfile:
+    """The robot to plan and check for: ``--robot`` > the mission's ``robot:`` > default.
+
+    ``--robot`` is read here, not by argparse, so that a bad name or file is one
+    NavseqError (exit 2) like every other input problem.
+    """
+    from navseq.mission.robot import DEFAULT_PROFILE
+    from navseq.mission.robot_format import robot_from_option
+
+    if option is not None:
+        return robot_from_option(option)
+    if mission is not None and mission.robot is not None:
+        return mission.robot
+    return DEFAULT_PROFILE
 
 
 def require_file(path: Path, what: str) -> None:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from navseq.commands.common import format_pose, parse_loops, parse_pose
+from navseq.commands.common import add_robot_option, format_pose, parse_loops, parse_pose
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.costmap import Costmap
@@ -92,6 +93,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N|forever",
         help="run the waypoint list N times, or until interrupted (default: the mission's loops:)",
     )
+    add_robot_option(parser)
     ros1 = parser.add_argument_group("ros1 navigator")
     ros1.add_argument(
         "--action", default=None, help="MoveBaseAction server name (default: move_base)"
@@ -122,6 +124,7 @@ class RunSetup:
     digest: str
     make_navigator: Callable[[], Navigator]
     navigator_info: dict[str, Any]
+    robot: RobotProfile  # what pre-flight, the planner and the simulator assume
     start: Pose2D | None = None
     grid: OccupancyGrid | None = None
     map_path: Path | None = None
@@ -164,32 +167,36 @@ def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
     }
 
 
-def _check_against_map(mission: Mission, costmap: Costmap, start: Pose2D | None) -> None:
+def _check_against_map(
+    mission: Mission, costmap: Costmap, start: Pose2D | None, robot: RobotProfile
+) -> None:
     """Pre-flight: every problem of the mission on this map, raised together."""
     from navseq.commands.common import preflight_errors
     from navseq.errors import MissionErrors
 
-    problems = preflight_errors(mission, costmap, start)
+    problems = preflight_errors(mission, costmap, start, robot=robot)
     if problems:
         raise MissionErrors(problems)
 
 
 def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyGrid | None:
     """The map, if one is known, with the mission checked against it."""
-    from navseq.sim.costmap import Costmap
+    from navseq.commands.common import costmap_for_robot
     from navseq.sim.occupancy import load_map
 
     if setup["map_path"] is None:
         return None
     grid = load_map(setup["map_path"])
     if not args.no_preflight:
-        _check_against_map(setup["mission"], Costmap.from_grid(grid), setup["start"])
+        robot = setup["robot"]
+        costmap = costmap_for_robot(grid, robot)
+        _check_against_map(setup["mission"], costmap, setup["start"], robot)
     return grid
 
 
 def prepare(args: argparse.Namespace) -> RunSetup:
     """Load and check the user's input; raise NavseqError on any problem."""
-    from navseq.commands.common import require_file
+    from navseq.commands.common import choose_robot, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
     from navseq.sinks.journal import mission_digest
@@ -226,6 +233,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "history": history,
         "map_path": map_path,
         "start": start,
+        "robot": choose_robot(args.robot, mission),
     }
     if args.navigator == "sim":
         setup = _prepare_sim(args, setup_kwargs)
@@ -334,6 +342,7 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.navigators.sim import SimNavigator
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
+    from navseq.sim.profile import SimSettings
     from navseq.sim.world import SimWorld, default_start
 
     mission: Mission = setup["mission"]
@@ -345,26 +354,31 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
             source=mission.source,
         )
     grid = load_map(map_path)
+    robot: RobotProfile = setup["robot"]
+    settings = SimSettings.of(robot)
     notes = []
     if start is None:
-        start = default_start(grid)
+        start = default_start(grid, settings.footprint)
         setup["start"] = start
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
             f"{format_pose(start)}, the roomy point nearest the map origin"
         )
     # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid)
+    costmap = Costmap.from_grid(grid, settings.costmap_params)
     # Pre-flight first: it lists every problem, where building the world would stop at
     # the first (a start pose inside an obstacle).
     if not args.no_preflight:
-        _check_against_map(mission, costmap, start)
-    world = SimWorld(grid, start, costmap=costmap)
+        _check_against_map(mission, costmap, start, robot)
+    world = SimWorld(
+        grid, start, costmap=costmap, nav_params=settings.nav_params,
+        footprint=settings.footprint,
+    )
     return RunSetup(
         **setup,
         grid=grid,
         make_navigator=lambda: SimNavigator(world),
-        navigator_info={"kind": "sim", "robot": "turtlebot3_burger"},
+        navigator_info={"kind": "sim", "robot": robot.name},
         notes=notes,
     )
 

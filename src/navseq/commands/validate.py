@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from navseq.commands.common import parse_pose
+from navseq.commands.common import add_robot_option, parse_pose
 from navseq.errors import NavseqError
 
 if TYPE_CHECKING:
@@ -35,15 +35,19 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="X,Y,YAW",
         help="start pose to check (metres, metres, degrees; default: the mission's start:)",
     )
+    add_robot_option(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
     from navseq.errors import MissionErrors
     from navseq.mission import inspect_mission_file
+    from navseq.mission.robot_format import robot_from_option
 
     if args.map is not None:
         require_file(args.map, "--map")
+    if args.robot is not None:
+        robot_from_option(args.robot)  # a bad --robot is reported before the mission
     mission, problems = inspect_mission_file(args.mission)
     errors = list(problems.errors)
     if mission is None and problems.salvage is not None:
@@ -59,8 +63,15 @@ def run(args: argparse.Namespace) -> int:
     loops = "forever" if mission.loops is None else str(mission.loops)
     map_path = _map_path(args, mission)
     checked = f"checked against map {map_path}" if map_path is not None else "no map to check"
-    print(f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
-          f"loops {loops}, {checked}", file=sys.stdout)
+    if map_path is not None:
+        from navseq.commands.common import choose_robot
+
+        checked += f" for robot {choose_robot(args.robot, mission).name}"
+    print(
+        f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
+        f"loops {loops}, {checked}",
+        file=sys.stdout,
+    )
     return 0
 
 
@@ -68,17 +79,19 @@ def _map_path(args: argparse.Namespace, mission: Mission) -> Path | None:
     return args.map if args.map is not None else mission.map
 
 
-def _map_problems(args: argparse.Namespace, mission: Mission,
-                  numbers: Sequence[int] | None = None) -> list[NavseqError]:
+def _map_problems(
+    args: argparse.Namespace, mission: Mission, numbers: Sequence[int] | None = None
+) -> list[NavseqError]:
     """The pre-flight problems of ``mission`` on the map given or named, if any."""
-    from navseq.commands.common import costmap_for_map, preflight_errors
+    from navseq.commands.common import choose_robot, costmap_for_map, preflight_errors
 
     map_path = _map_path(args, mission)
     if map_path is None:
         return []
+    robot = choose_robot(args.robot, mission)
     try:
-        costmap = costmap_for_map(map_path)
+        costmap = costmap_for_map(map_path, robot)
     except NavseqError as error:  # an unreadable map is one more problem to list
         return [error]
     start = args.start if args.start is not None else mission.start
-    return preflight_errors(mission, costmap, start, numbers)
+    return preflight_errors(mission, costmap, start, numbers, robot)

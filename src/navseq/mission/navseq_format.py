@@ -32,13 +32,14 @@ from navseq.mission import fields
 from navseq.mission.located import Located, describe
 from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
 from navseq.mission.problems import Problems, Salvage
+from navseq.mission.robot_format import read_robot
 
 FORMAT_VERSION = 1
 FOREVER = "forever"
 DEFAULT_SERVER_TIMEOUT = Mission.__dataclass_fields__["server_timeout"].default
 
-MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout")
-OPTIONAL_SETTINGS = ("map", "start")  # null: none, like leaving the key out
+MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout", "robot")
+OPTIONAL_SETTINGS = ("map", "start", "robot")  # null: none, like leaving the key out
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
 POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
@@ -93,13 +94,15 @@ def read_defaults(node: Located | None, problems: Problems) -> Policy:
 
 
 def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> dict[str, Any]:
-    """The mission-wide keys other than policies: frame, map, start, loops, server_timeout."""
+    """The mission-wide keys other than policies: frame, map, start, loops, server_timeout,
+    robot."""
     readers = {
         "frame": read_frame,
         "map": lambda entry, subject: read_map_path(entry, subject, base_dir),
         "start": read_start,
         "loops": read_loops,
         "server_timeout": read_server_timeout,
+        "robot": read_robot,
     }
     settings: dict[str, Any] = {}
     for key, reader in readers.items():

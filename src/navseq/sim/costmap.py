@@ -18,6 +18,15 @@ as costmap_2d's inflation layer computes them.
 
 Obstacles that are not on the map (other robots) are added with
 :meth:`Costmap.with_obstacles`, like costmap_2d's obstacle layer over the static one.
+
+Where the robot centre may be *for planning* is stricter than the cost bands: a cell
+is traversable only if the circle of ``circumscribed_radius`` about its centre touches
+no blocked cell (obstacle, unknown cell, or — with ``unknown_is_lethal`` — the map edge,
+beyond which nothing is known). That is where the robot can turn in place whatever its
+heading, as navfn on a costmap whose inscribed/circumscribed costs come from the
+footprint: a corridor narrower than the robot's turning circle is not planned through,
+so the robot never drives into a gap it cannot turn in or get out of. ``clearance`` holds,
+per cell, the distance from its centre to the nearest blocked cell's square (m).
 """
 
 from __future__ import annotations
@@ -40,10 +49,19 @@ class CostmapParams:
     inflation_radius: float = 1.0  # m: cells farther than this from an obstacle cost 0
     cost_scaling_factor: float = 3.0  # 1/m: how fast the cost decays with distance
     inscribed_radius: float = 0.105  # m: the footprint's inscribed radius
+    # m: the footprint's circumscribed radius (the burger's corner, 0.148 m); cells with
+    # less clearance are not traversable for planning
+    circumscribed_radius: float = math.hypot(0.105, 0.105)
     unknown_is_lethal: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("inflation_radius", "cost_scaling_factor", "inscribed_radius"):
+        names = (
+            "inflation_radius",
+            "cost_scaling_factor",
+            "inscribed_radius",
+            "circumscribed_radius",
+        )
+        for name in names:
             value = getattr(self, name)
             if not (isinstance(value, int | float) and 0.0 <= value < float("inf")):
                 raise ValueError(f"costmap {name} must be a number >= 0, got {value!r}")
@@ -56,13 +74,25 @@ class Costmap:
     grid: OccupancyGrid
     params: CostmapParams = field(default_factory=CostmapParams)
     cost: np.ndarray = field(default=None)  # type: ignore[assignment]
+    clearance: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         if self.cost is None:
             object.__setattr__(self, "cost", inflate(self.grid, self.params))
-        if self.cost.shape != self.grid.data.shape:
-            raise ValueError("cost array and grid differ in shape")
+        if self.clearance is None:
+            object.__setattr__(self, "clearance", clearance_to_blocked(self.grid, self.params))
+        if self.cost.shape != self.grid.data.shape or self.clearance.shape != self.cost.shape:
+            raise ValueError("cost or clearance array and grid differ in shape")
         self.cost.setflags(write=False)
+        self.clearance.setflags(write=False)
+        traversable = (self.cost < INSCRIBED) & (
+            self.clearance >= np.float32(self.params.circumscribed_radius)
+        )
+        traversable.setflags(write=False)
+        object.__setattr__(self, "_traversable", traversable)
+        planning = np.where(traversable, self.cost, np.uint8(INSCRIBED)).astype(np.uint8)
+        planning.setflags(write=False)
+        object.__setattr__(self, "_planning_cost", planning)
 
     @classmethod
     def from_grid(cls, grid: OccupancyGrid, params: CostmapParams | None = None) -> Costmap:
@@ -86,12 +116,26 @@ class Costmap:
         return int(self.cost[row, col])
 
     def is_free(self, x: float, y: float) -> bool:
-        """True if the robot centre may be at this point (cost below ``INSCRIBED``)."""
-        return self.cost_at(x, y) < INSCRIBED
+        """True if the cell under this point is traversable: the robot, centred there, can
+        turn in place without touching anything (see the module docstring)."""
+        row, col = self.grid.world_to_cell(x, y)
+        return self.grid.in_bounds(row, col) and bool(self._traversable[row, col])
 
     def free_mask(self) -> np.ndarray:
-        """Cells where the robot centre may be."""
-        return self.cost < INSCRIBED
+        """Cells where the planner may put the robot centre (read-only)."""
+        return self._traversable  # type: ignore[attr-defined,no-any-return]
+
+    @property
+    def planning_cost(self) -> np.ndarray:
+        """``cost`` with every cell that is not traversable raised to ``INSCRIBED``."""
+        return self._planning_cost  # type: ignore[attr-defined,no-any-return]
+
+    def clearance_at(self, x: float, y: float) -> float:
+        """The clearance (m) of the cell under a world point; 0 off the map."""
+        row, col = self.grid.world_to_cell(x, y)
+        if not self.grid.in_bounds(row, col):
+            return 0.0
+        return float(self.clearance[row, col])
 
     def with_obstacles(
         self, rows: np.ndarray, cols: np.ndarray, *, padding: float = 0.0
@@ -112,15 +156,19 @@ class Costmap:
         height, width = self.cost.shape
         top, bottom = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
         left, right = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
-        free = np.ones((bottom - top, right - left), dtype=bool)
-        free[rows - top, cols - left] = False
-        distance = ndimage.distance_transform_edt(free) * self.grid.resolution
+        blocked = np.zeros((bottom - top, right - left), dtype=bool)
+        blocked[rows - top, cols - left] = True
+        distance, to_square = _distances(blocked, self.grid.resolution)
         if padding > 0.0:
             distance = np.maximum(distance - padding, 0.0)
+            to_square = np.maximum(to_square - padding, 0.0)
         cost = self.cost.copy()
         window = cost[top:bottom, left:right]
         np.maximum(window, cost_of_distance(distance, self.params), out=window)
-        return Costmap(self.grid, self.params, cost)
+        clearance = self.clearance.copy()
+        window = clearance[top:bottom, left:right]
+        np.minimum(window, to_square.astype(np.float32), out=window)
+        return Costmap(self.grid, self.params, cost, clearance)
 
 
 def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:
@@ -137,6 +185,40 @@ def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:
     if params.unknown_is_lethal:
         cost[unknown] = NO_INFORMATION
     return cost
+
+
+def clearance_to_blocked(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:
+    """Per cell, metres from its centre to the nearest blocked cell's square (float32).
+
+    Blocked: occupied, and unknown when ``unknown_is_lethal`` — which also puts a blocked
+    border round the map, for nothing beyond it is known.
+    """
+    blocked = grid.occupied_mask()
+    if params.unknown_is_lethal:
+        blocked = np.pad(blocked | grid.unknown_mask(), 1, constant_values=True)
+    _, to_square = _distances(blocked, grid.resolution)
+    if params.unknown_is_lethal:
+        to_square = to_square[1:-1, 1:-1]
+    return to_square.astype(np.float32)
+
+
+def _distances(blocked: np.ndarray, resolution: float) -> tuple[np.ndarray, np.ndarray]:
+    """(centre-to-centre, centre-to-square) distances (m) to the nearest blocked cell.
+
+    The square distance is taken to the cell whose centre is nearest, which is the
+    nearest square but for rounding-sized differences; with no blocked cell both are inf.
+    """
+    if not blocked.any():
+        infinite = np.full(blocked.shape, np.inf)
+        return infinite, infinite
+    distance, (near_rows, near_cols) = ndimage.distance_transform_edt(~blocked, return_indices=True)
+    rows = np.arange(blocked.shape[0])[:, np.newaxis]  # broadcast: no full index arrays
+    cols = np.arange(blocked.shape[1])[np.newaxis, :]
+    d_row = np.maximum(np.abs(near_rows - rows) - 0.5, 0.0)
+    d_col = np.maximum(np.abs(near_cols - cols) - 0.5, 0.0)
+    to_square = np.hypot(d_row, d_col)
+    to_square[blocked] = 0.0
+    return distance * resolution, to_square * resolution
 
 
 def cost_of_distance(distance: np.ndarray, params: CostmapParams) -> np.ndarray:

@@ -8,11 +8,21 @@ Life of a goal (``state``): :meth:`set_goal` makes it ACTIVE (replacing any othe
 the first control step plans on the costmap. It ends
 
 - SUCCEEDED when the controller has the robot within the xy and yaw tolerances;
-- ABORTED when no plan exists on the map (start or goal not free, goal unreachable) or
-  when the next step could not be taken without the footprint touching an obstacle and
-  no evasive move (turning the other way, creeping forward or back) is safe either, or
-  evading has not brought the robot 0.2 m closer within ``blocked_patience`` seconds —
-  the command is then zero, so the robot stops rather than collides;
+- ABORTED at once when the goal is off the map or not free, or no way on the map leads
+  there from a robot that stands where it can turn (nothing the robot does changes that);
+- otherwise, when no plan exists from where the robot is (it stopped where it cannot
+  turn, and no free cell is near), or the next step could not
+  be taken without the footprint touching an obstacle and no evasive move (turning the
+  other way, creeping forward or back) is safe either, or evading has not brought the
+  robot 0.2 m closer within ``blocked_patience`` seconds, the server runs move_base's
+  recovery behaviours one at a time, each followed by a new plan: clear the costmap,
+  rotate in place (a full turn, as far as it is safe), back up a little (forward if
+  backing up is unsafe). A robot that can physically get out does. When the robot is
+  stuck again after the last one it ends ABORTED with move_base's text, "Failed to find
+  a valid plan. Even after executing recovery behaviors." or "Failed to find a valid
+  control. Even after executing recovery behaviors.", and our reason in brackets. Real
+  progress (0.2 m closer) re-arms the behaviours, at most ``recovery_rounds`` rounds per
+  goal, so a goal always ends. Stopping, the command is zero: the robot never collides;
 - CANCELED on :meth:`cancel`.
 
 Replanning happens when the robot strays more than ``stray_distance`` from the plan
@@ -55,7 +65,7 @@ import numpy as np
 
 from navseq.geometry import Pose2D, normalize_angle
 from navseq.sim.controller import ControllerParams, RegulatedPurePursuit
-from navseq.sim.costmap import INSCRIBED, Costmap
+from navseq.sim.costmap import Costmap
 from navseq.sim.footprint import (
     TURTLEBOT3_BURGER,
     Footprint,
@@ -68,6 +78,10 @@ from navseq.sim.planner import Plan, plan_path
 from navseq.sim.robot import integrate_arc, next_velocity
 
 OtherRobots = Sequence[tuple[Pose2D, Footprint]]
+
+PLAN_FAILED = "Failed to find a valid plan. Even after executing recovery behaviors."
+CONTROL_FAILED = "Failed to find a valid control. Even after executing recovery behaviors."
+RECOVERY_BEHAVIOURS = ("clear_costmap", "rotate", "back_up")
 
 
 class NavState(enum.Enum):
@@ -97,6 +111,9 @@ class NavParams(ControllerParams):
     robot_moved: float = 0.1  # m a robot's outline moves before the costmap holding it is stale
     robot_replan_period: float = 1.0  # s between replans while another robot blocks the way
     robot_margin: float = 0.05  # m kept from other robots: they move while this one brakes
+    recovery_rotation: float = 2.0 * math.pi  # rad turned in place by the rotate recovery
+    recovery_backup: float = 0.3  # m driven back (or forward) by the back-up recovery (Nav2's)
+    recovery_rounds: int = 3  # times per goal the behaviours re-arm after real progress
 
 
 class NavigationServer:
@@ -131,6 +148,11 @@ class NavigationServer:
         self._waiting = False  # holding still until a replan finds a way past another robot
         self._waiting_since: float | None = None
         self._remaining_when_waiting = math.inf
+        self._pending_recoveries: list[str] = []
+        self._recovery_rounds_left = 0
+        self._recovery = None
+        self._remaining_at_recovery = math.inf
+        self.recoveries_run = 0
         self.costmap_version = 0
         self._use_costmap(costmap)
 
@@ -151,6 +173,11 @@ class NavigationServer:
         self._waiting = False
         self._waiting_since: float | None = None  # goal time another robot first blocked the way
         self._remaining_when_waiting = math.inf
+        self._pending_recoveries = list(RECOVERY_BEHAVIOURS)
+        self._recovery_rounds_left = self.params.recovery_rounds - 1
+        self._recovery: _Recovery | None = None
+        self._remaining_at_recovery = math.inf
+        self.recoveries_run = 0  # behaviours run for this goal (tests, reports)
 
     def set_other_robots(self, others: Iterable[tuple[Pose2D, Footprint]]) -> None:
         """The other robots' poses (map frame) and footprints now; call every control step.
@@ -165,9 +192,7 @@ class NavigationServer:
         if self.state is NavState.ACTIVE:
             self._finish(NavState.CANCELED, "canceled")
 
-    def compute_velocity(
-        self, pose: Pose2D, v: float, w: float, dt: float
-    ) -> tuple[float, float]:
+    def compute_velocity(self, pose: Pose2D, v: float, w: float, dt: float) -> tuple[float, float]:
         """Velocity command for the next ``dt`` seconds; (0, 0) unless a goal is ACTIVE."""
         if self.state is not NavState.ACTIVE or self.goal is None:
             return 0.0, 0.0
@@ -175,6 +200,8 @@ class NavigationServer:
         self._since_plan += dt
         if self._waiting:
             return self._keep_waiting(pose, dt)
+        if self._recovery is not None:
+            return self._run_recovery(pose, v, w, dt)
         period = self.params.replan_period
         wants_plan = (
             self._needs_plan
@@ -189,8 +216,12 @@ class NavigationServer:
         if self._blocked_since is not None and (
             self._goal_time - self._blocked_since > self.params.blocked_patience
         ):
-            blocker = "another robot" if self._blocked_by_robot else "an obstacle"
-            self._finish(NavState.ABORTED, f"stopped: blocked by {blocker}, no way around it")
+            if self._blocked_by_robot:
+                self._finish(
+                    NavState.ABORTED, "stopped: blocked by another robot, no way around it"
+                )
+            else:
+                self._stuck(CONTROL_FAILED, "stopped: blocked by an obstacle, no way around it")
             return 0.0, 0.0
 
         if self._escape_time_left > 0.0:
@@ -204,6 +235,8 @@ class NavigationServer:
         if controller.goal_reached:
             self._finish(NavState.SUCCEEDED, "goal reached")
             return 0.0, 0.0
+        if remaining < self._remaining_at_recovery - 0.2:
+            self._rearm_recoveries()
         if self._blocked_since is not None and remaining < self._remaining_when_blocked - 0.2:
             self._blocked_since = None  # real progress since: the obstacle is behind us
         if self._waiting_since is not None and remaining < self._remaining_when_waiting - 0.2:
@@ -223,7 +256,7 @@ class NavigationServer:
             if robots_only:
                 self._wait_for_robot()  # only robots are in the way, and robots move
                 return 0.0, 0.0
-            self._finish(NavState.ABORTED, "stopped: the footprint would hit an obstacle")
+            self._stuck(CONTROL_FAILED, "stopped: the footprint would hit an obstacle")
             return 0.0, 0.0
         if evasion[0] != 0.0:  # creep on for a while, or the controller steers straight back
             self._escape_command = evasion
@@ -364,7 +397,13 @@ class NavigationServer:
             if on_the_map is not None:  # the map has a way: robots block it, for now
                 self._wait_for_robot(on_the_map.length)
                 return False
-            self._finish(NavState.ABORTED, self._why_no_plan(pose, goal))
+            why = self._why_no_plan(pose, goal)
+            if self._goal_is_hopeless(goal) or self.costmap.is_free(pose.x, pose.y):
+                # Nothing the robot can do changes the answer: the goal is ruled out, or
+                # the robot stands where it can turn and the map has no way from there.
+                self._finish(NavState.ABORTED, why)
+            else:
+                self._stuck(PLAN_FAILED, why)
             return False
         self.plan = plan
         self.plan_version += 1
@@ -372,6 +411,105 @@ class NavigationServer:
         self._waiting = False
         self.controller.set_path(plan.points, goal)
         return True
+
+    # -- recovery behaviours (move_base's, in small) -------------------------------------
+
+    def _goal_is_hopeless(self, goal: Pose2D) -> bool:
+        """True if no move of the robot can make a plan exist: the goal is off the map or
+        not free there."""
+        costmap = self.costmap
+        return not (costmap.grid.contains(goal.x, goal.y) and costmap.is_free(goal.x, goal.y))
+
+    def _stuck(self, failure: str, why: str) -> None:
+        """Start the next recovery behaviour, or ABORT with move_base's text if none is left."""
+        if not self._pending_recoveries:
+            self._finish(NavState.ABORTED, f"{failure} ({why})")
+            return
+        kind = self._pending_recoveries.pop(0)
+        self.recoveries_run += 1
+        if self.distance_remaining is not None:
+            self._remaining_at_recovery = min(self._remaining_at_recovery, self.distance_remaining)
+        amount = {
+            "clear_costmap": 0.0,
+            "rotate": self.params.recovery_rotation,
+            "back_up": self.params.recovery_backup,
+        }[kind]
+        self._recovery = _Recovery(kind, amount)
+        self._blocked_since = None
+        self._escape_time_left = 0.0
+
+    def _rearm_recoveries(self) -> None:
+        """Real progress since the last recovery: the behaviours may help again later."""
+        self._remaining_at_recovery = math.inf
+        full = len(self._pending_recoveries) == len(RECOVERY_BEHAVIOURS)
+        if not full and self._recovery_rounds_left > 0:
+            self._recovery_rounds_left -= 1
+            self._pending_recoveries = list(RECOVERY_BEHAVIOURS)
+
+    def _run_recovery(self, pose: Pose2D, v: float, w: float, dt: float) -> tuple[float, float]:
+        """One step of the running recovery behaviour; a new plan follows when it ends.
+
+        Each behaviour is bounded: by its amount (angle, distance) and by a time limit,
+        and it ends early when its next step would not be safe.
+        """
+        recovery = self._recovery
+        assert recovery is not None
+        self._goal_time += dt
+        recovery.elapsed += dt
+        command: tuple[float, float] | None = None
+        if recovery.kind == "rotate" and recovery.elapsed == dt and not self._can_turn_round(pose):
+            recovery.left = 0.0  # as move_base's rotate recovery: only a turn that is clear
+        if recovery.kind == "rotate":
+            speed = min(self.params.rotate_speed, self.params.limits.max_w)
+            recovery.left -= abs(w) * dt
+            limit = self.params.recovery_rotation / max(speed, 1e-6) + 2.0
+            if recovery.left > 0.0 and recovery.elapsed < limit:
+                command = self._first_safe(pose, v, w, dt, [(0.0, speed), (0.0, -speed)], recovery)
+        elif recovery.kind == "back_up":
+            speed = self.params.escape_speed
+            recovery.left -= abs(v) * dt
+            limit = self.params.recovery_backup / max(speed, 1e-6) + 2.0
+            if recovery.left > 0.0 and recovery.elapsed < limit:
+                command = self._first_safe(pose, v, w, dt, [(-speed, 0.0), (speed, 0.0)], recovery)
+        else:  # clear_costmap: the costmap from the map again, and a new plan
+            self.clear_costmaps()
+        if command is not None:
+            return command
+        if v != 0.0 or w != 0.0:
+            recovery.left = 0.0
+            return 0.0, 0.0  # done: come to rest before planning again
+        self._recovery = None
+        self._needs_plan = True
+        self._blocked_since = None
+        return 0.0, 0.0
+
+    def _can_turn_round(self, pose: Pose2D) -> bool:
+        """True if the footprint clears the map at every heading, turning in place here."""
+        if self._clearance_at(pose.x, pose.y) > self.footprint.circumscribed_radius + 0.1:
+            return True
+        grid, footprint = self.costmap.grid, self.footprint
+        return not any(
+            footprint_collides(grid, footprint, Pose2D(pose.x, pose.y, pose.yaw + k * math.pi / 16))
+            for k in range(1, 32)
+        )
+
+    def _first_safe(
+        self,
+        pose: Pose2D,
+        v: float,
+        w: float,
+        dt: float,
+        commands: list[tuple[float, float]],
+        recovery: _Recovery,
+    ) -> tuple[float, float] | None:
+        """The behaviour's command if safe (the first that is, chosen once), else None."""
+        if recovery.command is not None:
+            commands = [recovery.command]
+        for command in commands:
+            if self._command_is_safe(pose, v, w, *command, dt):
+                recovery.command = command
+                return command
+        return None
 
     def _plan_on(self, costmap: Costmap, start: Pose2D, goal: Pose2D) -> Plan | None:
         from_x, from_y = self._planning_start(costmap, start)
@@ -402,8 +540,8 @@ class NavigationServer:
         row, col = grid.world_to_cell(start.x, start.y)
         reach = math.ceil(self.params.start_search_radius / grid.resolution)
         top, left = max(row - reach, 0), max(col - reach, 0)
-        window = costmap.cost[top : row + reach + 1, left : col + reach + 1]
-        rows, cols = np.nonzero(window < INSCRIBED)
+        window = costmap.free_mask()[top : row + reach + 1, left : col + reach + 1]
+        rows, cols = np.nonzero(window)
         if rows.size == 0:
             return start.x, start.y
         nearest = np.argmin((rows + top - row) ** 2 + (cols + left - col) ** 2)
@@ -514,6 +652,16 @@ class NavigationServer:
             math.hypot(at.x - pose.x, at.y - pose.y) < own + fp.circumscribed_radius
             for at, fp in others
         )
+
+
+@dataclass
+class _Recovery:
+    """A running recovery behaviour: what is left of its angle (rad) or distance (m)."""
+
+    kind: str
+    left: float
+    elapsed: float = 0.0
+    command: tuple[float, float] | None = None
 
 
 def _with_exact_ends(plan: Plan, start: tuple[float, float], goal: tuple[float, float]) -> Plan:

@@ -73,17 +73,20 @@ def plan_path(
     """The cheapest path between two world points, or None if there is none.
 
     Start and goal snap to the cells containing them; either one off the map or not
-    free (cost >= ``INSCRIBED``) means no plan. ``use_compiled`` forces a backend
-    (``None``: the C one if available).
+    traversable means no plan. Only traversable cells are searched: those where the
+    robot, centred there, clears every obstacle by its circumscribed radius
+    (:meth:`Costmap.free_mask`), so no plan leads through a gap the robot cannot turn in.
+    ``use_compiled`` forces a backend (``None``: the C one if available).
     """
     grid = costmap.grid
     start_cell = grid.world_to_cell(*start)
     goal_cell = grid.world_to_cell(*goal)
+    cost = costmap.planning_cost
     for row, col in (start_cell, goal_cell):
-        if not grid.in_bounds(row, col) or costmap.cost[row, col] >= INSCRIBED:
+        if not grid.in_bounds(row, col) or cost[row, col] >= INSCRIBED:
             return None
 
-    cells = search_cells(costmap.cost, start_cell, goal_cell, use_compiled=use_compiled)
+    cells = search_cells(cost, start_cell, goal_cell, use_compiled=use_compiled)
     if cells is None:
         return None
     path_cells, cost_in_cells = cells
