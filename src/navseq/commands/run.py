@@ -388,7 +388,6 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
     mission: Mission = setup["mission"]
     frame = args.frame or mission.frame
-    grid = _optional_map(args, setup)
     try:
         from navseq.ros.run_setup import connect_for_run
     except ImportError as error:
@@ -406,14 +405,21 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
         frame=frame,
         namespace=args.ns,
         settle=args.settle,
-        read_robot=getattr(args, "robot", None) is None,
+        read_robot=getattr(args, "robot", None) is None and mission.robot is None,
     )
     info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
     notes = []
     if connection.robot is not None and connection.robot_note is not None:
-        info["robot"] = connection.robot.name
+        # The stack's own robot: what pre-flight checks against, as move_base plans with it.
+        setup["robot"] = connection.robot
         info["robot_source"] = connection.robot_note
         notes.append(connection.robot_note)
+    info["robot"] = setup["robot"].name
+    try:
+        grid = _optional_map(args, setup)
+    except BaseException:
+        connection.navigator.close()
+        raise
     return RunSetup(
         **setup,
         grid=grid,
