@@ -69,7 +69,15 @@ def test_failed_status_with_stop_policy_ends_the_mission(status: GoalStatus) -> 
     h.done(status, 7.0)
     failure = h.of_type(AttemptFailed)
     assert failure == [
-        AttemptFailed(t=7.0, index=1, attempt=1, reason=status.value, will_retry=False)
+        AttemptFailed(
+            t=7.0,
+            index=1,
+            attempt=1,
+            reason=status.value,
+            will_retry=False,
+            status=status.value,
+            duration=2.0,
+        )
     ]
     assert h.executor.finished
     assert outcomes(h) == [REACHED, WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN]

@@ -282,9 +282,10 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
 
 def _scripted_behaviours(script: str) -> list[Any]:
-    """Test-only: ``succeed,aborted@2,stall@1,hang`` -> ScriptedNavigator behaviours."""
+    """Test-only: ``succeed,aborted@2,stall@1,hang,falsesuccess`` -> ScriptedNavigator
+    behaviours."""
     from navseq.navigators.base import GoalStatus
-    from navseq.navigators.scripted import Finish, Hang, Stall, Succeed
+    from navseq.navigators.scripted import FalseSuccess, Finish, Hang, Stall, Succeed
 
     behaviours: list[Any] = []
     for token in filter(None, (part.strip() for part in script.split(","))):
@@ -296,6 +297,8 @@ def _scripted_behaviours(script: str) -> list[Any]:
             behaviours.append(Hang())
         elif name == "stall":
             behaviours.append(Stall(after=seconds))
+        elif name == "falsesuccess":
+            behaviours.append(FalseSuccess(after=seconds))
         else:
             behaviours.append(Finish(GoalStatus(name.upper()), after=seconds))
     return behaviours

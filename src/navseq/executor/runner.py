@@ -5,6 +5,12 @@ the state machine cannot keep on its own: whatever ends the run early (Ctrl-C,
 SIGTERM, an exception in a sink or a navigator), the active goal is cancelled on the
 navigator before the error leaves this function, so the robot never keeps driving
 to a goal nobody watches.
+
+For that it installs its own SIGINT and SIGTERM handlers while the mission runs (in
+the main thread), restoring the previous ones afterwards. SIGINT too: a process
+started in the background of a shell script inherits SIGINT as ignored, and Python
+then installs no KeyboardInterrupt handler, so ``kill -INT`` would leave the robot
+driving.
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ import signal
 import threading
 from collections.abc import Iterable, Iterator
 from types import FrameType
+from typing import Any
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
@@ -22,7 +29,9 @@ from navseq.executor.control import MissionControl
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
+from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
+from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import Navigator
 
 _log = logging.getLogger(__name__)
@@ -59,6 +68,7 @@ def run_mission(
     tick: float = 0.1,
     server_wait: float = 10.0,
     control: MissionControl | None = None,
+    robot: RobotProfile | None = None,
 ) -> MissionResult:
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
@@ -67,6 +77,9 @@ def run_mission(
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
     ``control`` lets other threads file operator requests (skip the current waypoint).
+    ``robot`` gives the goal tolerance of the arrival check (see
+    :class:`~navseq.executor.machine.MissionExecutor`; default: the mission's
+    ``robot:``, else the TurtleBot3 burger).
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
     :class:`MissionInterrupted` on SIGINT/SIGTERM, and re-raises any other exception;
@@ -74,10 +87,10 @@ def run_mission(
     listeners that the mission finished (``MissionFinished``, reason
     ``"interrupted: SIGINT"`` and so on).
     """
-    executor = MissionExecutor(mission, resume=resume)
+    executor = MissionExecutor(mission, resume=resume, robot=robot)
     for listener in listeners:
         executor.add_listener(listener)
-    with _sigterm_raises():
+    with _signals_raise():
         try:
             server_up = navigator.wait_for_server(server_wait)
             if server_up:
@@ -104,16 +117,23 @@ def _drive(
     executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
 ) -> None:
     """The loop: navigator events, operator requests and the clock in; commands out."""
-    _apply(navigator, executor.start(navigator.now()))
+    _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
         for event in navigator.poll():
-            _apply(navigator, executor.on_event(event, navigator.now()))
+            _apply(navigator, executor.on_event(event, navigator.now(), navigator.robot_pose()))
         if control is not None:
             for reason in control.take_skips():
                 _apply(navigator, executor.skip(navigator.now(), reason))
-        _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
+        pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
+        _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
         if not executor.finished:
             navigator.spin(tick)
+
+
+def _odometry_pose(navigator: Navigator) -> Pose2D | None:
+    """The navigator's odometry pose; None from navigators written before it existed."""
+    odometry_pose = getattr(navigator, "odometry_pose", None)
+    return odometry_pose() if odometry_pose is not None else None
 
 
 def _apply(navigator: Navigator, commands: list[Command]) -> None:
@@ -144,11 +164,13 @@ def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> Miss
 
 
 @contextlib.contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """While inside, SIGTERM raises :class:`_Terminated` like SIGINT raises KeyboardInterrupt.
+def _signals_raise() -> Iterator[None]:
+    """While inside, SIGINT raises KeyboardInterrupt and SIGTERM :class:`_Terminated`.
 
-    Signal handlers can only be set from the main thread; elsewhere (a ROS node's
-    worker thread, say) the process's own handling stays in place.
+    Installed whatever was there before — also over an ignored SIGINT, which is what
+    a background job of a shell script inherits — and restored afterwards. Signal
+    handlers can only be set from the main thread; elsewhere (a ROS node's worker
+    thread, say) the process's own handling stays in place.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -157,8 +179,18 @@ def _sigterm_raises() -> Iterator[None]:
     def raise_terminated(signum: int, frame: FrameType | None) -> None:
         raise _Terminated()
 
-    previous = signal.signal(signal.SIGTERM, raise_terminated)
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
-        yield
+        previous_term = signal.signal(signal.SIGTERM, raise_terminated)
+        try:
+            yield
+        finally:
+            _restore(signal.SIGTERM, previous_term)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        _restore(signal.SIGINT, previous_int)
+
+
+def _restore(signum: signal.Signals, previous: Any) -> None:
+    # None: the previous handler was not set from Python and cannot be put back.
+    if previous is not None:
+        signal.signal(signum, previous)
