@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -79,7 +80,7 @@ def remaining_along_path(path: Sequence[tuple[float, float]], x: float, y: float
     best_gap = math.inf
     best_segment = 0
     best_fraction = 0.0
-    for segment, ((ax, ay), (bx, by)) in enumerate(zip(path, path[1:], strict=False)):
+    for segment, ((ax, ay), (bx, by)) in enumerate(itertools.pairwise(path)):
         ex, ey = bx - ax, by - ay
         length_squared = ex * ex + ey * ey
         fraction = (

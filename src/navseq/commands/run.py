@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.commands.common import format_pose, parse_loops, parse_pose
+from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
@@ -112,6 +113,8 @@ class RunSetup:
     make_navigator: Callable[[], Navigator]
     navigator_info: dict[str, Any]
     start: Pose2D | None = None
+    start_source: str | None = None  # where ``start`` came from: "--start", "mission start:"
+    robot: RobotProfile = DEFAULT_PROFILE  # goal tolerance of the arrival check, ...
     grid: OccupancyGrid | None = None
     map_path: Path | None = None
     resume: ResumePoint | None = None
@@ -197,6 +200,9 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         mission = dataclasses.replace(mission, loops=args.loops)
     map_path = args.map if args.map is not None else mission.map
     start = args.start if args.start is not None else mission.start
+    start_source = (
+        "--start" if args.start is not None else "mission start:" if start is not None else None
+    )
     setup_kwargs: dict[str, Any] = {
         "mission": mission,
         "mission_path": mission_path,
@@ -206,6 +212,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "history": history,
         "map_path": map_path,
         "start": start,
+        "start_source": start_source,
     }
     if args.navigator == "sim":
         return _prepare_sim(args, setup_kwargs)
@@ -234,6 +241,7 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     if start is None:
         start = default_start(grid)
         setup["start"] = start
+        setup["start_source"] = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
             f"{format_pose(start)}, the roomy point nearest the map origin"
@@ -393,7 +401,11 @@ def _run_with_sinks(setup: RunSetup, args: argparse.Namespace, journal_path: Pat
         with progress, journal:
             try:
                 result = run_mission(
-                    setup.mission, navigator, [journal, recorder, progress], resume=setup.resume
+                    setup.mission,
+                    navigator,
+                    [journal, recorder, progress],
+                    resume=setup.resume,
+                    robot=setup.robot,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
@@ -466,6 +478,7 @@ def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) 
         if setup.grid is not None and setup.map_path is not None
         else None,
         start=setup.start,
+        start_source=setup.start_source,
         files=files,
     )
     write_report(report, Path(files["report"]))
@@ -475,7 +488,11 @@ def _write_outputs(setup: RunSetup, outcome: RunOutcome, files: dict[str, str]) 
         setup.mission,
         result,
         grid=setup.grid,
-        start=setup.start,
+        # Where the robot really set out from (the planned start if it never said; a
+        # resumed run's picture shows the whole mission, so its planned start too).
+        start=setup.start
+        if setup.resume is not None and setup.start is not None
+        else result.start_pose or setup.start,
         plans=outcome.recorder.leg_plans(),
         trajectory=trajectory,
         interrupted=outcome.interrupted,

@@ -282,9 +282,7 @@ class MissionExecutor:
         )
         return self._begin_visit(now, loop, index, new_loop=True)
 
-    def on_event(
-        self, event: NavEvent, now: float, pose: Pose2D | None = None
-    ) -> list[Command]:
+    def on_event(self, event: NavEvent, now: float, pose: Pose2D | None = None) -> list[Command]:
         """React to one navigator event.
 
         ``pose`` is the robot's pose (mission frame) when the event is handled, if the
