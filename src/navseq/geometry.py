@@ -69,9 +69,11 @@ def remaining_along_path(path: Sequence[tuple[float, float]], x: float, y: float
     """Distance (m) left along ``path`` from the point (x, y) to the path's end.
 
     The point is projected onto the nearest segment of the polyline (the earliest one
-    on a tie); the result is the rest of that segment plus every later segment. An
-    empty path leaves nothing to go (0.0); a single point is the straight-line
-    distance to it.
+    on a tie); the result is the rest of that segment plus every later segment. A
+    point whose nearest path point is the path's very start (it is behind it: a plan
+    made from a pose a little newer than the point) first has to get there, so that
+    gap counts too. An empty path leaves nothing to go (0.0); a single point is the
+    straight-line distance to it.
     """
     if not path:
         return 0.0
@@ -93,6 +95,8 @@ def remaining_along_path(path: Sequence[tuple[float, float]], x: float, y: float
             best_gap, best_segment, best_fraction = gap, segment, fraction
     (ax, ay), (bx, by) = path[best_segment], path[best_segment + 1]
     remaining = (1.0 - best_fraction) * math.hypot(bx - ax, by - ay)
+    if best_segment == 0 and best_fraction == 0.0:
+        remaining += best_gap
     for (px, py), (qx, qy) in zip(path[best_segment + 1 :], path[best_segment + 2 :], strict=False):
         remaining += math.hypot(qx - px, qy - py)
     return remaining
