@@ -189,3 +189,24 @@ def test_a_long_detour_on_the_simulator_is_driven_to_the_end_not_stalled() -> No
     assert visit.attempts == 1
     assert visit.distance_driven >= 15.0  # it really went round
     assert visit.duration > 20.0
+
+
+@given(
+    plans=st.lists(st.lists(points, min_size=1, max_size=6), min_size=1, max_size=12),
+    where=points,
+)
+def test_a_robot_that_never_moves_stalls_whatever_plans_arrive(
+    plans: list[list[tuple[float, float]]], where: tuple[float, float]
+) -> None:
+    h = Harness(far_goal(stall_timeout=3.0))
+    h.start(0.0)
+    robot = Pose2D(where[0], where[1], 0.0)
+    t = 0.0
+    for plan in plans:
+        h.plan(t, [*plan, (0.0, 2.0)])
+        h.tick(t, robot)
+        t += 0.25
+    while t <= 3.5:
+        h.tick(t, robot)
+        t += 0.25
+    assert stalled(h)
