@@ -322,15 +322,17 @@ def _attempt_of(event: ev.AttemptFailed) -> AttemptResult:
 
 
 def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[AttemptResult]:
-    """The visit's attempts, numbered 1..attempts; what the journal does not say stays blank.
+    """The visit's attempts the journal tells about, in order.
 
     The last attempt ended without an AttemptFailed when it reached the waypoint or
     was ended by navseq (interrupt, operator skip): it is rebuilt from the finish.
+    Only attempts the journal records are listed (never a padding of ``attempts``
+    blanks: a damaged journal may give any number there).
     """
     failures = trail.failures if trail is not None else {}
     sent_at = trail.sent_at if trail is not None else {}
-    attempts = [failures.get(n, AttemptResult(number=n)) for n in range(1, event.attempts + 1)]
     last = event.attempts
+    attempts = [failures[n] for n in sorted(failures) if 1 <= n <= last]
     if last >= 1 and last not in failures:
         first_sent = sent_at.get(1)
         last_sent = sent_at.get(last)
@@ -339,14 +341,16 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
             end = first_sent + event.duration if first_sent is not None else None
         else:
             end = event.t
-        before = sum(a.distance_driven for a in attempts[:-1])
-        attempts[-1] = AttemptResult(
-            number=last,
-            reached=reached,
-            status="SUCCEEDED" if reached and not event.passed_through else None,
-            reason="" if reached else event.reason,
-            duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
-            distance_driven=max(0.0, event.distance_driven - before),
+        before = sum(a.distance_driven for a in attempts)
+        attempts.append(
+            AttemptResult(
+                number=last,
+                reached=reached,
+                status="SUCCEEDED" if reached and not event.passed_through else None,
+                reason="" if reached else event.reason,
+                duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
+                distance_driven=max(0.0, event.distance_driven - before),
+            )
         )
     return attempts
 
