@@ -9,7 +9,15 @@ from navseq.executor.events import MissionEvent
 from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Policy, Waypoint
-from navseq.navigators.base import GoalDone, GoalFeedback, GoalStatus, ServerBack, ServerLost
+from navseq.mission.robot import RobotProfile
+from navseq.navigators.base import (
+    GoalDone,
+    GoalFeedback,
+    GoalPlan,
+    GoalStatus,
+    ServerBack,
+    ServerLost,
+)
 
 E = TypeVar("E")
 
@@ -34,8 +42,10 @@ def line_mission(
 class Harness:
     """Drives a :class:`MissionExecutor` by hand and keeps what it said and asked."""
 
-    def __init__(self, mission: Mission, resume: ResumePoint | None = None):
-        self.executor = MissionExecutor(mission, resume=resume)
+    def __init__(
+        self, mission: Mission, resume: ResumePoint | None = None, robot: RobotProfile | None = None
+    ):
+        self.executor = MissionExecutor(mission, resume=resume, robot=robot)
         self.events: list[MissionEvent] = []
         self.commands: list[Command] = []
         self.executor.add_listener(self.events.append)
@@ -61,12 +71,23 @@ class Harness:
     def clears(self) -> list[ClearCostmaps]:
         return [c for c in self.commands if isinstance(c, ClearCostmaps)]
 
-    def done(self, status: GoalStatus, t: float, goal_id: int | None = None) -> list[Command]:
+    def done(
+        self,
+        status: GoalStatus,
+        t: float,
+        goal_id: int | None = None,
+        *,
+        pose: Pose2D | None = None,
+        text: str = "",
+    ) -> list[Command]:
         gid = self.goal_id if goal_id is None else goal_id
-        return self._keep(self.executor.on_event(GoalDone(gid, status), t))
+        return self._keep(self.executor.on_event(GoalDone(gid, status, text), t, pose))
 
-    def succeed(self, t: float) -> list[Command]:
-        return self.done(GoalStatus.SUCCEEDED, t)
+    def succeed(self, t: float, pose: Pose2D | None = None) -> list[Command]:
+        return self.done(GoalStatus.SUCCEEDED, t, pose=pose)
+
+    def plan(self, t: float, path: list[tuple[float, float]]) -> list[Command]:
+        return self._keep(self.executor.on_event(GoalPlan(self.goal_id, tuple(path)), t))
 
     def feedback(
         self, t: float, pose: Pose2D, remaining: float | None = None, goal_id: int | None = None
@@ -74,8 +95,10 @@ class Harness:
         gid = self.goal_id if goal_id is None else goal_id
         return self._keep(self.executor.on_event(GoalFeedback(gid, pose, remaining), t))
 
-    def tick(self, t: float, pose: Pose2D | None = None) -> list[Command]:
-        return self._keep(self.executor.on_tick(t, pose))
+    def tick(
+        self, t: float, pose: Pose2D | None = None, odom: Pose2D | None = None
+    ) -> list[Command]:
+        return self._keep(self.executor.on_tick(t, pose, odom))
 
     def server_lost(self, t: float) -> list[Command]:
         return self._keep(self.executor.on_event(ServerLost("test"), t))

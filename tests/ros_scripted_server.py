@@ -5,6 +5,8 @@ Each goal it receives, in arrival order, follows the next behaviour of ``--scrip
 (then ``--then`` for every later goal). A behaviour is ``KIND[:SECONDS]``:
 
 ``succeed``  accept, drive the reported pose toward the goal, SUCCEEDED after SECONDS
+             (and one feedback period more: the feedback showing the robot at the goal,
+             facing its yaw, goes out first, as navseq checks a SUCCEEDED against it)
 ``abort``    accept, ABORTED after SECONDS
 ``reject``   REJECTED after SECONDS without accepting
 ``preempt``  accept, then the server itself cancels it: PREEMPTED after SECONDS
@@ -65,6 +67,7 @@ class TrackedGoal:
     goal_xy: tuple[float, float]
     accepted: bool = False
     done: bool = False
+    arrival_published: bool = False  # a feedback at the goal went out (succeed only)
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -193,6 +196,11 @@ class ScriptedMoveBase:
                     self._feedback(tracked, min(1.0, elapsed / max(seconds, 1e-3)))
                 if kind == "hang" or elapsed < seconds:
                     continue
+                if kind == "succeed" and not tracked.arrival_published:
+                    # Feedback and result travel on separate topics: give the feedback
+                    # at the goal a step's head start, so a client sees the robot there.
+                    tracked.arrival_published = True
+                    continue
                 if kind == "die":
                     self.log("die")
                     os._exit(3)
@@ -216,7 +224,10 @@ class ScriptedMoveBase:
         feedback.base_position.header.stamp = rospy.Time.now()
         feedback.base_position.pose.position.x = self._robot_xy[0]
         feedback.base_position.pose.position.y = self._robot_xy[1]
-        feedback.base_position.pose.orientation.w = 1.0
+        if tracked.behaviour.kind == "succeed" and fraction >= 1.0:
+            feedback.base_position.pose.orientation = target.pose.orientation  # turned
+        else:
+            feedback.base_position.pose.orientation.w = 1.0
         tracked.handle.publish_feedback(feedback)
 
 

@@ -69,7 +69,15 @@ def test_failed_status_with_stop_policy_ends_the_mission(status: GoalStatus) -> 
     h.done(status, 7.0)
     failure = h.of_type(AttemptFailed)
     assert failure == [
-        AttemptFailed(t=7.0, index=1, attempt=1, reason=status.value, will_retry=False)
+        AttemptFailed(
+            t=7.0,
+            index=1,
+            attempt=1,
+            reason=status.value,
+            will_retry=False,
+            status=status.value,
+            duration=2.0,
+        )
     ]
     assert h.executor.finished
     assert outcomes(h) == [REACHED, WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN]
@@ -335,7 +343,7 @@ def test_loops_n_times_and_passes_through_the_end_of_inner_loops_only() -> None:
     h.feedback(3.0, Pose2D(0.8, 0.0), remaining=0.2)  # pass p1 (loop 1)
     h.feedback(4.0, Pose2D(1.8, 0.0), remaining=0.2)  # last of last loop: must stop
     assert not h.executor.finished
-    h.succeed(5.0)
+    h.succeed(5.0, pose=Pose2D(2.0, 0.0))
     result = h.executor.result
     assert result.success and result.loops_completed == 2
     assert [(v.loop, v.index) for v in result.visits] == [(0, 0), (0, 1), (1, 0), (1, 1)]

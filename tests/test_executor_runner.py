@@ -233,3 +233,20 @@ def test_sigterm_handler_is_restored_after_the_run() -> None:
     before = signal.getsignal(signal.SIGTERM)
     run_mission(line_mission(1), ScriptedNavigator())
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_sigint_is_caught_during_the_run_even_when_ignored_before_and_restored_after() -> None:
+    seen: list[object] = []
+
+    class Watching(ScriptedNavigator):
+        def spin(self, seconds: float) -> None:
+            seen.append(signal.getsignal(signal.SIGINT))
+            super().spin(seconds)
+
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        run_mission(line_mission(1), Watching())
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert seen and all(handler is signal.default_int_handler for handler in seen)

@@ -27,7 +27,7 @@ from navseq.executor.events import (
 from navseq.executor.resume import ResumePoint
 from navseq.mission.model import FailureAction
 from navseq.navigators.base import GoalStatus
-from navseq.navigators.scripted import Finish, ScriptedNavigator
+from navseq.navigators.scripted import Finish, ScriptedNavigator, Succeed
 from navseq.sinks.journal import (
     JournalWriter,
     mission_digest,
@@ -160,7 +160,7 @@ def test_skipped_visits_are_not_rerun_but_a_failed_stop_is(
         resume_point(read_journal(path))
 
     stopped = tmp_path / "stopped.journal"
-    nav = ScriptedNavigator([Finish(GoalStatus.SUCCEEDED), Finish(GoalStatus.ABORTED)])
+    nav = ScriptedNavigator([Succeed(), Finish(GoalStatus.ABORTED)])
     with JournalWriter(stopped, str(mission_file), mission_digest(mission_file)) as journal:
         result = run_mission(line_mission(3), nav, [journal])
     assert result.reason.startswith("stopped")

@@ -99,7 +99,6 @@ def test_without_the_settle_navseq_runs_into_the_race(ros_master: RosMaster, tmp
     assert far, watched_results(watcher)
 
 
-@pytest.mark.xfail(reason="needs the executor's arrival check", strict=False)
 def test_without_the_settle_the_executor_reports_a_far_succeeded(
     ros_master: RosMaster, tmp_path: Path
 ):

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 
@@ -61,3 +63,40 @@ def inverse(a: Pose2D) -> Pose2D:
         sin_a * a.x - cos_a * a.y,
         normalize_angle(-a.yaw),
     )
+
+
+def remaining_along_path(path: Sequence[tuple[float, float]], x: float, y: float) -> float:
+    """Distance (m) left along ``path`` from the point (x, y) to the path's end.
+
+    The point is projected onto the nearest segment of the polyline (the earliest one
+    on a tie); the result is the rest of that segment plus every later segment. A
+    point whose nearest path point is the path's very start (it is behind it: a plan
+    made from a pose a little newer than the point) first has to get there, so that
+    gap counts too. An empty path leaves nothing to go (0.0); a single point is the
+    straight-line distance to it.
+    """
+    if not path:
+        return 0.0
+    if len(path) == 1:
+        return math.hypot(path[0][0] - x, path[0][1] - y)
+    best_gap = math.inf
+    best_segment = 0
+    best_fraction = 0.0
+    for segment, ((ax, ay), (bx, by)) in enumerate(itertools.pairwise(path)):
+        ex, ey = bx - ax, by - ay
+        length_squared = ex * ex + ey * ey
+        fraction = (
+            0.0
+            if length_squared == 0.0
+            else max(0.0, min(1.0, ((x - ax) * ex + (y - ay) * ey) / length_squared))
+        )
+        gap = math.hypot(ax + fraction * ex - x, ay + fraction * ey - y)
+        if gap < best_gap:
+            best_gap, best_segment, best_fraction = gap, segment, fraction
+    (ax, ay), (bx, by) = path[best_segment], path[best_segment + 1]
+    remaining = (1.0 - best_fraction) * math.hypot(bx - ax, by - ay)
+    if best_segment == 0 and best_fraction == 0.0:
+        remaining += best_gap
+    for (px, py), (qx, qy) in zip(path[best_segment + 1 :], path[best_segment + 2 :], strict=False):
+        remaining += math.hypot(qx - px, qy - py)
+    return remaining

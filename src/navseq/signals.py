@@ -73,7 +73,8 @@ class SignalGuard:
     def restore(self) -> None:
         """Put back the handlers the process had before the guard."""
         for signum, handler in self._original.items():
-            signal.signal(signum, handler)
+            if handler is not None:  # None: not set from Python, cannot be put back
+                signal.signal(signum, handler)
         self._original.clear()
 
     @contextlib.contextmanager

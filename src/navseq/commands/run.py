@@ -124,8 +124,10 @@ class RunSetup:
     digest: str
     make_navigator: Callable[[], Navigator]
     navigator_info: dict[str, Any]
-    robot: RobotProfile  # what pre-flight, the planner and the simulator assume
+    # What pre-flight, the planner, the simulator and the arrival check assume.
+    robot: RobotProfile
     start: Pose2D | None = None
+    start_source: str | None = None  # where ``start`` came from: "--start", "mission start:"
     grid: OccupancyGrid | None = None
     map_path: Path | None = None
     resume: ResumePoint | None = None
@@ -224,6 +226,9 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         MissionExecutor(mission, resume=resume)
     map_path = args.map if args.map is not None else mission.map
     start = args.start if args.start is not None else mission.start
+    start_source = (
+        "--start" if args.start is not None else "mission start:" if start is not None else None
+    )
     setup_kwargs: dict[str, Any] = {
         "mission": mission,
         "mission_path": mission_path,
@@ -234,6 +239,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "map_path": map_path,
         "start": start,
         "robot": choose_robot(args.robot, mission),
+        "start_source": start_source,
     }
     if args.navigator == "sim":
         setup = _prepare_sim(args, setup_kwargs)
@@ -360,6 +366,7 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     if start is None:
         start = default_start(grid, settings.footprint)
         setup["start"] = start
+        setup["start_source"] = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
             f"{format_pose(start)}, the roomy point nearest the map origin"
@@ -431,9 +438,10 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 
 
 def _scripted_behaviours(script: str) -> list[Any]:
-    """Test-only: ``succeed,aborted@2,stall@1,hang`` -> ScriptedNavigator behaviours."""
+    """Test-only: ``succeed,aborted@2,stall@1,hang,falsesuccess`` -> ScriptedNavigator
+    behaviours."""
     from navseq.navigators.base import GoalStatus
-    from navseq.navigators.scripted import Finish, Hang, Stall, Succeed
+    from navseq.navigators.scripted import FalseSuccess, Finish, Hang, Stall, Succeed
 
     behaviours: list[Any] = []
     for token in filter(None, (part.strip() for part in script.split(","))):
@@ -445,6 +453,8 @@ def _scripted_behaviours(script: str) -> list[Any]:
             behaviours.append(Hang())
         elif name == "stall":
             behaviours.append(Stall(after=seconds))
+        elif name == "falsesuccess":
+            behaviours.append(FalseSuccess(after=seconds))
         else:
             behaviours.append(Finish(GoalStatus(name.upper()), after=seconds))
     return behaviours
@@ -562,6 +572,7 @@ def _run_with_sinks(
                     [journal, recorder, StdoutGuard(progress), *setup.listeners],
                     resume=setup.resume,
                     signals=signals,
+                    robot=setup.robot,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:
@@ -692,6 +703,7 @@ def _report(
         if setup.grid is not None and setup.map_path is not None
         else None,
         start=setup.start,
+        start_source=setup.start_source,
         files=files,
     )
 
@@ -703,7 +715,11 @@ def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:
         setup.mission,
         outcome.result,
         grid=setup.grid,
-        start=setup.start,
+        # Where the robot really set out from (the planned start if it never said; a
+        # resumed run's picture shows the whole mission, so its planned start too).
+        start=setup.start
+        if setup.resume is not None and setup.start is not None
+        else outcome.result.start_pose or setup.start,
         plans=outcome.recorder.leg_plans(),
         trajectory=picture_trajectory(outcome),
         interrupted=outcome.interrupted,

@@ -65,11 +65,27 @@ class WaypointPlan:
 
 @dataclass(frozen=True)
 class AttemptFailed:
+    """One attempt at a waypoint failed; ``will_retry`` says whether another follows.
+
+    ``reason`` is navseq's verdict: a GoalStatus value (``"ABORTED"``), ``"timeout"``,
+    ``"stalled"``, or ``"succeeded far from goal (2.38 m)"`` / ``"succeeded 35° off the
+    goal yaw"`` when the stack said SUCCEEDED but the robot is not there. ``status`` is
+    the terminal status the navigation stack gave (None when navseq gave up on the goal
+    itself), ``text`` the stack's own words (move_base's result text, may be empty).
+    ``duration`` (s) and ``distance_driven`` (m) are the attempt's own. Fields after
+    ``will_retry`` default so that journals written before them still read.
+    """
+
     t: float
     index: int
     attempt: int
-    reason: str  # a GoalStatus value, "timeout" or "stalled"
+    reason: str
     will_retry: bool
+    status: str | None = None
+    text: str = ""
+    duration: float = 0.0
+    distance_driven: float = 0.0
+    loop: int = 0
 
 
 @dataclass(frozen=True)

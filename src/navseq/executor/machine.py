@@ -6,9 +6,11 @@ outside through four inputs, each given the current time ``now`` (seconds on the
 navigator's clock):
 
 * :meth:`~MissionExecutor.start` once, to send the first goal;
-* :meth:`~MissionExecutor.on_event` for every event the navigator reports;
+* :meth:`~MissionExecutor.on_event` for every event the navigator reports, with the
+  robot's pose when known (the arrival check on SUCCEEDED needs it);
 * :meth:`~MissionExecutor.on_tick` regularly (every 0.1 s is plenty), with the
-  latest robot pose, so that timeouts, dwell and back-off can expire;
+  latest robot pose (and odometry pose, when known), so that timeouts, dwell and
+  back-off can expire and distance driven adds up;
 * :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash).
 
 Each input returns the commands (:mod:`navseq.executor.commands`) the caller must
@@ -19,11 +21,30 @@ summarises the run. :func:`navseq.executor.runner.run_mission` is the usual driv
 Navigators are expected to report a vanished server with ``ServerLost`` (or the
 goal's ``LOST`` status) and its return with ``ServerBack``; the executor then resends
 the active goal without counting it as a failed attempt.
+
+The executor believes the robot, not only the navigation stack:
+
+* **Arrival.** A SUCCEEDED of a visit where the robot stops is checked against the
+  robot's pose (move_base can end a fresh goal SUCCEEDED with the robot metres away,
+  ros-planning/navigation #949). Farther than the goal tolerance plus
+  :data:`ARRIVAL_SLACK_M` (or turned more than the yaw tolerance plus
+  :data:`ARRIVAL_SLACK_RAD`), the attempt fails with a reason like ``succeeded far
+  from goal (2.38 m)`` and the waypoint's policy decides what follows.
+* **Progress** (the stall timeout) is judged on one measure per attempt, the best
+  one available: the navigator's distance remaining along its plan, else the
+  distance along the latest ``GoalPlan`` from the robot's projection onto it, else
+  the straight-line distance. Switching to a better measure restarts the best
+  distance from the new measure's value; a re-plan shifts it by how much longer or
+  shorter the new plan is from where the robot stands, so neither counts as
+  progress nor as its loss. The stall clock itself is never restarted by either.
+* **Distance driven** adds up odometry poses when the navigator gives them
+  (continuous, free of localisation jumps), map poses otherwise.
 """
 
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -43,10 +64,11 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.result import AttemptResult, MissionResult, WaypointResult
 from navseq.executor.resume import ResumePoint
-from navseq.geometry import Pose2D, normalize_angle
+from navseq.geometry import Pose2D, normalize_angle, remaining_along_path
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
+from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
 from navseq.navigators.base import (
     Goal,
     GoalDone,
@@ -68,6 +90,13 @@ PROGRESS_YAW = 0.05
 YAW_PROGRESS_RADIUS = 0.3
 #: Reason recorded when the navigation server stayed away longer than allowed.
 SERVER_LOST_REASON = "navigation server lost"
+#: Added to the goal's xy tolerance when checking a SUCCEEDED against the robot's pose
+#: (m): amcl's pose jitters by a few centimetres, and the pose the executor sees may be
+#: a tick (0.1 s, 0.02 m at TurtleBot3 speed) older than the stack's own.
+ARRIVAL_SLACK_M = 0.10
+#: Added to the goal's yaw tolerance in the same check (rad, about 6°), for the same
+#: reasons (amcl's heading jitter, a robot still settling its last turn).
+ARRIVAL_SLACK_RAD = 0.10
 
 MissionListener = Callable[[MissionEvent], None]
 
@@ -83,6 +112,14 @@ class ExecutorState(enum.Enum):
     FINISHED = "finished"  # the mission ended (see result.reason)
 
 
+class _Measure(enum.IntEnum):
+    """How the distance still to go is measured; a higher value is a better measure."""
+
+    STRAIGHT = 1  # straight line to the goal: no plan known
+    PLAN = 2  # along the latest GoalPlan, from the robot's projection onto it
+    NAVIGATOR = 3  # the navigator's own distance remaining (along its plan)
+
+
 @dataclass
 class _Attempt:
     """The goal currently out for the current visit, and how well it is going."""
@@ -90,9 +127,10 @@ class _Attempt:
     goal: Goal
     sent_at: float
     last_progress_at: float
-    best_distance: float | None = None
+    best_distance: float | None = None  # on ``measure``; None: the next value sets it
     best_yaw_error: float | None = None
-    plan_distance_seen: bool = False  # feedback gives distance along the plan: trust only it
+    measure: _Measure | None = None  # the best measure seen for this goal so far
+    plan: tuple[tuple[float, float], ...] | None = None  # the latest GoalPlan's path
     feedback_seen: bool = False
 
 
@@ -107,6 +145,8 @@ class _Visit:
     result: WaypointResult
     first_sent_at: float | None = None
     reached_at: float | None = None
+    attempt_sent_at: float = 0.0  # when the current attempt's goal was first sent
+    attempt_start_distance: float = 0.0  # the visit's distance driven at that moment
 
 
 class MissionExecutor:
@@ -116,15 +156,26 @@ class MissionExecutor:
     (see :class:`~navseq.executor.resume.ResumePoint`). Goal ids are unique and
     increasing within a run; events about any other goal than the current one are
     ignored, so late results of replaced or cancelled goals do no harm.
+
+    ``robot`` gives the goal tolerance for the arrival check where a waypoint's
+    policy sets none (``xy_tolerance`` / ``yaw_tolerance``); without it the mission's
+    ``robot:`` profile, else :data:`~navseq.mission.robot.DEFAULT_PROFILE`.
     """
 
-    def __init__(self, mission: Mission, *, resume: ResumePoint | None = None):
+    def __init__(
+        self,
+        mission: Mission,
+        *,
+        resume: ResumePoint | None = None,
+        robot: RobotProfile | None = None,
+    ):
         if not mission.waypoints:
             raise NavseqError("the mission has no waypoints", source=mission.source)
         if resume is not None:
             _check_resume_point(mission, resume)
         self._mission = mission
         self._resume = resume
+        self._robot = robot or mission.robot or DEFAULT_PROFILE
         self._listeners: list[MissionListener] = []
         self._state = ExecutorState.IDLE
         self._visits: dict[tuple[int, int], WaypointResult] = {}
@@ -138,7 +189,10 @@ class MissionExecutor:
         self._clear_costmaps_before_send = False
         self._server_up = True
         self._server_lost_at = 0.0
-        self._last_pose: Pose2D | None = None
+        self._last_pose: Pose2D | None = None  # of the distance driven, map frame
+        self._last_odom_pose: Pose2D | None = None  # of the distance driven, odom frame
+        self._latest_pose: Pose2D | None = None  # any input's, for the arrival check
+        self._start_pose: Pose2D | None = None  # the first robot pose of the run
         self._tick_pose_seen = False
         self._started_at: float | None = None
         self._now = 0.0
@@ -188,12 +242,31 @@ class MissionExecutor:
             duration=(self._now - started) + previous,
             distance_driven=sum(v.distance_driven for v in visits),
             loops_completed=self._loops_completed,
+            start_pose=self._start_pose,
         )
 
-    def start(self, now: float) -> list[Command]:
-        """Begin the mission (or resume it); returns the first goal to send."""
+    @property
+    def robot(self) -> RobotProfile:
+        """The robot profile whose goal tolerance the arrival check uses by default."""
+        return self._robot
+
+    def goal_tolerance(self, policy: Policy) -> GoalTolerance:
+        """The arrival tolerance of a visit: its policy's, else the robot profile's."""
+        default = self._robot.goal_tolerance
+        return GoalTolerance(
+            default.xy_m if policy.xy_tolerance is None else policy.xy_tolerance,
+            default.yaw_rad if policy.yaw_tolerance is None else policy.yaw_tolerance,
+        )
+
+    def start(self, now: float, pose: Pose2D | None = None) -> list[Command]:
+        """Begin the mission (or resume it); returns the first goal to send.
+
+        ``pose`` is the robot's pose now, if known: the run's start pose in the result
+        (otherwise the first pose any later input gives).
+        """
         if self._state is not ExecutorState.IDLE:
             raise RuntimeError("MissionExecutor.start() called twice")
+        self._see_pose(pose)
         self._now = now
         self._started_at = now
         self._reason = "running"
@@ -209,11 +282,17 @@ class MissionExecutor:
         )
         return self._begin_visit(now, loop, index, new_loop=True)
 
-    def on_event(self, event: NavEvent, now: float) -> list[Command]:
-        """React to one navigator event."""
+    def on_event(self, event: NavEvent, now: float, pose: Pose2D | None = None) -> list[Command]:
+        """React to one navigator event.
+
+        ``pose`` is the robot's pose (mission frame) when the event is handled, if the
+        navigator knows it. A SUCCEEDED is checked against it, else against the latest
+        pose any input gave; with no pose at all the SUCCEEDED is believed.
+        """
         self._now = max(self._now, now)
         if self.finished:
             return []
+        self._see_pose(pose)
         if isinstance(event, ServerLost):
             return self._on_server_lost(now, event.reason or "server lost")
         if isinstance(event, ServerBack):
@@ -225,26 +304,36 @@ class MissionExecutor:
         if isinstance(event, GoalFeedback):
             return self._on_feedback(now, event)
         if isinstance(event, GoalPlan):
+            self._on_plan(event)
             self._emit(WaypointPlan(t=now, index=self._current.index, path=event.path))
             return []
         if isinstance(event, GoalDone):
             return self._on_goal_done(now, event)
         return []  # GoalAccepted needs no reaction: timeouts run from the send
 
-    def on_tick(self, now: float, pose: Pose2D | None) -> list[Command]:
-        """Let time pass: check timeouts, dwell, back-off and pass-through."""
+    def on_tick(
+        self, now: float, pose: Pose2D | None, odom_pose: Pose2D | None = None
+    ) -> list[Command]:
+        """Let time pass: check timeouts, dwell, back-off and pass-through.
+
+        ``pose`` is the robot's pose in the mission frame, ``odom_pose`` its pose in
+        the odometry frame (either None when unknown). Distance driven adds up
+        successive odometry poses when given, map poses otherwise.
+        """
         self._now = max(self._now, now)
         if self._state in (ExecutorState.IDLE, ExecutorState.FINISHED):
             return []
         commands: list[Command] = []
-        if pose is not None:
+        if pose is not None or odom_pose is not None:
             self._tick_pose_seen = True
-            self._accumulate_distance(pose)
+            self._accumulate_distance(pose, odom_pose)
+        if pose is not None:
+            self._see_pose(pose)
             if self._state is ExecutorState.ACTIVE:
                 commands = self._observe_pose(now, pose, None)
                 attempt = self._attempt
                 if attempt is not None and not attempt.feedback_seen and not commands:
-                    self._emit_progress(now, pose, pose.distance_to(attempt.goal.pose))
+                    self._emit_progress(now, pose, self._remaining(attempt, pose))
             if commands:
                 return commands
         return self._check_clock(now)
@@ -300,8 +389,36 @@ class MissionExecutor:
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:
-        self._current.result.attempts += 1
+        visit = self._current
+        visit.result.attempts += 1
+        visit.attempt_sent_at = now
+        visit.attempt_start_distance = visit.result.distance_driven
         return self._send_goal(now)
+
+    def _passes_through(self, visit: _Visit) -> bool:
+        """Whether the visit ends when the robot comes near, without stopping there."""
+        return (
+            visit.policy.pass_through is not None
+            and visit.policy.dwell == 0
+            and not self._is_last_visit(visit.loop, visit.index)
+        )
+
+    def _close_attempt(
+        self, now: float, *, reached: bool, status: str | None, reason: str, text: str = ""
+    ) -> AttemptResult:
+        """Record how the current attempt ended in the visit's result."""
+        visit = self._current
+        record = AttemptResult(
+            number=visit.result.attempts,
+            reached=reached,
+            status=status,
+            reason=reason,
+            text=text,
+            duration=max(0.0, now - visit.attempt_sent_at),
+            distance_driven=visit.result.distance_driven - visit.attempt_start_distance,
+        )
+        visit.result.attempt_results.append(record)
+        return record
 
     def _send_goal(self, now: float) -> list[Command]:
         """Send the current visit's goal (a fresh goal id), or wait for the server first."""
@@ -347,9 +464,12 @@ class MissionExecutor:
             return loop + 1, 0
         return None
 
-    def _reached(self, now: float, *, passed_through: bool) -> list[Command]:
+    def _reached(
+        self, now: float, *, passed_through: bool, status: str | None = None, text: str = ""
+    ) -> list[Command]:
         visit = self._current
         visit.reached_at = now
+        self._close_attempt(now, reached=True, status=status, reason="", text=text)
         self._attempt = None
         if not passed_through and visit.policy.dwell > 0:
             self._state = ExecutorState.DWELLING
@@ -381,6 +501,9 @@ class MissionExecutor:
     ) -> None:
         visit = self._current
         result = visit.result
+        if outcome is not WaypointOutcome.REACHED and len(result.attempt_results) < result.attempts:
+            # Ended by navseq while a goal was out (interrupt, operator skip, server gone).
+            self._close_attempt(now, reached=False, status=None, reason=reason)
         end = visit.reached_at if outcome is WaypointOutcome.REACHED else now
         start = visit.first_sent_at
         result.outcome = outcome
@@ -432,7 +555,15 @@ class MissionExecutor:
 
     # ------------------------------------------------------------------ failures
 
-    def _attempt_failed(self, now: float, reason: str, *, cancel: bool) -> list[Command]:
+    def _attempt_failed(
+        self,
+        now: float,
+        reason: str,
+        *,
+        cancel: bool,
+        status: GoalStatus | None = None,
+        text: str = "",
+    ) -> list[Command]:
         visit = self._current
         commands: list[Command] = [CancelGoal()] if cancel else []
         attempts = visit.result.attempts
@@ -440,9 +571,25 @@ class MissionExecutor:
         will_retry = policy.on_failure is FailureAction.RETRY or attempts <= policy.retries
         self._attempt = None
         visit.result.reason = reason
+        record = self._close_attempt(
+            now,
+            reached=False,
+            status=status.value if status is not None else None,
+            reason=reason,
+            text=text,
+        )
         self._emit(
             AttemptFailed(
-                t=now, index=visit.index, attempt=attempts, reason=reason, will_retry=will_retry
+                t=now,
+                index=visit.index,
+                attempt=attempts,
+                reason=reason,
+                will_retry=will_retry,
+                status=record.status,
+                text=text,
+                duration=record.duration,
+                distance_driven=record.distance_driven,
+                loop=visit.loop,
             )
         )
         if will_retry:
@@ -460,7 +607,14 @@ class MissionExecutor:
 
     def _on_goal_done(self, now: float, event: GoalDone) -> list[Command]:
         if event.status is GoalStatus.SUCCEEDED:
-            return self._reached(now, passed_through=False)
+            miss = self._arrival_miss()
+            if miss is None:
+                return self._reached(
+                    now, passed_through=False, status=event.status.value, text=event.text
+                )
+            return self._attempt_failed(
+                now, miss, cancel=False, status=event.status, text=event.text
+            )
         if event.status is GoalStatus.LOST:
             # Not the waypoint's fault: the stack lost track of the goal. Treat it as
             # a vanished server and resend once it reports back.
@@ -468,7 +622,31 @@ class MissionExecutor:
             self._state = ExecutorState.WAITING_SERVER
             self._attempt = None
             return self._check_clock(now)
-        return self._attempt_failed(now, event.status.value, cancel=False)
+        return self._attempt_failed(
+            now, event.status.value, cancel=False, status=event.status, text=event.text
+        )
+
+    def _arrival_miss(self) -> str | None:
+        """Why a SUCCEEDED is not believed (the robot is not there), or None.
+
+        Only visits where the robot stops are checked: a pass-through visit is
+        reached by coming near, and its SUCCEEDED is as good as that. Without any
+        robot pose the SUCCEEDED is believed.
+        """
+        visit = self._current
+        attempt = self._attempt
+        pose = self._latest_pose
+        if pose is None or attempt is None or self._passes_through(visit):
+            return None
+        tolerance = self.goal_tolerance(visit.policy)
+        goal = attempt.goal.pose
+        off = pose.distance_to(goal)
+        if off > tolerance.xy_m + ARRIVAL_SLACK_M:
+            return f"succeeded far from goal ({off:.2f} m)"
+        yaw_off = abs(normalize_angle(goal.yaw - pose.yaw))
+        if yaw_off > tolerance.yaw_rad + ARRIVAL_SLACK_RAD:
+            return f"succeeded {math.degrees(yaw_off):.0f}° off the goal yaw"
+        return None
 
     def _mark_server_lost(self, now: float, reason: str) -> None:
         if self._server_up:
@@ -527,20 +705,72 @@ class MissionExecutor:
         attempt.feedback_seen = True
         if not self._tick_pose_seen:
             self._accumulate_distance(event.pose)
+        self._see_pose(event.pose)
         commands = self._observe_pose(now, event.pose, event.distance_remaining)
         if not commands and self._attempt is attempt:
             remaining = event.distance_remaining
             if remaining is None:
-                remaining = event.pose.distance_to(attempt.goal.pose)
+                remaining = self._remaining(attempt, event.pose)
             self._emit_progress(now, event.pose, remaining)
         return commands
 
-    def _accumulate_distance(self, pose: Pose2D) -> None:
-        if self._last_pose is not None and self._visit is not None:
-            self._visit.result.distance_driven += self._last_pose.distance_to(pose)
-        self._last_pose = pose
+    @staticmethod
+    def _remaining(attempt: _Attempt, pose: Pose2D) -> float:
+        """Distance to go for display: along the known plan, else straight."""
+        if attempt.plan is not None:
+            return remaining_along_path(attempt.plan, pose.x, pose.y)
+        return pose.distance_to(attempt.goal.pose)
 
-    def _observe_pose(self, now: float, pose: Pose2D, plan_distance: float | None) -> list[Command]:
+    def _see_pose(self, pose: Pose2D | None) -> None:
+        if pose is not None:
+            self._latest_pose = pose
+            if self._start_pose is None:
+                self._start_pose = pose
+
+    def _accumulate_distance(self, pose: Pose2D | None, odom_pose: Pose2D | None = None) -> None:
+        step = 0.0
+        if odom_pose is not None:
+            if self._last_odom_pose is not None:
+                step = self._last_odom_pose.distance_to(odom_pose)
+        elif pose is not None and self._last_pose is not None:
+            step = self._last_pose.distance_to(pose)
+        if self._visit is not None:
+            self._visit.result.distance_driven += step
+        if pose is not None:
+            self._last_pose = pose
+        # Forgotten when missing, so that odometry coming back does not count the gap
+        # a second time (the map poses counted it).
+        self._last_odom_pose = odom_pose
+
+    def _on_plan(self, event: GoalPlan) -> None:
+        """Adopt a new plan for the attempt; keep the best distance on its measure.
+
+        A re-plan moves the best distance by how much the remaining path changed
+        where the robot stands, so a longer detour is not a lost progress and a
+        shorter one not a gained one. Where the change cannot be measured (no
+        earlier plan or no pose), the next value restarts the best distance.
+        """
+        attempt = self._attempt
+        assert attempt is not None
+        if not event.path:
+            return
+        old, attempt.plan = attempt.plan, event.path
+        if attempt.best_distance is None or attempt.measure not in (
+            _Measure.PLAN,
+            _Measure.NAVIGATOR,
+        ):
+            return  # a straight-line measure gives way to the plan at the next pose
+        pose = self._latest_pose
+        if old is None or pose is None:
+            attempt.best_distance = None
+            return
+        attempt.best_distance += remaining_along_path(
+            event.path, pose.x, pose.y
+        ) - remaining_along_path(old, pose.x, pose.y)
+
+    def _observe_pose(
+        self, now: float, pose: Pose2D, navigator_distance: float | None
+    ) -> list[Command]:
         """Update progress from a pose; pass through the waypoint when close enough."""
         attempt = self._attempt
         visit = self._current
@@ -548,29 +778,12 @@ class MissionExecutor:
         goal = attempt.goal.pose
         straight = pose.distance_to(goal)
         radius = visit.policy.pass_through
-        if (
-            radius is not None
-            and visit.policy.dwell == 0
-            and straight <= radius
-            and not self._is_last_visit(visit.loop, visit.index)
-        ):
+        if radius is not None and straight <= radius and self._passes_through(visit):
             # The next goal replaces this one at once, without a cancel: the robot
             # keeps rolling instead of braking at every intermediate point.
             return self._reached(now, passed_through=True)
 
-        if plan_distance is not None:
-            attempt.plan_distance_seen = True
-            distance: float | None = plan_distance
-        else:
-            # Straight-line and along-the-plan distances are not comparable.
-            distance = None if attempt.plan_distance_seen else straight
-        progressed = False
-        if distance is not None:
-            if attempt.best_distance is None:
-                attempt.best_distance = distance
-            elif distance <= attempt.best_distance - PROGRESS_DISTANCE:
-                attempt.best_distance = distance
-                progressed = True
+        progressed = self._distance_progressed(attempt, pose, straight, navigator_distance)
         if straight <= YAW_PROGRESS_RADIUS:
             # Turning in place to the goal yaw is progress too.
             yaw_error = abs(normalize_angle(goal.yaw - pose.yaw))
@@ -582,6 +795,34 @@ class MissionExecutor:
         if progressed:
             attempt.last_progress_at = now
         return []
+
+    @staticmethod
+    def _distance_progressed(
+        attempt: _Attempt, pose: Pose2D, straight: float, navigator_distance: float | None
+    ) -> bool:
+        """Whether the distance to go dropped, judged on the attempt's best measure."""
+        if navigator_distance is not None:
+            measure, distance = _Measure.NAVIGATOR, navigator_distance
+        elif attempt.measure is _Measure.NAVIGATOR:
+            return False  # a pose alone says nothing on the navigator's measure
+        elif attempt.plan is not None:
+            measure = _Measure.PLAN
+            distance = remaining_along_path(attempt.plan, pose.x, pose.y)
+        elif attempt.measure is None or attempt.measure is _Measure.STRAIGHT:
+            measure, distance = _Measure.STRAIGHT, straight
+        else:
+            return False
+        if attempt.measure is None or measure > attempt.measure:
+            # Different measures are not comparable: start afresh on the better one.
+            attempt.measure, attempt.best_distance = measure, distance
+            return False
+        if attempt.best_distance is None:
+            attempt.best_distance = distance
+            return False
+        if distance <= attempt.best_distance - PROGRESS_DISTANCE:
+            attempt.best_distance = distance
+            return True
+        return False
 
     def _emit_progress(self, now: float, pose: Pose2D, remaining: float | None) -> None:
         visit = self._current
@@ -632,6 +873,8 @@ def _result_for(mission: Mission, done: WaypointResult) -> WaypointResult:
 
 
 __all__ = [
+    "ARRIVAL_SLACK_M",
+    "ARRIVAL_SLACK_RAD",
     "PROGRESS_DISTANCE",
     "PROGRESS_YAW",
     "RETRY_BACKOFF",

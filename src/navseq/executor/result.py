@@ -6,6 +6,26 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from navseq.executor.events import WaypointOutcome
+from navseq.geometry import Pose2D
+
+
+@dataclass
+class AttemptResult:
+    """One goal sent for a visit, and how it ended.
+
+    ``status`` is the terminal status the navigation stack reported (a GoalStatus
+    value), or None when navseq ended the attempt itself (timeout, stalled, skip,
+    interrupt). ``reason`` is empty for the attempt that reached the waypoint, else
+    why it failed; ``text`` is the stack's own result text.
+    """
+
+    number: int  # 1-based
+    reached: bool = False
+    status: str | None = None
+    reason: str = ""
+    text: str = ""
+    duration: float = 0.0  # s from the goal sent to its end
+    distance_driven: float = 0.0  # m
 
 
 @dataclass
@@ -24,6 +44,12 @@ class WaypointResult:
     distance_driven: float = 0.0  # m
     reason: str = ""
     passed_through: bool = False
+    attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
+
+    @property
+    def last_failure(self) -> AttemptResult | None:
+        """The latest attempt that did not reach the waypoint, if any."""
+        return next((a for a in reversed(self.attempt_results) if not a.reached), None)
 
 
 @dataclass
@@ -34,6 +60,7 @@ class MissionResult:
     duration: float = 0.0
     distance_driven: float = 0.0
     loops_completed: int = 0
+    start_pose: Pose2D | None = None  # the robot's first known pose of the run
 
     @property
     def exit_code(self) -> int:

@@ -5,6 +5,12 @@ the state machine cannot keep on its own: whatever ends the run early (Ctrl-C,
 SIGTERM, an exception in a sink or a navigator), the active goal is cancelled on the
 navigator before the error leaves this function, so the robot never keeps driving
 to a goal nobody watches.
+
+For that it installs its own SIGINT and SIGTERM handlers while the mission runs (in
+the main thread), restoring the previous ones afterwards. SIGINT too: a process
+started in the background of a shell script inherits SIGINT as ignored, and Python
+then installs no KeyboardInterrupt handler, so ``kill -INT`` would leave the robot
+driving.
 """
 
 from __future__ import annotations
@@ -18,7 +24,9 @@ from navseq.executor.control import MissionControl
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
+from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
+from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import Navigator
 from navseq.signals import SignalGuard, Terminated
 
@@ -64,6 +72,7 @@ def run_mission(
     server_wait: float = 10.0,
     control: MissionControl | None = None,
     signals: SignalGuard | None = None,
+    robot: RobotProfile | None = None,
 ) -> MissionResult:
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
@@ -76,7 +85,9 @@ def run_mission(
     (SIGINT, SIGTERM and SIGHUP end it, also where SIGINT was ignored), deferring from
     the moment the run is stopped or ends, so that the caller can finish its outputs
     before it restores the handlers. Without one, a guard of the run's own is restored
-    on return.
+    on return. ``robot`` gives the goal tolerance of the arrival check (see
+    :class:`~navseq.executor.machine.MissionExecutor`; default: the mission's
+    ``robot:``, else the TurtleBot3 burger).
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
     :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP, :class:`MissionAborted` when
@@ -86,7 +97,7 @@ def run_mission(
     listeners that the mission finished (``MissionFinished``, reason
     ``"interrupted: SIGINT"`` and so on).
     """
-    executor = MissionExecutor(mission, resume=resume)
+    executor = MissionExecutor(mission, resume=resume, robot=robot)
     for listener in listeners:
         executor.add_listener(listener)
     guard = signals if signals is not None else SignalGuard()
@@ -130,16 +141,23 @@ def _drive(
     executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
 ) -> None:
     """The loop: navigator events, operator requests and the clock in; commands out."""
-    _apply(navigator, executor.start(navigator.now()))
+    _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
         for event in navigator.poll():
-            _apply(navigator, executor.on_event(event, navigator.now()))
+            _apply(navigator, executor.on_event(event, navigator.now(), navigator.robot_pose()))
         if control is not None:
             for reason in control.take_skips():
                 _apply(navigator, executor.skip(navigator.now(), reason))
-        _apply(navigator, executor.on_tick(navigator.now(), navigator.robot_pose()))
+        pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
+        _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
         if not executor.finished:
             navigator.spin(tick)
+
+
+def _odometry_pose(navigator: Navigator) -> Pose2D | None:
+    """The navigator's odometry pose; None from navigators written before it existed."""
+    odometry_pose = getattr(navigator, "odometry_pose", None)
+    return odometry_pose() if odometry_pose is not None else None
 
 
 def _apply(navigator: Navigator, commands: list[Command]) -> None:

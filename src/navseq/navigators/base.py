@@ -112,6 +112,14 @@ class Navigator(Protocol):
         """Latest known robot pose in the mission frame, or None if unknown."""
         ...
 
+    def odometry_pose(self) -> Pose2D | None:
+        """The robot's pose in the odometry frame, or None if unknown.
+
+        Continuous (no localisation jumps, unlike the map pose), so the executor adds
+        up distance driven from it; its origin does not matter.
+        """
+        ...
+
     def poll(self) -> list[NavEvent]:
         """Events since the last call, oldest first. Never blocks."""
         ...

@@ -8,7 +8,9 @@ step. What each goal does is scripted, in the order goals are sent::
     nav = ScriptedNavigator([Succeed(), Finish(GoalStatus.ABORTED, after=2.0), Stall()])
 
 The first goal succeeds on arrival, the second is aborted after 2 s, the third stops
-moving and never finishes; goals beyond the script succeed. A goal resent after a
+moving and never finishes; goals beyond the script succeed. :class:`FalseSuccess`
+plays move_base's plan race (ros-planning/navigation #949): SUCCEEDED at once, with
+the robot still where it was. A goal resent after a
 server loss is a new goal and takes the next behaviour.
 
 Everything the executor asked for (goals, cancels, costmap clears) is recorded for
@@ -27,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from navseq.geometry import Pose2D, normalize_angle
+from navseq.geometry import Pose2D, compose, inverse, normalize_angle
 from navseq.navigators.base import (
     Goal,
     GoalAccepted,
@@ -83,7 +85,18 @@ class Stall:
     after: float = 0.0
 
 
-Behaviour = Succeed | Finish | LoseServer | Hang | Stall
+@dataclass(frozen=True)
+class FalseSuccess:
+    """Report SUCCEEDED ``after`` seconds into the goal without the robot moving at all.
+
+    What move_base sometimes does with a fresh goal (ros-planning/navigation #949).
+    """
+
+    after: float = 0.0
+    text: str = ""
+
+
+Behaviour = Succeed | Finish | LoseServer | Hang | Stall | FalseSuccess
 
 _UNACCEPTED = (GoalStatus.REJECTED, GoalStatus.RECALLED)
 _ARRIVED_YAW = 1e-3
@@ -129,6 +142,7 @@ class ScriptedNavigator:
         self.cancels: list[tuple[float, int | None]] = []  # (time, active goal id or None)
         self.costmap_clears: list[float] = []
         self._pose = start or Pose2D(0.0, 0.0, 0.0)
+        self._odom_origin = self._pose  # odometry reads (0, 0, 0) where the robot starts
         self._t = 0.0
         self._events: list[NavEvent] = []
         self._active: _ActiveGoal | None = None
@@ -171,6 +185,9 @@ class ScriptedNavigator:
 
     def robot_pose(self) -> Pose2D | None:
         return self._pose
+
+    def odometry_pose(self) -> Pose2D | None:
+        return compose(inverse(self._odom_origin), self._pose)
 
     def poll(self) -> list[NavEvent]:
         events, self._events = self._events, []
@@ -219,6 +236,11 @@ class ScriptedNavigator:
             self._events.append(GoalDone(goal_id, behaviour.status, behaviour.text))
             self._active = None
             return
+        if isinstance(behaviour, FalseSuccess):
+            if elapsed >= behaviour.after:
+                self._events.append(GoalDone(goal_id, GoalStatus.SUCCEEDED, behaviour.text))
+                self._active = None
+            return  # the robot never moves
         stalled = isinstance(behaviour, Stall) and elapsed >= behaviour.after
         arrived = self._move_towards(active.goal.pose, 0.0 if stalled else dt)
         remaining = self._pose.distance_to(active.goal.pose) if self.report_distance else None
@@ -257,6 +279,7 @@ class ScriptedNavigator:
 
 __all__ = [
     "Behaviour",
+    "FalseSuccess",
     "Finish",
     "Hang",
     "LoseServer",

@@ -104,6 +104,9 @@ class SimNavigator:
     def robot_pose(self) -> Pose2D | None:
         return self.world.robot.pose
 
+    def odometry_pose(self) -> Pose2D | None:
+        return self.world.body.odom_pose
+
     def poll(self) -> list[NavEvent]:
         events, self._events = self._events, []
         return events

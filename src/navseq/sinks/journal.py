@@ -26,6 +26,10 @@ reordered by hand no longer chains, and is refused with the line number where th
 chain breaks: resuming from it could re-run reached waypoints or skip unreached ones.
 The header records the run's options (``run``: loops, navigator, ...), so that a resume
 continues the mission as it was started.
+
+Fields added to an event type later (``AttemptFailed``'s ``status``, ``text``,
+``duration``, ``distance_driven``, ``loop``) default when an older journal lacks them,
+so journals written by earlier versions still read and resume.
 """
 
 from __future__ import annotations
@@ -46,7 +50,7 @@ from typing import Any, Union, get_args, get_origin, get_type_hints
 
 from navseq.errors import NavseqError
 from navseq.executor import events as ev
-from navseq.executor.result import WaypointResult
+from navseq.executor.result import AttemptResult, WaypointResult
 from navseq.executor.resume import ResumePoint
 
 JOURNAL_FORMAT = "navseq-journal"
@@ -340,11 +344,21 @@ def _check_chain(
     return chain
 
 
+@dataclass
+class _VisitTrail:
+    """What a segment's events said about the visit being driven, attempt by attempt."""
+
+    key: tuple[int, int]
+    sent_at: dict[int, float] = field(default_factory=dict)  # attempt number -> first send
+    failures: dict[int, AttemptResult] = field(default_factory=dict)
+
+
 def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]]) -> None:
     """Fill ``state`` from the records after the header, segment by segment."""
     path = state.path
     segment_start: float | None = None
     segment_end: float | None = None
+    trail: _VisitTrail | None = None
     for position, (number, record) in enumerate(records):
         if record is None:
             following = records[position + 1][1] if position + 1 < len(records) else None
@@ -371,16 +385,71 @@ def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]
         state.events.append(event)
         if isinstance(event, ev.MissionStarted):
             segment_start = event.t
+            trail = None  # a new segment: its clock starts afresh
         segment_end = event.t
-        if isinstance(event, ev.WaypointFinished):
-            state.visits[(event.loop, event.index)] = _visit_of(event)
+        if isinstance(event, ev.WaypointStarted):
+            key = (event.loop, event.index)
+            if trail is None or trail.key != key:
+                trail = _VisitTrail(key)
+            trail.sent_at.setdefault(event.attempt, event.t)
+        elif isinstance(event, ev.AttemptFailed) and trail is not None:
+            # The visit is the one last started: older journals name no loop here.
+            trail.failures[event.attempt] = _attempt_of(event)
+        elif isinstance(event, ev.WaypointFinished):
+            key = (event.loop, event.index)
+            state.visits[key] = _visit_of(event, trail if trail and trail.key == key else None)
         elif isinstance(event, ev.MissionFinished):
             state.finish_reason = event.reason
     if segment_start is not None and segment_end is not None:
         state.previous_duration += max(0.0, segment_end - segment_start)
 
 
-def _visit_of(event: ev.WaypointFinished) -> WaypointResult:
+def _attempt_of(event: ev.AttemptFailed) -> AttemptResult:
+    return AttemptResult(
+        number=event.attempt,
+        status=event.status,
+        reason=event.reason,
+        text=event.text,
+        duration=event.duration,
+        distance_driven=event.distance_driven,
+    )
+
+
+def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[AttemptResult]:
+    """The visit's attempts the journal tells about, in order.
+
+    The last attempt ended without an AttemptFailed when it reached the waypoint or
+    was ended by navseq (interrupt, operator skip): it is rebuilt from the finish.
+    Only attempts the journal records are listed (never a padding of ``attempts``
+    blanks: a damaged journal may give any number there).
+    """
+    failures = trail.failures if trail is not None else {}
+    sent_at = trail.sent_at if trail is not None else {}
+    last = event.attempts
+    attempts = [failures[n] for n in sorted(failures) if 1 <= n <= last]
+    if last >= 1 and last not in failures:
+        first_sent = sent_at.get(1)
+        last_sent = sent_at.get(last)
+        reached = event.outcome is ev.WaypointOutcome.REACHED
+        if reached:
+            end = first_sent + event.duration if first_sent is not None else None
+        else:
+            end = event.t
+        before = sum(a.distance_driven for a in attempts)
+        attempts.append(
+            AttemptResult(
+                number=last,
+                reached=reached,
+                status="SUCCEEDED" if reached and not event.passed_through else None,
+                reason="" if reached else event.reason,
+                duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
+                distance_driven=max(0.0, event.distance_driven - before),
+            )
+        )
+    return attempts
+
+
+def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> WaypointResult:
     """A finished visit as the result lists it (the waypoint's pose comes from the mission)."""
     return WaypointResult(
         index=event.index,
@@ -395,6 +464,7 @@ def _visit_of(event: ev.WaypointFinished) -> WaypointResult:
         distance_driven=event.distance_driven,
         reason=event.reason,
         passed_through=event.passed_through,
+        attempt_results=_attempts_of(event, trail),
     )
 
 

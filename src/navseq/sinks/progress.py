@@ -42,7 +42,7 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import MissionResult
+from navseq.executor.result import MissionResult, WaypointResult
 from navseq.mission.model import Mission
 
 OUTCOME_STYLE = {
@@ -61,6 +61,14 @@ OUTCOME_MARK = {
 
 def _plural(count: int, word: str) -> str:
     return f"{count} {word}{'' if count == 1 else 's'}"
+
+
+def _why(reason: str, text: str) -> str:
+    """navseq's reason with the navigation stack's own words after it, when it gave any."""
+    text = text.strip()
+    if not text or text == reason:
+        return reason
+    return f"{reason}: {text}" if reason else text
 
 
 class RunView:
@@ -113,7 +121,8 @@ class RunView:
             self.distance_driven = event.distance_driven
         elif isinstance(event, AttemptFailed):
             then = "will retry" if event.will_retry else "giving up"
-            self.status = f"attempt {event.attempt} failed ({event.reason}), {then}"
+            why = _why(event.reason, event.text)
+            self.status = f"attempt {event.attempt} failed ({why}), {then}"
         elif isinstance(event, WaypointDwelling):
             self.status = f"dwelling {event.seconds:g} s"
             self.distance_remaining = 0.0
@@ -244,7 +253,7 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     if isinstance(event, AttemptFailed):
         then = "will retry" if event.will_retry else "giving up"
         return (f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
-                f"({event.reason}), {then}")
+                f"({_why(event.reason, event.text)}), {then}")
     if isinstance(event, WaypointDwelling):
         return f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s"
     if isinstance(event, WaypointFinished):
@@ -365,8 +374,22 @@ def make_progress(
     return LogProgress(mission, stream)
 
 
+def _visit_reason(visit: WaypointResult) -> str:
+    """Why a visit was not reached: its last failure's reason and the stack's text."""
+    if WaypointOutcome(visit.outcome) is WaypointOutcome.REACHED:
+        return visit.reason
+    failure = visit.last_failure
+    if failure is None:
+        return visit.reason
+    return _why(visit.reason or failure.reason, failure.text)
+
+
 def summary_table(mission: Mission, result: MissionResult) -> Table:
-    """Per-visit outcome, attempts, time and distance, with totals in the footer."""
+    """Per-visit outcome, attempts, time and distance, with totals in the footer.
+
+    For a visit not reached, the reason column says why: the last failure's reason
+    and the navigation stack's own text (move_base's "Failed to find a valid plan").
+    """
     several_loops = any(visit.loop > 0 for visit in result.visits)
     table = Table(title=Text(f"mission {mission.source}: {result.reason}"), show_footer=True)
     table.add_column("#", justify="right", footer="total")
@@ -380,10 +403,11 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
     table.add_column(escape("time [s]"), justify="right", footer=f"{result.duration:.1f}")
     table.add_column(escape("distance [m]"), justify="right",
                      footer=f"{result.distance_driven:.2f}")
-    any_reason = any(visit.reason for visit in result.visits)
+    reasons = [_visit_reason(visit) for visit in result.visits]
+    any_reason = any(reasons)
     if any_reason:
         table.add_column("reason")
-    for visit in result.visits:
+    for visit, reason in zip(result.visits, reasons, strict=True):
         outcome = WaypointOutcome(visit.outcome)
         label = "passed through" if visit.passed_through else outcome.value.replace("_", " ")
         cells = [str(visit.index + 1)]
@@ -397,7 +421,7 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
             f"{visit.distance_driven:.2f}",
         ]
         if any_reason:
-            cells.append(visit.reason)
+            cells.append(reason)
         # Text cells: a name or reason with [brackets] is not markup.
         table.add_row(*(Text(cell) for cell in cells), style=OUTCOME_STYLE[outcome])
     return table

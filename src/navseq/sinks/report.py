@@ -1,15 +1,17 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 1; times in seconds, distances in metres, angles in degrees)::
+Schema (``schema_version`` 2; times in seconds, distances in metres, angles in degrees)::
 
     {
-      "schema_version": 1,
+      "schema_version": 2,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
       "navigator": {"kind": "sim" | "ros1" | ..., ...options},
       "map": {"source", "resolution", "width", "height", "origin"} | null,
-      "start": {"x", "y", "yaw_deg"} | null,
+      "start": {"x", "y", "yaw_deg"} | null,      # where the robot was when the run began
+      "start_source": "robot" | "mission start:" | "--start" | ... | null,
+      "planned_start": {"x", "y", "yaw_deg"} | null,  # --start or the mission's start:
       "success": bool,            # every visit reached
       "reason": "completed" | "stopped: ..." | "interrupted: SIGINT" | ...,
       "interrupted": "SIGINT" | "SIGTERM" | null,
@@ -17,13 +19,24 @@ Schema (``schema_version`` 1; times in seconds, distances in metres, angles in d
       "totals": {"visits", "reached", "skipped", "failed", "not_run",
                  "duration_s", "distance_m", "loops_completed"},
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
-                  "attempts", "duration_s", "distance_m", "reason", "passed_through"}],
+                  "attempts": [{"number", "reached", "status", "reason", "text",
+                                "duration_s", "distance_m"}],
+                  "duration_s", "distance_m", "reason", "passed_through"}],
       "files": {"journal", "picture", ...}
     }
 
 ``index`` is 0-based (as in events and the journal), ``number`` 1-based (as in
 messages: "waypoint 3"); ``loop`` is 0-based; ``outcome`` is one of reached,
-skipped, failed, not_run.
+skipped, failed, not_run. ``start`` is the robot's first pose the navigator gave
+(``start_source`` ``"robot"``); when the navigator gave none, the planned start
+(``--start`` or the mission's ``start:``, as ``start_source`` says).
+
+Each attempt is one goal sent: ``status`` is the navigation stack's terminal status
+(SUCCEEDED, ABORTED, ...; null when navseq ended the attempt: timeout, stalled,
+interrupt), ``reason`` navseq's verdict (empty for the attempt that reached the
+waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but the
+robot was not there), ``text`` the stack's own result text. Version 1 had
+``attempts`` as a count: it is the length of the list now.
 """
 
 from __future__ import annotations
@@ -38,12 +51,14 @@ from typing import Any
 
 from navseq import __version__
 from navseq.executor.events import WaypointOutcome
-from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.result import AttemptResult, MissionResult, WaypointResult
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: ``start_source`` when the report's start is the robot's own first pose.
+START_FROM_ROBOT = "robot"
 
 
 def _rounded(value: float, digits: int = 3) -> float | None:
@@ -58,6 +73,18 @@ def _pose_dict(pose: Pose2D) -> dict[str, float | None]:
     }
 
 
+def _attempt_dict(attempt: AttemptResult) -> dict[str, Any]:
+    return {
+        "number": attempt.number,
+        "reached": attempt.reached,
+        "status": attempt.status,
+        "reason": attempt.reason,
+        "text": attempt.text,
+        "duration_s": _rounded(attempt.duration, 2),
+        "distance_m": _rounded(attempt.distance_driven),
+    }
+
+
 def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
     return {
         "index": visit.index,
@@ -68,7 +95,7 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "y": _rounded(visit.y),
         "yaw_deg": _rounded(math.degrees(visit.yaw), 1),
         "outcome": WaypointOutcome(visit.outcome).value,
-        "attempts": visit.attempts,
+        "attempts": [_attempt_dict(attempt) for attempt in visit.attempt_results],
         "duration_s": _rounded(visit.duration, 2),
         "distance_m": _rounded(visit.distance_driven),
         "reason": visit.reason,
@@ -86,9 +113,19 @@ def build_report(
     mission_digest: str | None = None,
     map_info: Mapping[str, Any] | None = None,
     start: Pose2D | None = None,
+    start_source: str | None = None,
     files: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
-    """The report of one run as a JSON-ready dict (see the module docstring)."""
+    """The report of one run as a JSON-ready dict (see the module docstring).
+
+    ``start`` is the planned start pose (``--start``, the mission's ``start:``, the
+    simulator's default) and ``start_source`` says which; the report's ``start`` is
+    the robot's own first pose (``result.start_pose``) whenever the run saw one.
+    """
+    if result.start_pose is not None:
+        actual, actual_source = result.start_pose, START_FROM_ROBOT
+    else:
+        actual, actual_source = start, start_source if start is not None else None
     counts = Counter(WaypointOutcome(visit.outcome).value for visit in result.visits)
     return {
         "schema_version": SCHEMA_VERSION,
@@ -104,7 +141,9 @@ def build_report(
         },
         "navigator": dict(navigator),
         "map": dict(map_info) if map_info is not None else None,
-        "start": _pose_dict(start) if start is not None else None,
+        "start": _pose_dict(actual) if actual is not None else None,
+        "start_source": actual_source,
+        "planned_start": _pose_dict(start) if start is not None else None,
         "success": result.success,
         "reason": result.reason,
         "interrupted": interrupted,
