@@ -236,17 +236,28 @@ def test_sigterm_handler_is_restored_after_the_run() -> None:
 
 
 def test_sigint_is_caught_during_the_run_even_when_ignored_before_and_restored_after() -> None:
-    seen: list[object] = []
+    import os
 
-    class Watching(ScriptedNavigator):
+    import pytest
+
+    from navseq.executor.runner import MissionInterrupted
+
+    cancels: list[bool] = []
+
+    class Interrupted(ScriptedNavigator):
         def spin(self, seconds: float) -> None:
-            seen.append(signal.getsignal(signal.SIGINT))
+            os.kill(os.getpid(), signal.SIGINT)  # as `kill -INT` from a script would
             super().spin(seconds)
+
+        def cancel_goal(self) -> None:
+            cancels.append(True)
+            super().cancel_goal()
 
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        run_mission(line_mission(1), Watching())
+        with pytest.raises(MissionInterrupted) as stopped:
+            run_mission(line_mission(1), Interrupted())
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, previous)
-    assert seen and all(handler is signal.default_int_handler for handler in seen)
+    assert stopped.value.exit_code == 130 and cancels
