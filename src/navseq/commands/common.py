@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import math
+import stat
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -74,8 +76,21 @@ def costmap_for_map(map_path: Path) -> Costmap:
 
 
 def require_file(path: Path, what: str) -> None:
-    """A clear NavseqError for a missing path given by the user (``what`` names the role)."""
-    if not path.exists():
-        raise NavseqError(f"no such file: {path}", source=what)
-    if path.is_dir():
-        raise NavseqError(f"{path} is a directory, not a file", source=what)
+    """A clear NavseqError unless ``path``, given by the user as ``what``, is a regular file.
+
+    A FIFO or a device would hang or never end when read, so they are refused here,
+    before anything opens them.
+    """
+    shown = printable(str(path))
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise NavseqError(f"no such file: {shown}", source=what) from None
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the name
+        reason = error.strerror if isinstance(error, OSError) else "not a valid file name"
+        raise NavseqError(f"cannot read {shown}: {reason or error}", source=what) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise NavseqError(f"{shown} is a directory, not a file", source=what)
+    if not stat.S_ISREG(info.st_mode):
+        raise NavseqError(f"{shown} is not a regular file (a device, pipe or socket?)",
+                          source=what)
