@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.mission.fields import MAX_COORDINATE, MAX_YAW_DEGREES, normalized_yaw
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -34,8 +35,15 @@ def parse_pose(text: str) -> Pose2D:
         ) from None
     if not all(math.isfinite(value) for value in values):
         raise argparse.ArgumentTypeError(f"x,y,yaw must be finite numbers, got {text!r}")
+    # The limits of mission files: beyond them map arithmetic overflows.
+    if any(abs(value) > MAX_COORDINATE for value in values[:2]):
+        raise argparse.ArgumentTypeError(
+            f"x and y must be within ±{MAX_COORDINATE:g} m, got {text!r}")
     yaw_degrees = values[2] if len(values) == 3 else 0.0
-    return Pose2D(values[0], values[1], math.radians(yaw_degrees))
+    if abs(yaw_degrees) > MAX_YAW_DEGREES:
+        raise argparse.ArgumentTypeError(
+            f"yaw must be within ±{MAX_YAW_DEGREES:g} degrees, got {text!r}")
+    return Pose2D(values[0], values[1], normalized_yaw(math.radians(yaw_degrees)))
 
 
 def parse_loops(text: str) -> int | None:

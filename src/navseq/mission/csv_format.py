@@ -98,4 +98,6 @@ def _number(cell: str, where: str, label: str, column: str) -> float:
     except ValueError:
         raise NavseqError(f"must be a number, got {cell[:40]!r}", source=where,
                           subject=subject) from None
+    if column in ("x", "y", "z"):
+        return fields.coordinate(Located(value, where), subject)
     return fields.number(Located(value, where), subject)
