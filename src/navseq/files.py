@@ -24,7 +24,9 @@ def write_atomically(path: Path, data: str | bytes, *, replace: bool = True) -> 
     and :class:`FileExistsError` is raised instead. The new file gets ordinary
     permissions under the umask. Other failures raise :class:`OSError`.
     """
-    payload = data.encode("utf-8") if isinstance(data, str) else data
+    # A file name with bytes that are not UTF-8 reaches Python as lone surrogates;
+    # written as "\udcff" it stays readable (and JSON reads the escape back).
+    payload = data.encode("utf-8", "backslashreplace") if isinstance(data, str) else data
     temporary = path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
     try:
         # O_EXCL: never follow or reuse someone else's file; 0o666 honours the umask.

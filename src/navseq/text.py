@@ -20,15 +20,20 @@ def _needs_escape(code: int) -> bool:
     return code in _CONTROL or code in _BIDI or code in _SURROGATES
 
 
-def printable(value: str) -> str:
+def printable(value: str, *, keep_newlines: bool = False) -> str:
     """``value`` with control, bidi and surrogate characters escaped (``\\x1b``, ``\\ud800``).
 
-    Everything else, including non-ASCII letters, is kept as written. A string that
-    needs no escaping is returned unchanged, so calling this twice is harmless.
+    Everything else, including non-ASCII letters, is kept as written; with
+    ``keep_newlines`` so are line breaks (a message listing several problems). A
+    string that needs no escaping is returned unchanged.
     """
-    if all(not _needs_escape(ord(ch)) for ch in value):
+
+    def escaped(ch: str) -> bool:
+        return _needs_escape(ord(ch)) and not (keep_newlines and ch == "\n")
+
+    if not any(escaped(ch) for ch in value):
         return value
-    return "".join(_escape(ch) if _needs_escape(ord(ch)) else ch for ch in value)
+    return "".join(_escape(ch) if escaped(ch) else ch for ch in value)
 
 
 def _escape(ch: str) -> str:

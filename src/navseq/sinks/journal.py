@@ -42,7 +42,7 @@ from navseq.executor.result import WaypointResult
 from navseq.executor.resume import ResumePoint
 from navseq.files import limit_from_environment, open_input_file
 from navseq.mission.reading import MAX_MISSION_BYTES
-from navseq.text import has_surrogates, printable
+from navseq.text import printable
 
 JOURNAL_FORMAT = "navseq-journal"
 JOURNAL_VERSION = 1
@@ -279,8 +279,8 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
 
 
 def _check_header_text(value: Any, key: str, where: str) -> None:
-    """The header's texts name files and digests: no NUL, no lone surrogate."""
-    if not isinstance(value, str) or "\0" in value or has_surrogates(value):
+    """The header's texts name files and digests: no NUL, nothing a path cannot hold."""
+    if not isinstance(value, str) or "\0" in value or not _is_path_text(value):
         raise NavseqError(f"the header's {key} is not a valid text or path "
                           f"({printable(repr(value))[:60]}); the journal is damaged",
                           source=where)
@@ -386,6 +386,15 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
         if key < (loop, index) and visit.outcome in _DONE_OUTCOMES
     )
     return ResumePoint(loop=loop, index=index, done=done, previous_duration=state.previous_duration)
+
+
+def _is_path_text(value: str) -> bool:
+    """False for a lone surrogate other than a file name's undecodable byte."""
+    try:
+        os.fsencode(value)
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _parse_line(line: bytes, where: str) -> dict[str, Any] | None:
