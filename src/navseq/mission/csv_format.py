@@ -19,6 +19,8 @@ from navseq.mission.navseq_format import quaternion_yaw_checked
 from navseq.mission.problems import Problems
 
 COLUMNS = ("x", "y", "z", "qx", "qy", "qz", "qw")
+# An hour recorded at 25 Hz; beyond it, checking and running take minutes and gigabytes.
+MAX_WAYPOINTS = 100_000
 
 
 def mission_from_csv(text: str, source: str, problems: Problems) -> Mission | None:
@@ -34,6 +36,11 @@ def mission_from_csv(text: str, source: str, problems: Problems) -> Mission | No
                 seen_data = True
                 continue
             seen_data = True
+            if len(waypoints) >= MAX_WAYPOINTS:
+                problems.add(f"holds more than {MAX_WAYPOINTS:,} waypoints; navseq refuses "
+                             "missions this long (thin the recorded path out)",
+                             source=f"{source}:{line_number}")
+                return None
             waypoint = _waypoint(cells, len(waypoints), f"{source}:{line_number}", problems)
             if waypoint is not None:
                 waypoints.append(waypoint)

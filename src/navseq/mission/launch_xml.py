@@ -43,7 +43,12 @@ from navseq.mission.problems import Problems
 from navseq.mission.reading import MAX_MISSION_BYTES, read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
 from navseq.mission.xml_tree import XmlElement, parse_xml
-from navseq.mission.yaml_doc import parse_yaml, parse_yaml_value
+from navseq.mission.yaml_doc import (
+    TooManyValuesError,
+    ValueBudget,
+    parse_yaml,
+    parse_yaml_value,
+)
 
 # Real launch trees are a few includes deep; these bound a file that includes others
 # many times over (each of which includes more), not just cycles.
@@ -131,6 +136,7 @@ class _LaunchReader:
         self.tree = _ParamTree(f"{source}:1")
         self.not_followed: list[str] = []
         self.budget = ExpansionBudget()
+        self.values = ValueBudget()  # the YAML values of every param and file together
         self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages,
                                               self.budget))
         self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
@@ -209,7 +215,10 @@ class _LaunchReader:
         located = Located(value, where)
         if element.attrs.get("type", "auto") not in ("str", "string"):
             try:
-                parsed = parse_yaml_value(value, file.source, first_line=element.line)
+                parsed = parse_yaml_value(value, file.source, first_line=element.line,
+                                          budget=self.values)
+            except TooManyValuesError:
+                raise
             except NavseqError:
                 parsed = None  # plain text, as roslaunch would keep it
             if parsed is not None:
@@ -244,7 +253,10 @@ class _LaunchReader:
                 self.problems.add(error.message, source=file.where(line))
                 return None
         try:
-            return parse_yaml(body, file.source, self.problems, first_line=first_line)
+            return parse_yaml(body, file.source, self.problems, first_line=first_line,
+                              budget=self.values)
+        except TooManyValuesError:
+            raise
         except NavseqError as error:
             self.problems.record(error)
             return None
@@ -269,7 +281,9 @@ class _LaunchReader:
                 self.problems.add(error.message, source=f"{path}:{line}")
                 return None
         try:
-            return parse_yaml(text, str(path), self.problems)
+            return parse_yaml(text, str(path), self.problems, budget=self.values)
+        except TooManyValuesError:
+            raise
         except NavseqError:
             self.not_followed.append(file_name)
             return None

@@ -18,6 +18,7 @@ import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from navseq.errors import NavseqError
+from navseq.files import limit_from_environment
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.problems import Problems
 from navseq.text import text_problem
@@ -25,6 +26,14 @@ from navseq.text import text_problem
 # Aliases may repeat what was written, but not blow it up: the expanded document may
 # hold at most this many values more than were written.
 MAX_ALIAS_EXPANSION = 100_000
+
+# About 10 000 waypoints written long-hand, 25 000 as [x, y, yaw]: far above a real
+# mission, and read in a few seconds.
+MAX_VALUES = 100_000
+MAX_VALUES_VARIABLE = "NAVSEQ_MAX_YAML_VALUES"
+_VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent,
+                 yaml.AliasEvent)
+_FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
@@ -35,15 +44,17 @@ _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 EXPONENT_FLOAT = re.compile(r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)[eE][-+]?+\d++")
 
 
-def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1
-               ) -> Located | None:
+def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1,
+               budget: ValueBudget | None = None) -> Located | None:
     """Parse one YAML document. Syntax errors raise; duplicate keys are recorded.
 
     ``first_line`` is the file line of the text's first line (YAML inside a launch
-    file). Returns None for an empty document.
+    file). ``budget`` bounds the values read, across documents if shared. Returns
+    None for an empty document.
     """
     offset = first_line - 1
     try:
+        _spend_values(text, source, offset, budget or ValueBudget())
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
@@ -61,10 +72,50 @@ def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 
     return walker.walk(root, 0)
 
 
-def parse_yaml_value(text: str, source: str, *, first_line: int = 1) -> Located | None:
+class TooManyValuesError(NavseqError):
+    """A document (or a launch tree's documents together) holds too many values."""
+
+
+class ValueBudget:
+    """How many more YAML values may be read; one budget can span several documents
+    (the parameters of a launch file and the files it includes)."""
+
+    def __init__(self, limit: int | None = None):
+        self.limit = limit or limit_from_environment(MAX_VALUES_VARIABLE, MAX_VALUES)
+        self.left = self.limit
+
+
+def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> None:
+    """Count the document's values against ``budget`` before composing it; refuse excess.
+
+    PyYAML composes some 15 000 values a second; the 10 MiB a file may hold can write
+    millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
+    parser where installed) is linear and quick, and stops at the limit. Syntax
+    errors are left to the composer, which reports them with their lines.
+    """
+    count = 0
+    try:
+        for event in yaml.parse(text, Loader=_FAST_LOADER):
+            if isinstance(event, _VALUE_EVENTS):
+                count += 1
+                if count > budget.left:
+                    line = event.start_mark.line + 1 + offset
+                    raise TooManyValuesError(
+                        f"holds more than {budget.limit:,} YAML values (with the documents "
+                        "read before it); navseq refuses missions this large (write long "
+                        "recorded paths as CSV, or set the environment variable "
+                        f"{MAX_VALUES_VARIABLE} to raise the limit)",
+                        source=f"{source}:{line}")
+    except yaml.YAMLError:
+        pass
+    budget.left -= count
+
+
+def parse_yaml_value(text: str, source: str, *, first_line: int = 1,
+                     budget: ValueBudget | None = None) -> Located | None:
     """A YAML value written inside another file (a launch file's attribute or body)."""
     problems = Problems()
-    result = parse_yaml(text, source, problems, first_line=first_line)
+    result = parse_yaml(text, source, problems, first_line=first_line, budget=budget)
     problems.raise_if_any()
     return result
 
