@@ -203,7 +203,9 @@ class _Walker:
             return float(node.value)
         try:
             return self.constructor.construct_object(node)
-        except (yaml.YAMLError, ValueError, OverflowError) as error:
+        # PyYAML's constructors fail on some empty or odd values (``!!float ""``:
+        # IndexError, ``!!bool maybe``: KeyError) with more than YAMLError.
+        except (yaml.YAMLError, ValueError, OverflowError, LookupError, TypeError) as error:
             raise NavseqError(f"cannot read the value {node.value[:40]!r}: {error}",
                               source=self.where(node)) from None
 

@@ -27,6 +27,7 @@ import contextlib
 import dataclasses
 import datetime
 import enum
+import functools
 import hashlib
 import json
 import os
@@ -415,7 +416,7 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
     cls = _EVENT_TYPES.get(str(record.get("type")))
     if cls is None:
         return None
-    hints = get_type_hints(cls)
+    hints = _field_types(cls)
     values: dict[str, Any] = {}
     try:
         for spec in dataclasses.fields(cls):
@@ -426,6 +427,12 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
         raise NavseqError(
             f"journal event {cls.__name__} is malformed: {error}", source=where
         ) from None
+
+
+@functools.cache
+def _field_types(cls: type) -> dict[str, Any]:
+    """The event's field types, evaluated once per class (not once per journal line)."""
+    return get_type_hints(cls)
 
 
 def _coerce(value: Any, hint: Any) -> Any:
