@@ -26,6 +26,9 @@ MAX_YAW_DEGREES = 3600.0  # ten turns; normalised to (-180, 180] afterwards
 MAX_YAW_RADIANS = math.radians(MAX_YAW_DEGREES)
 MAX_SECONDS = 1e6  # about 11.5 days for one goal, dwell or wait
 MAX_METRES = MAX_COORDINATE
+# Names and frames are labels: every message and progress line about a waypoint
+# repeats its name, so a megabyte name would flood the terminal.
+MAX_LABEL_CHARACTERS = 256
 
 
 def field_subject(owner: str | None, name: str) -> str:
@@ -133,6 +136,10 @@ def text(node: Located, subject: str, *, allow_numbers: bool = False,
     problem = text_problem(value, single_line=single_line)
     if problem is not None:
         raise NavseqError(problem, source=node.where, subject=subject)
+    if single_line and len(value) > MAX_LABEL_CHARACTERS:
+        raise NavseqError(f"is {len(value):,} characters long; at most "
+                          f"{MAX_LABEL_CHARACTERS} are allowed", source=node.where,
+                          subject=subject)
     return value
 
 
@@ -166,7 +173,12 @@ def check_keys(node: Located, known: Collection[str], owner: str | None,
     for key in node.value:
         if key not in known:
             problems.add(f"unknown key{closest_hint(key, known)}", source=node.where_key(key),
-                         subject=field_subject(owner, key))
+                         subject=field_subject(owner, shortened(key)))
+
+
+def shortened(written: str, limit: int = 60) -> str:
+    """Text the user wrote, cut to a length a message can quote."""
+    return written if len(written) <= limit else written[: limit - 3] + "..."
 
 
 def attempt(problems: Problems, read: Callable[[], T]) -> T | None:

@@ -293,8 +293,8 @@ def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
             continue
         name = str(name_node.value)
         if name in first_use:
-            problems.add(f"the name '{name}' is already used by waypoint {first_use[name] + 1}; "
-                         "names must be unique", source=name_node.where,
+            problems.add(f"the name '{fields.shortened(name)}' is already used by waypoint "
+                         f"{first_use[name] + 1}; names must be unique", source=name_node.where,
                          subject=f"waypoint {index + 1}, field name")
         else:
             first_use[name] = index

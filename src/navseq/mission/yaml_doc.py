@@ -222,8 +222,9 @@ class _Walker:
                 raise NavseqError(f"the key {key[:40]!r} {problem}", source=self.where(key_node))
             if key in values:
                 first_line = key_where[key].rsplit(":", 1)[1]
+                shown = key if len(key) <= 60 else key[:57] + "..."
                 self.problems.add(
-                    f"the key '{key}' appears twice (first at line {first_line}); "
+                    f"the key '{shown}' appears twice (first at line {first_line}); "
                     "the second one would silently win",
                     source=self.where(key_node),
                 )
