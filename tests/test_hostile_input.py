@@ -492,8 +492,14 @@ def test_printable_text_holds_no_control_characters_and_always_encodes(text):
 
 
 def test_megabyte_names_and_keys_give_short_messages(tmp_path):
-    path = mission_file(tmp_path, "waypoints:\n  - x: 0\n    y: 0\n    ? " + "k" * 100_000
-                        + "\n    : 1\n    name: " + "n" * 1_000_000 + "\n")
+    path = mission_file(
+        tmp_path,
+        "waypoints:\n  - x: 0\n    y: 0\n    ? "
+        + "k" * 100_000
+        + "\n    : 1\n    name: "
+        + "n" * 1_000_000
+        + "\n",
+    )
     message = one_message(navseq("validate", path, cwd=tmp_path, timeout=GENEROUS))
     assert "at most 256" in message
     assert len(message) < 2000

@@ -128,8 +128,9 @@ def main(argv: list[str] | None = None) -> int:
     except NavseqError as error:
         # MissionErrors is a NavseqError whose text lists every problem.
         # Messages quote what the user wrote: escaped, so it cannot drive the terminal.
-        print(f"navseq {args.command}: {printable(str(error), keep_newlines=True)}",
-              file=sys.stderr)
+        print(
+            f"navseq {args.command}: {printable(str(error), keep_newlines=True)}", file=sys.stderr
+        )
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"navseq {args.command}: interrupted", file=sys.stderr)

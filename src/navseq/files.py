@@ -58,8 +58,9 @@ def _publish_without_replacing(temporary: Path, target: Path) -> None:
 # --- reading what a user names ---------------------------------------------------------
 
 
-def open_input_file(path: Path, *, what: str, max_bytes: int,
-                    too_big: Callable[[int, int], str] | None = None) -> BinaryIO:
+def open_input_file(
+    path: Path, *, what: str, max_bytes: int, too_big: Callable[[int, int], str] | None = None
+) -> BinaryIO:
     """Open a file the user named for reading, or raise NavseqError saying why not.
 
     Only regular files: a FIFO would block forever and a device (``/dev/zero``) never
@@ -88,8 +89,9 @@ def open_input_file(path: Path, *, what: str, max_bytes: int,
         raise
 
 
-def read_input_bytes(path: Path, *, what: str, max_bytes: int,
-                     too_big: Callable[[int, int], str] | None = None) -> bytes:
+def read_input_bytes(
+    path: Path, *, what: str, max_bytes: int, too_big: Callable[[int, int], str] | None = None
+) -> bytes:
     """The bytes of a file the user named, with the checks of :func:`open_input_file`."""
     describe_size = too_big or (lambda size, limit: _too_big(size, limit, what))
     with open_input_file(path, what=what, max_bytes=max_bytes, too_big=describe_size) as stream:
@@ -97,8 +99,9 @@ def read_input_bytes(path: Path, *, what: str, max_bytes: int,
             # The size can change between the check and the read; never read past the cap.
             data = stream.read(max_bytes + 1)
         except OSError as error:
-            raise NavseqError(f"cannot be read: {error.strerror or error}",
-                              source=str(path)) from None
+            raise NavseqError(
+                f"cannot be read: {error.strerror or error}", source=str(path)
+            ) from None
     if len(data) > max_bytes:
         raise NavseqError(describe_size(len(data), max_bytes), source=str(path))
     return data
@@ -114,18 +117,23 @@ def limit_from_environment(variable: str, default: int) -> int:
     except ValueError:
         value = 0
     if value < 1:
-        raise NavseqError(f"must be a whole number >= 1, got {printable(repr(written))}",
-                          source=f"environment variable {variable}")
+        raise NavseqError(
+            f"must be a whole number >= 1, got {printable(repr(written))}",
+            source=f"environment variable {variable}",
+        )
     return value
 
 
-def _refuse_unless_regular(info: os.stat_result, what: str, max_bytes: int,
-                           too_big: Callable[[int, int], str], source: str) -> None:
+def _refuse_unless_regular(
+    info: os.stat_result, what: str, max_bytes: int, too_big: Callable[[int, int], str], source: str
+) -> None:
     if stat.S_ISDIR(info.st_mode):
         raise NavseqError(f"is a folder, not a {what}", source=source)
     if not stat.S_ISREG(info.st_mode):
-        raise NavseqError(f"is not a regular file (a device, pipe or socket?); a {what} "
-                          "must be a regular file", source=source)
+        raise NavseqError(
+            f"is not a regular file (a device, pipe or socket?); a {what} must be a regular file",
+            source=source,
+        )
     if info.st_size > max_bytes:
         raise NavseqError(too_big(info.st_size, max_bytes), source=source)
 

@@ -275,8 +275,11 @@ class _MapSettings:
             raise fail("resolution", "the map YAML has no 'resolution' (metres per cell)")
         resolution = _number(doc["resolution"])
         if resolution is None or not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
-            raise fail("resolution", f"expected metres per cell from {MIN_RESOLUTION:g} to "
-                       f"{MAX_RESOLUTION:g}, got {_shown(description, 'resolution')}")
+            raise fail(
+                "resolution",
+                f"expected metres per cell from {MIN_RESOLUTION:g} to "
+                f"{MAX_RESOLUTION:g}, got {_shown(description, 'resolution')}",
+            )
 
         origin_value = doc.get("origin", [0.0, 0.0, 0.0])
         origin_numbers = (
@@ -286,11 +289,15 @@ class _MapSettings:
             raise fail("origin", f"expected [x, y, yaw], got {_shown(description, 'origin')}")
         x, y, yaw = (float(v) for v in origin_numbers)  # type: ignore[arg-type]
         if not (abs(x) <= MAX_ORIGIN and abs(y) <= MAX_ORIGIN):
-            raise fail("origin", f"x and y must be within ±{MAX_ORIGIN:g} m, got "
-                       f"{_shown(description, 'origin')}")
+            raise fail(
+                "origin",
+                f"x and y must be within ±{MAX_ORIGIN:g} m, got {_shown(description, 'origin')}",
+            )
         if not abs(yaw) <= MAX_ORIGIN_YAW:
-            raise fail("origin", f"the yaw (radians) must be within ±{MAX_ORIGIN_YAW:.4g} "
-                       f"(ten turns), got {yaw:g}")
+            raise fail(
+                "origin",
+                f"the yaw (radians) must be within ±{MAX_ORIGIN_YAW:.4g} (ten turns), got {yaw:g}",
+            )
 
         negate_value = doc.get("negate", 0)
         if negate_value not in (0, 1) or isinstance(negate_value, float):
@@ -303,8 +310,9 @@ class _MapSettings:
         ):
             value = _number(doc.get(key, default))
             if value is None or not 0.0 <= value <= 1.0:
-                raise fail(key, "expected a probability between 0 and 1, got "
-                           f"{_shown(description, key)}")
+                raise fail(
+                    key, f"expected a probability between 0 and 1, got {_shown(description, key)}"
+                )
             thresholds[key] = value
         if thresholds["free_thresh"] >= thresholds["occupied_thresh"]:
             raise fail(
@@ -315,8 +323,9 @@ class _MapSettings:
 
         mode = doc.get("mode", "trinary")
         if mode not in MODES:
-            raise fail("mode", f"expected one of {', '.join(MODES)}, got "
-                       f"{_shown(description, 'mode')}")
+            raise fail(
+                "mode", f"expected one of {', '.join(MODES)}, got {_shown(description, 'mode')}"
+            )
 
         return cls(
             image=image,
@@ -387,11 +396,15 @@ def _read_image(image_path: Path, source: str) -> np.ndarray:
     subject = f"image {printable(str(image_path))}"
     limit = max_map_pixels()
     try:
-        stream = open_input_file(image_path, what="map image",
-                                 max_bytes=limit * _MAX_BYTES_PER_PIXEL + 2**20)
+        stream = open_input_file(
+            image_path, what="map image", max_bytes=limit * _MAX_BYTES_PER_PIXEL + 2**20
+        )
     except NavseqError as error:
-        message = ("the map image does not exist" if error.message == "no such file"
-                   else f"the map image {error.message}")
+        message = (
+            "the map image does not exist"
+            if error.message == "no such file"
+            else f"the map image {error.message}"
+        )
         raise NavseqError(message, source=source, subject=subject) from None
     try:
         with stream, _pillow_size_checks_off(), Image.open(stream) as image:
@@ -401,11 +414,19 @@ def _read_image(image_path: Path, source: str) -> np.ndarray:
                     f"the map image is {width} x {height} = {width * height:,} pixels; navseq "
                     f"loads at most {limit:,} (set the environment variable "
                     f"{MAX_PIXELS_VARIABLE} to raise the limit, if the machine has the memory)",
-                    source=source, subject=subject)
+                    source=source,
+                    subject=subject,
+                )
             image.load()
             return _to_uint8_channels(image)
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError, EOFError,
-            Image.DecompressionBombError) as error:
+    except (
+        UnidentifiedImageError,
+        OSError,
+        SyntaxError,
+        ValueError,
+        EOFError,
+        Image.DecompressionBombError,
+    ) as error:
         raise NavseqError(
             f"cannot read the map image (not a valid PGM/PNG?): {printable(str(error))}",
             source=source,
@@ -415,7 +436,9 @@ def _read_image(image_path: Path, source: str) -> np.ndarray:
         raise NavseqError(
             "there is not enough memory to load the map image; lower "
             f"{MAX_PIXELS_VARIABLE} or use a smaller map",
-            source=source, subject=subject) from None
+            source=source,
+            subject=subject,
+        ) from None
 
 
 @contextlib.contextmanager

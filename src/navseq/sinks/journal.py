@@ -86,11 +86,14 @@ def mission_digest(path: str | os.PathLike[str]) -> str:
             for chunk in iter(lambda: stream.read(1 << 20), b""):
                 digest.update(chunk)
                 if stream.tell() > MAX_MISSION_BYTES:  # it grew after the check
-                    raise NavseqError(f"is over {MAX_MISSION_BYTES / 2**20:g} MiB, too big "
-                                      "for a mission file", source=str(source))
+                    raise NavseqError(
+                        f"is over {MAX_MISSION_BYTES / 2**20:g} MiB, too big for a mission file",
+                        source=str(source),
+                    )
         except OSError as error:
-            raise NavseqError(f"cannot read the mission file: {error.strerror or error}",
-                              source=str(source)) from None
+            raise NavseqError(
+                f"cannot read the mission file: {error.strerror or error}", source=str(source)
+            ) from None
     return digest.hexdigest()
 
 
@@ -239,8 +242,10 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
     limit = limit_from_environment(MAX_JOURNAL_BYTES_VARIABLE, DEFAULT_MAX_JOURNAL_BYTES)
 
     def too_big(size: int, cap: int) -> str:
-        return (f"is {size / 2**20:.1f} MiB; navseq reads journals up to {cap / 2**20:g} MiB "
-                f"(set the environment variable {MAX_JOURNAL_BYTES_VARIABLE} to raise it)")
+        return (
+            f"is {size / 2**20:.1f} MiB; navseq reads journals up to {cap / 2**20:g} MiB "
+            f"(set the environment variable {MAX_JOURNAL_BYTES_VARIABLE} to raise it)"
+        )
 
     with open_input_file(path, what="journal", max_bytes=limit, too_big=too_big) as handle:
         try:
@@ -250,8 +255,9 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
                 raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
             rest = handle.read(limit + 1)
         except OSError as error:
-            raise NavseqError(f"cannot read the journal: {error.strerror}",
-                              source=str(path)) from None
+            raise NavseqError(
+                f"cannot read the journal: {error.strerror}", source=str(path)
+            ) from None
     if len(rest) > limit:
         raise NavseqError(too_big(len(rest), limit), source=str(path))
     if header.get("format") != JOURNAL_FORMAT:
@@ -282,9 +288,11 @@ def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str,
 def _check_header_text(value: Any, key: str, where: str) -> None:
     """The header's texts name files and digests: no NUL, nothing a path cannot hold."""
     if not isinstance(value, str) or "\0" in value or not _is_path_text(value):
-        raise NavseqError(f"the header's {key} is not a valid text or path "
-                          f"({printable(repr(value))[:60]}); the journal is damaged",
-                          source=where)
+        raise NavseqError(
+            f"the header's {key} is not a valid text or path "
+            f"({printable(repr(value))[:60]}); the journal is damaged",
+            source=where,
+        )
 
 
 def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]]) -> None:
@@ -406,9 +414,11 @@ def _parse_line(line: bytes, where: str) -> dict[str, Any] | None:
         return None
     except RecursionError:
         # No journal record nests more than a few levels; this one is no journal line.
-        raise NavseqError("a line nests JSON lists or objects too deeply to be a journal "
-                          "record; the journal is damaged or is not a navseq journal",
-                          source=where) from None
+        raise NavseqError(
+            "a line nests JSON lists or objects too deeply to be a journal "
+            "record; the journal is damaged or is not a navseq journal",
+            source=where,
+        ) from None
     return record if isinstance(record, dict) else None
 
 
