@@ -163,9 +163,11 @@ def test_arbitrary_params(params):
 
 # --- dump / load round trip ----------------------------------------------------------
 
-finite = st.floats(allow_nan=False, allow_infinity=False)
-# Yaws as people write them: degrees with a few decimals (these must survive exactly).
-typed_yaw = st.decimals(min_value=-720, max_value=720, places=4).map(
+# Coordinates a robot can mean (navseq refuses |x| > 1e6 m).
+finite = st.floats(-1e6, 1e6)
+# Yaws as people write them: degrees with a few decimals (these must survive exactly);
+# navseq keeps yaws in (-180, 180] degrees.
+typed_yaw = st.decimals(min_value="-179.9999", max_value=180, places=4).map(
     lambda d: math.radians(float(d)))
 positive = st.floats(min_value=1e-6, max_value=1e6)
 policy_values = st.fixed_dictionaries({}, optional={
@@ -177,7 +179,9 @@ policy_values = st.fixed_dictionaries({}, optional={
     "pass_through": st.none() | st.floats(0, 100),
     "dwell": st.floats(0, 1e4),
 })
-names = st.none() | st.text(min_size=1, max_size=10).filter(str.strip)
+# Names are one line of real text: no control characters, no lone surrogates.
+names = st.none() | st.text(st.characters(blacklist_categories=("Cc", "Cs", "Cf")),
+                            min_size=1, max_size=10).filter(str.strip)
 
 
 @st.composite
@@ -215,7 +219,7 @@ def test_dump_then_load_gives_the_same_mission(scratch, mission):
 
 
 @settings(max_examples=100, deadline=None)
-@given(mission=missions(yaws=st.floats(-10, 10)))
+@given(mission=missions(yaws=st.floats(-3.14159, math.pi)))
 def test_computed_yaws_round_to_a_millionth_of_a_degree_and_then_stay(scratch, mission):
     text = dump_mission_yaml(mission)
     again = reload(scratch, text)

@@ -191,7 +191,7 @@ def test_missing_image_file(tmp_path: Path) -> None:
     (tmp_path / "map.pgm").unlink()
     with pytest.raises(NavseqError, match="does not exist") as caught:
         load_map(yaml_path)
-    assert caught.value.source == str(yaml_path)
+    assert caught.value.source == f"{yaml_path}:1"  # the line that names the image
     assert "map.pgm" in str(caught.value)
 
 

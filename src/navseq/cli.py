@@ -28,6 +28,7 @@ from navseq import __version__
 from navseq.commands import SUBCOMMANDS
 from navseq.errors import NavseqError
 from navseq.signals import Terminated
+from navseq.text import printable
 
 EXIT_OK = 0
 EXIT_NOT_ALL_REACHED = 1
@@ -138,7 +139,10 @@ def _main(argv: list[str] | None) -> int:
         return args.command_module.run(args)
     except NavseqError as error:
         # MissionErrors is a NavseqError whose text lists every problem.
-        print(f"navseq {args.command}: {error}", file=sys.stderr)
+        # Messages quote what the user wrote: escaped, so it cannot drive the terminal.
+        print(
+            f"navseq {args.command}: {printable(str(error), keep_newlines=True)}", file=sys.stderr
+        )
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"navseq {args.command}: interrupted", file=sys.stderr)
@@ -156,7 +160,8 @@ def _main(argv: list[str] | None) -> int:
         if debug:
             traceback.print_exc()
         print(
-            f"navseq {args.command}: internal error: {type(error).__name__}: {error}"
+            f"navseq {args.command}: internal error: {type(error).__name__}: "
+            f"{printable(str(error))}"
             + ("" if debug else " (run again with --debug to see the traceback)"),
             file=sys.stderr,
         )

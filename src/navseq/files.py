@@ -1,10 +1,19 @@
-"""Writing files so that a crash never leaves half of one, and nothing is replaced by accident."""
+"""Files, carefully: writing so that a crash never leaves half of one and nothing is
+replaced by accident; reading what a user names so that a pipe, a device or a huge
+file is refused before it can hang navseq or fill the memory.
+"""
 
 from __future__ import annotations
 
 import os
 import secrets
+import stat
+from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
+
+from navseq.errors import NavseqError
+from navseq.text import printable
 
 
 def write_atomically(path: Path, data: str | bytes, *, replace: bool = True) -> None:
@@ -15,7 +24,9 @@ def write_atomically(path: Path, data: str | bytes, *, replace: bool = True) -> 
     and :class:`FileExistsError` is raised instead. The new file gets ordinary
     permissions under the umask. Other failures raise :class:`OSError`.
     """
-    payload = data.encode("utf-8") if isinstance(data, str) else data
+    # A file name with bytes that are not UTF-8 reaches Python as lone surrogates;
+    # written as "\udcff" it stays readable (and JSON reads the escape back).
+    payload = data.encode("utf-8", "backslashreplace") if isinstance(data, str) else data
     temporary = path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
     try:
         # O_EXCL: never follow or reuse someone else's file; 0o666 honours the umask.
@@ -42,3 +53,90 @@ def _publish_without_replacing(temporary: Path, target: Path) -> None:
         if target.exists():
             raise FileExistsError(str(target)) from None
         os.replace(temporary, target)
+
+
+# --- reading what a user names ---------------------------------------------------------
+
+
+def open_input_file(
+    path: Path, *, what: str, max_bytes: int, too_big: Callable[[int, int], str] | None = None
+) -> BinaryIO:
+    """Open a file the user named for reading, or raise NavseqError saying why not.
+
+    Only regular files: a FIFO would block forever and a device (``/dev/zero``) never
+    ends. Files over ``max_bytes`` are refused before anything is read. The type is
+    checked on the open descriptor (opened non-blocking, so a FIFO cannot hang the
+    open itself), so a file swapped for a pipe after the check is refused too.
+    ``what`` names the role in messages (``mission file``, ``map image``).
+    """
+    source = str(path)
+    describe_size = too_big or (lambda size, limit: _too_big(size, limit, what))
+    try:
+        _refuse_unless_regular(path.stat(), what, max_bytes, describe_size, source)
+        descriptor = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except FileNotFoundError:
+        raise NavseqError("no such file", source=source) from None
+    except OSError as error:
+        raise NavseqError(f"cannot be read: {error.strerror or error}", source=source) from None
+    except (ValueError, UnicodeEncodeError):  # a NUL byte or a lone surrogate in the name
+        raise NavseqError("is not a valid file name", source=printable(repr(source))) from None
+    try:
+        _refuse_unless_regular(os.fstat(descriptor), what, max_bytes, describe_size, source)
+        os.set_blocking(descriptor, True)
+        return os.fdopen(descriptor, "rb")
+    except BaseException:
+        os.close(descriptor)
+        raise
+
+
+def read_input_bytes(
+    path: Path, *, what: str, max_bytes: int, too_big: Callable[[int, int], str] | None = None
+) -> bytes:
+    """The bytes of a file the user named, with the checks of :func:`open_input_file`."""
+    describe_size = too_big or (lambda size, limit: _too_big(size, limit, what))
+    with open_input_file(path, what=what, max_bytes=max_bytes, too_big=describe_size) as stream:
+        try:
+            # The size can change between the check and the read; never read past the cap.
+            data = stream.read(max_bytes + 1)
+        except OSError as error:
+            raise NavseqError(
+                f"cannot be read: {error.strerror or error}", source=str(path)
+            ) from None
+    if len(data) > max_bytes:
+        raise NavseqError(describe_size(len(data), max_bytes), source=str(path))
+    return data
+
+
+def limit_from_environment(variable: str, default: int) -> int:
+    """A positive whole-number limit that the environment variable ``variable`` may raise."""
+    written = os.environ.get(variable, "").strip()
+    if not written:
+        return default
+    try:
+        value = int(written.replace("_", ""))
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise NavseqError(
+            f"must be a whole number >= 1, got {printable(repr(written))}",
+            source=f"environment variable {variable}",
+        )
+    return value
+
+
+def _refuse_unless_regular(
+    info: os.stat_result, what: str, max_bytes: int, too_big: Callable[[int, int], str], source: str
+) -> None:
+    if stat.S_ISDIR(info.st_mode):
+        raise NavseqError(f"is a folder, not a {what}", source=source)
+    if not stat.S_ISREG(info.st_mode):
+        raise NavseqError(
+            f"is not a regular file (a device, pipe or socket?); a {what} must be a regular file",
+            source=source,
+        )
+    if info.st_size > max_bytes:
+        raise NavseqError(too_big(info.st_size, max_bytes), source=source)
+
+
+def _too_big(size: int, limit: int, what: str) -> str:
+    return f"is {size / 2**20:.1f} MiB; navseq refuses a {what} over {limit / 2**20:g} MiB"

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import argparse
 import math
+import stat
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.mission.fields import MAX_COORDINATE, MAX_YAW_DEGREES, normalized_yaw
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -34,8 +37,15 @@ def parse_pose(text: str) -> Pose2D:
         ) from None
     if not all(math.isfinite(value) for value in values):
         raise argparse.ArgumentTypeError(f"x,y,yaw must be finite numbers, got {text!r}")
+    # The limits of mission files: beyond them map arithmetic overflows.
+    if any(abs(value) > MAX_COORDINATE for value in values[:2]):
+        raise argparse.ArgumentTypeError(
+            f"x and y must be within ±{MAX_COORDINATE:g} m, got {text!r}")
     yaw_degrees = values[2] if len(values) == 3 else 0.0
-    return Pose2D(values[0], values[1], math.radians(yaw_degrees))
+    if abs(yaw_degrees) > MAX_YAW_DEGREES:
+        raise argparse.ArgumentTypeError(
+            f"yaw must be within ±{MAX_YAW_DEGREES:g} degrees, got {text!r}")
+    return Pose2D(values[0], values[1], normalized_yaw(math.radians(yaw_degrees)))
 
 
 def parse_loops(text: str) -> int | None:
@@ -116,8 +126,21 @@ def choose_robot(option: str | None, mission: Mission | None) -> RobotProfile:
 
 
 def require_file(path: Path, what: str) -> None:
-    """A clear NavseqError for a missing path given by the user (``what`` names the role)."""
-    if not path.exists():
-        raise NavseqError(f"no such file: {path}", source=what)
-    if path.is_dir():
-        raise NavseqError(f"{path} is a directory, not a file", source=what)
+    """A clear NavseqError unless ``path``, given by the user as ``what``, is a regular file.
+
+    A FIFO or a device would hang or never end when read, so they are refused here,
+    before anything opens them.
+    """
+    shown = printable(str(path))
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise NavseqError(f"no such file: {shown}", source=what) from None
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the name
+        reason = error.strerror if isinstance(error, OSError) else "not a valid file name"
+        raise NavseqError(f"cannot read {shown}: {reason or error}", source=what) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise NavseqError(f"{shown} is a directory, not a file", source=what)
+    if not stat.S_ISREG(info.st_mode):
+        raise NavseqError(f"{shown} is not a regular file (a device, pipe or socket?)",
+                          source=what)

@@ -19,6 +19,8 @@ from navseq.mission.navseq_format import quaternion_yaw_checked
 from navseq.mission.problems import Problems
 
 COLUMNS = ("x", "y", "z", "qx", "qy", "qz", "qw")
+# An hour recorded at 25 Hz; beyond it, checking and running take minutes and gigabytes.
+MAX_WAYPOINTS = 100_000
 
 
 def mission_from_csv(text: str, source: str, problems: Problems) -> Mission | None:
@@ -34,6 +36,11 @@ def mission_from_csv(text: str, source: str, problems: Problems) -> Mission | No
                 seen_data = True
                 continue
             seen_data = True
+            if len(waypoints) >= MAX_WAYPOINTS:
+                problems.add(f"holds more than {MAX_WAYPOINTS:,} waypoints; navseq refuses "
+                             "missions this long (thin the recorded path out)",
+                             source=f"{source}:{line_number}")
+                return None
             waypoint = _waypoint(cells, len(waypoints), f"{source}:{line_number}", problems)
             if waypoint is not None:
                 waypoints.append(waypoint)
@@ -98,4 +105,6 @@ def _number(cell: str, where: str, label: str, column: str) -> float:
     except ValueError:
         raise NavseqError(f"must be a number, got {cell[:40]!r}", source=where,
                           subject=subject) from None
+    if column in ("x", "y", "z"):
+        return fields.coordinate(Located(value, where), subject)
     return fields.number(Located(value, where), subject)

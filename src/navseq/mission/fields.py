@@ -15,8 +15,20 @@ from navseq.errors import NavseqError
 from navseq.mission.located import Located, describe
 from navseq.mission.model import FailureAction
 from navseq.mission.problems import Problems, closest_hint
+from navseq.text import text_problem
 
 T = TypeVar("T")
+
+# What a robot can mean. Beyond these, map and controller arithmetic overflows or
+# loses all precision (a yaw of 1e20 rad is no direction: the goal was never reached).
+MAX_COORDINATE = 1e6  # m: 1000 km from the frame's origin
+MAX_YAW_DEGREES = 3600.0  # ten turns; normalised to (-180, 180] afterwards
+MAX_YAW_RADIANS = math.radians(MAX_YAW_DEGREES)
+MAX_SECONDS = 1e6  # about 11.5 days for one goal, dwell or wait
+MAX_METRES = MAX_COORDINATE
+# Names and frames are labels: every message and progress line about a waypoint
+# repeats its name, so a megabyte name would flood the terminal.
+MAX_LABEL_CHARACTERS = 256
 
 
 def field_subject(owner: str | None, name: str) -> str:
@@ -42,14 +54,48 @@ def number(node: Located, subject: str) -> float:
 
 
 def bounded_number(node: Located, subject: str, *, minimum: float, inclusive: bool,
-                   unit: str = "") -> float:
-    """A finite number ``>= minimum`` (or ``> minimum`` when not inclusive)."""
+                   unit: str = "", maximum: float | None = None) -> float:
+    """A finite number ``>= minimum`` (or ``> minimum`` when not inclusive), ``<= maximum``."""
     result = number(node, subject)
     if result < minimum or (not inclusive and result == minimum):
         relation = ">=" if inclusive else ">"
         raise NavseqError(f"must be {relation} {minimum:g}{unit}, got {result:g}",
                           source=node.where, subject=subject)
+    if maximum is not None and result > maximum:
+        raise NavseqError(f"must be <= {maximum:g}{unit}, got {result:g}", source=node.where,
+                          subject=subject)
     return result
+
+
+def within(node: Located, subject: str, *, limit: float, unit: str, what: str = "") -> float:
+    """A finite number with ``|value| <= limit``."""
+    result = number(node, subject)
+    if abs(result) > limit:
+        raise NavseqError(f"must be within ±{limit:g}{unit}{what}, got {result:g}",
+                          source=node.where, subject=subject)
+    return result
+
+
+def coordinate(node: Located, subject: str) -> float:
+    """A position in metres, within ±MAX_COORDINATE of the frame's origin."""
+    return within(node, subject, limit=MAX_COORDINATE, unit=" m", what=" of the origin")
+
+
+def yaw_degrees(node: Located, subject: str) -> float:
+    """A yaw written in degrees (within ten turns), as radians in (-pi, pi]."""
+    degrees = within(node, subject, limit=MAX_YAW_DEGREES, unit=" degrees")
+    return normalized_yaw(math.radians(degrees))
+
+
+def yaw_radians(node: Located, subject: str) -> float:
+    """A yaw written in radians (within ten turns), normalised to (-pi, pi]."""
+    return normalized_yaw(within(node, subject, limit=MAX_YAW_RADIANS, unit=" rad"))
+
+
+def normalized_yaw(radians: float) -> float:
+    """The same direction in (-pi, pi]; exact for any finite angle (math.remainder)."""
+    wrapped = math.remainder(radians, math.tau)
+    return math.pi if wrapped <= -math.pi else wrapped
 
 
 def integer(node: Located, subject: str, *, minimum: int) -> int:
@@ -73,14 +119,27 @@ def boolean(node: Located, subject: str) -> bool:
     return node.value
 
 
-def text(node: Located, subject: str, *, allow_numbers: bool = False) -> str:
-    """Non-empty text; with ``allow_numbers`` a number is taken as its text (``name: 7``)."""
+def text(node: Located, subject: str, *, allow_numbers: bool = False,
+         single_line: bool = True) -> str:
+    """Non-empty text; with ``allow_numbers`` a number is taken as its text (``name: 7``).
+
+    Lone surrogates are refused (they cannot be printed or written as UTF-8), and with
+    ``single_line`` (names, frames) control characters too: printed, they could
+    retitle or clear the operator's terminal.
+    """
     value = node.value
     if allow_numbers and isinstance(value, int | float) and not isinstance(value, bool):
         value = str(value)
     if not isinstance(value, str) or not value.strip():
         raise NavseqError(f"must be non-empty text, got {describe(node.value)}",
                           source=node.where, subject=subject)
+    problem = text_problem(value, single_line=single_line)
+    if problem is not None:
+        raise NavseqError(problem, source=node.where, subject=subject)
+    if single_line and len(value) > MAX_LABEL_CHARACTERS:
+        raise NavseqError(f"is {len(value):,} characters long; at most "
+                          f"{MAX_LABEL_CHARACTERS} are allowed", source=node.where,
+                          subject=subject)
     return value
 
 
@@ -114,7 +173,12 @@ def check_keys(node: Located, known: Collection[str], owner: str | None,
     for key in node.value:
         if key not in known:
             problems.add(f"unknown key{closest_hint(key, known)}", source=node.where_key(key),
-                         subject=field_subject(owner, key))
+                         subject=field_subject(owner, shortened(key)))
+
+
+def shortened(written: str, limit: int = 60) -> str:
+    """Text the user wrote, cut to a length a message can quote."""
+    return written if len(written) <= limit else written[: limit - 3] + "..."
 
 
 def attempt(problems: Problems, read: Callable[[], T]) -> T | None:
@@ -138,12 +202,14 @@ def _optional(reader: Callable[[Located, str], Any]) -> Callable[[Located, str],
     return read
 
 
-def _positive_seconds(node: Located, subject: str) -> float:
-    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s")
+def positive_seconds(node: Located, subject: str) -> float:
+    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s",
+                          maximum=MAX_SECONDS)
 
 
 def _positive_metres(node: Located, subject: str) -> float:
-    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" m")
+    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" m",
+                          maximum=MAX_METRES)
 
 
 def _angle_degrees_as_radians(node: Located, subject: str) -> float:
@@ -160,16 +226,16 @@ def _failure_action(node: Located, subject: str) -> FailureAction:
 
 
 POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
-    "goal_timeout": _optional(_positive_seconds),
-    "stall_timeout": _optional(_positive_seconds),
+    "goal_timeout": _optional(positive_seconds),
+    "stall_timeout": _optional(positive_seconds),
     "retries": lambda node, subject: integer(node, subject, minimum=0),
     "clear_costmaps_on_retry": boolean,
     "on_failure": _failure_action,
     "pass_through": _optional(
         lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
-                                             unit=" m")),
+                                             unit=" m", maximum=MAX_METRES)),
     "dwell": lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
-                                                  unit=" s"),
+                                                  unit=" s", maximum=MAX_SECONDS),
     "xy_tolerance": _optional(_positive_metres),
     "yaw_tolerance": _optional(_angle_degrees_as_radians),
 }

@@ -23,6 +23,12 @@ COMMANDS = ("arg", "dirname", "env", "optenv", "find", "anon", "eval")
 # rospack crawls whole trees; navseq bounds the walk, since ROS_PACKAGE_PATH may name "/".
 MAX_SEARCH_DEPTH = 6
 MAX_SEARCHED_FOLDERS = 20_000
+# Args that expand other args can grow ten-fold per level (an 874-byte file reached
+# gigabytes in five). One attribute or body may grow by at most MAX_EXPANSION_CHARS,
+# and all substitutions of a launch tree together by at most MAX_TOTAL_EXPANSION_CHARS,
+# which also bounds the work spent parsing what they produce.
+MAX_EXPANSION_CHARS = 1024 * 1024
+MAX_TOTAL_EXPANSION_CHARS = 4 * 1024 * 1024
 
 
 class SubstitutionError(NavseqError):
@@ -31,6 +37,41 @@ class SubstitutionError(NavseqError):
     def __init__(self, message: str, offset: int = 0):
         super().__init__(message)
         self.offset = offset
+
+
+class ExpansionLimitError(NavseqError):
+    """Substitution would grow the text beyond navseq's limits; reading stops here."""
+
+
+class ExpansionBudget:
+    """How much text substitutions may still add, shared by every file of a launch tree."""
+
+    def __init__(self, total: int = MAX_TOTAL_EXPANSION_CHARS,
+                 per_text: int = MAX_EXPANSION_CHARS):
+        self.left = total
+        self.total = total
+        self.per_text = per_text
+
+    def check(self, written: int, resolved: int, command: str) -> None:
+        """Refuse a text that has grown from ``written`` to ``resolved`` characters so far."""
+        growth = resolved - written
+        if growth > self.per_text:
+            raise ExpansionLimitError(
+                f"$({command}) makes this value grow by more than {_mib(self.per_text)} "
+                "(navseq's limit for one attribute or body); do args expand each other "
+                "over and over (an expansion bomb)?")
+        if growth > self.left:
+            raise ExpansionLimitError(
+                f"$({command}) makes the launch files' substitutions grow by more than "
+                f"{_mib(self.total)} in all (navseq's limit); do args expand each other "
+                "over and over (an expansion bomb)?")
+
+    def spend(self, written: int, resolved: int) -> None:
+        self.left -= max(0, resolved - written)
+
+
+def _mib(chars: int) -> str:
+    return f"{chars / 2**20:g} MiB"
 
 
 class LaunchArgs:
@@ -139,10 +180,12 @@ def _package_name(path: Path) -> str | None:
 class Substitution:
     """Resolves the substitution args in the text of one launch file."""
 
-    def __init__(self, args: LaunchArgs, folder: Path | None, packages: PackageFinder):
+    def __init__(self, args: LaunchArgs, folder: Path | None, packages: PackageFinder,
+                 budget: ExpansionBudget | None = None):
         self.args = args
         self.folder = folder
         self.packages = packages
+        self.budget = budget or ExpansionBudget()
 
     def resolve(self, text: str) -> str:
         if "$(" not in text:
@@ -151,16 +194,23 @@ class Substitution:
             return text  # Python code; navseq never runs what a file says
         parts = []
         position = 0
+        length = 0  # of the parts so far: checked before the text is built, not after
         while (start := text.find("$(", position)) != -1:
             end = text.find(")", start)
             if end == -1:
                 break  # roslaunch keeps an unclosed "$(" as text too
+            body = text[start + 2:end]
+            resolved = self._one(body, start)
+            piece = text[start:end + 1] if resolved is None else resolved
+            length += (start - position) + len(piece)
+            self.budget.check(end + 1, length, " ".join(body.split()[:2]))
             parts.append(text[position:start])
-            resolved = self._one(text[start + 2:end], start)
-            parts.append(text[start:end + 1] if resolved is None else resolved)
+            parts.append(piece)
             position = end + 1
         parts.append(text[position:])
-        return "".join(parts)
+        result = "".join(parts)
+        self.budget.spend(len(text), len(result))
+        return result
 
     def explain(self, text: str) -> str:
         """``text``, plus why a ``$(find)`` in it stayed unresolved (for "not followed")."""

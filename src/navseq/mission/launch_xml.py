@@ -30,6 +30,8 @@ from pathlib import Path
 
 from navseq.errors import NavseqError
 from navseq.mission.launch_subst import (
+    ExpansionBudget,
+    ExpansionLimitError,
     LaunchArgs,
     PackageFinder,
     Substitution,
@@ -38,15 +40,22 @@ from navseq.mission.launch_subst import (
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.model import Mission
 from navseq.mission.problems import Problems
-from navseq.mission.reading import read_mission_text
+from navseq.mission.reading import MAX_MISSION_BYTES, read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
 from navseq.mission.xml_tree import XmlElement, parse_xml
-from navseq.mission.yaml_doc import parse_yaml, parse_yaml_value
+from navseq.mission.yaml_doc import (
+    TooManyValuesError,
+    ValueBudget,
+    parse_yaml,
+    parse_yaml_value,
+)
 
 # Real launch trees are a few includes deep; these bound a file that includes others
 # many times over (each of which includes more), not just cycles.
 MAX_INCLUDE_DEPTH = 16
 MAX_INCLUDED_FILES = 200
+# ... and the text of all of them together (each file alone may hold MAX_MISSION_BYTES).
+MAX_LAUNCH_TREE_BYTES = 2 * MAX_MISSION_BYTES
 
 
 def mission_from_launch(text: str, source: str, base_dir: Path | None,
@@ -57,6 +66,7 @@ def mission_from_launch(text: str, source: str, base_dir: Path | None,
                      "expected <launch>", source=f"{source}:{root.line}")
         return None
     reader = _LaunchReader(source, base_dir, problems)
+    reader.bytes_read = len(text)
     before = len(problems)
     reader.walk(root, "/", None, reader.top)
     if len(problems) > before:  # e.g. a broken <rosparam> body: what it set is unknown
@@ -125,9 +135,13 @@ class _LaunchReader:
         self.packages = PackageFinder()
         self.tree = _ParamTree(f"{source}:1")
         self.not_followed: list[str] = []
-        self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages))
+        self.budget = ExpansionBudget()
+        self.values = ValueBudget()  # the YAML values of every param and file together
+        self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages,
+                                              self.budget))
         self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
         self.files_read = 1
+        self.bytes_read = 0
 
     def walk(self, element: XmlElement, namespace: str, private: str | None, file: _File,
              depth: int = 0) -> None:
@@ -140,6 +154,9 @@ class _LaunchReader:
                 self.visit(child, namespace, private, file, depth)
             except SubstitutionError as error:
                 self.problems.add(error.message, source=file.where(child.line))
+            except ExpansionLimitError as error:
+                # Fatal: going on would only hit the limit again, element after element.
+                raise NavseqError(error.message, source=file.where(child.line)) from None
 
     def visit(self, element: XmlElement, namespace: str, private: str | None, file: _File,
               depth: int) -> None:
@@ -198,7 +215,10 @@ class _LaunchReader:
         located = Located(value, where)
         if element.attrs.get("type", "auto") not in ("str", "string"):
             try:
-                parsed = parse_yaml_value(value, file.source, first_line=element.line)
+                parsed = parse_yaml_value(value, file.source, first_line=element.line,
+                                          budget=self.values)
+            except TooManyValuesError:
+                raise
             except NavseqError:
                 parsed = None  # plain text, as roslaunch would keep it
             if parsed is not None:
@@ -222,7 +242,7 @@ class _LaunchReader:
         substitute = _boolean(self.attr(element, "subst_value", file) or "false") is True
         file_name = self.attr(element, "file", file)
         if file_name is not None:
-            return self.rosparam_file(file_name, file, substitute)
+            return self.rosparam_file(file_name, file, substitute, element.line)
         body = element.body
         first_line = element.text_line or element.line
         if substitute:
@@ -233,12 +253,16 @@ class _LaunchReader:
                 self.problems.add(error.message, source=file.where(line))
                 return None
         try:
-            return parse_yaml(body, file.source, self.problems, first_line=first_line)
+            return parse_yaml(body, file.source, self.problems, first_line=first_line,
+                              budget=self.values)
+        except TooManyValuesError:
+            raise
         except NavseqError as error:
             self.problems.record(error)
             return None
 
-    def rosparam_file(self, file_name: str, file: _File, substitute: bool) -> Located | None:
+    def rosparam_file(self, file_name: str, file: _File, substitute: bool,
+                      element_line: int) -> Located | None:
         if "$(" in file_name:
             self.not_followed.append(file.subst.explain(file_name))
             return None
@@ -248,6 +272,7 @@ class _LaunchReader:
         except NavseqError:
             self.not_followed.append(file_name)
             return None
+        self.count_bytes(text, file.where(element_line))
         if substitute:
             try:
                 text = file.subst.resolve(text)
@@ -256,7 +281,9 @@ class _LaunchReader:
                 self.problems.add(error.message, source=f"{path}:{line}")
                 return None
         try:
-            return parse_yaml(text, str(path), self.problems)
+            return parse_yaml(text, str(path), self.problems, budget=self.values)
+        except TooManyValuesError:
+            raise
         except NavseqError:
             self.not_followed.append(file_name)
             return None
@@ -286,8 +313,12 @@ class _LaunchReader:
                               f" includes deep, {MAX_INCLUDED_FILES} files in all)", source=here)
             return
         try:
-            root = parse_xml(read_mission_text(path), str(path))
+            text = read_mission_text(path)
+            self.count_bytes(text, here)
+            root = parse_xml(text, str(path))
         except NavseqError as error:
+            if error.source == here:  # over the launch tree's size limit: stop reading
+                raise
             if error.source == str(path):  # the file itself is missing or unreadable
                 self.problems.add(f"includes {file_name}, which navseq cannot read: "
                                   f"{error.message} ({path})", source=here)
@@ -299,12 +330,22 @@ class _LaunchReader:
                               f"element is <{root.tag}>", source=f"{path}:{root.line}")
             return
         self.files_read += 1
-        included = _File(str(path), Substitution(LaunchArgs(passed), path.parent, self.packages))
+        included = _File(str(path), Substitution(LaunchArgs(passed), path.parent, self.packages,
+                                                 self.budget))
         self.reading.append(key)
         try:
             self.walk(root, inner, None, included, depth + 1)
         finally:
             self.reading.pop()
+
+    def count_bytes(self, text: str, where: str) -> None:
+        """Refuse a launch tree whose files hold more text, all together, than navseq reads."""
+        self.bytes_read += len(text)
+        if self.bytes_read > MAX_LAUNCH_TREE_BYTES:
+            raise NavseqError(f"the launch file and the files it includes hold more than "
+                              f"{MAX_LAUNCH_TREE_BYTES / 2**20:g} MiB of text together; "
+                              "navseq refuses to read on (a file included over and over?)",
+                              source=where)
 
     def passed_args(self, element: XmlElement, file: _File) -> dict[str, str] | None:
         """The args an <include> gives the included file; None when one is wrong."""

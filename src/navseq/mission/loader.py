@@ -30,7 +30,8 @@ from navseq.mission.yaml_doc import parse_yaml
 
 Reader = Callable[[str, str, Path, Problems], "Mission | None"]
 
-_CSV_LINE = re.compile(r"\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+)+\s*")
+# Possessive quantifiers: the match never backtracks, so it is linear in the line.
+_CSV_LINE = re.compile(r"\s*+[-+0-9.eE]++(?:\s*+,\s*+[-+0-9.eE]++)++\s*+")
 _NAVSEQ_KEYS = ("waypoints", "navseq")
 SUPPORTED = ("navseq YAML or rosparam YAML (.yaml, .yml), roslaunch XML (.launch, .xml), "
              "CSV x,y,z,qx,qy,qz,qw (.csv)")

@@ -21,7 +21,7 @@ from __future__ import annotations
 import difflib
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -134,7 +134,7 @@ def read_map_path(node: Located, subject: str, base_dir: Path | None) -> Path:
 
 def read_path(node: Located, subject: str, base_dir: Path | None) -> Path:
     """A file path as written, ``~`` expanded, anchored at ``base_dir`` when relative."""
-    written = fields.text(node, subject)
+    written = fields.text(node, subject, single_line=False)
     if "\0" in written:
         raise NavseqError("a file path cannot contain a NUL character", source=node.where,
                           subject=subject)
@@ -157,7 +157,7 @@ def read_loops(node: Located, subject: str) -> int | None:
 def read_server_timeout(node: Located, subject: str) -> float | None:
     if node.value is None:
         return None
-    return fields.bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s")
+    return fields.positive_seconds(node, subject)
 
 
 def read_start(node: Located, subject: str) -> Pose2D:
@@ -165,8 +165,8 @@ def read_start(node: Located, subject: str) -> Pose2D:
     fields.mapping(node, subject)
     problems = Problems()
     fields.check_keys(node, ("x", "y", *ORIENTATION_KEYS), "start", problems)
-    x = _required_number(node, "x", "start", problems)
-    y = _required_number(node, "y", "start", problems)
+    x = _required_number(node, "x", "start", problems, fields.coordinate)
+    y = _required_number(node, "y", "start", problems, fields.coordinate)
     yaw = read_yaw(node, "start", problems)
     problems.raise_if_any()
     assert x is not None and y is not None and yaw is not None
@@ -211,9 +211,9 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         if name is not None:
             label = f"{label} '{name}'"
     fields.check_keys(node, WAYPOINT_KEYS, label, problems)
-    x = _required_number(node, "x", label, problems)
-    y = _required_number(node, "y", label, problems)
-    z = _optional_number(node, "z", label, problems)
+    x = _required_number(node, "x", label, problems, fields.coordinate)
+    y = _required_number(node, "y", label, problems, fields.coordinate)
+    z = _optional_number(node, "z", label, problems, fields.coordinate)
     yaw = read_yaw(node, label, problems)
     overrides = fields.policy_values(node, label, problems)
     if len(problems) > before or x is None or y is None or yaw is None:
@@ -231,12 +231,14 @@ def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoi
         return None
     names = ("x", "y", "yaw")
     before = len(problems)
-    values = [fields.attempt(problems, lambda i=item, n=name: fields.number(
-        i, fields.field_subject(label, n))) for item, name in zip(items, names, strict=False)]
+    readers = (fields.coordinate, fields.coordinate, fields.yaw_degrees)
+    values = [fields.attempt(problems, lambda i=item, n=name, r=read: r(
+        i, fields.field_subject(label, n)))
+        for item, name, read in zip(items, names, readers, strict=False)]
     if len(problems) > before:
         return None
     x, y, *rest = (v for v in values if v is not None)
-    yaw = math.radians(rest[0]) if rest else 0.0
+    yaw = rest[0] if rest else 0.0
     return Waypoint(x=x, y=y, yaw=yaw, where=node.where)
 
 
@@ -256,10 +258,9 @@ def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:
     entry = node.value[key]
     subject = fields.field_subject(owner, key)
     if key == "yaw":
-        degrees = fields.attempt(problems, lambda: fields.number(entry, subject))
-        return None if degrees is None else math.radians(degrees)
+        return fields.attempt(problems, lambda: fields.yaw_degrees(entry, subject))
     if key == "yaw_rad":
-        return fields.attempt(problems, lambda: fields.number(entry, subject))
+        return fields.attempt(problems, lambda: fields.yaw_radians(entry, subject))
     return fields.attempt(problems, lambda: read_quaternion_yaw(entry, subject))
 
 
@@ -275,11 +276,15 @@ def read_quaternion_yaw(node: Located, subject: str) -> float:
 
 def quaternion_yaw_checked(parts: Sequence[float], where: str, subject: str) -> float:
     qx, qy, qz, qw = parts
-    norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-    if not math.isfinite(norm) or norm < 1e-9:
+    # hypot scales before squaring: components near 1e200 do not overflow to inf.
+    norm = math.hypot(qx, qy, qz, qw)
+    if not math.isfinite(norm):
+        raise NavseqError("the quaternion (x, y, z, w) is too long to normalise; write a "
+                          "unit quaternion", source=where, subject=subject)
+    if norm < 1e-9:
         raise NavseqError("the quaternion (x, y, z, w) has length 0; it is no rotation",
                           source=where, subject=subject)
-    return quaternion_to_yaw(qx / norm, qy / norm, qz / norm, qw / norm)
+    return fields.normalized_yaw(quaternion_to_yaw(qx / norm, qy / norm, qz / norm, qw / norm))
 
 
 def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
@@ -291,24 +296,29 @@ def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
             continue
         name = str(name_node.value)
         if name in first_use:
-            problems.add(f"the name '{name}' is already used by waypoint {first_use[name] + 1}; "
-                         "names must be unique", source=name_node.where,
+            problems.add(f"the name '{fields.shortened(name)}' is already used by waypoint "
+                         f"{first_use[name] + 1}; names must be unique", source=name_node.where,
                          subject=f"waypoint {index + 1}, field name")
         else:
             first_use[name] = index
 
 
-def _required_number(node: Located, key: str, owner: str, problems: Problems) -> float | None:
+NumberReader = Callable[[Located, str], float]
+
+
+def _required_number(node: Located, key: str, owner: str, problems: Problems,
+                     read: NumberReader = fields.number) -> float | None:
     entry = node.get(key)
     if entry is None:
         problems.add(f"'{key}' is missing", source=node.where,
                      subject=fields.field_subject(owner, key))
         return None
-    return fields.attempt(problems, lambda: fields.number(entry, fields.field_subject(owner, key)))
+    return fields.attempt(problems, lambda: read(entry, fields.field_subject(owner, key)))
 
 
-def _optional_number(node: Located, key: str, owner: str, problems: Problems) -> float | None:
+def _optional_number(node: Located, key: str, owner: str, problems: Problems,
+                     read: NumberReader = fields.number) -> float | None:
     entry = node.get(key)
     if entry is None:
         return None
-    return fields.attempt(problems, lambda: fields.number(entry, fields.field_subject(owner, key)))
+    return fields.attempt(problems, lambda: read(entry, fields.field_subject(owner, key)))

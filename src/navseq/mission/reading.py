@@ -5,49 +5,28 @@ huge, or binary. Each case is one clear NavseqError, decided before reading much
 from __future__ import annotations
 
 import re
-import stat
 from pathlib import Path
 
 from navseq.errors import NavseqError
+from navseq.files import read_input_bytes
 
 MAX_MISSION_BYTES = 10 * 1024 * 1024  # far above any real mission; refuses accidents
 # Text files never hold these; tab, newline and carriage return are fine.
 _CONTROL_CHARACTER = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
 
 
-def read_mission_text(path: Path, *, max_bytes: int = MAX_MISSION_BYTES) -> str:
+def read_mission_text(path: Path, *, max_bytes: int = MAX_MISSION_BYTES,
+                      what: str = "mission file") -> str:
     """The file's text (UTF-8, an optional BOM dropped) or a NavseqError saying why not."""
-    source = str(path)
-    try:
-        info = path.stat()
-    except FileNotFoundError:
-        raise NavseqError("no such file", source=source) from None
-    except OSError as error:
-        raise NavseqError(f"cannot be read: {error.strerror or error}", source=source) from None
-    except ValueError:  # a NUL byte in the name
-        raise NavseqError("is not a valid file name", source=repr(source)) from None
-    if stat.S_ISDIR(info.st_mode):
-        raise NavseqError("is a folder, not a mission file", source=source)
-    if not stat.S_ISREG(info.st_mode):
-        # Reading a FIFO or a device could block forever or never end.
-        raise NavseqError("is not a regular file (a device, pipe or socket?)", source=source)
-    if info.st_size > max_bytes:
-        raise NavseqError(_too_big(info.st_size, max_bytes), source=source)
-    try:
-        with open(path, "rb") as stream:
-            # The size can change between stat and read; never read more than the cap.
-            data = stream.read(max_bytes + 1)
-    except OSError as error:
-        raise NavseqError(f"cannot be read: {error.strerror or error}", source=source) from None
-    if len(data) > max_bytes:
-        raise NavseqError(_too_big(len(data), max_bytes), source=source)
-    return decode_text(data, source)
+    data = read_input_bytes(path, what=what, max_bytes=max_bytes,
+                            too_big=lambda size, limit: _too_big(size, limit, what))
+    return decode_text(data, str(path), what.removesuffix(" file"))
 
 
-def decode_text(data: bytes, source: str) -> str:
+def decode_text(data: bytes, source: str, what: str = "mission") -> str:
     """UTF-8 text, refusing binary data with a message that says so."""
     if b"\x00" in data:
-        raise NavseqError("is a binary file (it contains NUL bytes), not a mission",
+        raise NavseqError(f"is a binary file (it contains NUL bytes), not a {what}",
                           source=source)
     try:
         text = data.decode("utf-8-sig")
@@ -66,7 +45,7 @@ def decode_text(data: bytes, source: str) -> str:
     return text
 
 
-def _too_big(size: int, limit: int) -> str:
-    return (f"is {size / 2**20:.1f} MiB; navseq refuses mission files over "
-            f"{limit / 2**20:g} MiB (is this really a mission?)")
+def _too_big(size: int, limit: int, what: str) -> str:
+    return (f"is {size / 2**20:.1f} MiB; navseq refuses {what}s over "
+            f"{limit / 2**20:g} MiB (is this really a {what.removesuffix(' file')}?)")
 

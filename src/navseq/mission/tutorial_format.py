@@ -8,7 +8,6 @@ match; here every mismatch is an error that says both counts.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 from navseq.errors import NavseqError
@@ -35,8 +34,9 @@ def waypoints_from_sequences(p_seq: Located | None, yea_seq: Located | None,
         problems.add(f"'{POSITIONS_KEY}' is set but '{YAWS_KEY}' (one yaw in degrees per "
                      "point) is missing", source=p_seq.where if p_seq else None,
                      subject=f"field {YAWS_KEY}")
-    positions = _number_list(p_seq, POSITIONS_KEY, _position_subject, problems)
-    yaws = _number_list(yea_seq, YAWS_KEY, _yaw_subject, problems)
+    positions = _number_list(p_seq, POSITIONS_KEY, _position_subject, problems,
+                             fields.coordinate)
+    yaws = _number_list(yea_seq, YAWS_KEY, _yaw_subject, problems, fields.yaw_degrees)
     if p_seq is not None and positions is not None:
         if not positions:
             problems.add("is empty; a mission needs at least one waypoint", source=p_seq.where,
@@ -55,7 +55,7 @@ def waypoints_from_sequences(p_seq: Located | None, yea_seq: Located | None,
     if len(problems) > before or not positions or yaws is None:
         return ()
     return tuple(
-        Waypoint(x=x.value, y=y.value, z=z.value, yaw=math.radians(yaw.value), where=x.where)
+        Waypoint(x=x.value, y=y.value, z=z.value, yaw=yaw.value, where=x.where)
         for (x, y, z), yaw in zip(_triples(positions), yaws, strict=True)
     )
 
@@ -73,9 +73,9 @@ def _yaw_subject(index: int) -> str:
 
 
 def _number_list(node: Located | None, key: str, subject_of: Callable[[int], str],
-                 problems: Problems
+                 problems: Problems, read: Callable[[Located, str], float],
                  ) -> list[Located] | None:
-    """The list's items, each a checked finite float, or None when anything is wrong."""
+    """The list's items, each checked by ``read``, or None when anything is wrong."""
     if node is None:
         return None
     try:
@@ -86,7 +86,7 @@ def _number_list(node: Located | None, key: str, subject_of: Callable[[int], str
     before = len(problems)
     checked = []
     for index, item in enumerate(node.value):
-        value = fields.attempt(problems, lambda i=item, n=index: fields.number(i, subject_of(n)))
+        value = fields.attempt(problems, lambda i=item, n=index: read(i, subject_of(n)))
         checked.append(Located(value, item.where))
     return checked if len(problems) == before else None
 

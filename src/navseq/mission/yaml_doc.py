@@ -18,29 +18,43 @@ import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from navseq.errors import NavseqError
+from navseq.files import limit_from_environment
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.problems import Problems
+from navseq.text import text_problem
 
 # Aliases may repeat what was written, but not blow it up: the expanded document may
 # hold at most this many values more than were written.
 MAX_ALIAS_EXPANSION = 100_000
 
+# About 10 000 waypoints written long-hand, 25 000 as [x, y, yaw]: far above a real
+# mission, and read in a few seconds.
+MAX_VALUES = 100_000
+MAX_VALUES_VARIABLE = "NAVSEQ_MAX_YAML_VALUES"
+_VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent,
+                 yaml.AliasEvent)
+_FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 # PyYAML follows YAML 1.1, where "1e3" (no dot) is text; YAML 1.2 and every user
-# reads it as a number.
-EXPONENT_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+# reads it as a number. Possessive quantifiers never give back what they matched, so
+# the match is linear in the scalar's length (a backtracking "\d+\.?\d*" was quadratic:
+# 38 s on 100 000 digits).
+EXPONENT_FLOAT = re.compile(r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)[eE][-+]?+\d++")
 
 
-def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1
-               ) -> Located | None:
+def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1,
+               budget: ValueBudget | None = None) -> Located | None:
     """Parse one YAML document. Syntax errors raise; duplicate keys are recorded.
 
     ``first_line`` is the file line of the text's first line (YAML inside a launch
-    file). Returns None for an empty document.
+    file). ``budget`` bounds the values read, across documents if shared. Returns
+    None for an empty document.
     """
     offset = first_line - 1
     try:
+        _spend_values(text, source, offset, budget or ValueBudget())
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
@@ -58,10 +72,50 @@ def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 
     return walker.walk(root, 0)
 
 
-def parse_yaml_value(text: str, source: str, *, first_line: int = 1) -> Located | None:
+class TooManyValuesError(NavseqError):
+    """A document (or a launch tree's documents together) holds too many values."""
+
+
+class ValueBudget:
+    """How many more YAML values may be read; one budget can span several documents
+    (the parameters of a launch file and the files it includes)."""
+
+    def __init__(self, limit: int | None = None):
+        self.limit = limit or limit_from_environment(MAX_VALUES_VARIABLE, MAX_VALUES)
+        self.left = self.limit
+
+
+def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> None:
+    """Count the document's values against ``budget`` before composing it; refuse excess.
+
+    PyYAML composes some 15 000 values a second; the 10 MiB a file may hold can write
+    millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
+    parser where installed) is linear and quick, and stops at the limit. Syntax
+    errors are left to the composer, which reports them with their lines.
+    """
+    count = 0
+    try:
+        for event in yaml.parse(text, Loader=_FAST_LOADER):
+            if isinstance(event, _VALUE_EVENTS):
+                count += 1
+                if count > budget.left:
+                    line = event.start_mark.line + 1 + offset
+                    raise TooManyValuesError(
+                        f"holds more than {budget.limit:,} YAML values (with the documents "
+                        "read before it); navseq refuses missions this large (write long "
+                        "recorded paths as CSV, or set the environment variable "
+                        f"{MAX_VALUES_VARIABLE} to raise the limit)",
+                        source=f"{source}:{line}")
+    except yaml.YAMLError:
+        pass
+    budget.left -= count
+
+
+def parse_yaml_value(text: str, source: str, *, first_line: int = 1,
+                     budget: ValueBudget | None = None) -> Located | None:
     """A YAML value written inside another file (a launch file's attribute or body)."""
     problems = Problems()
-    result = parse_yaml(text, source, problems, first_line=first_line)
+    result = parse_yaml(text, source, problems, first_line=first_line, budget=budget)
     problems.raise_if_any()
     return result
 
@@ -140,14 +194,19 @@ class _Walker:
             raise NavseqError(f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
                               "navseq does not accept (quote it if it is text)",
                               source=self.where(node))
+        problem = text_problem(node.value, single_line=False)
+        if problem is not None:  # also in keys: messages print them
+            raise NavseqError(f"the text {node.value[:40]!r} {problem}", source=self.where(node))
         if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(
             node.value
         ):
             return float(node.value)
         try:
             return self.constructor.construct_object(node)
-        except (yaml.YAMLError, ValueError, OverflowError) as error:
-            raise NavseqError(f"cannot read the value {node.value!r}: {error}",
+        # PyYAML's constructors fail on some empty or odd values (``!!float ""``:
+        # IndexError, ``!!bool maybe``: KeyError) with more than YAMLError.
+        except (yaml.YAMLError, ValueError, OverflowError, LookupError, TypeError) as error:
+            raise NavseqError(f"cannot read the value {node.value[:40]!r}: {error}",
                               source=self.where(node)) from None
 
     def mapping(self, node: MappingNode, depth: int) -> Located:
@@ -158,10 +217,14 @@ class _Walker:
                 raise NavseqError("has a key that is a list or mapping; keys must be names",
                                   source=self.where(key_node))
             key = key_node.value
+            problem = text_problem(key, single_line=False)
+            if problem is not None:
+                raise NavseqError(f"the key {key[:40]!r} {problem}", source=self.where(key_node))
             if key in values:
                 first_line = key_where[key].rsplit(":", 1)[1]
+                shown = key if len(key) <= 60 else key[:57] + "..."
                 self.problems.add(
-                    f"the key '{key}' appears twice (first at line {first_line}); "
+                    f"the key '{shown}' appears twice (first at line {first_line}); "
                     "the second one would silently win",
                     source=self.where(key_node),
                 )

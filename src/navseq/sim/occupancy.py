@@ -29,21 +29,35 @@ means the same thing here as on a robot:
 
 Where map_server insists on ``occupied_thresh`` and ``free_thresh``, navseq falls back
 on the values ``map_saver`` writes (0.65 and 0.196).
+
+A map is input like a mission file and gets the same care: the YAML is read by the
+mission files' reader (YAML 1.2 numbers such as ``5e-2``, alias bombs and Python tags
+refused, every message with its line), both files must be regular files of bounded
+size, and an image may hold at most ``NAVSEQ_MAX_MAP_PIXELS`` pixels, checked from its
+header before a byte of it is decoded.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from PIL import Image, UnidentifiedImageError
 
 from navseq.errors import NavseqError
-from navseq.geometry import Pose2D
+from navseq.files import limit_from_environment, open_input_file
+from navseq.geometry import Pose2D, normalize_angle
+from navseq.mission.located import Located, describe
+from navseq.mission.problems import Problems
+from navseq.mission.reading import read_mission_text
+from navseq.mission.yaml_doc import parse_yaml
+from navseq.text import printable
 
 OCCUPIED = 100
 FREE = 0
@@ -52,6 +66,19 @@ UNKNOWN = -1
 DEFAULT_OCCUPIED_THRESH = 0.65
 DEFAULT_FREE_THRESH = 0.196
 MODES = ("trinary", "scale", "raw")
+
+# What a map can mean: cells from 0.1 mm to 1 km, an origin within 1000 km, a yaw
+# within ten turns (then normalised). Beyond these, arithmetic on the map overflows.
+MIN_RESOLUTION = 1e-4
+MAX_RESOLUTION = 1e3
+MAX_ORIGIN = 1e6
+MAX_ORIGIN_YAW = 20 * math.pi
+# A 4000 x 4000 map (200 m square at 5 cm) takes about 750 MB with its costmap.
+MAX_PIXELS_VARIABLE = "NAVSEQ_MAX_MAP_PIXELS"
+DEFAULT_MAX_PIXELS = 4000 * 4000
+MAX_MAP_YAML_BYTES = 1024 * 1024
+# Bytes per pixel of the widest image (16-bit RGBA PGM/PNG, uncompressed).
+_MAX_BYTES_PER_PIXEL = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,7 +191,7 @@ def load_map(yaml_path: str | Path) -> OccupancyGrid:
     image_path = Path(settings.image)
     if not image_path.is_absolute():
         image_path = path.parent / image_path
-    pixels = _read_image(image_path, source)
+    pixels = _read_image(image_path, description.where_key("image"))
     data = pixels_to_occupancy(
         pixels,
         mode=settings.mode,
@@ -230,35 +257,51 @@ class _MapSettings:
     mode: str
 
     @classmethod
-    def from_yaml(cls, doc: dict[str, Any], source: str) -> _MapSettings:
+    def from_yaml(cls, description: Located, source: str) -> _MapSettings:
+        doc = {key: entry.value for key, entry in description.value.items()}
+
         def fail(key: str, message: str) -> NavseqError:
-            return NavseqError(message, source=source, subject=f"key {key}")
+            return NavseqError(message, source=description.where_key(key), subject=f"key {key}")
 
         image = doc.get("image")
         if image is None:
             raise fail("image", "the map YAML has no 'image' (the PGM/PNG file to load)")
         if not isinstance(image, str) or not image.strip():
-            raise fail("image", f"expected a file name, got {image!r}")
+            raise fail("image", f"expected a file name, got {_shown(description, 'image')}")
+        if "\0" in image:
+            raise fail("image", "a file name cannot contain a NUL character")
 
         if "resolution" not in doc:
             raise fail("resolution", "the map YAML has no 'resolution' (metres per cell)")
         resolution = _number(doc["resolution"])
-        if resolution is None or not resolution > 0 or not math.isfinite(resolution):
-            raise fail("resolution", f"expected a positive number, got {doc['resolution']!r}")
+        if resolution is None or not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
+            raise fail(
+                "resolution",
+                f"expected metres per cell from {MIN_RESOLUTION:g} to "
+                f"{MAX_RESOLUTION:g}, got {_shown(description, 'resolution')}",
+            )
 
         origin_value = doc.get("origin", [0.0, 0.0, 0.0])
         origin_numbers = (
-            [_number(v) for v in origin_value] if isinstance(origin_value, list) else []
+            [_number(v.value) for v in origin_value] if isinstance(origin_value, list) else []
         )
-        if len(origin_numbers) != 3 or any(
-            v is None or not math.isfinite(v) for v in origin_numbers
-        ):
-            raise fail("origin", f"expected [x, y, yaw], got {origin_value!r}")
+        if len(origin_numbers) != 3 or any(v is None for v in origin_numbers):
+            raise fail("origin", f"expected [x, y, yaw], got {_shown(description, 'origin')}")
         x, y, yaw = (float(v) for v in origin_numbers)  # type: ignore[arg-type]
+        if not (abs(x) <= MAX_ORIGIN and abs(y) <= MAX_ORIGIN):
+            raise fail(
+                "origin",
+                f"x and y must be within ±{MAX_ORIGIN:g} m, got {_shown(description, 'origin')}",
+            )
+        if not abs(yaw) <= MAX_ORIGIN_YAW:
+            raise fail(
+                "origin",
+                f"the yaw (radians) must be within ±{MAX_ORIGIN_YAW:.4g} (ten turns), got {yaw:g}",
+            )
 
         negate_value = doc.get("negate", 0)
         if negate_value not in (0, 1) or isinstance(negate_value, float):
-            raise fail("negate", f"expected 0 or 1, got {negate_value!r}")
+            raise fail("negate", f"expected 0 or 1, got {_shown(description, 'negate')}")
 
         thresholds = {}
         for key, default in (
@@ -267,7 +310,9 @@ class _MapSettings:
         ):
             value = _number(doc.get(key, default))
             if value is None or not 0.0 <= value <= 1.0:
-                raise fail(key, f"expected a probability between 0 and 1, got {doc[key]!r}")
+                raise fail(
+                    key, f"expected a probability between 0 and 1, got {_shown(description, key)}"
+                )
             thresholds[key] = value
         if thresholds["free_thresh"] >= thresholds["occupied_thresh"]:
             raise fail(
@@ -278,12 +323,14 @@ class _MapSettings:
 
         mode = doc.get("mode", "trinary")
         if mode not in MODES:
-            raise fail("mode", f"expected one of {', '.join(MODES)}, got {mode!r}")
+            raise fail(
+                "mode", f"expected one of {', '.join(MODES)}, got {_shown(description, 'mode')}"
+            )
 
         return cls(
             image=image,
             resolution=resolution,
-            origin=Pose2D(x, y, yaw),
+            origin=Pose2D(x, y, normalize_angle(yaw)),
             negate=bool(negate_value),
             occupied_thresh=thresholds["occupied_thresh"],
             free_thresh=thresholds["free_thresh"],
@@ -291,47 +338,121 @@ class _MapSettings:
         )
 
 
+def _shown(description: Located, key: str) -> str:
+    """A value from the map YAML as a message shows it: short, escaped."""
+    value = description.value[key].value
+    if isinstance(value, list) and len(value) <= 4:
+        return printable("[" + ", ".join(_short(item.value) for item in value) + "]")
+    return printable(_short(value))
+
+
+def _short(value: Any) -> str:
+    return f"{value:g}" if isinstance(value, float) else describe(value)
+
+
 def _number(value: Any) -> float | None:
     if isinstance(value, bool) or not isinstance(value, int | float):
         return None
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer with hundreds of digits
+        return None
+    return number if math.isfinite(number) else None
 
 
-def _read_yaml(path: Path) -> dict[str, Any]:
+def _read_yaml(path: Path) -> Located:
+    """The map YAML as a located mapping, read with the mission files' care."""
+    source = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise NavseqError("map file not found", source=str(path)) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise NavseqError(f"cannot read the map YAML: {error}", source=str(path)) from None
+        text = read_mission_text(path, max_bytes=MAX_MAP_YAML_BYTES, what="map YAML file")
+    except NavseqError as error:
+        if error.message == "no such file":
+            raise NavseqError("map file not found", source=source) from None
+        raise
+    problems = Problems()
     try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
-        raise NavseqError(f"not valid YAML: {error}", source=where) from None
-    if not isinstance(doc, dict):
+        doc = parse_yaml(text, source, problems)
+    except RecursionError:
+        raise NavseqError("is nested too deeply to be a map YAML", source=source) from None
+    problems.raise_if_any()
+    if doc is None or not doc.is_mapping:
         raise NavseqError(
-            "a map YAML must be a mapping with image, resolution, origin, ...", source=str(path)
+            "a map YAML must be a mapping with image, resolution, origin, ...",
+            source=source if doc is None else doc.where,
         )
     return doc
 
 
+def max_map_pixels() -> int:
+    """The largest map image navseq loads, in pixels (``NAVSEQ_MAX_MAP_PIXELS`` raises it)."""
+    return limit_from_environment(MAX_PIXELS_VARIABLE, DEFAULT_MAX_PIXELS)
+
+
 def _read_image(image_path: Path, source: str) -> np.ndarray:
-    """Pixels of a PGM/PNG as uint8 (H, W[, C]), top row first."""
-    subject = f"image {image_path}"
-    if not image_path.is_file():
-        raise NavseqError("the map image does not exist", source=source, subject=subject)
+    """Pixels of a PGM/PNG as uint8 (H, W[, C]), top row first.
+
+    ``source`` is where the YAML names the image (``map.yaml:1``).
+    """
+    subject = f"image {printable(str(image_path))}"
+    limit = max_map_pixels()
     try:
-        with Image.open(image_path) as image:
+        stream = open_input_file(
+            image_path, what="map image", max_bytes=limit * _MAX_BYTES_PER_PIXEL + 2**20
+        )
+    except NavseqError as error:
+        message = (
+            "the map image does not exist"
+            if error.message == "no such file"
+            else f"the map image {error.message}"
+        )
+        raise NavseqError(message, source=source, subject=subject) from None
+    try:
+        with stream, _pillow_size_checks_off(), Image.open(stream) as image:
+            width, height = image.size
+            if width * height > limit:
+                raise NavseqError(
+                    f"the map image is {width} x {height} = {width * height:,} pixels; navseq "
+                    f"loads at most {limit:,} (set the environment variable "
+                    f"{MAX_PIXELS_VARIABLE} to raise the limit, if the machine has the memory)",
+                    source=source,
+                    subject=subject,
+                )
             image.load()
             return _to_uint8_channels(image)
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as error:
+    except (
+        UnidentifiedImageError,
+        OSError,
+        SyntaxError,
+        ValueError,
+        EOFError,
+        Image.DecompressionBombError,
+    ) as error:
         raise NavseqError(
-            f"cannot read the map image (not a valid PGM/PNG?): {error}",
+            f"cannot read the map image (not a valid PGM/PNG?): {printable(str(error))}",
             source=source,
             subject=subject,
         ) from None
+    except MemoryError:
+        raise NavseqError(
+            "there is not enough memory to load the map image; lower "
+            f"{MAX_PIXELS_VARIABLE} or use a smaller map",
+            source=source,
+            subject=subject,
+        ) from None
+
+
+@contextlib.contextmanager
+def _pillow_size_checks_off() -> Iterator[None]:
+    """navseq checks the pixel count itself: no DecompressionBombWarning on stderr and no
+    Pillow limit below the one the user set."""
+    saved = Image.MAX_IMAGE_PIXELS
+    Image.MAX_IMAGE_PIXELS = None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            yield
+    finally:
+        Image.MAX_IMAGE_PIXELS = saved
 
 
 def _to_uint8_channels(image: Image.Image) -> np.ndarray:

@@ -39,6 +39,7 @@ import dataclasses
 import datetime
 import enum
 import errno
+import functools
 import hashlib
 import json
 import os
@@ -52,6 +53,9 @@ from navseq.errors import NavseqError
 from navseq.executor import events as ev
 from navseq.executor.result import AttemptResult, WaypointResult
 from navseq.executor.resume import ResumePoint
+from navseq.files import limit_from_environment, open_input_file
+from navseq.mission.reading import MAX_MISSION_BYTES
+from navseq.text import printable
 
 JOURNAL_FORMAT = "navseq-journal"
 JOURNAL_VERSION = 2
@@ -63,6 +67,10 @@ _CHAIN_SUFFIX_LENGTH = len(_CHAIN_KEY) + _CHAIN_DIGITS + 2  # digits, closing qu
 #: Mission time between two journaled WaypointProgress events (s).
 PROGRESS_INTERVAL = 1.0
 _MAX_HEADER_BYTES = 64 * 1024
+# Progress is journaled once a second: 64 MiB hold days of patrolling. The variable
+# raises the limit for a journal that legitimately grew beyond it.
+MAX_JOURNAL_BYTES_VARIABLE = "NAVSEQ_MAX_JOURNAL_BYTES"
+DEFAULT_MAX_JOURNAL_BYTES = 64 * 1024 * 1024
 
 _EVENT_TYPES: dict[str, type] = {
     cls.__name__: cls
@@ -83,13 +91,27 @@ _DONE_OUTCOMES = (ev.WaypointOutcome.REACHED, ev.WaypointOutcome.SKIPPED)
 
 
 def mission_digest(path: str | os.PathLike[str]) -> str:
-    """sha256 (hex) of a mission file's bytes: a resumed run must use the same mission."""
-    try:
-        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    except OSError as error:
-        raise NavseqError(
-            f"cannot read the mission file: {error.strerror}", source=str(path)
-        ) from None
+    """sha256 (hex) of a mission file's bytes: a resumed run must use the same mission.
+
+    The file gets the checks of any mission file (a regular file of at most
+    ``MAX_MISSION_BYTES``): a journal may name ``/dev/zero`` or a FIFO.
+    """
+    digest = hashlib.sha256()
+    source = Path(path)
+    with open_input_file(source, what="mission file", max_bytes=MAX_MISSION_BYTES) as stream:
+        try:
+            for chunk in iter(lambda: stream.read(1 << 20), b""):
+                digest.update(chunk)
+                if stream.tell() > MAX_MISSION_BYTES:  # it grew after the check
+                    raise NavseqError(
+                        f"is over {MAX_MISSION_BYTES / 2**20:g} MiB, too big for a mission file",
+                        source=str(source),
+                    )
+        except OSError as error:
+            raise NavseqError(
+                f"cannot read the mission file: {error.strerror or error}", source=str(source)
+            ) from None
+    return digest.hexdigest()
 
 
 class NothingToResume(NavseqError):
@@ -261,32 +283,49 @@ def read_journal(path: str | os.PathLike[str]) -> JournalState:
 
 def _read_records(path: Path) -> tuple[dict[str, Any], list[tuple[int, dict[str, Any] | None]]]:
     """The header, then (line number, record or None if unreadable) for every other line."""
-    try:
-        with path.open("rb") as handle:
+    limit = limit_from_environment(MAX_JOURNAL_BYTES_VARIABLE, DEFAULT_MAX_JOURNAL_BYTES)
+
+    def too_big(size: int, cap: int) -> str:
+        return (
+            f"is {size / 2**20:.1f} MiB; navseq reads journals up to {cap / 2**20:g} MiB "
+            f"(set the environment variable {MAX_JOURNAL_BYTES_VARIABLE} to raise it)"
+        )
+
+    with open_input_file(path, what="journal", max_bytes=limit, too_big=too_big) as handle:
+        try:
             # Check the header before reading on, so a huge wrong file fails fast.
             first = handle.readline(_MAX_HEADER_BYTES).rstrip(b"\n")
-            header = _parse_line(first)
+            header = _parse_line(first, f"{path}:1")
             if header is None or header.get("kind") != "header":
                 raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
-            rest = handle.read()
-    except OSError as error:
-        raise NavseqError(f"cannot read the journal: {error.strerror}", source=str(path)) from None
+            rest = handle.read(limit + 1)
+        except OSError as error:
+            raise NavseqError(
+                f"cannot read the journal: {error.strerror}", source=str(path)
+            ) from None
+    if len(rest) > limit:
+        raise NavseqError(too_big(len(rest), limit), source=str(path))
     if header.get("format") != JOURNAL_FORMAT:
         raise NavseqError(
-            f"not a navseq journal (format {header.get('format')!r})", source=f"{path}:1"
+            f"not a navseq journal (format {printable(repr(header.get('format')))[:60]})",
+            source=f"{path}:1",
         )
     version = header.get("version")
     if not isinstance(version, int) or isinstance(version, bool) or version > JOURNAL_VERSION:
         raise NavseqError(
-            f"journal format version {version!r} is not one this navseq understands "
-            f"(up to {JOURNAL_VERSION}); upgrade navseq",
+            f"journal format version {printable(repr(version))[:40]} is not one this navseq "
+            f"understands (up to {JOURNAL_VERSION}); upgrade navseq",
             source=f"{path}:1",
         )
+    for key in ("mission_source", "mission_digest", "started"):
+        _check_header_text(header.get(key, ""), key, f"{path}:1")
     lines = rest.split(b"\n")
     if lines[-1] == b"":
         lines.pop()
     records = [
-        (number, _parse_line(line)) for number, line in enumerate(lines, start=2) if line.strip()
+        (number, _parse_line(line, f"{path}:{number}"))
+        for number, line in enumerate(lines, start=2)
+        if line.strip()
     ]
     if version >= _CHAINED_SINCE:
         header["_lines"] = (first, lines)
@@ -351,6 +390,16 @@ class _VisitTrail:
     key: tuple[int, int]
     sent_at: dict[int, float] = field(default_factory=dict)  # attempt number -> first send
     failures: dict[int, AttemptResult] = field(default_factory=dict)
+
+
+def _check_header_text(value: Any, key: str, where: str) -> None:
+    """The header's texts name files and digests: no NUL, nothing a path cannot hold."""
+    if not isinstance(value, str) or "\0" in value or not _is_path_text(value):
+        raise NavseqError(
+            f"the header's {key} is not a valid text or path "
+            f"({printable(repr(value))[:60]}); the journal is damaged",
+            source=where,
+        )
 
 
 def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]]) -> None:
@@ -512,11 +561,28 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
     return ResumePoint(loop=loop, index=index, done=done, previous_duration=state.previous_duration)
 
 
-def _parse_line(line: bytes) -> dict[str, Any] | None:
+def _is_path_text(value: str) -> bool:
+    """False for a lone surrogate other than a file name's undecodable byte."""
+    try:
+        os.fsencode(value)
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def _parse_line(line: bytes, where: str) -> dict[str, Any] | None:
+    """One JSON record; None for a line that is not one (e.g. cut short by a crash)."""
     try:
         record = json.loads(line)
     except (ValueError, UnicodeDecodeError):
         return None
+    except RecursionError:
+        # No journal record nests more than a few levels; this one is no journal line.
+        raise NavseqError(
+            "a line nests JSON lists or objects too deeply to be a journal "
+            "record; the journal is damaged or is not a navseq journal",
+            source=where,
+        ) from None
     return record if isinstance(record, dict) else None
 
 
@@ -524,7 +590,7 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
     cls = _EVENT_TYPES.get(str(record.get("type")))
     if cls is None:
         return None
-    hints = get_type_hints(cls)
+    hints = _field_types(cls)
     values: dict[str, Any] = {}
     try:
         for spec in dataclasses.fields(cls):
@@ -535,6 +601,12 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
         raise NavseqError(
             f"journal event {cls.__name__} is malformed: {error}", source=where
         ) from None
+
+
+@functools.cache
+def _field_types(cls: type) -> dict[str, Any]:
+    """The event's field types, evaluated once per class (not once per journal line)."""
+    return get_type_hints(cls)
 
 
 def _coerce(value: Any, hint: Any) -> Any:

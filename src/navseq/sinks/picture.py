@@ -27,6 +27,7 @@ from navseq.executor.result import MissionResult
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -224,7 +225,7 @@ def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> object | None:
 
 
 def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> str:
-    name = Path(mission.source).stem if mission.source else "mission"
+    name = printable(Path(mission.source).stem) if mission.source else "mission"
     reached = sum(
         1 for visit in result.visits if WaypointOutcome(visit.outcome) == WaypointOutcome.REACHED
     )
@@ -344,7 +345,7 @@ def mission_figure(
         ax.text(waypoint.x, waypoint.y, str(index + 1), ha="center", va="center",
                 fontsize=7.5, fontweight="bold", color="white", zorder=7)
         if waypoint.name:
-            ax.annotate(waypoint.name, (waypoint.x, waypoint.y), xytext=(9, -12),
+            ax.annotate(printable(waypoint.name), (waypoint.x, waypoint.y), xytext=(9, -12),
                         textcoords="offset points", fontsize=7, color="#222222", zorder=7,
                         bbox={"boxstyle": "round,pad=0.15", "facecolor": "white",
                               "edgecolor": "none", "alpha": 0.75})

@@ -44,6 +44,7 @@ from navseq.executor.events import (
 )
 from navseq.executor.result import MissionResult, WaypointResult
 from navseq.mission.model import Mission
+from navseq.text import printable
 
 OUTCOME_STYLE = {
     WaypointOutcome.REACHED: "green",
@@ -65,7 +66,7 @@ def _plural(count: int, word: str) -> str:
 
 def _why(reason: str, text: str) -> str:
     """navseq's reason with the navigation stack's own words after it, when it gave any."""
-    text = text.strip()
+    reason, text = printable(reason), printable(text.strip())
     if not text or text == reason:
         return reason
     return f"{reason}: {text}" if reason else text
@@ -96,7 +97,7 @@ class RunView:
 
     def waypoint_label(self, index: int) -> str:
         name = self.mission.waypoints[index].name if index < self.count else None
-        return f"waypoint {index + 1}/{self.count}" + (f" '{name}'" if name else "")
+        return f"waypoint {index + 1}/{self.count}" + (f" '{printable(name)}'" if name else "")
 
     def loop_label(self) -> str:
         total = "∞" if self.loops is None else str(self.loops)
@@ -137,12 +138,13 @@ class RunView:
             self.status = (
                 "navigation server back"
                 if event.available
-                else f"navigation server lost{': ' + event.reason if event.reason else ''}"
+                else "navigation server lost"
+                + (f": {printable(event.reason)}" if event.reason else "")
                 + ", waiting"
             )
         elif isinstance(event, MissionFinished):
             self.finished = event
-            self.status = event.reason
+            self.status = printable(event.reason)
 
 
 class LiveProgress:
@@ -242,7 +244,7 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
             if event.resumed_from is not None
             else ""
         )
-        return (f"mission {view.mission.source}: "
+        return (f"mission {printable(view.mission.source)}: "
                 f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}")
     if isinstance(event, LoopStarted):
         return view.loop_label() if view.loops != 1 else None
@@ -259,7 +261,8 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     if isinstance(event, WaypointFinished):
         outcome = WaypointOutcome(event.outcome)
         how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
-        why = f" ({event.reason})" if event.reason and outcome != WaypointOutcome.REACHED else ""
+        why = (f" ({printable(event.reason)})"
+               if event.reason and outcome != WaypointOutcome.REACHED else "")
         return (f"{view.waypoint_label(event.index)}: {how}{why} after "
                 f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
                 f"{_plural(event.attempts, 'attempt')}")
@@ -391,7 +394,8 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
     and the navigation stack's own text (move_base's "Failed to find a valid plan").
     """
     several_loops = any(visit.loop > 0 for visit in result.visits)
-    table = Table(title=Text(f"mission {mission.source}: {result.reason}"), show_footer=True)
+    title = printable(f"mission {mission.source}: {result.reason}")
+    table = Table(title=Text(title), show_footer=True)
     table.add_column("#", justify="right", footer="total")
     if several_loops:
         table.add_column("loop", justify="right")
@@ -422,6 +426,7 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
         ]
         if any_reason:
             cells.append(reason)
-        # Text cells: a name or reason with [brackets] is not markup.
-        table.add_row(*(Text(cell) for cell in cells), style=OUTCOME_STYLE[outcome])
+        # Text cells: a name or reason with [brackets] is not markup; a control
+        # character in one is shown escaped, never sent to the terminal.
+        table.add_row(*(Text(printable(cell)) for cell in cells), style=OUTCOME_STYLE[outcome])
     return table
