@@ -49,7 +49,7 @@ def free_name(folder: Path, name: str, start: int = 1) -> Path:
     raise NavseqError(f"no free name for {name} in {MAX_NAME_ATTEMPTS} tries", source=str(folder))
 
 
-def write_new_file(folder: Path, name: str, render: Callable[[Path], bytes]) -> Path:
+def write_new_file(folder: Path, name: str, render: Callable[[Path], str | bytes]) -> Path:
     """Write ``render(path)`` to a free name in ``folder``; never replaces a file.
 
     ``render`` gets the path the file will have (a report names its own path). OSError
@@ -107,15 +107,17 @@ def write_outputs(
     picture_path = free_name(folder, "mission.png")
     files.paths["picture"] = str(picture_path)
 
-    def report_bytes(path: Path) -> bytes:
+    def report_text(path: Path) -> str:
         files.paths["report"] = str(path)
         report = build_report(dict(files.paths), exit_code)
         if files.failed:
             report["files_not_written"] = dict(files.failed)
-        return (json.dumps(report, indent=2, ensure_ascii=False) + "\n").encode()
+        # Text, not bytes: write_atomically escapes what UTF-8 cannot hold (a file name's
+        # undecodable bytes) so that JSON reads it back.
+        return json.dumps(report, indent=2, ensure_ascii=False) + "\n"
 
     try:
-        report_path: Path | None = write_new_file(folder, "report.json", report_bytes)
+        report_path: Path | None = write_new_file(folder, "report.json", report_text)
     except NavseqError as error:
         report_path = None
         files.failed["report"] = str(error)
@@ -135,7 +137,7 @@ def write_outputs(
             from navseq.files import write_atomically
 
             try:
-                write_atomically(report_path, report_bytes(report_path))
+                write_atomically(report_path, report_text(report_path))
             except OSError as again:
                 files.failed["report"] = str(output_error(report_path, again))
     return exit_code
