@@ -8,6 +8,7 @@ blank lines and ``#`` comments. Every other line must hold exactly seven numbers
 from __future__ import annotations
 
 import csv
+import functools
 import math
 from collections.abc import Iterator
 
@@ -86,7 +87,7 @@ def _waypoint(cells: list[str], index: int, where: str, problems: Problems) -> W
                      source=where, subject=label)
         return None
     before = len(problems)
-    values = [fields.attempt(problems, lambda c=cell, n=name: _number(c, where, label, n))
+    values = [fields.attempt(problems, functools.partial(_number, cell, where, label, name))
               for cell, name in zip(cells, COLUMNS, strict=True)]
     if len(problems) > before:
         return None

@@ -7,6 +7,7 @@ catch the error into a :class:`Problems` list and go on with the next field.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Collection
 from typing import Any, TypeVar
@@ -249,7 +250,7 @@ def policy_values(node: Located, owner: str | None, problems: Problems) -> dict[
         if entry is None:
             continue
         before = len(problems)
-        value = attempt(problems, lambda r=reader, e=entry, k=key: r(e, field_subject(owner, k)))
+        value = attempt(problems, functools.partial(reader, entry, field_subject(owner, key)))
         if len(problems) == before:
             values[key] = value
     return values

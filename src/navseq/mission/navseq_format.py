@@ -19,6 +19,7 @@ every problem it finds. The same readers serve ROS parameters (``~waypoints``).
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -113,7 +114,7 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
             settings[key] = None
             continue
         before = len(problems)
-        value = fields.attempt(problems, lambda r=reader, e=entry, k=key: r(e, f"field {k}"))
+        value = fields.attempt(problems, functools.partial(reader, entry, f"field {key}"))
         if len(problems) == before:
             settings[key] = value
     return settings
@@ -232,9 +233,9 @@ def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoi
     names = ("x", "y", "yaw")
     before = len(problems)
     readers = (fields.coordinate, fields.coordinate, fields.yaw_degrees)
-    values = [fields.attempt(problems, lambda i=item, n=name, r=read: r(
-        i, fields.field_subject(label, n)))
-        for item, name, read in zip(items, names, readers, strict=False)]
+    values = [fields.attempt(problems, functools.partial(read, item,
+                                                         fields.field_subject(label, name)))
+              for item, name, read in zip(items, names, readers, strict=False)]
     if len(problems) > before:
         return None
     x, y, *rest = (v for v in values if v is not None)

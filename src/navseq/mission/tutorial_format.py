@@ -8,6 +8,7 @@ match; here every mismatch is an error that says both counts.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 
 from navseq.errors import NavseqError
@@ -86,7 +87,7 @@ def _number_list(node: Located | None, key: str, subject_of: Callable[[int], str
     before = len(problems)
     checked = []
     for index, item in enumerate(node.value):
-        value = fields.attempt(problems, lambda i=item, n=index: read(i, subject_of(n)))
+        value = fields.attempt(problems, functools.partial(read, item, subject_of(index)))
         checked.append(Located(value, item.where))
     return checked if len(problems) == before else None
 

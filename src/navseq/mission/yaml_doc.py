@@ -1,7 +1,7 @@
 """Safe YAML parsing into :class:`Located` trees with line numbers.
 
-PyYAML's SafeLoader *composes* the document (syntax only, no object construction);
-navseq then walks the node graph itself so that every value keeps its line number.
+PyYAML *composes* the document (syntax only, no object construction; libyaml's C
+parser where installed); navseq then walks the node graph itself so that every value keeps its line number.
 Only plain YAML types are accepted (null, bool, int, float, str, lists, mappings):
 any other tag is an error. Aliases are allowed, but before anything is built the
 document's size *with aliases expanded* is computed on the node graph (linear in
@@ -27,9 +27,9 @@ from navseq.text import text_problem
 # hold at most this many values more than were written.
 MAX_ALIAS_EXPANSION = 100_000
 
-# About 10 000 waypoints written long-hand, 25 000 as [x, y, yaw]: far above a real
-# mission, and read in a few seconds.
-MAX_VALUES = 100_000
+# About 160 000 waypoints written long-hand: a 100 000-waypoint mission (recorded
+# patrols) still loads, while a 10 MiB file of tiny values is refused before composing.
+MAX_VALUES = 1_000_000
 MAX_VALUES_VARIABLE = "NAVSEQ_MAX_YAML_VALUES"
 _VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent,
                  yaml.AliasEvent)
@@ -55,7 +55,7 @@ def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 
     offset = first_line - 1
     try:
         _spend_values(text, source, offset, budget or ValueBudget())
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_FAST_LOADER)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = f"{source}:{mark.line + 1 + offset}" if mark is not None else source
@@ -88,8 +88,8 @@ class ValueBudget:
 def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> None:
     """Count the document's values against ``budget`` before composing it; refuse excess.
 
-    PyYAML composes some 15 000 values a second; the 10 MiB a file may hold can write
-    millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
+    Composing and checking cost some 20 µs a value; the 10 MiB a file may hold can
+    write millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
     parser where installed) is linear and quick, and stops at the limit. Syntax
     errors are left to the composer, which reports them with their lines.
     """
@@ -99,7 +99,8 @@ def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> N
             if isinstance(event, _VALUE_EVENTS):
                 count += 1
                 if count > budget.left:
-                    line = event.start_mark.line + 1 + offset
+                    mark = event.start_mark
+                    line = (mark.line if mark is not None else 0) + 1 + offset
                     raise TooManyValuesError(
                         f"holds more than {budget.limit:,} YAML values (with the documents "
                         "read before it); navseq refuses missions this large (write long "

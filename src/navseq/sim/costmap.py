@@ -73,8 +73,8 @@ class Costmap:
 
     grid: OccupancyGrid
     params: CostmapParams = field(default_factory=CostmapParams)
-    cost: np.ndarray = field(default=None)  # type: ignore[assignment]
-    clearance: np.ndarray = field(default=None)  # type: ignore[assignment]
+    cost: np.ndarray = field(default=None)  # type: ignore[arg-type]
+    clearance: np.ndarray = field(default=None)  # type: ignore[arg-type]
 
     def __post_init__(self) -> None:
         if self.cost is None:
@@ -119,7 +119,7 @@ class Costmap:
         """True if the cell under this point is traversable: the robot, centred there, can
         turn in place without touching anything (see the module docstring)."""
         row, col = self.grid.world_to_cell(x, y)
-        return self.grid.in_bounds(row, col) and bool(self._traversable[row, col])
+        return self.grid.in_bounds(row, col) and bool(self.free_mask()[row, col])
 
     def free_mask(self) -> np.ndarray:
         """Cells where the planner may put the robot centre (read-only)."""

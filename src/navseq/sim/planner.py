@@ -30,7 +30,7 @@ import numpy as np
 from navseq.sim.costmap import INSCRIBED, Costmap
 
 try:  # the optional compiled search; the fallback below gives the same plans
-    from navseq.sim import _astar as _compiled_astar
+    from navseq.sim import _astar as _compiled_astar  # type: ignore[attr-defined]
 except ImportError:  # pragma: no cover - depends on the build
     _compiled_astar = None
 

@@ -166,7 +166,7 @@ class JournalWriter:
         # Refuse to append to something that is not an intact journal; go on with its chain.
         writer._chain = read_journal(writer.path).chain
         writer._open(0, fsync)
-        if not _ends_with_newline(writer.path):
+        if not _ends_with_newline(writer.path) and writer._fd is not None:
             os.write(writer._fd, b"\n")  # end the line a crash cut short
         writer._write(
             {

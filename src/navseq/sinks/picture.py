@@ -31,6 +31,7 @@ from navseq.text import printable
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
     from navseq.sim.occupancy import OccupancyGrid
@@ -203,7 +204,7 @@ def _draw_pose_arrow(
     )
 
 
-def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> object | None:
+def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> LineCollection | None:
     """Driven path coloured by mission time; returns the collection for a colour bar."""
     from matplotlib.collections import LineCollection
 
