@@ -123,12 +123,12 @@ class Costmap:
 
     def free_mask(self) -> np.ndarray:
         """Cells where the planner may put the robot centre (read-only)."""
-        return self._traversable  # type: ignore[attr-defined,no-any-return]
+        return self._traversable  # type: ignore[attr-defined]
 
     @property
     def planning_cost(self) -> np.ndarray:
         """``cost`` with every cell that is not traversable raised to ``INSCRIBED``."""
-        return self._planning_cost  # type: ignore[attr-defined,no-any-return]
+        return self._planning_cost  # type: ignore[attr-defined]
 
     def clearance_at(self, x: float, y: float) -> float:
         """The clearance (m) of the cell under a world point; 0 off the map."""

@@ -119,7 +119,7 @@ def search_cells(
     heuristic_scale = float(finite.min()) if finite.size else 1.0
     start_index = start[0] * width + start[1]
     goal_index = goal[0] * width + goal[1]
-    search = _compiled_astar.search if compiled else _search_python  # type: ignore[union-attr]
+    search = _compiled_astar.search if compiled else _search_python
     found = search(cost, width, lut, start_index, goal_index, heuristic_scale)
     if found is None:
         return None

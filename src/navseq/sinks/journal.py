@@ -596,7 +596,7 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
         for spec in dataclasses.fields(cls):
             if spec.name in record:
                 values[spec.name] = _coerce(record[spec.name], hints[spec.name])
-        return cls(**values)  # type: ignore[no-any-return]
+        return cls(**values)
     except (TypeError, ValueError) as error:
         raise NavseqError(
             f"journal event {cls.__name__} is malformed: {error}", source=where
