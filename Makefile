@@ -16,6 +16,8 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/ruff format --check src tests benchmarks
+	$(VENV)/bin/mypy
 	$(VENV)/bin/python -m pytest
 
 # The loaders' fuzz tests at scale: FUZZ_SCALE x 2000 cases per loader (6 loaders;

@@ -118,8 +118,7 @@ def role_server(log: Path, delay_max: float) -> None:
     def on_cancel(handle: Any) -> None:
         handle.set_canceled(MoveBaseResult(), "bench: canceled")
 
-    server = actionlib.ActionServer(ACTION, MoveBaseAction, on_goal, on_cancel,
-                                    auto_start=False)
+    server = actionlib.ActionServer(ACTION, MoveBaseAction, on_goal, on_cancel, auto_start=False)
     server.start()
     print("bench server ready", flush=True)
     rospy.spin()
@@ -200,8 +199,10 @@ def role_plan_lengths(legs: list[list[float]]) -> None:
 
     lengths = []
     for x0, y0, x1, y1 in legs:
-        points = [(p.pose.position.x, p.pose.position.y)
-                  for p in make_plan(stamped(x0, y0), stamped(x1, y1), 0.0).plan.poses]
+        points = [
+            (p.pose.position.x, p.pose.position.y)
+            for p in make_plan(stamped(x0, y0), stamped(x1, y1), 0.0).plan.poses
+        ]
         if len(points) < 2:
             raise SystemExit(f"make_plan found no path from ({x0}, {y0}) to ({x1}, {y1})")
         lengths.append(sum(math.dist(a, b) for a, b in itertools.pairwise(points)))
@@ -256,7 +257,13 @@ def measure_turnaround(
     (server_name, delay_max), (client_name, client_args) = server, client
     log = master.workdir / f"server-{len(master.processes)}.jsonl"
     server_process = master.start_python(
-        THIS_SCRIPT, "--role", "server", "--log", str(log), "--delay-max", str(delay_max),
+        THIS_SCRIPT,
+        "--role",
+        "server",
+        "--log",
+        str(log),
+        "--delay-max",
+        str(delay_max),
         label="bench_server",
     )
     try:
@@ -268,8 +275,10 @@ def measure_turnaround(
             raise RuntimeError(f"{client_name} failed ({status}):\n{process.output()[-3000:]}")
     finally:
         server_process.stop()
-    records = sorted((json.loads(line) for line in log.read_text().splitlines()),
-                     key=lambda record: record["arrived"])
+    records = sorted(
+        (json.loads(line) for line in log.read_text().splitlines()),
+        key=lambda record: record["arrived"],
+    )
     if len(records) < 2:
         raise RuntimeError(f"{client_name}: the server saw {len(records)} goal(s)")
     arrived = np.array([r["arrived"] for r in records])
@@ -312,16 +321,33 @@ def turnaround_rows(goals: int) -> list[tuple[Turnaround, Turnaround]]:
 
 
 def turnaround_table(goals: int) -> Table:
-    table = Table(title="Goal turnaround over actionlib (server clock: result n sent -> "
-                        "goal n+1 received)")
-    for column in ("server succeeds", "client", "goals", "all ok", "median ms", "p99 ms",
-                   "max ms", "median / base", "p99 / base", "goals/s"):
+    table = Table(
+        title="Goal turnaround over actionlib (server clock: result n sent -> goal n+1 received)"
+    )
+    for column in (
+        "server succeeds",
+        "client",
+        "goals",
+        "all ok",
+        "median ms",
+        "p99 ms",
+        "max ms",
+        "median / base",
+        "p99 / base",
+        "goals/s",
+    ):
         table.add_column(column, justify="right")
     for row, base in turnaround_rows(goals):
         table.add_row(
-            row.server, row.client, str(row.goals_done), "yes" if row.success else "NO",
-            f"{row.median:.2f}", f"{row.p99:.2f}", f"{row.gaps_ms.max():.2f}",
-            f"{row.median / base.median:.1f}x", f"{row.p99 / base.p99:.1f}x",
+            row.server,
+            row.client,
+            str(row.goals_done),
+            "yes" if row.success else "NO",
+            f"{row.median:.2f}",
+            f"{row.p99:.2f}",
+            f"{row.gaps_ms.max():.2f}",
+            f"{row.median / base.median:.1f}x",
+            f"{row.p99 / base.p99:.1f}x",
             f"{row.goals_per_s:.1f}",
         )
     return table
@@ -346,11 +372,20 @@ def sim_nodes(master: RosMaster, mission: Mission, speed: float) -> Iterator[Non
     assert mission.start is not None and mission.map is not None
     master.set_param("/use_sim_time", True)
     start = mission.start
-    robot = master.start([REPO_ROOT / "nodes" / "sim_robot_node", f"_map:={mission.map}",
-                          f"_x:={start.x}", f"_y:={start.y}", f"_yaw:={start.yaw}",
-                          f"_speed:={speed}"], label="sim_robot")
-    nav = master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={mission.map}"],
-                       label="move_base")
+    robot = master.start(
+        [
+            REPO_ROOT / "nodes" / "sim_robot_node",
+            f"_map:={mission.map}",
+            f"_x:={start.x}",
+            f"_y:={start.y}",
+            f"_yaw:={start.yaw}",
+            f"_speed:={speed}",
+        ],
+        label="sim_robot",
+    )
+    nav = master.start(
+        [REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={mission.map}"], label="move_base"
+    )
     try:
         master.wait_for_action_server(f"/{ACTION}", timeout=60)
         master.wait_for_service(f"/{ACTION}/make_plan", timeout=30)
@@ -362,8 +397,9 @@ def sim_nodes(master: RosMaster, mission: Mission, speed: float) -> Iterator[Non
 
 def make_plan_lengths(master: RosMaster, points: list[tuple[float, float]]) -> list[float]:
     legs = [[*a, *b] for a, b in itertools.pairwise(points)]
-    caller = master.start_python(THIS_SCRIPT, "--role", "plan", "--legs", json.dumps(legs),
-                                 label="make_plan")
+    caller = master.start_python(
+        THIS_SCRIPT, "--role", "plan", "--legs", json.dumps(legs), label="make_plan"
+    )
     status = caller.wait(timeout=CLIENT_TIMEOUT)
     reply = last_json_line(caller.output())
     if status != 0 or "lengths" not in reply:
@@ -382,8 +418,11 @@ def journal_mission_time(journal: Path) -> tuple[float, bool]:
 def run_cli_mission(master: RosMaster, variant: str, mission_file: Path) -> MissionRun:
     out = master.workdir / f"out-{len(master.processes)}"
     began = time.monotonic()
-    process = master.start([NAVSEQ, "run", mission_file, "--navigator", "ros1", "--json",
-                            "--out", out], cwd=master.workdir, label="navseq-run")
+    process = master.start(
+        [NAVSEQ, "run", mission_file, "--navigator", "ros1", "--json", "--out", out],
+        cwd=master.workdir,
+        label="navseq-run",
+    )
     status = process.wait(timeout=CLIENT_TIMEOUT * 2)
     wall = time.monotonic() - began
     journal = out / "journal.jsonl"
@@ -421,17 +460,33 @@ def mission_table(speed: float) -> Table:
                     plan_bound = sum(make_plan_lengths(master, points)) / max_v
                 runs.append(run_cli_mission(master, name, mission_file))
 
-    table = Table(title=f"{EXAMPLE.name} via `navseq run --navigator ros1` on the sim nodes "
-                        f"(/clock at {speed:g}x)")
-    for column in ("variant", "reached all", "mission s (sim)", "bound make_plan s", "ratio",
-                   "bound free path s", "ratio", "wall s", "sim s / wall s"):
+    table = Table(
+        title=f"{EXAMPLE.name} via `navseq run --navigator ros1` on the sim nodes "
+        f"(/clock at {speed:g}x)"
+    )
+    for column in (
+        "variant",
+        "reached all",
+        "mission s (sim)",
+        "bound make_plan s",
+        "ratio",
+        "bound free path s",
+        "ratio",
+        "wall s",
+        "sim s / wall s",
+    ):
         table.add_column(column, justify="right")
     for run in runs:
         table.add_row(
-            run.variant, "yes" if run.success else "NO", f"{run.mission_s:.1f}",
-            f"{plan_bound:.1f}", f"{run.mission_s / plan_bound:.3f}",
-            f"{free_path_bound:.1f}", f"{run.mission_s / free_path_bound:.3f}",
-            f"{run.wall_s:.1f}", f"{run.mission_s / run.wall_s:.1f}",
+            run.variant,
+            "yes" if run.success else "NO",
+            f"{run.mission_s:.1f}",
+            f"{plan_bound:.1f}",
+            f"{run.mission_s / plan_bound:.3f}",
+            f"{free_path_bound:.1f}",
+            f"{run.mission_s / free_path_bound:.3f}",
+            f"{run.wall_s:.1f}",
+            f"{run.mission_s / run.wall_s:.1f}",
         )
     return table
 
@@ -442,13 +497,15 @@ def mission_table(speed: float) -> Table:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--goals", type=int, default=200, help="goals per turnaround client")
-    parser.add_argument("--speed", type=float, default=10.0,
-                        help="sim time / wall time of the sim nodes' /clock")
+    parser.add_argument(
+        "--speed", type=float, default=10.0, help="sim time / wall time of the sim nodes' /clock"
+    )
     parser.add_argument("--skip-turnaround", action="store_true")
     parser.add_argument("--skip-mission", action="store_true")
     # Internal: this script also plays each ROS process of the benchmark.
-    parser.add_argument("--role", choices=("server", "navseq", "baseline", "plan"),
-                        help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--role", choices=("server", "navseq", "baseline", "plan"), help=argparse.SUPPRESS
+    )
     parser.add_argument("--log", help=argparse.SUPPRESS)
     parser.add_argument("--delay-max", type=float, default=0.0, help=argparse.SUPPRESS)
     parser.add_argument("--tick", type=float, default=DEFAULT_TICK, help=argparse.SUPPRESS)

@@ -49,8 +49,9 @@ def with_pass_through(mission: Mission, radius: float | None) -> Mission:
     return dataclasses.replace(mission, waypoints=waypoints)
 
 
-def shortest_path_length(costmap: Costmap, start: tuple[float, float], goal: tuple[float, float]
-                         ) -> float:
+def shortest_path_length(
+    costmap: Costmap, start: tuple[float, float], goal: tuple[float, float]
+) -> float:
     """Length (m) of the shortest 8-connected path over free cells between two points."""
     grid = costmap.grid
     costs = np.where(costmap.free_mask(), 1.0, np.inf)
@@ -89,8 +90,16 @@ def main() -> None:
     mission = load_mission(args.mission)
 
     table = Table(title=f"Simulator on {Path(args.mission).name}")
-    for column in ("variant", "reached all", "mission s", "lower bound s", "efficiency",
-                   "target", "wall s", "real-time factor"):
+    for column in (
+        "variant",
+        "reached all",
+        "mission s",
+        "lower bound s",
+        "efficiency",
+        "target",
+        "wall s",
+        "real-time factor",
+    ):
         table.add_column(column, justify="right")
     variants = [
         ("as written", mission, None),

@@ -22,14 +22,20 @@ TURTLEBOT3_MAP = REPO / "maps" / "turtlebot3_world.yaml"
 
 def navseq(*args: Any, cwd: Path, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
     """Run ``navseq ARGS``; output is captured, so stdout is not a terminal."""
-    return subprocess.run([NAVSEQ, *map(str, args)], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run(
+        [NAVSEQ, *map(str, args)], cwd=cwd, capture_output=True, text=True, timeout=timeout
+    )
 
 
 def start_navseq(*args: Any, cwd: Path) -> subprocess.Popen[str]:
     """Start ``navseq ARGS`` in the background, stdout and stderr piped."""
-    return subprocess.Popen([NAVSEQ, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [NAVSEQ, *map(str, args)],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> None:

@@ -46,11 +46,15 @@ SQUARE = """\
 """
 
 
-def run_scripted(tmp_path: Path, *extra: Any, mission: Path | None = None,
-                 ) -> subprocess.CompletedProcess[str]:
+def run_scripted(
+    tmp_path: Path,
+    *extra: Any,
+    mission: Path | None = None,
+) -> subprocess.CompletedProcess[str]:
     mission = mission or write_mission(tmp_path / "square.yaml", SQUARE)
-    return navseq("run", mission, "--navigator", "scripted", "--out", tmp_path / "out", *extra,
-                  cwd=tmp_path)
+    return navseq(
+        "run", mission, "--navigator", "scripted", "--out", tmp_path / "out", *extra, cwd=tmp_path
+    )
 
 
 # ----------------------------------------------------------------------- basics
@@ -69,8 +73,13 @@ def test_no_command_prints_usage_and_exits_2(tmp_path):
 
 
 def test_python_dash_m_navseq_is_the_same_command(tmp_path):
-    result = subprocess.run([sys.executable, "-m", "navseq", "--version"], cwd=tmp_path,
-                            capture_output=True, text=True, timeout=60)
+    result = subprocess.run(
+        [sys.executable, "-m", "navseq", "--version"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 0 and result.stdout.startswith("navseq ")
 
 
@@ -141,13 +150,17 @@ def test_validate_missing_file(tmp_path):
 
 
 def test_validate_against_a_map_finds_a_waypoint_in_a_pillar(tmp_path):
-    mission = write_mission(tmp_path / "m.yaml", (
-        "  - {name: free, x: 0.5, y: -1.6, yaw: 0}\n"
-        "  - {name: pillar, x: 0.0, y: 0.0, yaw: 0}\n"
-        "  - {name: outside, x: 30.0, y: 0.0, yaw: 0}\n"
-    ))
-    result = navseq("validate", mission, "--map", TURTLEBOT3_MAP, "--start", "-2,-0.5,0",
-                    cwd=tmp_path)
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        (
+            "  - {name: free, x: 0.5, y: -1.6, yaw: 0}\n"
+            "  - {name: pillar, x: 0.0, y: 0.0, yaw: 0}\n"
+            "  - {name: outside, x: 30.0, y: 0.0, yaw: 0}\n"
+        ),
+    )
+    result = navseq(
+        "validate", mission, "--map", TURTLEBOT3_MAP, "--start", "-2,-0.5,0", cwd=tmp_path
+    )
     assert_clean_error(result)
     assert "waypoint 2 'pillar'" in result.stderr
     assert "waypoint 3 'outside'" in result.stderr
@@ -156,12 +169,16 @@ def test_validate_against_a_map_finds_a_waypoint_in_a_pillar(tmp_path):
 
 def test_validate_lists_file_and_map_problems_in_one_run(tmp_path):
     """A typo in one waypoint does not hide that another one sits in a pillar."""
-    mission = write_mission(tmp_path / "m.yaml", (
-        "  - {name: free, x: 0.5, y: -1.6, yaw: 0}\n"
-        "  - {name: typo, x: 1.0, y: oops}\n"
-        "  - {name: pillar, x: 0.0, y: 0.0, yaw: 0}\n"
-        "  - {name: far, x: 1.6, y: 0.5, yaw: 90, goal_timeout: -1}\n"
-    ), header=f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2.0, y: -0.5, yaw: 0}}\n")
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        (
+            "  - {name: free, x: 0.5, y: -1.6, yaw: 0}\n"
+            "  - {name: typo, x: 1.0, y: oops}\n"
+            "  - {name: pillar, x: 0.0, y: 0.0, yaw: 0}\n"
+            "  - {name: far, x: 1.6, y: 0.5, yaw: 90, goal_timeout: -1}\n"
+        ),
+        header=f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2.0, y: -0.5, yaw: 0}}\n",
+    )
     result = navseq("validate", mission, cwd=tmp_path)
     assert_clean_error(result)
     lines = [line for line in result.stderr.splitlines() if line.startswith("  - ")]
@@ -173,8 +190,11 @@ def test_validate_lists_file_and_map_problems_in_one_run(tmp_path):
 
 
 def test_validate_names_an_unreadable_map_next_to_the_file_problems(tmp_path):
-    mission = write_mission(tmp_path / "m.yaml", "  - {x: 1.0, y: oops}\n  - {x: 0.5, y: 0.5}\n",
-                            header="map: missing_map.yaml\n")
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {x: 1.0, y: oops}\n  - {x: 0.5, y: 0.5}\n",
+        header="map: missing_map.yaml\n",
+    )
     result = navseq("validate", mission, cwd=tmp_path)
     assert_clean_error(result)
     assert "field y" in result.stderr and "missing_map.yaml" in result.stderr
@@ -276,8 +296,7 @@ def test_default_output_folder_is_named_after_mission_and_time(tmp_path):
     assert result.returncode == 0, result.stderr
     folders = list((tmp_path / "navseq-out").iterdir())
     assert len(folders) == 1 and folders[0].name.startswith("square-20")
-    assert {p.name for p in folders[0].iterdir()} == {"report.json", "mission.png",
-                                                      "journal.jsonl"}
+    assert {p.name for p in folders[0].iterdir()} == {"report.json", "mission.png", "journal.jsonl"}
 
 
 def test_run_with_a_broken_mission_writes_nothing(tmp_path):
@@ -310,8 +329,19 @@ def test_signal_cancels_the_goal_and_reports_interrupted(tmp_path, name):
     signum, status = {"SIGINT": (signal.SIGINT, 130), "SIGTERM": (signal.SIGTERM, 143)}[name]
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     log = tmp_path / "nav.log"
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", tmp_path / "out",
-                           "--scripted-realtime", "1", "--scripted-log", log, cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        tmp_path / "out",
+        "--scripted-realtime",
+        "1",
+        "--scripted-log",
+        log,
+        cwd=tmp_path,
+    )
     wait_for(lambda: scripted_log(log, "send_goal"), 30, "the first goal")
     process.send_signal(signum)
     _, stderr = process.communicate(timeout=60)
@@ -331,11 +361,23 @@ def test_resume_after_kill_runs_only_what_is_left(tmp_path):
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     log = tmp_path / "nav.log"
     out = tmp_path / "out"
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
-                           "--scripted-realtime", "4", "--scripted-log", log, cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        out,
+        "--scripted-realtime",
+        "4",
+        "--scripted-log",
+        log,
+        cwd=tmp_path,
+    )
     journal = out / "journal.jsonl"
-    wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60,
-             "two waypoints reached")
+    wait_for(
+        lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60, "two waypoints reached"
+    )
     process.kill()  # kill -9: no chance to clean up
     process.communicate(timeout=30)
     reached = {e["index"] for e in journal_events(journal, "WaypointFinished")}
@@ -344,8 +386,16 @@ def test_resume_after_kill_runs_only_what_is_left(tmp_path):
     # Another directory: the journal names the mission by its absolute path.
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
-    result = navseq("run", "--resume", journal, "--navigator", "scripted",
-                    "--scripted-log", resumed_log, cwd=elsewhere)
+    result = navseq(
+        "run",
+        "--resume",
+        journal,
+        "--navigator",
+        "scripted",
+        "--scripted-log",
+        resumed_log,
+        cwd=elsewhere,
+    )
     assert result.returncode == 0, result.stderr
     sent = [(round(g["x"], 3), round(g["y"], 3)) for g in scripted_log(resumed_log, "send_goal")]
     square = [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)]
@@ -364,11 +414,21 @@ def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkey
 
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     out = tmp_path / "out"
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
-                           "--scripted-realtime", "4", cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        out,
+        "--scripted-realtime",
+        "4",
+        cwd=tmp_path,
+    )
     journal = out / "journal.jsonl"
-    wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60,
-             "two waypoints reached")
+    wait_for(
+        lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60, "two waypoints reached"
+    )
     process.kill()
     process.communicate(timeout=30)
     before = read_journal(journal)
@@ -377,8 +437,9 @@ def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkey
 
     drawn: dict[str, Any] = {}
     real_draw = picture.mission_picture_png
-    monkeypatch.setattr(picture, "mission_picture_png",
-                        lambda *a, **kw: drawn.update(kw) or real_draw(*a, **kw))
+    monkeypatch.setattr(
+        picture, "mission_picture_png", lambda *a, **kw: drawn.update(kw) or real_draw(*a, **kw)
+    )
     assert cli.main(["run", "--resume", str(journal), "--navigator", "scripted"]) == 0
 
     points = [tuple(p) for p in drawn["trajectory"]]
@@ -386,7 +447,7 @@ def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkey
     # Everything driven before the crash is in the picture, then a break, then the rest.
     assert [(x, y) for _, x, y in finite[: len(driven_before)]] == driven_before
     assert math.isnan(points[len(driven_before)][0])
-    after = finite[len(driven_before):]
+    after = finite[len(driven_before) :]
     assert {(round(x, 3), round(y, 3)) for _, x, y in after} >= {(0.0, 1.0), (0.0, 0.0)}
     # One mission clock: the resumed part is coloured after the part before the crash.
     times = [t for t, _, _ in finite]
@@ -398,8 +459,14 @@ def test_resume_refuses_a_changed_mission(tmp_path):
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     assert run_scripted(tmp_path, mission=mission).returncode == 0
     mission.write_text(mission.read_text().replace("x: 1.0, y: 0.0", "x: 1.5, y: 0.0"))
-    result = navseq("run", "--resume", tmp_path / "out" / "journal.jsonl", "--navigator",
-                    "scripted", cwd=tmp_path)
+    result = navseq(
+        "run",
+        "--resume",
+        tmp_path / "out" / "journal.jsonl",
+        "--navigator",
+        "scripted",
+        cwd=tmp_path,
+    )
     assert_clean_error(result)
     assert "journal.jsonl" in result.stderr and "changed" in result.stderr.lower()
 
@@ -418,7 +485,10 @@ def test_ros1_without_a_server_is_a_clean_error(tmp_path):
     env_master = {"ROS_MASTER_URI": "http://127.0.0.1:9"}  # nothing listens on port 9
     result = subprocess.run(
         [NAVSEQ, "run", str(mission), "--navigator", "ros1", "--out", str(tmp_path / "out")],
-        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
         env={**os.environ, **env_master, "ROS_HOME": str(tmp_path / "ros")},
     )
     assert_clean_error(result)
@@ -429,9 +499,20 @@ def test_ros1_without_a_server_is_a_clean_error(tmp_path):
 def test_reader_going_away_does_not_stop_the_mission_or_lose_the_report(tmp_path):
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     log = tmp_path / "nav.log"
-    process = start_navseq("run", mission, "--navigator", "scripted", "--json", "--out",
-                           tmp_path / "out", "--scripted-realtime", "2", "--scripted-log", log,
-                           cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--json",
+        "--out",
+        tmp_path / "out",
+        "--scripted-realtime",
+        "2",
+        "--scripted-log",
+        log,
+        cwd=tmp_path,
+    )
     assert json.loads(process.stdout.readline())["event"] == "MissionStarted"
     process.stdout.close()  # like `navseq run --json ... | head -1`
     stderr = process.stderr.read()

@@ -19,24 +19,46 @@ pytestmark = pytest.mark.ros
 
 
 def mission(tmp_path):
-    return write_mission(tmp_path / "ros.yaml", (
-        "  - {name: west, x: -1.6, y: -0.5, yaw: 90}\n"
-        "  - {name: south, x: -0.55, y: -1.75, yaw: 0}\n"
-    ), "defaults: {goal_timeout: 120}\n")
+    return write_mission(
+        tmp_path / "ros.yaml",
+        (
+            "  - {name: west, x: -1.6, y: -0.5, yaw: 90}\n"
+            "  - {name: south, x: -0.55, y: -1.75, yaw: 0}\n"
+        ),
+        "defaults: {goal_timeout: 120}\n",
+    )
 
 
 def test_ros1_run_completes_and_reports(ros_master, tmp_path):
     start_sim(ros_master)
     out = tmp_path / "out"
-    process = ros_master.start([NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1",
-                                "--map", MAP, "--start", "-2,-0.5,0", "--out", out],
-                               cwd=tmp_path, label="navseq")
+    process = ros_master.start(
+        [
+            NAVSEQ,
+            "run",
+            mission(tmp_path),
+            "--navigator",
+            "ros1",
+            "--map",
+            MAP,
+            "--start",
+            "-2,-0.5,0",
+            "--out",
+            out,
+        ],
+        cwd=tmp_path,
+        label="navseq",
+    )
     assert process.wait(timeout=120) == 0, process.output()
     report = json.loads((out / "report.json").read_text())
     assert report["success"] is True
     navigator = report["navigator"]
     assert {k: navigator[k] for k in ("kind", "action", "frame", "ns")} == {
-        "kind": "ros1", "action": "move_base", "frame": "map", "ns": ""}
+        "kind": "ros1",
+        "action": "move_base",
+        "frame": "map",
+        "ns": "",
+    }
     # The sim's move_base sets no footprint or local planner: navseq says it assumes the burger.
     assert navigator["robot"] == "turtlebot3_burger"
     assert "assuming turtlebot3_burger" in navigator["robot_source"]
@@ -48,8 +70,11 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
 def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
     _robot, nav = start_sim(ros_master)
     out = tmp_path / "out"
-    process = ros_master.start([NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1",
-                                "--out", out], cwd=tmp_path, label="navseq")
+    process = ros_master.start(
+        [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", out],
+        cwd=tmp_path,
+        label="navseq",
+    )
     journal = out / "journal.jsonl"
     wait_for(lambda: journal_events(journal, "WaypointProgress"), 60, "the robot moving")
     process.send_signal(signal.SIGINT)
@@ -61,8 +86,18 @@ def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
 
 
 def test_a_negative_settle_is_a_clean_error(tmp_path):
-    result = navseq("run", mission(tmp_path), "--navigator", "ros1", "--settle", "-1",
-                    "--out", tmp_path / "out", cwd=tmp_path, timeout=60)
+    result = navseq(
+        "run",
+        mission(tmp_path),
+        "--navigator",
+        "ros1",
+        "--settle",
+        "-1",
+        "--out",
+        tmp_path / "out",
+        cwd=tmp_path,
+        timeout=60,
+    )
     assert_clean_error(result)
     assert "settle" in result.stderr and ">= 0" in result.stderr
     assert not (tmp_path / "out").exists()

@@ -337,16 +337,16 @@ def test_recorder_from_journal_keeps_earlier_segments_on_one_mission_clock(
     tmp_path: Path,
 ) -> None:
     def progress(t: float, x: float) -> WaypointProgress:
-        return WaypointProgress(t=t, index=0, x=x, y=0.0, yaw=0.0, distance_remaining=None,
-                                distance_driven=x)
+        return WaypointProgress(
+            t=t, index=0, x=x, y=0.0, yaw=0.0, distance_remaining=None, distance_driven=x
+        )
 
     path = tmp_path / "run.journal"
     # The first segment runs on a clock that starts at 100 s (ROS time, say)...
     with JournalWriter(path, "m.yaml", "digest") as journal:
         for event in (
             MissionStarted(t=100.0, waypoint_count=2, loops=1),
-            WaypointStarted(t=100.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0,
-                            yaw=0.0),
+            WaypointStarted(t=100.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0, yaw=0.0),
             WaypointPlan(t=100.0, index=0, path=((0.0, 0.0), (2.0, 0.0))),
             progress(100.5, 0.5),
             progress(102.0, 1.0),

@@ -79,7 +79,11 @@ def test_the_main_job_runs_without_ros(tmp_path: Path):
         from navseq.cli import main
         sys.exit(main(sys.argv[1:]))
         """,
-        "run", "examples/turtlebot3_world.yaml", "--out", str(tmp_path / "out"), "--json",
+        "run",
+        "examples/turtlebot3_world.yaml",
+        "--out",
+        str(tmp_path / "out"),
+        "--json",
     )
     assert done.returncode == 0, done.stderr
     report = json.loads((tmp_path / "out" / "report.json").read_text())
@@ -94,8 +98,12 @@ def test_asking_for_ros_without_ros_is_one_clear_error(tmp_path: Path):
         from navseq.cli import main
         sys.exit(main(sys.argv[1:]))
         """,
-        "run", "examples/turtlebot3_world.yaml", "--navigator", "ros1",
-        "--out", str(tmp_path / "out"),
+        "run",
+        "examples/turtlebot3_world.yaml",
+        "--navigator",
+        "ros1",
+        "--out",
+        str(tmp_path / "out"),
     )
     assert done.returncode == 2
     assert "Traceback" not in done.stderr

@@ -65,34 +65,46 @@ def test_missing_yea_seq_is_named(tmp_path):
 
 def test_unresolvable_launch_substitutions_are_reported_not_guessed(tmp_path):
     # $(eval) needs roslaunch's Python evaluator, which navseq does not reimplement.
-    path = write(tmp_path, "seq.launch", """<launch>
+    path = write(
+        tmp_path,
+        "seq.launch",
+        """<launch>
   <arg name="points" default="[1,2,0]"/>
   <node pkg="p" type="t" name="seq">
     <param name="p_seq" value="$(eval arg('points'))"/>
     <param name="yea_seq" value="[0]"/>
   </node>
-</launch>""")
+</launch>""",
+    )
     message = only_error(path)
     assert ":4" in message and "substitution" in message and "p_seq" in message
 
 
 def test_two_nodes_with_missions_in_one_launch_file(tmp_path):
-    body = '<rosparam>{p_seq: [1, 2, 0], yea_seq: [0]}</rosparam>'
-    path = write(tmp_path, "two.launch", f'<launch><node pkg="a" type="b" name="one">{body}'
-                 f'</node><node pkg="a" type="b" name="two">{body}</node></launch>')
+    body = "<rosparam>{p_seq: [1, 2, 0], yea_seq: [0]}</rosparam>"
+    path = write(
+        tmp_path,
+        "two.launch",
+        f'<launch><node pkg="a" type="b" name="one">{body}'
+        f'</node><node pkg="a" type="b" name="two">{body}</node></launch>',
+    )
     message = only_error(path)
     assert "/one" in message and "/two" in message
 
 
 def test_broken_yaml_inside_rosparam_is_located_in_the_launch_file(tmp_path):
-    path = write(tmp_path, "body.launch", """<launch>
+    path = write(
+        tmp_path,
+        "body.launch",
+        """<launch>
   <node pkg="a" type="b" name="n">
     <rosparam>
       p_seq: [1, 2, 0]
       yea_seq: {0
     </rosparam>
   </node>
-</launch>""")
+</launch>""",
+    )
     message = only_error(path)
     assert f"{path}:6" in message and "not valid YAML" in message
 
@@ -107,8 +119,7 @@ def test_launch_without_any_mission(tmp_path):
     [
         ('<launch><node name="a"></launch>', [":1", "not well-formed XML", "mismatched"]),
         ("<robot name='r'/>", ["not a roslaunch file", "<robot>"]),
-        ('<?xml version="1.0"?>\n<!DOCTYPE l [<!ENTITY a "aaaa">]>\n<launch/>',
-         [":2", "DTD"]),
+        ('<?xml version="1.0"?>\n<!DOCTYPE l [<!ENTITY a "aaaa">]>\n<launch/>', [":2", "DTD"]),
     ],
 )
 def test_broken_or_foreign_xml(tmp_path, text, expected):
@@ -119,50 +130,72 @@ def test_broken_or_foreign_xml(tmp_path, text, expected):
 
 NAVSEQ_CASES = [
     # (yaml text, substrings of the one error)
-    ("waypoints:\n  - {x: 1, y: 2}\n  - {x: 1, y: two}\n",
-     [":3", "waypoint 2, field y", "must be a number", "'two'"]),
+    (
+        "waypoints:\n  - {x: 1, y: 2}\n  - {x: 1, y: two}\n",
+        [":3", "waypoint 2, field y", "must be a number", "'two'"],
+    ),
     ("waypoints:\n  - {x: 1, y: .nan}\n", [":2", "waypoint 1, field y", "finite"]),
     ("waypoints:\n  - {x: 1, y: -.inf}\n", [":2", "waypoint 1, field y", "finite"]),
     ("waypoints:\n  - {x: 1, y: 2, yaw: true}\n", ["waypoint 1, field yaw", "true"]),
     ("waypoints:\n  - {x: 1}\n", [":2", "waypoint 1, field y", "missing"]),
-    ("waypoints:\n  - {name: dock, x: 1, y: 2, goal_timout: 3}\n",
-     [":2", "waypoint 1 'dock', field goal_timout", "did you mean 'goal_timeout'"]),
+    (
+        "waypoints:\n  - {name: dock, x: 1, y: 2, goal_timout: 3}\n",
+        [":2", "waypoint 1 'dock', field goal_timout", "did you mean 'goal_timeout'"],
+    ),
     ("waypoint:\n  - {x: 1, y: 2}\n", [":1", "field waypoint", "did you mean 'waypoints'"]),
     ("waypoints: []\n", [":1", "field waypoints", "empty"]),
     ("frame: map\n", ["no 'waypoints'"]),
     ("", ["empty"]),
     ("just some words\n", ["must be a mapping", "text 'just some words'"]),
-    ("defaults: {goal_timeout: 0}\nwaypoints: [[0, 0]]\n",
-     [":1", "defaults, field goal_timeout", "> 0 s", "got 0"]),
-    ("defaults: {stall_timeout: -5}\nwaypoints: [[0, 0]]\n",
-     ["defaults, field stall_timeout", "> 0 s", "-5"]),
-    ("defaults:\n  retries: -1\nwaypoints: [[0, 0]]\n",
-     [":2", "defaults, field retries", ">= 0", "-1"]),
+    (
+        "defaults: {goal_timeout: 0}\nwaypoints: [[0, 0]]\n",
+        [":1", "defaults, field goal_timeout", "> 0 s", "got 0"],
+    ),
+    (
+        "defaults: {stall_timeout: -5}\nwaypoints: [[0, 0]]\n",
+        ["defaults, field stall_timeout", "> 0 s", "-5"],
+    ),
+    (
+        "defaults:\n  retries: -1\nwaypoints: [[0, 0]]\n",
+        [":2", "defaults, field retries", ">= 0", "-1"],
+    ),
     ("defaults: {retries: 1.5}\nwaypoints: [[0, 0]]\n", ["field retries", "whole number"]),
     ("waypoints:\n  - {x: 0, y: 0, dwell: -1}\n", [":2", "waypoint 1, field dwell", ">= 0"]),
-    ("waypoints:\n  - {x: 0, y: 0, pass_through: -0.5}\n",
-     ["waypoint 1, field pass_through", ">= 0 m"]),
-    ("defaults: {on_failure: skipp}\nwaypoints: [[0, 0]]\n",
-     ["field on_failure", "stop | skip | retry", "did you mean 'skip'"]),
-    ("defaults: {clear_costmaps_on_retry: maybe}\nwaypoints: [[0, 0]]\n",
-     ["field clear_costmaps_on_retry", "true or false"]),
+    (
+        "waypoints:\n  - {x: 0, y: 0, pass_through: -0.5}\n",
+        ["waypoint 1, field pass_through", ">= 0 m"],
+    ),
+    (
+        "defaults: {on_failure: skipp}\nwaypoints: [[0, 0]]\n",
+        ["field on_failure", "stop | skip | retry", "did you mean 'skip'"],
+    ),
+    (
+        "defaults: {clear_costmaps_on_retry: maybe}\nwaypoints: [[0, 0]]\n",
+        ["field clear_costmaps_on_retry", "true or false"],
+    ),
     ("loops: 0\nwaypoints: [[0, 0]]\n", [":1", "field loops", ">= 1"]),
     ("loops: always\nwaypoints: [[0, 0]]\n", ["field loops", "'forever'"]),
     ("server_timeout: -1\nwaypoints: [[0, 0]]\n", ["field server_timeout", "> 0"]),
     ("navseq: 2\nwaypoints: [[0, 0]]\n", ["field navseq", "version 2"]),
     ("frame: base link\nwaypoints: [[0, 0]]\n", ["field frame", "no spaces"]),
     ("start: {x: 0}\nwaypoints: [[0, 0]]\n", ["start, field y", "missing"]),
-    ("waypoints:\n  - {x: 0, y: 0, yaw: 5, yaw_rad: 1}\n",
-     ["waypoint 1, field yaw_rad", "only one of yaw, yaw_rad"]),
-    ("waypoints:\n  - {x: 0, y: 0, orientation: {x: 0, y: 0, z: 0, w: 0}}\n",
-     ["waypoint 1, field orientation", "length 0"]),
+    (
+        "waypoints:\n  - {x: 0, y: 0, yaw: 5, yaw_rad: 1}\n",
+        ["waypoint 1, field yaw_rad", "only one of yaw, yaw_rad"],
+    ),
+    (
+        "waypoints:\n  - {x: 0, y: 0, orientation: {x: 0, y: 0, z: 0, w: 0}}\n",
+        ["waypoint 1, field orientation", "length 0"],
+    ),
     ("waypoints:\n  - [1, 2, 3, 4]\n", [":2", "waypoint 1", "short form"]),
     ("waypoints:\n  - 7\n", [":2", "waypoint 1", "must be a mapping"]),
     ("waypoints: {x: 1}\n", ["field waypoints", "must be a list"]),
     ("waypoints: [[0, 0]]\nwaypoints: [[1, 1]]\n", [":2", "'waypoints' appears twice"]),
     ("waypoints: [[0, 0]\n", ["not valid YAML"]),
-    ("waypoints:\n  - !!python/object/apply:os.system [echo hi]\n",
-     [":2", "python/object/apply:os.system", "does not accept"]),
+    (
+        "waypoints:\n  - !!python/object/apply:os.system [echo hi]\n",
+        [":2", "python/object/apply:os.system", "does not accept"],
+    ),
     ("waypoints:\n  - {x: 0, y: 0, name: 2024-01-01}\n", [":2", "timestamp"]),
     ("a: 1\n---\nwaypoints: [[0, 0]]\n", ["not valid YAML"]),
 ]
@@ -178,25 +211,39 @@ def test_navseq_yaml_mistakes(tmp_path, text, expected):
 
 
 def test_duplicate_names_name_both_waypoints(tmp_path):
-    path = write(tmp_path, "m.yaml", "waypoints:\n  - {name: dock, x: 0, y: 0}\n"
-                 "  - {name: door, x: 1, y: 0}\n  - {name: dock, x: 2, y: 0}\n")
+    path = write(
+        tmp_path,
+        "m.yaml",
+        "waypoints:\n  - {name: dock, x: 0, y: 0}\n"
+        "  - {name: door, x: 1, y: 0}\n  - {name: dock, x: 2, y: 0}\n",
+    )
     message = only_error(path)
     assert ":4" in message and "waypoint 3, field name" in message
     assert "already used by waypoint 1" in message
 
 
 def test_every_problem_is_reported_at_once(tmp_path):
-    path = write(tmp_path, "m.yaml", """defaults: {goal_timeout: -1, retries: -2}
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """defaults: {goal_timeout: -1, retries: -2}
 loops: 0
 waypoints:
   - {name: a, x: 1, y: nope}
   - {name: a, x: 1, y: 2, dwel: 3}
-""")
+""",
+    )
     errors = validate_mission_file(path)
     texts = [str(e) for e in errors]
     assert len(errors) == 6, texts
-    for field in ("goal_timeout", "retries", "loops", "waypoint 1 'a', field y",
-                  "waypoint 2, field name", "field dwel"):
+    for field in (
+        "goal_timeout",
+        "retries",
+        "loops",
+        "waypoint 1 'a', field y",
+        "waypoint 2, field name",
+        "field dwel",
+    ):
         assert any(field in t for t in texts), field
     with pytest.raises(MissionErrors) as raised:
         load_mission(path)
@@ -294,12 +341,16 @@ def test_self_referencing_yaml_is_refused(tmp_path):
         ({"p_seq": [1, 2, 0, 3, 4, 0], "yea_seq": [0]}, ["param ~yea_seq", "1 yaw", "2 points"]),
         ({"p_seq": [1, "x", 0], "yea_seq": [0]}, ["param ~p_seq", "waypoint 1, field y"]),
         ({"p_seq": [1, 2, 0], "yea_seq": [float("nan")]}, ["param ~yea_seq", "finite"]),
-        ({"p_seq": [1, 2, 0], "yea_seq": [0], "goal_timout": 5},
-         ["param ~goal_timout", "did you mean 'goal_timeout'"]),
+        (
+            {"p_seq": [1, 2, 0], "yea_seq": [0], "goal_timout": 5},
+            ["param ~goal_timout", "did you mean 'goal_timeout'"],
+        ),
         ({"p_seq": [1, 2, 0], "yea_seq": [0], "goal_timeout": 0}, ["param ~goal_timeout", "> 0"]),
         ({}, ["param ~", "exactly one way"]),
-        ({"p_seq": [1, 2, 0], "yea_seq": [0], "waypoints": [[0, 0]]},
-         ["exactly one way", "waypoints"]),
+        (
+            {"p_seq": [1, 2, 0], "yea_seq": [0], "waypoints": [[0, 0]]},
+            ["exactly one way", "waypoints"],
+        ),
         ({"waypoints": [{"x": 1}]}, ["param ~waypoints", "waypoint 1, field y", "missing"]),
         ({"mission": "/nonexistent/m.yaml"}, ["/nonexistent/m.yaml", "no such file"]),
         ({"p_seq": "[1, 2, 0, 5]", "yea_seq": "[0]"}, ["param ~p_seq", "4 numbers"]),
@@ -315,8 +366,12 @@ def test_param_mistakes(params, expected):
 
 
 def test_a_launch_file_naming_itself_as_its_mission_does_not_recurse(tmp_path):
-    path = write(tmp_path, "self.launch", '<launch><node pkg="a" type="b" name="n">'
-                 '<param name="mission" value="self.launch"/></node></launch>')
+    path = write(
+        tmp_path,
+        "self.launch",
+        '<launch><node pkg="a" type="b" name="n">'
+        '<param name="mission" value="self.launch"/></node></launch>',
+    )
     message = only_error(path)
     assert f"{path}:1, field mission" in message and "cannot itself name another" in message
 

@@ -53,12 +53,16 @@ waypoints:
 """,
     "header.csv": "x,y,z,qx,qy,qz,qw\n1,2,0,0,0,0,1\n\n3,4,0,0,0,0.7,0.7\n",
 }
-SAMPLES = {path.name: path.read_bytes() for path in sorted(EXAMPLES.iterdir())
-           if path.suffix in (".yaml", ".launch", ".csv")}
+SAMPLES = {
+    path.name: path.read_bytes()
+    for path in sorted(EXAMPLES.iterdir())
+    if path.suffix in (".yaml", ".launch", ".csv")
+}
 SAMPLES.update({name: text.encode() for name, text in EXTRA_SAMPLES.items()})
 
-FUZZ = settings(max_examples=150, deadline=None,
-                suppress_health_check=[HealthCheck.function_scoped_fixture])
+FUZZ = settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 
 @pytest.fixture(scope="module")
@@ -82,11 +86,36 @@ def load_never_crashes(path: Path, data: bytes) -> None:
 
 # --- loaders on garbage --------------------------------------------------------------
 
-MISSION_ALPHABET = st.sampled_from([
-    *"[]{}:,-&*!<>/=\"'# \n\t0123456789.eE+xyzaw_",
-    "p_seq", "yea_seq", "waypoints", "yaw", "name", "<launch>", "</launch>", "<rosparam",
-    "</rosparam>", "<node", "<param", "value=", "param=", ".nan", ".inf", "null", "true",
-    "forever", "loops", "defaults", "<<", "goal_timeout", "\xe9", "\x00", "\x85"])
+MISSION_ALPHABET = st.sampled_from(
+    [
+        *"[]{}:,-&*!<>/=\"'# \n\t0123456789.eE+xyzaw_",
+        "p_seq",
+        "yea_seq",
+        "waypoints",
+        "yaw",
+        "name",
+        "<launch>",
+        "</launch>",
+        "<rosparam",
+        "</rosparam>",
+        "<node",
+        "<param",
+        "value=",
+        "param=",
+        ".nan",
+        ".inf",
+        "null",
+        "true",
+        "forever",
+        "loops",
+        "defaults",
+        "<<",
+        "goal_timeout",
+        "\xe9",
+        "\x00",
+        "\x85",
+    ]
+)
 
 
 @FUZZ
@@ -108,14 +137,14 @@ def _mutate(data: bytes, draw) -> bytes:
     if kind == "flip":
         for _ in range(draw(st.integers(1, 4))):
             at = draw(st.integers(0, len(data) - 1))
-            data = data[:at] + bytes([data[at] ^ (1 << draw(st.integers(0, 7)))]) + data[at + 1:]
+            data = data[:at] + bytes([data[at] ^ (1 << draw(st.integers(0, 7)))]) + data[at + 1 :]
         return data
     if kind == "truncate":
         return data[: draw(st.integers(0, len(data)))]
     lines = data.splitlines(keepends=True)
     at = draw(st.integers(0, len(lines) - 1))
     if kind == "delete_line":
-        return b"".join(lines[:at] + lines[at + 1:])
+        return b"".join(lines[:at] + lines[at + 1 :])
     if kind == "duplicate_line":
         return b"".join(lines[: at + 1] + lines[at:])
     token = draw(MISSION_ALPHABET).encode()
@@ -143,12 +172,27 @@ def test_samples_are_valid_before_mutation(scratch):
 PARAM_TEXT = st.text(max_size=8) | st.text(st.sampled_from(list("~/.$()[],1 e\x00")), max_size=8)
 PARAM_VALUES = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats() | PARAM_TEXT,
-    lambda inner: st.lists(inner, max_size=6) | st.dictionaries(st.text(max_size=6), inner,
-                                                                max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=6) | st.dictionaries(st.text(max_size=6), inner, max_size=4)
+    ),
     max_leaves=20,
 )
-PARAM_KEYS = st.sampled_from(["p_seq", "yea_seq", "waypoints", "mission", "frame", "loops",
-                              "start", "goal_timeout", "retries", "on_failure", "dwell", "x"])
+PARAM_KEYS = st.sampled_from(
+    [
+        "p_seq",
+        "yea_seq",
+        "waypoints",
+        "mission",
+        "frame",
+        "loops",
+        "start",
+        "goal_timeout",
+        "retries",
+        "on_failure",
+        "dwell",
+        "x",
+    ]
+)
 
 
 @FUZZ
@@ -168,33 +212,47 @@ finite = st.floats(-1e6, 1e6)
 # Yaws as people write them: degrees with a few decimals (these must survive exactly);
 # navseq keeps yaws in (-180, 180] degrees.
 typed_yaw = st.decimals(min_value="-179.9999", max_value=180, places=4).map(
-    lambda d: math.radians(float(d)))
+    lambda d: math.radians(float(d))
+)
 positive = st.floats(min_value=1e-6, max_value=1e6)
-policy_values = st.fixed_dictionaries({}, optional={
-    "goal_timeout": st.none() | positive,
-    "stall_timeout": st.none() | positive,
-    "retries": st.integers(0, 100),
-    "clear_costmaps_on_retry": st.booleans(),
-    "on_failure": st.sampled_from(FailureAction),
-    "pass_through": st.none() | st.floats(0, 100),
-    "dwell": st.floats(0, 1e4),
-})
+policy_values = st.fixed_dictionaries(
+    {},
+    optional={
+        "goal_timeout": st.none() | positive,
+        "stall_timeout": st.none() | positive,
+        "retries": st.integers(0, 100),
+        "clear_costmaps_on_retry": st.booleans(),
+        "on_failure": st.sampled_from(FailureAction),
+        "pass_through": st.none() | st.floats(0, 100),
+        "dwell": st.floats(0, 1e4),
+    },
+)
 # Names are one line of real text: no control characters, no lone surrogates.
-names = st.none() | st.text(st.characters(blacklist_categories=("Cc", "Cs", "Cf")),
-                            min_size=1, max_size=10).filter(str.strip)
+names = st.none() | st.text(
+    st.characters(blacklist_categories=("Cc", "Cs", "Cf")), min_size=1, max_size=10
+).filter(str.strip)
 
 
 @st.composite
 def missions(draw, yaws=typed_yaw):
     count = draw(st.integers(1, 6))
-    chosen_names = draw(st.lists(names, min_size=count, max_size=count).filter(
-        lambda ns: len([n for n in ns if n]) == len({n for n in ns if n})))
+    chosen_names = draw(
+        st.lists(names, min_size=count, max_size=count).filter(
+            lambda ns: len([n for n in ns if n]) == len({n for n in ns if n})
+        )
+    )
     waypoints = tuple(
-        Waypoint(x=draw(finite), y=draw(finite), z=draw(st.just(0.0) | finite), yaw=draw(yaws),
-                 name=name, overrides=draw(policy_values))
-        for name in chosen_names)
-    segments = st.lists(st.from_regex(r"[a-z0-9_]{1,6}", fullmatch=True), min_size=1,
-                        max_size=3)
+        Waypoint(
+            x=draw(finite),
+            y=draw(finite),
+            z=draw(st.just(0.0) | finite),
+            yaw=draw(yaws),
+            name=name,
+            overrides=draw(policy_values),
+        )
+        for name in chosen_names
+    )
+    segments = st.lists(st.from_regex(r"[a-z0-9_]{1,6}", fullmatch=True), min_size=1, max_size=3)
     return Mission(
         waypoints=waypoints,
         defaults=Policy(**draw(policy_values)),

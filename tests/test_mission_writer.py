@@ -32,17 +32,27 @@ def small_mission(**changes) -> Mission:
 @pytest.mark.parametrize("degrees", [90, -90, 180, 45, 30, 0, 12.5, 359.9])
 def test_yaw_from_a_quaternion_is_written_as_the_degrees_a_person_would_type(degrees):
     yaw = quaternion_to_yaw(*yaw_degrees_to_quaternion(degrees))
-    assert yaw_degrees_for_file(yaw) == pytest.approx(degrees if degrees <= 180
-                                                      else degrees - 360, abs=1e-12)
+    assert yaw_degrees_for_file(yaw) == pytest.approx(
+        degrees if degrees <= 180 else degrees - 360, abs=1e-12
+    )
     assert len(repr(yaw_degrees_for_file(yaw))) <= len(repr(degrees)) + 1
 
 
 def test_dump_is_plain_yaml_with_degrees_and_policy_overrides():
     mission = small_mission(
-        waypoints=(Waypoint(1.0, 2.0, math.radians(90), name="dock",
-                            overrides={"dwell": 5.0, "on_failure": FailureAction.SKIP}),
-                   Waypoint(3.0, 4.0, quaternion_to_yaw(0, 0, math.sqrt(0.5), math.sqrt(0.5)))),
-        defaults=Policy(goal_timeout=60.0), loops=None)
+        waypoints=(
+            Waypoint(
+                1.0,
+                2.0,
+                math.radians(90),
+                name="dock",
+                overrides={"dwell": 5.0, "on_failure": FailureAction.SKIP},
+            ),
+            Waypoint(3.0, 4.0, quaternion_to_yaw(0, 0, math.sqrt(0.5), math.sqrt(0.5))),
+        ),
+        defaults=Policy(goal_timeout=60.0),
+        loops=None,
+    )
     text = dump_mission_yaml(mission)
     doc = yaml.safe_load(text)
     assert doc["loops"] == "forever"
@@ -54,19 +64,26 @@ def test_dump_is_plain_yaml_with_degrees_and_policy_overrides():
     assert "  - {name: dock, x: 1.0, y: 2.0, yaw: 90," in text  # one line per waypoint
 
 
-@pytest.mark.parametrize("name", ["tutorial_move_base_seq.launch", "tutorial_params.yaml",
-                                  "recorded.csv", "patrol.yaml"])
+@pytest.mark.parametrize(
+    "name", ["tutorial_move_base_seq.launch", "tutorial_params.yaml", "recorded.csv", "patrol.yaml"]
+)
 def test_every_example_converts_to_navseq_yaml_that_loads_the_same(tmp_path, name):
     original = load_mission(EXAMPLES / name)
     target = tmp_path / "converted.yaml"
     write_mission(original, target)
     converted = load_mission(target)
     assert [(w.x, w.y, w.z, w.name) for w in converted.waypoints] == [
-        (w.x, w.y, w.z, w.name) for w in original.waypoints]
+        (w.x, w.y, w.z, w.name) for w in original.waypoints
+    ]
     assert [w.yaw for w in converted.waypoints] == pytest.approx(
-        [w.yaw for w in original.waypoints], abs=1e-7)
+        [w.yaw for w in original.waypoints], abs=1e-7
+    )
     assert (converted.defaults, converted.loops, converted.map, converted.start) == (
-        original.defaults, original.loops, original.map, original.start)
+        original.defaults,
+        original.loops,
+        original.map,
+        original.start,
+    )
 
 
 def test_map_path_is_written_relative_to_the_new_file(tmp_path):

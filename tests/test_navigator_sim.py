@@ -129,7 +129,7 @@ def test_spin_counts_simulated_time_exactly(nav: SimNavigator) -> None:
 
 def test_trajectory_records_where_the_robot_drove(nav: SimNavigator) -> None:
     nav.spin(5.0)
-    assert nav.trajectory == [(0.0, START.x, START.y)]  # idle: nothing new
+    assert nav.trajectory.rows() == [(0.0, START.x, START.y)]  # idle: nothing new
     nav.send_goal(Goal(1, Pose2D(-0.5, -1.8)))
     spin_until_done(nav)
     times = [t for t, _, _ in nav.trajectory]

@@ -42,12 +42,16 @@ MISSION = Mission(WAYPOINTS, defaults=Policy(pass_through=0.3), source="demo.yam
 
 def result_of(*outcomes: WaypointOutcome) -> MissionResult:
     visits = [
-        WaypointResult(i % 3, i // 3, None, WAYPOINTS[i % 3].x, WAYPOINTS[i % 3].y, 0.0,
-                       outcome=o)
+        WaypointResult(i % 3, i // 3, None, WAYPOINTS[i % 3].x, WAYPOINTS[i % 3].y, 0.0, outcome=o)
         for i, o in enumerate(outcomes)
     ]
-    return MissionResult(success=False, reason="stopped: waypoint 2 failed", visits=visits,
-                         duration=42.0, distance_driven=3.2)
+    return MissionResult(
+        success=False,
+        reason="stopped: waypoint 2 failed",
+        visits=visits,
+        duration=42.0,
+        distance_driven=3.2,
+    )
 
 
 def pixel(fig, x: float, y: float, dx: float = 0.0) -> np.ndarray:
@@ -59,7 +63,7 @@ def pixel(fig, x: float, y: float, dx: float = 0.0) -> np.ndarray:
 
 
 def hex_rgb(colour: str) -> np.ndarray:
-    return np.array([int(colour[i:i + 2], 16) for i in (1, 3, 5)]) / 255.0
+    return np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)]) / 255.0
 
 
 def test_map_is_drawn_in_metres_with_row_zero_at_the_bottom():
@@ -86,29 +90,41 @@ def test_map_origin_yaw_rotates_the_map_about_its_origin():
 
 def test_waypoints_are_coloured_by_their_worst_visit():
     outcomes = result_of(
-        WaypointOutcome.REACHED, WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.FAILED,
+        WaypointOutcome.NOT_RUN,
     )
     fig = mission_figure(MISSION, outcomes, grid=make_grid())
     # Left of the centre: away from the white number and the heading arrow (yaw 0).
-    for waypoint, outcome in zip(WAYPOINTS, (WaypointOutcome.REACHED, WaypointOutcome.FAILED,
-                                             WaypointOutcome.NOT_RUN), strict=True):
+    for waypoint, outcome in zip(
+        WAYPOINTS,
+        (WaypointOutcome.REACHED, WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN),
+        strict=True,
+    ):
         colour = pixel(fig, waypoint.x, waypoint.y, dx=-9)
         assert np.allclose(colour, hex_rgb(OUTCOME_COLOURS[outcome]), atol=0.06), outcome
 
 
 def test_a_patrol_waypoint_shows_its_worst_visit():
     r = result_of(
-        WaypointOutcome.REACHED, WaypointOutcome.REACHED, WaypointOutcome.REACHED,
-        WaypointOutcome.REACHED, WaypointOutcome.SKIPPED, WaypointOutcome.NOT_RUN,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.SKIPPED,
+        WaypointOutcome.NOT_RUN,
     )
     assert waypoint_outcomes(r, 3) == [
-        WaypointOutcome.REACHED, WaypointOutcome.SKIPPED, WaypointOutcome.REACHED,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.SKIPPED,
+        WaypointOutcome.REACHED,
     ]
 
 
 def test_view_is_cropped_to_the_mission_on_a_big_map():
-    big = OccupancyGrid(np.zeros((2000, 2000), dtype=np.int8), 0.05, Pose2D(-50.0, -50.0),
-                        source="big.yaml")
+    big = OccupancyGrid(
+        np.zeros((2000, 2000), dtype=np.int8), 0.05, Pose2D(-50.0, -50.0), source="big.yaml"
+    )
     fig = mission_figure(MISSION, result_of(), grid=big)
     xmin, xmax = fig.axes[0].get_xlim()
     ymin, ymax = fig.axes[0].get_ylim()
@@ -128,16 +144,29 @@ def test_png_has_title_legend_and_is_written_atomically(tmp_path):
     trajectory = [(0.1 * i, -0.5 + 0.02 * i, -1.0 + 0.01 * i) for i in range(100)]
     plans = [((-0.5, -1.0), (1.0, -1.0)), ((1.0, -1.0), (2.0, 0.0))]
     path = tmp_path / "out" / "mission.png"
-    draw_mission_picture(path, MISSION, result_of(WaypointOutcome.REACHED), grid=make_grid(),
-                         start=Pose2D(-0.5, -1.0, 0.0), plans=plans, trajectory=trajectory)
+    draw_mission_picture(
+        path,
+        MISSION,
+        result_of(WaypointOutcome.REACHED),
+        grid=make_grid(),
+        start=Pose2D(-0.5, -1.0, 0.0),
+        plans=plans,
+        trajectory=trajectory,
+    )
     with Image.open(path) as image:
         assert image.format == "PNG"
         assert image.width >= 800 and image.height >= 500
     assert [p.name for p in path.parent.iterdir()] == ["mission.png"]
 
-    fig = mission_figure(MISSION, result_of(WaypointOutcome.REACHED), grid=make_grid(),
-                         start=Pose2D(-0.5, -1.0, 0.0), plans=plans, trajectory=trajectory,
-                         interrupted="SIGINT")
+    fig = mission_figure(
+        MISSION,
+        result_of(WaypointOutcome.REACHED),
+        grid=make_grid(),
+        start=Pose2D(-0.5, -1.0, 0.0),
+        plans=plans,
+        trajectory=trajectory,
+        interrupted="SIGINT",
+    )
     ax = fig.axes[0]
     assert "demo" in ax.get_title(loc="left") and "interrupted (SIGINT)" in ax.get_title("left")
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
@@ -166,8 +195,13 @@ def test_a_nan_row_breaks_the_driven_path_between_resumed_segments():
 
     nan = math.nan
     # Before the crash the robot got to (1, 0); the resumed run started again at (0, 0).
-    trajectory = [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (nan, nan, nan), (2.0, 0.0, 0.0),
-                  (3.0, 0.0, 1.0)]
+    trajectory = [
+        (0.0, 0.0, 0.0),
+        (1.0, 1.0, 0.0),
+        (nan, nan, nan),
+        (2.0, 0.0, 0.0),
+        (3.0, 0.0, 1.0),
+    ]
     fig = mission_figure(MISSION, result_of(WaypointOutcome.REACHED), trajectory=trajectory)
     (driven,) = [c for c in fig.axes[0].collections if isinstance(c, LineCollection)]
     segments = [tuple(map(tuple, s)) for s in driven.get_segments()]

@@ -158,8 +158,9 @@ def test_summary_table_lists_every_visit_with_totals():
         reason="stopped: waypoint 2 failed",
         visits=[
             WaypointResult(0, 0, "dock", 1.0, 0.0, 0.0, WaypointOutcome.REACHED, 1, 13.0, 1.0),
-            WaypointResult(1, 0, None, 2.0, 0.0, 1.57, WaypointOutcome.FAILED, 3, 40.0, 0.4,
-                           reason="ABORTED"),
+            WaypointResult(
+                1, 0, None, 2.0, 0.0, 1.57, WaypointOutcome.FAILED, 3, 40.0, 0.4, reason="ABORTED"
+            ),
             WaypointResult(2, 0, "desk", 2.0, 2.0, 3.14, WaypointOutcome.NOT_RUN),
         ],
         duration=53.0,
@@ -169,7 +170,16 @@ def test_summary_table_lists_every_visit_with_totals():
     console.print(summary_table(MISSION, result))
     text = console.export_text()
     assert "stopped: waypoint 2 failed" in text
-    for expected in ("dock", "reached", "failed", "ABORTED", "not run", "53.0", "1.40",
-                     "time [s]", "distance [m]"):
+    for expected in (
+        "dock",
+        "reached",
+        "failed",
+        "ABORTED",
+        "not run",
+        "53.0",
+        "1.40",
+        "time [s]",
+        "distance [m]",
+    ):
         assert expected in text
     assert "loop" not in text  # a single loop needs no loop column

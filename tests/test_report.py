@@ -21,34 +21,65 @@ MISSION = Mission(
 def result(*outcomes: WaypointOutcome, success: bool = False) -> MissionResult:
     visits = [
         WaypointResult(
-            index=i % 2, loop=i // 2, name=MISSION.waypoints[i % 2].name,
-            x=MISSION.waypoints[i % 2].x, y=0.0, yaw=MISSION.waypoints[i % 2].yaw,
-            outcome=o, attempts=1 if o != WaypointOutcome.NOT_RUN else 0,
-            duration=10.0 * (i + 1), distance_driven=1.25, reason="ABORTED"
-            if o in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED) else "",
+            index=i % 2,
+            loop=i // 2,
+            name=MISSION.waypoints[i % 2].name,
+            x=MISSION.waypoints[i % 2].x,
+            y=0.0,
+            yaw=MISSION.waypoints[i % 2].yaw,
+            outcome=o,
+            attempts=1 if o != WaypointOutcome.NOT_RUN else 0,
+            duration=10.0 * (i + 1),
+            distance_driven=1.25,
+            reason="ABORTED" if o in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED) else "",
         )
         for i, o in enumerate(outcomes)
     ]
-    return MissionResult(success=success, reason="interrupted: SIGINT", visits=visits,
-                         duration=100.0, distance_driven=5.0, loops_completed=1)
+    return MissionResult(
+        success=success,
+        reason="interrupted: SIGINT",
+        visits=visits,
+        duration=100.0,
+        distance_driven=5.0,
+        loops_completed=1,
+    )
 
 
 def test_report_counts_each_outcome_and_records_how_the_run_ended():
-    r = result(WaypointOutcome.REACHED, WaypointOutcome.SKIPPED, WaypointOutcome.REACHED,
-               WaypointOutcome.NOT_RUN)
+    r = result(
+        WaypointOutcome.REACHED,
+        WaypointOutcome.SKIPPED,
+        WaypointOutcome.REACHED,
+        WaypointOutcome.NOT_RUN,
+    )
     report = build_report(
-        MISSION, r, exit_code=130, navigator={"kind": "sim"}, interrupted="SIGINT",
-        mission_digest="ab" * 32, start=Pose2D(-2.0, -0.5, math.pi),
+        MISSION,
+        r,
+        exit_code=130,
+        navigator={"kind": "sim"},
+        interrupted="SIGINT",
+        mission_digest="ab" * 32,
+        start=Pose2D(-2.0, -0.5, math.pi),
         files={"journal": "out/journal.jsonl"},
     )
     assert report["schema_version"] == SCHEMA_VERSION
     assert report["mission"] == {
-        "source": "/data/missions/office.yaml", "name": "office", "digest": "ab" * 32,
-        "frame": "map", "waypoints": 2, "loops": "forever",
+        "source": "/data/missions/office.yaml",
+        "name": "office",
+        "digest": "ab" * 32,
+        "frame": "map",
+        "waypoints": 2,
+        "loops": "forever",
     }
     assert report["totals"] == {
-        "visits": 4, "reached": 2, "skipped": 1, "failed": 0, "not_run": 1,
-        "duration_s": 100.0, "distance_m": 5.0, "loops_completed": 1,
+        "visits": 4,
+        "reached": 2,
+        "skipped": 1,
+        "failed": 0,
+        "not_run": 1,
+        "duration_s": 100.0,
+        "distance_m": 5.0,
+        "loops_completed": 1,
     }
     assert report["success"] is False
     assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130

@@ -36,12 +36,25 @@ def killed_run(tmp_path: Path, *extra: Any, visits: int = 2) -> tuple[Path, Path
     """A patrol run killed with -9 after ``visits`` finished visits: (mission, journal, pid)."""
     mission = write_mission(tmp_path / "patrol.yaml", PATROL, header="loops: forever\n")
     out = tmp_path / "out"
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
-                           "--scripted-realtime", "4", *extra, cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        out,
+        "--scripted-realtime",
+        "4",
+        *extra,
+        cwd=tmp_path,
+    )
     journal = out / "journal.jsonl"
     try:
-        wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= visits, 60,
-                 f"{visits} visits finished")
+        wait_for(
+            lambda: len(journal_events(journal, "WaypointFinished")) >= visits,
+            60,
+            f"{visits} visits finished",
+        )
     finally:
         process.kill()
         process.communicate(timeout=30)
@@ -50,8 +63,15 @@ def killed_run(tmp_path: Path, *extra: Any, visits: int = 2) -> tuple[Path, Path
 
 def test_resume_keeps_the_journaled_loop_count_instead_of_patrolling_forever(tmp_path):
     _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=4)
-    result = navseq("run", "--resume", journal, "--scripted-log", tmp_path / "nav.log",
-                    cwd=tmp_path, timeout=120)
+    result = navseq(
+        "run",
+        "--resume",
+        journal,
+        "--scripted-log",
+        tmp_path / "nav.log",
+        cwd=tmp_path,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr
     report = json.loads((journal.parent / "report.json").read_text())
     assert report["success"] is True
@@ -61,8 +81,17 @@ def test_resume_keeps_the_journaled_loop_count_instead_of_patrolling_forever(tmp
 
 def test_an_option_given_again_overrides_the_journal_and_says_so(tmp_path):
     _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=1)
-    result = navseq("run", "--resume", journal, "--loops", "1", "--scripted-log",
-                    tmp_path / "nav.log", cwd=tmp_path, timeout=120)
+    result = navseq(
+        "run",
+        "--resume",
+        journal,
+        "--loops",
+        "1",
+        "--scripted-log",
+        tmp_path / "nav.log",
+        cwd=tmp_path,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr
     assert "resuming with --loops 1 instead of the journal's 2" in result.stderr
     report = json.loads((journal.parent / "report.json").read_text())
@@ -71,11 +100,13 @@ def test_an_option_given_again_overrides_the_journal_and_says_so(tmp_path):
 
 def test_a_second_resume_of_a_live_run_is_refused_and_moves_nothing(tmp_path):
     _, journal, _ = killed_run(tmp_path, "--loops", "3")
-    first = start_navseq("run", "--resume", journal, "--scripted-realtime", "0.5",
-                         cwd=tmp_path)
+    first = start_navseq("run", "--resume", journal, "--scripted-realtime", "0.5", cwd=tmp_path)
     try:
-        wait_for(lambda: any(r.get("kind") == "resumed" for r in journal_records(journal)),
-                 30, "the first resume to start")
+        wait_for(
+            lambda: any(r.get("kind") == "resumed" for r in journal_records(journal)),
+            30,
+            "the first resume to start",
+        )
         before = journal.read_bytes()
         log = tmp_path / "second.log"
         second = navseq("run", "--resume", journal, "--scripted-log", log, cwd=tmp_path)
@@ -104,8 +135,7 @@ def test_a_refused_resume_writes_nothing_to_the_journal(tmp_path):
     _, journal, _ = killed_run(tmp_path, "--loops", "2", visits=4)  # in the second loop
     before = journal.read_bytes()
     log = tmp_path / "nav.log"
-    result = navseq("run", "--resume", journal, "--loops", "1", "--scripted-log", log,
-                    cwd=tmp_path)
+    result = navseq("run", "--resume", journal, "--loops", "1", "--scripted-log", log, cwd=tmp_path)
     assert_clean_error(result)
     assert "loop 2" in result.stderr
     assert journal.read_bytes() == before
@@ -139,11 +169,15 @@ def test_lock_refusal_names_the_holder(tmp_path):
     from navseq.runlock import RunLock
 
     holder = subprocess.Popen(
-        [os.sys.executable, "-c",
-         "import sys, time; from pathlib import Path; from navseq.runlock import RunLock; "
-         "RunLock(Path(sys.argv[1])).acquire(); print('held', flush=True); time.sleep(30)",
-         str(tmp_path)],
-        stdout=subprocess.PIPE, text=True,
+        [
+            os.sys.executable,
+            "-c",
+            "import sys, time; from pathlib import Path; from navseq.runlock import RunLock; "
+            "RunLock(Path(sys.argv[1])).acquire(); print('held', flush=True); time.sleep(30)",
+            str(tmp_path),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
     )
     try:
         assert holder.stdout is not None and holder.stdout.readline().strip() == "held"

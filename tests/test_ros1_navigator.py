@@ -249,9 +249,7 @@ def test_cancel_reaches_the_server_and_ends_the_goal_preempted(
     assert next(r for r in records if r["event"] == "goal")["stamp"] == 0.0
 
 
-def test_a_new_goal_replaces_the_active_one_without_a_cancel(
-    ros_master: RosMaster, tmp_path: Path
-):
+def test_a_new_goal_replaces_the_active_one_without_a_cancel(ros_master: RosMaster, tmp_path: Path):
     log = tmp_path / "server.jsonl"
     start_server(ros_master, log, "hang succeed:0.3")
     code, driver = drive(ros_master, "--goals", "1,0,0", "--replace-after", "0.5")
@@ -305,7 +303,13 @@ def test_spin_returns_as_soon_as_the_server_reports(ros_master: RosMaster, tmp_p
     log = tmp_path / "server.jsonl"
     start_server(ros_master, log, "succeed:0.5 succeed:0.5")
     code, driver = drive(
-        ros_master, "--goals", "1,0,0;2,0,0", "--spin", "30", "--goal-timeout", "60",
+        ros_master,
+        "--goals",
+        "1,0,0;2,0,0",
+        "--spin",
+        "30",
+        "--goal-timeout",
+        "60",
         timeout=150,
     )
     assert code == 0, driver.output()

@@ -176,9 +176,7 @@ def test_pause_stops_the_robot_and_resume_sends_the_goal_again(
     assert goals == [(-1, -4), (1, -4), (1, -4), (1, -1)]
 
 
-def test_cancel_service_ends_the_mission_and_stops_the_robot(
-    ros_master: RosMaster, tmp_path: Path
-):
+def test_cancel_service_ends_the_mission_and_stops_the_robot(ros_master: RosMaster, tmp_path: Path):
     log = tmp_path / "server.jsonl"
     start_server(ros_master, log, then="hang")
     node = start_node(ros_master)

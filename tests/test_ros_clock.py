@@ -43,7 +43,8 @@ def test_navseq_started_before_a_5x_sim_runs_on_the_sims_clock(
     # No /use_sim_time yet: navseq's rospy comes up on wall time.
     navseq = ros_master.start(
         [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", out],
-        cwd=tmp_path, label="navseq",
+        cwd=tmp_path,
+        label="navseq",
     )
     # Its action client subscribes only once init_node (which reads /use_sim_time) is done.
     ros_master.wait_for_subscriber("/move_base/status", timeout=30)
@@ -63,7 +64,8 @@ def test_sim_time_without_a_clock_is_a_clear_error_naming_clock(
     ros_master.set_param("/use_sim_time", True)
     navseq = ros_master.start(
         [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", tmp_path / "out"],
-        cwd=tmp_path, label="navseq",
+        cwd=tmp_path,
+        label="navseq",
     )
     ros_master.wait_for_subscriber("/move_base/status", timeout=30)  # init_node done
     # The server comes up on wall time (no /clock ever): navseq's rospy stays at time 0.
@@ -121,7 +123,9 @@ def test_sim_launch_at_other_speeds_or_when_asked_runs_on_sim_time():
     def use_sim_time(*args: str) -> str:
         result = subprocess.run(
             ["roslaunch", "--dump-params", "navseq", "sim.launch", *args],
-            capture_output=True, text=True, timeout=60,
+            capture_output=True,
+            text=True,
+            timeout=60,
             env={**os.environ, "ROS_PACKAGE_PATH": str(REPO_ROOT)},
         )
         assert result.returncode == 0, result.stderr

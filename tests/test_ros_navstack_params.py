@@ -60,8 +60,10 @@ def test_a_waffles_move_base_params_give_the_waffles_profile():
 
 
 def test_robot_radius_gives_a_round_robot_and_missing_values_keep_the_base():
-    tree = {"local_costmap": {"robot_radius": 0.3},
-            "TrajectoryPlannerROS": {"xy_goal_tolerance": 0.2, "max_rot_vel": 1.0}}
+    tree = {
+        "local_costmap": {"robot_radius": 0.3},
+        "TrajectoryPlannerROS": {"xy_goal_tolerance": 0.2, "max_rot_vel": 1.0},
+    }
     profile, note = profile_from_navstack_params(tree, "/robot1/move_base")
     assert profile.circumscribed_radius == pytest.approx(0.3)
     assert profile.goal_tolerance.xy_m == 0.2
@@ -81,18 +83,36 @@ def test_nothing_to_read_keeps_the_base_profile_and_says_so():
 @pytest.mark.parametrize(
     ("tree", "param", "complaint"),
     [
-        ({"global_costmap": {"footprint": "[[0.1, 0.1], [0.2]]"}},
-         "/move_base/global_costmap/footprint", "[x, y]"),
-        ({"global_costmap": {"footprint": [[0.1, 0.1], [0.2, -0.1]]}},
-         "/move_base/global_costmap/footprint", "2 point"),
-        ({"local_costmap": {"footprint": "0.1, 0.2"}},
-         "/move_base/local_costmap/footprint", "at least 3 points"),
-        ({"global_costmap": {"robot_radius": "big"}},
-         "/move_base/global_costmap/robot_radius", "expected a number"),
-        ({"DWAPlannerROS": {"xy_goal_tolerance": -0.1}},
-         "/move_base/DWAPlannerROS/xy_goal_tolerance", "> 0"),
-        ({"global_costmap": {"inflation_layer": {"inflation_radius": True}}},
-         "/move_base/global_costmap/inflation_layer/inflation_radius", "expected a number"),
+        (
+            {"global_costmap": {"footprint": "[[0.1, 0.1], [0.2]]"}},
+            "/move_base/global_costmap/footprint",
+            "[x, y]",
+        ),
+        (
+            {"global_costmap": {"footprint": [[0.1, 0.1], [0.2, -0.1]]}},
+            "/move_base/global_costmap/footprint",
+            "2 point",
+        ),
+        (
+            {"local_costmap": {"footprint": "0.1, 0.2"}},
+            "/move_base/local_costmap/footprint",
+            "at least 3 points",
+        ),
+        (
+            {"global_costmap": {"robot_radius": "big"}},
+            "/move_base/global_costmap/robot_radius",
+            "expected a number",
+        ),
+        (
+            {"DWAPlannerROS": {"xy_goal_tolerance": -0.1}},
+            "/move_base/DWAPlannerROS/xy_goal_tolerance",
+            "> 0",
+        ),
+        (
+            {"global_costmap": {"inflation_layer": {"inflation_radius": True}}},
+            "/move_base/global_costmap/inflation_layer/inflation_radius",
+            "expected a number",
+        ),
     ],
 )
 def test_a_bad_value_is_a_clear_error_naming_the_param(tree, param, complaint):
@@ -129,12 +149,15 @@ def test_navseq_run_reads_the_robot_from_the_running_move_base(
     mission = write_mission(tmp_path / "m.yaml", "  - {x: 1, y: 0, yaw: 0}\n")
     out = tmp_path / "out"
     navseq = ros_master.start(
-        [NAVSEQ, "run", mission, "--navigator", "ros1", "--out", out], cwd=tmp_path,
+        [NAVSEQ, "run", mission, "--navigator", "ros1", "--out", out],
+        cwd=tmp_path,
         label="navseq",
     )
     assert navseq.wait(timeout=60) == 0, navseq.output()[-3000:]
-    note = ("robot from /move_base parameters: footprint 4 points, circumscribed 0.26 m, "
-            "tolerance 0.1 m / 20°")
+    note = (
+        "robot from /move_base parameters: footprint 4 points, circumscribed 0.26 m, "
+        "tolerance 0.1 m / 20°"
+    )
     assert f"navseq run: {note}" in navseq.output()
     navigator = json.loads((out / "report.json").read_text())["navigator"]
     assert navigator["robot"] == "navstack:/move_base"
@@ -151,7 +174,8 @@ def test_a_bad_move_base_param_stops_navseq_run_before_the_robot_moves(
     mission = write_mission(tmp_path / "m.yaml", "  - {x: 1, y: 0, yaw: 0}\n")
     navseq = ros_master.start(
         [NAVSEQ, "run", mission, "--navigator", "ros1", "--out", tmp_path / "out"],
-        cwd=tmp_path, label="navseq",
+        cwd=tmp_path,
+        label="navseq",
     )
     assert navseq.wait(timeout=60) == 2, navseq.output()[-3000:]
     assert "param /move_base/local_costmap/footprint" in navseq.output()

@@ -47,9 +47,20 @@ def mission(tmp_path: Path) -> Path:
 def run_navseq(master: RosMaster, tmp_path: Path, *extra: str) -> tuple[RosProcess, Path]:
     out = tmp_path / "out"
     process = master.start(
-        [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--map", MAP, "--out", out,
-         *extra],
-        cwd=tmp_path, label="navseq",
+        [
+            NAVSEQ,
+            "run",
+            mission(tmp_path),
+            "--navigator",
+            "ros1",
+            "--map",
+            MAP,
+            "--out",
+            out,
+            *extra,
+        ],
+        cwd=tmp_path,
+        label="navseq",
     )
     process.wait(timeout=180)
     return process, out
@@ -94,8 +105,11 @@ def test_without_the_settle_navseq_runs_into_the_race(ros_master: RosMaster, tmp
     process, _out = run_navseq(ros_master, tmp_path, "--settle", "0")
     assert "Traceback" not in process.output()
     assert "race (~race_window)" in nav.output()
-    far = [r for r in watched_results(watcher)
-           if r["status"] == SUCCEEDED and r["distance"] is not None and r["distance"] > 0.5]
+    far = [
+        r
+        for r in watched_results(watcher)
+        if r["status"] == SUCCEEDED and r["distance"] is not None and r["distance"] > 0.5
+    ]
     assert far, watched_results(watcher)
 
 
@@ -115,7 +129,8 @@ def test_without_the_settle_the_executor_reports_a_far_succeeded(
 )
 def test_a_bad_race_option_stops_the_node_naming_it(ros_master: RosMaster, param, complaint):
     ros_master.set_param("/use_sim_time", False)
-    nav = ros_master.start([REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}", param],
-                           label="move_base")
+    nav = ros_master.start(
+        [REPO_ROOT / "nodes" / "sim_nav_node", f"_map:={MAP}", param], label="move_base"
+    )
     assert nav.wait(timeout=60) == 2, nav.output()
     assert f"/move_base/{complaint}" in nav.output() and "Traceback" not in nav.output()

@@ -133,8 +133,11 @@ def test_existing_file_is_never_replaced_unless_asked(ros_master: RosMaster, tmp
     recorder = start_recorder(ros_master, out, overwrite=True)
     recorder.wait_for_output("navseq record: ready", timeout=20)
     publish(ros_master, tmp_path, "/move_base_simple/goal", "1,1,0").wait(timeout=20)
-    wait_for(lambda: "user's" not in out.read_text() and waypoint_count(out) == 1, 10,
-             "the file replaced by the recording")
+    wait_for(
+        lambda: "user's" not in out.read_text() and waypoint_count(out) == 1,
+        10,
+        "the file replaced by the recording",
+    )
 
 
 def test_record_service_takes_the_robot_pose_from_tf(ros_master: RosMaster, tmp_path: Path):

@@ -105,16 +105,21 @@ def test_navseq_run_publishes_waypoint_markers_and_status(ros_master: RosMaster,
     )
     navseq = ros_master.start(
         [NAVSEQ, "run", mission, "--navigator", "ros1", "--map", MAP, "--out", tmp_path / "out"],
-        cwd=tmp_path, label="navseq",
+        cwd=tmp_path,
+        label="navseq",
     )
     assert navseq.wait(timeout=120) == 0, navseq.output()[-3000:]
 
     def lines(key: str) -> list:
-        return [json.loads(line)[key] for line in watcher.output().splitlines()
-                if line.startswith(f'{{"{key}"')]
+        return [
+            json.loads(line)[key]
+            for line in watcher.output().splitlines()
+            if line.startswith(f'{{"{key}"')
+        ]
 
-    wait_for(lambda: any(s.get("state") == "succeeded" for s in lines("status")), 10,
-             "the final status")
+    wait_for(
+        lambda: any(s.get("state") == "succeeded" for s in lines("status")), 10, "the final status"
+    )
     states = [s["state"] for s in lines("status")]
     assert "running" in states
     assert states[-1] == "succeeded"

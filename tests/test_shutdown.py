@@ -40,11 +40,23 @@ def calls(log: Path, call: str) -> list[dict[str, Any]]:
 def start_run(tmp_path: Path, *extra: Any, **popen: Any) -> tuple[subprocess.Popen[str], Path]:
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
     log = tmp_path / "nav.log"
-    args = [NAVSEQ, "run", str(mission), "--navigator", "scripted", "--out",
-            str(tmp_path / "out"), "--scripted-realtime", "1", "--scripted-log", str(log),
-            *map(str, extra)]
-    process = subprocess.Popen(args, cwd=tmp_path, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, **popen)
+    args = [
+        NAVSEQ,
+        "run",
+        str(mission),
+        "--navigator",
+        "scripted",
+        "--out",
+        str(tmp_path / "out"),
+        "--scripted-realtime",
+        "1",
+        "--scripted-log",
+        str(log),
+        *map(str, extra),
+    ]
+    process = subprocess.Popen(
+        args, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen
+    )
     wait_for(lambda: calls(log, "send_goal"), 30, "the first goal")
     return process, log
 
@@ -82,8 +94,17 @@ def test_signals_at_the_end_of_a_run_never_lose_the_report(tmp_path: Path, delay
     """Signals around the moment the mission finishes (while outputs are written)."""
     out = tmp_path / "out"
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
-                           "--scripted-realtime", "8", cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        out,
+        "--scripted-realtime",
+        "8",
+        cwd=tmp_path,
+    )
     journal = out / "journal.jsonl"
     wait_for(lambda: journal_events(journal, "MissionFinished"), 60, "the mission to finish")
     time.sleep(delay)
@@ -135,9 +156,7 @@ def test_kill_9_after_the_last_journal_line_then_report_rebuilds_it(tmp_path: Pa
     report = json.loads((out / "report.json").read_text())
     assert report["rebuilt_from_journal"] is True
     assert report["exit_code"] == 0 and report["success"] is True
-    assert [v["outcome"] for v in report["visits"]] == [
-        v["outcome"] for v in original["visits"]
-    ]
+    assert [v["outcome"] for v in report["visits"]] == [v["outcome"] for v in original["visits"]]
     assert (out / "mission.png").read_bytes().startswith(b"\x89PNG")
     again = navseq("report", out, cwd=tmp_path)
     assert again.returncode == 0 and "complete" in again.stdout
@@ -146,8 +165,10 @@ def test_kill_9_after_the_last_journal_line_then_report_rebuilds_it(tmp_path: Pa
 def test_resume_of_a_finished_journal_rebuilds_a_missing_report(tmp_path: Path) -> None:
     out = tmp_path / "out"
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
-    assert navseq("run", mission, "--navigator", "scripted", "--out", out,
-                  cwd=tmp_path).returncode == 0
+    assert (
+        navseq("run", mission, "--navigator", "scripted", "--out", out, cwd=tmp_path).returncode
+        == 0
+    )
     (out / "report.json").unlink()
     result = navseq("run", "--resume", out / "journal.jsonl", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -165,12 +186,24 @@ def test_kill_9_at_any_journal_line_then_resume_finishes_with_a_true_report(
 ) -> None:
     out = tmp_path / "out"
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
-    process = start_navseq("run", mission, "--navigator", "scripted", "--out", out,
-                           "--scripted-realtime", "4", cwd=tmp_path)
+    process = start_navseq(
+        "run",
+        mission,
+        "--navigator",
+        "scripted",
+        "--out",
+        out,
+        "--scripted-realtime",
+        "4",
+        cwd=tmp_path,
+    )
     journal = out / "journal.jsonl"
     try:
-        wait_for(lambda: len(journal_records(journal)) >= cut or process.poll() is not None,
-                 120, f"{cut} journal lines")
+        wait_for(
+            lambda: len(journal_records(journal)) >= cut or process.poll() is not None,
+            120,
+            f"{cut} journal lines",
+        )
     finally:
         process.kill()
         _, stderr = process.communicate(timeout=30)
@@ -203,8 +236,18 @@ def test_a_full_disk_under_the_journal_stops_the_robot_and_exits_2(
 
     monkeypatch.setattr(journal_module.os, "write", write_until_full)
     out = tmp_path / "out"
-    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out),
-                     "--scripted-log", str(log)])
+    code = cli.main(
+        [
+            "run",
+            str(mission),
+            "--navigator",
+            "scripted",
+            "--out",
+            str(out),
+            "--scripted-log",
+            str(log),
+        ]
+    )
     stderr = capsys.readouterr().err
     assert code == 2
     assert f"{out / 'journal.jsonl'}: cannot write the journal: the disk is full" in stderr

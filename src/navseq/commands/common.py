@@ -40,11 +40,13 @@ def parse_pose(text: str) -> Pose2D:
     # The limits of mission files: beyond them map arithmetic overflows.
     if any(abs(value) > MAX_COORDINATE for value in values[:2]):
         raise argparse.ArgumentTypeError(
-            f"x and y must be within ±{MAX_COORDINATE:g} m, got {text!r}")
+            f"x and y must be within ±{MAX_COORDINATE:g} m, got {text!r}"
+        )
     yaw_degrees = values[2] if len(values) == 3 else 0.0
     if abs(yaw_degrees) > MAX_YAW_DEGREES:
         raise argparse.ArgumentTypeError(
-            f"yaw must be within ±{MAX_YAW_DEGREES:g} degrees, got {text!r}")
+            f"yaw must be within ±{MAX_YAW_DEGREES:g} degrees, got {text!r}"
+        )
     return Pose2D(values[0], values[1], normalized_yaw(math.radians(yaw_degrees)))
 
 
@@ -142,5 +144,4 @@ def require_file(path: Path, what: str) -> None:
     if stat.S_ISDIR(info.st_mode):
         raise NavseqError(f"{shown} is a directory, not a file", source=what)
     if not stat.S_ISREG(info.st_mode):
-        raise NavseqError(f"{shown} is not a regular file (a device, pipe or socket?)",
-                          source=what)
+        raise NavseqError(f"{shown} is not a regular file (a device, pipe or socket?)", source=what)

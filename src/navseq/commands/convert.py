@@ -17,9 +17,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="mission file (navseq YAML, launch, rosparam, CSV)",
     )
     parser.add_argument("output", type=Path, metavar="OUTPUT", help="navseq YAML file to write")
-    parser.add_argument(
-        "--force", action="store_true", help="overwrite OUTPUT if it exists"
-    )
+    parser.add_argument("--force", action="store_true", help="overwrite OUTPUT if it exists")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -97,10 +97,9 @@ def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
     def visit(loop: int, index: int) -> WaypointResult:
         waypoint = mission.waypoints[index]
         known = state.visits.get((loop, index))
-        details = {"name": waypoint.name, "x": waypoint.x, "y": waypoint.y, "yaw": waypoint.yaw}
         if known is not None:
-            return replace(known, **details)
-        return WaypointResult(index=index, loop=loop, **details)
+            return replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw)
+        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw)
 
     count = len(mission.waypoints)
     started = state.mission_started

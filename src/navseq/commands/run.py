@@ -378,7 +378,10 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     if not args.no_preflight:
         _check_against_map(mission, costmap, start, robot)
     world = SimWorld(
-        grid, start, costmap=costmap, nav_params=settings.nav_params,
+        grid,
+        start,
+        costmap=costmap,
+        nav_params=settings.nav_params,
         footprint=settings.footprint,
     )
     return RunSetup(

@@ -79,6 +79,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.track import simplify_path
 
 #: Pause between a failed attempt and the next one, so a failing stack is not hammered.
 RETRY_BACKOFF = 1.0
@@ -88,6 +89,8 @@ PROGRESS_DISTANCE = 0.05
 PROGRESS_YAW = 0.05
 #: Within this distance of the goal, turning towards the goal yaw counts as progress (m).
 YAW_PROGRESS_RADIUS = 0.3
+#: Planned paths are told to sinks simplified to within this distance (m).
+PLAN_TOLERANCE = 0.01
 #: Reason recorded when the navigation server stayed away longer than allowed.
 SERVER_LOST_REASON = "navigation server lost"
 #: Added to the goal's xy tolerance when checking a SUCCEEDED against the robot's pose
@@ -305,7 +308,10 @@ class MissionExecutor:
             return self._on_feedback(now, event)
         if isinstance(event, GoalPlan):
             self._on_plan(event)
-            self._emit(WaypointPlan(t=now, index=self._current.index, path=event.path))
+            # Sinks get the plan's corners only: a journal, a picture and markers need no
+            # point every grid cell, and a patrol's journal must not grow by whole plans.
+            path = simplify_path(event.path, PLAN_TOLERANCE)
+            self._emit(WaypointPlan(t=now, index=self._current.index, path=path))
             return []
         if isinstance(event, GoalDone):
             return self._on_goal_done(now, event)

@@ -8,6 +8,7 @@ blank lines and ``#`` comments. Every other line must hold exactly seven numbers
 from __future__ import annotations
 
 import csv
+import functools
 import math
 from collections.abc import Iterator
 
@@ -37,9 +38,11 @@ def mission_from_csv(text: str, source: str, problems: Problems) -> Mission | No
                 continue
             seen_data = True
             if len(waypoints) >= MAX_WAYPOINTS:
-                problems.add(f"holds more than {MAX_WAYPOINTS:,} waypoints; navseq refuses "
-                             "missions this long (thin the recorded path out)",
-                             source=f"{source}:{line_number}")
+                problems.add(
+                    f"holds more than {MAX_WAYPOINTS:,} waypoints; navseq refuses "
+                    "missions this long (thin the recorded path out)",
+                    source=f"{source}:{line_number}",
+                )
                 return None
             waypoint = _waypoint(cells, len(waypoints), f"{source}:{line_number}", problems)
             if waypoint is not None:
@@ -77,17 +80,25 @@ def _is_number(cell: str) -> bool:
 def _waypoint(cells: list[str], index: int, where: str, problems: Problems) -> Waypoint | None:
     label = f"waypoint {index + 1}"
     if len(cells) != len(COLUMNS):
-        problems.add(f"has {len(cells)} values, expected {len(COLUMNS)}: "
-                     + ",".join(COLUMNS), source=where, subject=label)
+        problems.add(
+            f"has {len(cells)} values, expected {len(COLUMNS)}: " + ",".join(COLUMNS),
+            source=where,
+            subject=label,
+        )
         return None
     if not any(_is_number(cell) for cell in cells):
         shown = ",".join(cells)
-        problems.add(f"holds no numbers ({shown[:60]!r}); only the first line may be a header",
-                     source=where, subject=label)
+        problems.add(
+            f"holds no numbers ({shown[:60]!r}); only the first line may be a header",
+            source=where,
+            subject=label,
+        )
         return None
     before = len(problems)
-    values = [fields.attempt(problems, lambda c=cell, n=name: _number(c, where, label, n))
-              for cell, name in zip(cells, COLUMNS, strict=True)]
+    values = [
+        fields.attempt(problems, functools.partial(_number, cell, where, label, name))
+        for cell, name in zip(cells, COLUMNS, strict=True)
+    ]
     if len(problems) > before:
         return None
     x, y, z, *quaternion = (v for v in values if v is not None)
@@ -103,8 +114,9 @@ def _number(cell: str, where: str, label: str, column: str) -> float:
     try:
         value = float(cell)
     except ValueError:
-        raise NavseqError(f"must be a number, got {cell[:40]!r}", source=where,
-                          subject=subject) from None
+        raise NavseqError(
+            f"must be a number, got {cell[:40]!r}", source=where, subject=subject
+        ) from None
     if column in ("x", "y", "z"):
         return fields.coordinate(Located(value, where), subject)
     return fields.number(Located(value, where), subject)

@@ -7,6 +7,7 @@ catch the error into a :class:`Problems` list and go on with the next field.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Collection
 from typing import Any, TypeVar
@@ -40,30 +41,44 @@ def number(node: Located, subject: str) -> float:
     """A finite real number. Booleans and text are refused, not coerced."""
     value = node.value
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise NavseqError(f"must be a number, got {describe(value)}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"must be a number, got {describe(value)}", source=node.where, subject=subject
+        )
     try:
         result = float(value)
     except OverflowError:
-        raise NavseqError("is too large to be a coordinate or a time", source=node.where,
-                          subject=subject) from None
+        raise NavseqError(
+            "is too large to be a coordinate or a time", source=node.where, subject=subject
+        ) from None
     if not math.isfinite(result):
-        raise NavseqError(f"must be a finite number, got {value!r}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"must be a finite number, got {value!r}", source=node.where, subject=subject
+        )
     return result
 
 
-def bounded_number(node: Located, subject: str, *, minimum: float, inclusive: bool,
-                   unit: str = "", maximum: float | None = None) -> float:
+def bounded_number(
+    node: Located,
+    subject: str,
+    *,
+    minimum: float,
+    inclusive: bool,
+    unit: str = "",
+    maximum: float | None = None,
+) -> float:
     """A finite number ``>= minimum`` (or ``> minimum`` when not inclusive), ``<= maximum``."""
     result = number(node, subject)
     if result < minimum or (not inclusive and result == minimum):
         relation = ">=" if inclusive else ">"
-        raise NavseqError(f"must be {relation} {minimum:g}{unit}, got {result:g}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be {relation} {minimum:g}{unit}, got {result:g}",
+            source=node.where,
+            subject=subject,
+        )
     if maximum is not None and result > maximum:
-        raise NavseqError(f"must be <= {maximum:g}{unit}, got {result:g}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"must be <= {maximum:g}{unit}, got {result:g}", source=node.where, subject=subject
+        )
     return result
 
 
@@ -71,8 +86,11 @@ def within(node: Located, subject: str, *, limit: float, unit: str, what: str = 
     """A finite number with ``|value| <= limit``."""
     result = number(node, subject)
     if abs(result) > limit:
-        raise NavseqError(f"must be within ±{limit:g}{unit}{what}, got {result:g}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be within ±{limit:g}{unit}{what}, got {result:g}",
+            source=node.where,
+            subject=subject,
+        )
     return result
 
 
@@ -104,23 +122,27 @@ def integer(node: Located, subject: str, *, minimum: int) -> int:
     if isinstance(value, float) and math.isfinite(value) and value.is_integer():
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, int):
-        raise NavseqError(f"must be a whole number, got {describe(node.value)}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be a whole number, got {describe(node.value)}",
+            source=node.where,
+            subject=subject,
+        )
     if value < minimum:
-        raise NavseqError(f"must be >= {minimum}, got {value}", source=node.where,
-                          subject=subject)
+        raise NavseqError(f"must be >= {minimum}, got {value}", source=node.where, subject=subject)
     return value
 
 
 def boolean(node: Located, subject: str) -> bool:
     if not isinstance(node.value, bool):
-        raise NavseqError(f"must be true or false, got {describe(node.value)}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be true or false, got {describe(node.value)}", source=node.where, subject=subject
+        )
     return node.value
 
 
-def text(node: Located, subject: str, *, allow_numbers: bool = False,
-         single_line: bool = True) -> str:
+def text(
+    node: Located, subject: str, *, allow_numbers: bool = False, single_line: bool = True
+) -> str:
     """Non-empty text; with ``allow_numbers`` a number is taken as its text (``name: 7``).
 
     Lone surrogates are refused (they cannot be printed or written as UTF-8), and with
@@ -131,15 +153,20 @@ def text(node: Located, subject: str, *, allow_numbers: bool = False,
     if allow_numbers and isinstance(value, int | float) and not isinstance(value, bool):
         value = str(value)
     if not isinstance(value, str) or not value.strip():
-        raise NavseqError(f"must be non-empty text, got {describe(node.value)}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be non-empty text, got {describe(node.value)}",
+            source=node.where,
+            subject=subject,
+        )
     problem = text_problem(value, single_line=single_line)
     if problem is not None:
         raise NavseqError(problem, source=node.where, subject=subject)
     if single_line and len(value) > MAX_LABEL_CHARACTERS:
-        raise NavseqError(f"is {len(value):,} characters long; at most "
-                          f"{MAX_LABEL_CHARACTERS} are allowed", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"is {len(value):,} characters long; at most {MAX_LABEL_CHARACTERS} are allowed",
+            source=node.where,
+            subject=subject,
+        )
     return value
 
 
@@ -148,32 +175,43 @@ def choice(node: Located, subject: str, options: Collection[str]) -> str:
     if not isinstance(value, str) or value not in options:
         hint = closest_hint(value, options) if isinstance(value, str) else ""
         listed = " | ".join(options)
-        raise NavseqError(f"must be one of {listed}, got {describe(value)}{hint}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be one of {listed}, got {describe(value)}{hint}",
+            source=node.where,
+            subject=subject,
+        )
     return value
 
 
 def mapping(node: Located, subject: str) -> Located:
     if not node.is_mapping:
-        raise NavseqError(f"must be a mapping of keys to values, got {describe(node.value)}",
-                          source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be a mapping of keys to values, got {describe(node.value)}",
+            source=node.where,
+            subject=subject,
+        )
     return node
 
 
 def sequence(node: Located, subject: str) -> list[Located]:
     if not node.is_list:
-        raise NavseqError(f"must be a list, got {describe(node.value)}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"must be a list, got {describe(node.value)}", source=node.where, subject=subject
+        )
     return node.value
 
 
-def check_keys(node: Located, known: Collection[str], owner: str | None,
-               problems: Problems) -> None:
+def check_keys(
+    node: Located, known: Collection[str], owner: str | None, problems: Problems
+) -> None:
     """Report every key of a mapping that navseq does not know, with the closest known one."""
     for key in node.value:
         if key not in known:
-            problems.add(f"unknown key{closest_hint(key, known)}", source=node.where_key(key),
-                         subject=field_subject(owner, shortened(key)))
+            problems.add(
+                f"unknown key{closest_hint(key, known)}",
+                source=node.where_key(key),
+                subject=field_subject(owner, shortened(key)),
+            )
 
 
 def shortened(written: str, limit: int = 60) -> str:
@@ -203,21 +241,24 @@ def _optional(reader: Callable[[Located, str], Any]) -> Callable[[Located, str],
 
 
 def positive_seconds(node: Located, subject: str) -> float:
-    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" s",
-                          maximum=MAX_SECONDS)
+    return bounded_number(
+        node, subject, minimum=0.0, inclusive=False, unit=" s", maximum=MAX_SECONDS
+    )
 
 
 def _positive_metres(node: Located, subject: str) -> float:
-    return bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" m",
-                          maximum=MAX_METRES)
+    return bounded_number(
+        node, subject, minimum=0.0, inclusive=False, unit=" m", maximum=MAX_METRES
+    )
 
 
 def _angle_degrees_as_radians(node: Located, subject: str) -> float:
     """An angular tolerance written in degrees (like yaw), kept in radians."""
     degrees = bounded_number(node, subject, minimum=0.0, inclusive=False, unit=" degrees")
     if degrees > 180.0:
-        raise NavseqError(f"must be <= 180 degrees, got {degrees:g}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"must be <= 180 degrees, got {degrees:g}", source=node.where, subject=subject
+        )
     return math.radians(degrees)
 
 
@@ -232,10 +273,13 @@ POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
     "clear_costmaps_on_retry": boolean,
     "on_failure": _failure_action,
     "pass_through": _optional(
-        lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
-                                             unit=" m", maximum=MAX_METRES)),
-    "dwell": lambda node, subject: bounded_number(node, subject, minimum=0.0, inclusive=True,
-                                                  unit=" s", maximum=MAX_SECONDS),
+        lambda node, subject: bounded_number(
+            node, subject, minimum=0.0, inclusive=True, unit=" m", maximum=MAX_METRES
+        )
+    ),
+    "dwell": lambda node, subject: bounded_number(
+        node, subject, minimum=0.0, inclusive=True, unit=" s", maximum=MAX_SECONDS
+    ),
     "xy_tolerance": _optional(_positive_metres),
     "yaw_tolerance": _optional(_angle_degrees_as_radians),
 }
@@ -249,7 +293,7 @@ def policy_values(node: Located, owner: str | None, problems: Problems) -> dict[
         if entry is None:
             continue
         before = len(problems)
-        value = attempt(problems, lambda r=reader, e=entry, k=key: r(e, field_subject(owner, k)))
+        value = attempt(problems, functools.partial(reader, entry, field_subject(owner, key)))
         if len(problems) == before:
             values[key] = value
     return values

@@ -46,8 +46,7 @@ class ExpansionLimitError(NavseqError):
 class ExpansionBudget:
     """How much text substitutions may still add, shared by every file of a launch tree."""
 
-    def __init__(self, total: int = MAX_TOTAL_EXPANSION_CHARS,
-                 per_text: int = MAX_EXPANSION_CHARS):
+    def __init__(self, total: int = MAX_TOTAL_EXPANSION_CHARS, per_text: int = MAX_EXPANSION_CHARS):
         self.left = total
         self.total = total
         self.per_text = per_text
@@ -59,12 +58,14 @@ class ExpansionBudget:
             raise ExpansionLimitError(
                 f"$({command}) makes this value grow by more than {_mib(self.per_text)} "
                 "(navseq's limit for one attribute or body); do args expand each other "
-                "over and over (an expansion bomb)?")
+                "over and over (an expansion bomb)?"
+            )
         if growth > self.left:
             raise ExpansionLimitError(
                 f"$({command}) makes the launch files' substitutions grow by more than "
                 f"{_mib(self.total)} in all (navseq's limit); do args expand each other "
-                "over and over (an expansion bomb)?")
+                "over and over (an expansion bomb)?"
+            )
 
     def spend(self, written: int, resolved: int) -> None:
         self.left -= max(0, resolved - written)
@@ -91,7 +92,8 @@ class LaunchArgs:
             if name in self.passed:
                 raise SubstitutionError(
                     f"arg '{name}' has a fixed value= here, so the including file cannot "
-                    "set it (roslaunch refuses this too); write default= to allow it")
+                    "set it (roslaunch refuses this too); write default= to allow it"
+                )
             self.values[name] = value
         else:
             self.values[name] = self.passed.get(name, default)
@@ -100,13 +102,17 @@ class LaunchArgs:
         if name not in self.values:
             raise SubstitutionError(
                 f"$(arg {name}): no arg '{name}' is declared in this file before this line; "
-                f"declare it with <arg name=\"{name}\" default=\"...\"/>", offset)
+                f'declare it with <arg name="{name}" default="..."/>',
+                offset,
+            )
         value = self.values[name]
         if value is None:
             raise SubstitutionError(
                 f"$(arg {name}): arg '{name}' has neither a default nor a value and no "
                 f"including file passes it (roslaunch would need {name}:=... on its command "
-                "line); give it a default=", offset)
+                "line); give it a default=",
+                offset,
+            )
         return value
 
     def given(self) -> dict[str, str]:
@@ -155,8 +161,11 @@ class PackageFinder:
                         index.setdefault(name, folder)
                     continue
                 if depth < MAX_SEARCH_DEPTH:
-                    stack.extend((Path(entry.path), depth + 1) for entry in entries
-                                 if not entry.name.startswith(".") and _is_folder(entry))
+                    stack.extend(
+                        (Path(entry.path), depth + 1)
+                        for entry in entries
+                        if not entry.name.startswith(".") and _is_folder(entry)
+                    )
         return index
 
 
@@ -180,8 +189,13 @@ def _package_name(path: Path) -> str | None:
 class Substitution:
     """Resolves the substitution args in the text of one launch file."""
 
-    def __init__(self, args: LaunchArgs, folder: Path | None, packages: PackageFinder,
-                 budget: ExpansionBudget | None = None):
+    def __init__(
+        self,
+        args: LaunchArgs,
+        folder: Path | None,
+        packages: PackageFinder,
+        budget: ExpansionBudget | None = None,
+    ):
         self.args = args
         self.folder = folder
         self.packages = packages
@@ -199,9 +213,9 @@ class Substitution:
             end = text.find(")", start)
             if end == -1:
                 break  # roslaunch keeps an unclosed "$(" as text too
-            body = text[start + 2:end]
+            body = text[start + 2 : end]
             resolved = self._one(body, start)
-            piece = text[start:end + 1] if resolved is None else resolved
+            piece = text[start : end + 1] if resolved is None else resolved
             length += (start - position) + len(piece)
             self.budget.check(end + 1, length, " ".join(body.split()[:2]))
             parts.append(text[position:start])
@@ -223,8 +237,9 @@ class Substitution:
         words = body.split()
         if not words or words[0] not in COMMANDS:
             known = ", ".join(f"$({command})" for command in COMMANDS)
-            raise SubstitutionError(f"$({body}) is not a roslaunch substitution (roslaunch "
-                                    f"knows {known})", offset)
+            raise SubstitutionError(
+                f"$({body}) is not a roslaunch substitution (roslaunch knows {known})", offset
+            )
         command, rest = words[0], words[1:]
         if command in ("anon", "eval"):
             return None
@@ -243,7 +258,9 @@ class Substitution:
             if value is None:
                 raise SubstitutionError(
                     f"$(env {rest[0]}): the environment variable {rest[0]} is not set "
-                    f"(write $(optenv {rest[0]} DEFAULT) for a default)", offset)
+                    f"(write $(optenv {rest[0]} DEFAULT) for a default)",
+                    offset,
+                )
             return value
         package = self.packages.find(rest[0])
         return None if package is None else str(package)

@@ -58,12 +58,15 @@ MAX_INCLUDED_FILES = 200
 MAX_LAUNCH_TREE_BYTES = 2 * MAX_MISSION_BYTES
 
 
-def mission_from_launch(text: str, source: str, base_dir: Path | None,
-                        problems: Problems) -> Mission | None:
+def mission_from_launch(
+    text: str, source: str, base_dir: Path | None, problems: Problems
+) -> Mission | None:
     root = parse_xml(text, source)
     if root.tag != "launch":
-        problems.add(f"is XML but not a roslaunch file: its root element is <{root.tag}>, "
-                     "expected <launch>", source=f"{source}:{root.line}")
+        problems.add(
+            f"is XML but not a roslaunch file: its root element is <{root.tag}>, expected <launch>",
+            source=f"{source}:{root.line}",
+        )
         return None
     reader = _LaunchReader(source, base_dir, problems)
     reader.bytes_read = len(text)
@@ -71,8 +74,9 @@ def mission_from_launch(text: str, source: str, base_dir: Path | None,
     reader.walk(root, "/", None, reader.top)
     if len(problems) > before:  # e.g. a broken <rosparam> body: what it set is unknown
         return None
-    return mission_from_tree(reader.tree.located(), source, base_dir, problems,
-                             not_followed=reader.not_followed)
+    return mission_from_tree(
+        reader.tree.located(), source, base_dir, problems, not_followed=reader.not_followed
+    )
 
 
 class _ParamTree:
@@ -98,8 +102,10 @@ class _ParamTree:
         child.set(rest, value)
 
     def located(self) -> Located:
-        values = {key: entry.located() if isinstance(entry, _ParamTree) else entry
-                  for key, entry in self.entries.items()}
+        values = {
+            key: entry.located() if isinstance(entry, _ParamTree) else entry
+            for key, entry in self.entries.items()
+        }
         return Located(values, self.where, {key: v.where for key, v in values.items()})
 
 
@@ -137,17 +143,19 @@ class _LaunchReader:
         self.not_followed: list[str] = []
         self.budget = ExpansionBudget()
         self.values = ValueBudget()  # the YAML values of every param and file together
-        self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages,
-                                              self.budget))
+        self.top = _File(source, Substitution(LaunchArgs(), base_dir, self.packages, self.budget))
         self.reading = [_file_key(Path(source))]  # the chain of includes, to refuse cycles
         self.files_read = 1
         self.bytes_read = 0
 
-    def walk(self, element: XmlElement, namespace: str, private: str | None, file: _File,
-             depth: int = 0) -> None:
+    def walk(
+        self, element: XmlElement, namespace: str, private: str | None, file: _File, depth: int = 0
+    ) -> None:
         if depth > MAX_DEPTH:
-            self.problems.add(f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
-                              source=file.where(element.line))
+            self.problems.add(
+                f"nests groups, nodes and includes more than {MAX_DEPTH} deep",
+                source=file.where(element.line),
+            )
             return
         for child in element.children:
             try:
@@ -158,8 +166,9 @@ class _LaunchReader:
                 # Fatal: going on would only hit the limit again, element after element.
                 raise NavseqError(error.message, source=file.where(child.line)) from None
 
-    def visit(self, element: XmlElement, namespace: str, private: str | None, file: _File,
-              depth: int) -> None:
+    def visit(
+        self, element: XmlElement, namespace: str, private: str | None, file: _File, depth: int
+    ) -> None:
         if not self.condition_holds(element, file):
             return
         if element.tag == "arg":
@@ -191,8 +200,10 @@ class _LaunchReader:
                 continue
             truth = _boolean(value)
             if truth is None:
-                raise SubstitutionError(f"{key}=\"{value}\" is neither true nor false "
-                                        "(roslaunch accepts true, false, 1 and 0)")
+                raise SubstitutionError(
+                    f'{key}="{value}" is neither true nor false '
+                    "(roslaunch accepts true, false, 1 and 0)"
+                )
             if truth != keep_when:
                 return False
         return True
@@ -202,11 +213,13 @@ class _LaunchReader:
         if not name:
             self.problems.add("<arg> needs a name=", source=file.where(element.line))
             return
-        file.subst.args.declare(name, value=self.attr(element, "value", file),
-                                default=self.attr(element, "default", file))
+        file.subst.args.declare(
+            name,
+            value=self.attr(element, "value", file),
+            default=self.attr(element, "default", file),
+        )
 
-    def param(self, element: XmlElement, namespace: str, private: str | None,
-              file: _File) -> None:
+    def param(self, element: XmlElement, namespace: str, private: str | None, file: _File) -> None:
         name = self.attr(element, "name", file)
         value = self.attr(element, "value", file)
         if not name or value is None:  # textfile=, binfile=, command= need ROS
@@ -215,8 +228,9 @@ class _LaunchReader:
         located = Located(value, where)
         if element.attrs.get("type", "auto") not in ("str", "string"):
             try:
-                parsed = parse_yaml_value(value, file.source, first_line=element.line,
-                                          budget=self.values)
+                parsed = parse_yaml_value(
+                    value, file.source, first_line=element.line, budget=self.values
+                )
             except TooManyValuesError:
                 raise
             except NavseqError:
@@ -225,8 +239,9 @@ class _LaunchReader:
                 located = parsed
         self.tree.set(_parts(_resolve(name, namespace, private)), located)
 
-    def rosparam(self, element: XmlElement, namespace: str, private: str | None,
-                 file: _File) -> None:
+    def rosparam(
+        self, element: XmlElement, namespace: str, private: str | None, file: _File
+    ) -> None:
         if (self.attr(element, "command", file) or "load") != "load":
             return
         target = _resolve(self.attr(element, "ns", file) or "", namespace, private)
@@ -249,20 +264,22 @@ class _LaunchReader:
             try:
                 body = file.subst.resolve(body)
             except SubstitutionError as error:
-                line = first_line + body[:error.offset].count("\n")
+                line = first_line + body[: error.offset].count("\n")
                 self.problems.add(error.message, source=file.where(line))
                 return None
         try:
-            return parse_yaml(body, file.source, self.problems, first_line=first_line,
-                              budget=self.values)
+            return parse_yaml(
+                body, file.source, self.problems, first_line=first_line, budget=self.values
+            )
         except TooManyValuesError:
             raise
         except NavseqError as error:
             self.problems.record(error)
             return None
 
-    def rosparam_file(self, file_name: str, file: _File, substitute: bool,
-                      element_line: int) -> Located | None:
+    def rosparam_file(
+        self, file_name: str, file: _File, substitute: bool, element_line: int
+    ) -> Located | None:
         if "$(" in file_name:
             self.not_followed.append(file.subst.explain(file_name))
             return None
@@ -277,7 +294,7 @@ class _LaunchReader:
             try:
                 text = file.subst.resolve(text)
             except SubstitutionError as error:
-                line = 1 + text[:error.offset].count("\n")
+                line = 1 + text[: error.offset].count("\n")
                 self.problems.add(error.message, source=f"{path}:{line}")
                 return None
         try:
@@ -304,13 +321,18 @@ class _LaunchReader:
         path = self.path(file_name, file)
         key = _file_key(path)
         if key in self.reading:
-            chain = " -> ".join(str(p) for p in [*self.reading[self.reading.index(key):], key])
-            self.problems.add(f"includes {file_name}, which is already being read: an include "
-                              f"cycle ({chain})", source=here)
+            chain = " -> ".join(str(p) for p in [*self.reading[self.reading.index(key) :], key])
+            self.problems.add(
+                f"includes {file_name}, which is already being read: an include cycle ({chain})",
+                source=here,
+            )
             return
         if len(self.reading) > MAX_INCLUDE_DEPTH or self.files_read >= MAX_INCLUDED_FILES:
-            self.problems.add(f"includes {file_name} beyond navseq's limits ({MAX_INCLUDE_DEPTH}"
-                              f" includes deep, {MAX_INCLUDED_FILES} files in all)", source=here)
+            self.problems.add(
+                f"includes {file_name} beyond navseq's limits ({MAX_INCLUDE_DEPTH}"
+                f" includes deep, {MAX_INCLUDED_FILES} files in all)",
+                source=here,
+            )
             return
         try:
             text = read_mission_text(path)
@@ -320,18 +342,24 @@ class _LaunchReader:
             if error.source == here:  # over the launch tree's size limit: stop reading
                 raise
             if error.source == str(path):  # the file itself is missing or unreadable
-                self.problems.add(f"includes {file_name}, which navseq cannot read: "
-                                  f"{error.message} ({path})", source=here)
+                self.problems.add(
+                    f"includes {file_name}, which navseq cannot read: {error.message} ({path})",
+                    source=here,
+                )
             else:
                 self.problems.record(error)
             return
         if root.tag != "launch":
-            self.problems.add(f"is included by {here} but is not a roslaunch file: its root "
-                              f"element is <{root.tag}>", source=f"{path}:{root.line}")
+            self.problems.add(
+                f"is included by {here} but is not a roslaunch file: its root "
+                f"element is <{root.tag}>",
+                source=f"{path}:{root.line}",
+            )
             return
         self.files_read += 1
-        included = _File(str(path), Substitution(LaunchArgs(passed), path.parent, self.packages,
-                                                 self.budget))
+        included = _File(
+            str(path), Substitution(LaunchArgs(passed), path.parent, self.packages, self.budget)
+        )
         self.reading.append(key)
         try:
             self.walk(root, inner, None, included, depth + 1)
@@ -342,10 +370,12 @@ class _LaunchReader:
         """Refuse a launch tree whose files hold more text, all together, than navseq reads."""
         self.bytes_read += len(text)
         if self.bytes_read > MAX_LAUNCH_TREE_BYTES:
-            raise NavseqError(f"the launch file and the files it includes hold more than "
-                              f"{MAX_LAUNCH_TREE_BYTES / 2**20:g} MiB of text together; "
-                              "navseq refuses to read on (a file included over and over?)",
-                              source=where)
+            raise NavseqError(
+                f"the launch file and the files it includes hold more than "
+                f"{MAX_LAUNCH_TREE_BYTES / 2**20:g} MiB of text together; "
+                "navseq refuses to read on (a file included over and over?)",
+                source=where,
+            )
 
     def passed_args(self, element: XmlElement, file: _File) -> dict[str, str] | None:
         """The args an <include> gives the included file; None when one is wrong."""
@@ -365,8 +395,9 @@ class _LaunchReader:
                 self.problems.add(error.message, source=file.where(child.line))
                 return None
             if not name or value is None:
-                self.problems.add("<arg> in an <include> needs name= and value=",
-                                  source=file.where(child.line))
+                self.problems.add(
+                    "<arg> in an <include> needs name= and value=", source=file.where(child.line)
+                )
                 return None
             passed[name] = value
         return passed

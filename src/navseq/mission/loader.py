@@ -33,8 +33,10 @@ Reader = Callable[[str, str, Path, Problems], "Mission | None"]
 # Possessive quantifiers: the match never backtracks, so it is linear in the line.
 _CSV_LINE = re.compile(r"\s*+[-+0-9.eE]++(?:\s*+,\s*+[-+0-9.eE]++)++\s*+")
 _NAVSEQ_KEYS = ("waypoints", "navseq")
-SUPPORTED = ("navseq YAML or rosparam YAML (.yaml, .yml), roslaunch XML (.launch, .xml), "
-             "CSV x,y,z,qx,qy,qz,qw (.csv)")
+SUPPORTED = (
+    "navseq YAML or rosparam YAML (.yaml, .yml), roslaunch XML (.launch, .xml), "
+    "CSV x,y,z,qx,qy,qz,qw (.csv)"
+)
 
 
 def load_mission(path: str | os.PathLike[str]) -> Mission:
@@ -112,8 +114,9 @@ def _sniff(path: Path, text: str) -> Reader:
         doc = None
     if doc is not None and doc.is_mapping:
         return _read_yaml
-    raise NavseqError(f"is not a mission file navseq can read; it reads {SUPPORTED}",
-                      source=str(path))
+    raise NavseqError(
+        f"is not a mission file navseq can read; it reads {SUPPORTED}", source=str(path)
+    )
 
 
 def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:

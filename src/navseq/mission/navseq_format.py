@@ -19,6 +19,7 @@ every problem it finds. The same readers serve ROS parameters (``~waypoints``).
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -46,40 +47,48 @@ POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
 WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_FIELDS)
 
 
-def mission_from_document(doc: Located | None, source: str, base_dir: Path | None,
-                          problems: Problems) -> Mission | None:
+def mission_from_document(
+    doc: Located | None, source: str, base_dir: Path | None, problems: Problems
+) -> Mission | None:
     """The Mission a navseq YAML document describes, or None when it has problems."""
     if doc is None:
         problems.add("is empty; a mission needs at least one waypoint", source=source)
         return None
     if not doc.is_mapping:
-        problems.add(f"must be a mapping with a 'waypoints' list, got {describe(doc.value)}",
-                     source=doc.where)
+        problems.add(
+            f"must be a mapping with a 'waypoints' list, got {describe(doc.value)}",
+            source=doc.where,
+        )
         return None
     before = len(problems)
     fields.check_keys(doc, TOP_LEVEL_KEYS, None, problems)
     version = doc.get("navseq")
-    if version is not None and (isinstance(version.value, bool)
-                                or version.value != FORMAT_VERSION):
-        problems.add(f"format version {describe(version.value)} is not supported; this navseq "
-                     f"reads version {FORMAT_VERSION}", source=version.where,
-                     subject="field navseq")
+    if version is not None and (isinstance(version.value, bool) or version.value != FORMAT_VERSION):
+        problems.add(
+            f"format version {describe(version.value)} is not supported; this navseq "
+            f"reads version {FORMAT_VERSION}",
+            source=version.where,
+            subject="field navseq",
+        )
     defaults = read_defaults(doc.get("defaults"), problems)
     waypoints_node = doc.get("waypoints")
     waypoints: tuple[Waypoint, ...] = ()
     if waypoints_node is None:
         # A misspelt 'waypoints' key is already reported with its correction.
         if not any(difflib.get_close_matches(key, ["waypoints"], cutoff=0.6) for key in doc.value):
-            problems.add("has no 'waypoints' list; a mission needs at least one waypoint "
-                         "(or p_seq/yea_seq, the tutorial's lists)", source=doc.where)
+            problems.add(
+                "has no 'waypoints' list; a mission needs at least one waypoint "
+                "(or p_seq/yea_seq, the tutorial's lists)",
+                source=doc.where,
+            )
     else:
         waypoints, numbers = read_numbered_waypoints(waypoints_node, problems)
     settings = read_settings(doc, base_dir, problems)
     if len(problems) > before:
         if waypoints:
             problems.salvage = Salvage(
-                Mission(waypoints=waypoints, defaults=defaults, source=source, **settings),
-                numbers)
+                Mission(waypoints=waypoints, defaults=defaults, source=source, **settings), numbers
+            )
         return None
     return Mission(waypoints=waypoints, defaults=defaults, source=source, **settings)
 
@@ -113,7 +122,7 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
             settings[key] = None
             continue
         before = len(problems)
-        value = fields.attempt(problems, lambda r=reader, e=entry, k=key: r(e, f"field {k}"))
+        value = fields.attempt(problems, functools.partial(reader, entry, f"field {key}"))
         if len(problems) == before:
             settings[key] = value
     return settings
@@ -122,8 +131,9 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
 def read_frame(node: Located, subject: str) -> str:
     frame = fields.text(node, subject)
     if any(ch.isspace() for ch in frame):
-        raise NavseqError(f"a frame id has no spaces, got {frame!r}", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            f"a frame id has no spaces, got {frame!r}", source=node.where, subject=subject
+        )
     return frame
 
 
@@ -136,8 +146,9 @@ def read_path(node: Located, subject: str, base_dir: Path | None) -> Path:
     """A file path as written, ``~`` expanded, anchored at ``base_dir`` when relative."""
     written = fields.text(node, subject, single_line=False)
     if "\0" in written:
-        raise NavseqError("a file path cannot contain a NUL character", source=node.where,
-                          subject=subject)
+        raise NavseqError(
+            "a file path cannot contain a NUL character", source=node.where, subject=subject
+        )
     path = Path(os.path.expanduser(written))  # unlike Path.expanduser, never raises
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
@@ -149,8 +160,11 @@ def read_loops(node: Located, subject: str) -> int | None:
     if node.value == FOREVER:
         return None
     if isinstance(node.value, str):
-        raise NavseqError(f"must be a whole number >= 1 or '{FOREVER}', got "
-                          f"{describe(node.value)}", source=node.where, subject=subject)
+        raise NavseqError(
+            f"must be a whole number >= 1 or '{FOREVER}', got {describe(node.value)}",
+            source=node.where,
+            subject=subject,
+        )
     return fields.integer(node, subject, minimum=1)
 
 
@@ -177,15 +191,20 @@ def read_waypoints(node: Located, problems: Problems) -> tuple[Waypoint, ...]:
     return read_numbered_waypoints(node, problems)[0]
 
 
-def read_numbered_waypoints(node: Located, problems: Problems,
-                            ) -> tuple[tuple[Waypoint, ...], tuple[int, ...]]:
+def read_numbered_waypoints(
+    node: Located,
+    problems: Problems,
+) -> tuple[tuple[Waypoint, ...], tuple[int, ...]]:
     """The waypoints that read without a problem, and their indices in the list."""
     items = fields.attempt(problems, lambda: fields.sequence(node, "field waypoints"))
     if items is None:
         return (), ()
     if not items:
-        problems.add("the waypoint list is empty; a mission needs at least one waypoint",
-                     source=node.where, subject="field waypoints")
+        problems.add(
+            "the waypoint list is empty; a mission needs at least one waypoint",
+            source=node.where,
+            subject="field waypoints",
+        )
         return (), ()
     read = [(index, read_waypoint(item, index, problems)) for index, item in enumerate(items)]
     check_unique_names(items, problems)
@@ -199,15 +218,19 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         return _waypoint_from_list(node, index, problems)
     label = f"waypoint {index + 1}"
     if not node.is_mapping:
-        problems.add(f"must be a mapping like {{x: 1.0, y: 2.0, yaw: 90}}, got "
-                     f"{describe(node.value)}", source=node.where, subject=label)
+        problems.add(
+            f"must be a mapping like {{x: 1.0, y: 2.0, yaw: 90}}, got {describe(node.value)}",
+            source=node.where,
+            subject=label,
+        )
         return None
     before = len(problems)
     name = None
     if node.get("name") is not None:
         name_node = node.value["name"]
-        name = fields.attempt(problems, lambda: fields.text(name_node, f"{label}, field name",
-                                                            allow_numbers=True))
+        name = fields.attempt(
+            problems, lambda: fields.text(name_node, f"{label}, field name", allow_numbers=True)
+        )
         if name is not None:
             label = f"{label} '{name}'"
     fields.check_keys(node, WAYPOINT_KEYS, label, problems)
@@ -218,23 +241,34 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
     overrides = fields.policy_values(node, label, problems)
     if len(problems) > before or x is None or y is None or yaw is None:
         return None
-    return Waypoint(x=x, y=y, z=z or 0.0, yaw=yaw, name=name,
-                    overrides=MappingProxyType(overrides), where=node.where)
+    return Waypoint(
+        x=x,
+        y=y,
+        z=z or 0.0,
+        yaw=yaw,
+        name=name,
+        overrides=MappingProxyType(overrides),
+        where=node.where,
+    )
 
 
 def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoint | None:
     label = f"waypoint {index + 1}"
     items: Sequence[Located] = node.value
     if len(items) not in (2, 3):
-        problems.add(f"the short form is [x, y] or [x, y, yaw_degrees], got {len(items)} values",
-                     source=node.where, subject=label)
+        problems.add(
+            f"the short form is [x, y] or [x, y, yaw_degrees], got {len(items)} values",
+            source=node.where,
+            subject=label,
+        )
         return None
     names = ("x", "y", "yaw")
     before = len(problems)
     readers = (fields.coordinate, fields.coordinate, fields.yaw_degrees)
-    values = [fields.attempt(problems, lambda i=item, n=name, r=read: r(
-        i, fields.field_subject(label, n)))
-        for item, name, read in zip(items, names, readers, strict=False)]
+    values = [
+        fields.attempt(problems, functools.partial(read, item, fields.field_subject(label, name)))
+        for item, name, read in zip(items, names, readers, strict=False)
+    ]
     if len(problems) > before:
         return None
     x, y, *rest = (v for v in values if v is not None)
@@ -249,8 +283,11 @@ def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:
     """
     given = [key for key in ORIENTATION_KEYS if node.get(key) is not None]
     if len(given) > 1:
-        problems.add(f"give only one of {', '.join(given)}", source=node.where,
-                     subject=fields.field_subject(owner, given[1]))
+        problems.add(
+            f"give only one of {', '.join(given)}",
+            source=node.where,
+            subject=fields.field_subject(owner, given[1]),
+        )
         return None
     if not given:
         return 0.0
@@ -279,11 +316,17 @@ def quaternion_yaw_checked(parts: Sequence[float], where: str, subject: str) -> 
     # hypot scales before squaring: components near 1e200 do not overflow to inf.
     norm = math.hypot(qx, qy, qz, qw)
     if not math.isfinite(norm):
-        raise NavseqError("the quaternion (x, y, z, w) is too long to normalise; write a "
-                          "unit quaternion", source=where, subject=subject)
+        raise NavseqError(
+            "the quaternion (x, y, z, w) is too long to normalise; write a unit quaternion",
+            source=where,
+            subject=subject,
+        )
     if norm < 1e-9:
-        raise NavseqError("the quaternion (x, y, z, w) has length 0; it is no rotation",
-                          source=where, subject=subject)
+        raise NavseqError(
+            "the quaternion (x, y, z, w) has length 0; it is no rotation",
+            source=where,
+            subject=subject,
+        )
     return fields.normalized_yaw(quaternion_to_yaw(qx / norm, qy / norm, qz / norm, qw / norm))
 
 
@@ -296,9 +339,12 @@ def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
             continue
         name = str(name_node.value)
         if name in first_use:
-            problems.add(f"the name '{fields.shortened(name)}' is already used by waypoint "
-                         f"{first_use[name] + 1}; names must be unique", source=name_node.where,
-                         subject=f"waypoint {index + 1}, field name")
+            problems.add(
+                f"the name '{fields.shortened(name)}' is already used by waypoint "
+                f"{first_use[name] + 1}; names must be unique",
+                source=name_node.where,
+                subject=f"waypoint {index + 1}, field name",
+            )
         else:
             first_use[name] = index
 
@@ -306,18 +352,21 @@ def check_unique_names(items: Sequence[Located], problems: Problems) -> None:
 NumberReader = Callable[[Located, str], float]
 
 
-def _required_number(node: Located, key: str, owner: str, problems: Problems,
-                     read: NumberReader = fields.number) -> float | None:
+def _required_number(
+    node: Located, key: str, owner: str, problems: Problems, read: NumberReader = fields.number
+) -> float | None:
     entry = node.get(key)
     if entry is None:
-        problems.add(f"'{key}' is missing", source=node.where,
-                     subject=fields.field_subject(owner, key))
+        problems.add(
+            f"'{key}' is missing", source=node.where, subject=fields.field_subject(owner, key)
+        )
         return None
     return fields.attempt(problems, lambda: read(entry, fields.field_subject(owner, key)))
 
 
-def _optional_number(node: Located, key: str, owner: str, problems: Problems,
-                     read: NumberReader = fields.number) -> float | None:
+def _optional_number(
+    node: Located, key: str, owner: str, problems: Problems, read: NumberReader = fields.number
+) -> float | None:
     entry = node.get(key)
     if entry is None:
         return None

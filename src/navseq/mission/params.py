@@ -40,8 +40,9 @@ MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_FIELDS)
 _reading_named_file: ContextVar[bool] = ContextVar("_reading_named_file", default=False)
 
 
-def mission_from_params(params: Mapping[str, Any], source: str = "param ~", *,
-                        ignore: Collection[str] = ()) -> Mission:
+def mission_from_params(
+    params: Mapping[str, Any], source: str = "param ~", *, ignore: Collection[str] = ()
+) -> Mission:
     """The mission a ROS node's private parameters describe.
 
     ``params`` is the node's private namespace as a dict (``rospy.get_param("~")``);
@@ -50,10 +51,14 @@ def mission_from_params(params: Mapping[str, Any], source: str = "param ~", *,
     any other unknown key is an error naming the closest known one. Raises
     NavseqError, or MissionErrors when there are several problems.
     """
-    values = {str(key): from_plain(value, f"{source}{key}") for key, value in params.items()
-              if str(key) not in ignore}
-    namespace = Located(values, source.rstrip() or "params",
-                        {key: node.where for key, node in values.items()})
+    values = {
+        str(key): from_plain(value, f"{source}{key}")
+        for key, value in params.items()
+        if str(key) not in ignore
+    }
+    namespace = Located(
+        values, source.rstrip() or "params", {key: node.where for key, node in values.items()}
+    )
     problems = Problems()
     mission = mission_from_namespace(namespace, problems, base_dir=None, strict=True)
     problems.raise_if_any()
@@ -61,8 +66,9 @@ def mission_from_params(params: Mapping[str, Any], source: str = "param ~", *,
     return mission
 
 
-def mission_from_namespace(namespace: Located, problems: Problems, *, base_dir: Path | None,
-                           strict: bool) -> Mission | None:
+def mission_from_namespace(
+    namespace: Located, problems: Problems, *, base_dir: Path | None, strict: bool
+) -> Mission | None:
     """Build the mission from one parameter namespace, recording every problem.
 
     ``strict`` reports unknown keys (a node's own namespace); launch and rosparam
@@ -77,23 +83,26 @@ def mission_from_namespace(namespace: Located, problems: Problems, *, base_dir: 
         given.insert(0, f"{POSITIONS_KEY}/{YAWS_KEY}")
     if len(given) != 1:
         what = " and ".join(given) if given else "none of them"
-        problems.add(f"give the waypoints exactly one way: {POSITIONS_KEY} + {YAWS_KEY} (the "
-                     f"tutorial's lists), waypoints, or mission (a file); found {what}",
-                     source=namespace.where)
+        problems.add(
+            f"give the waypoints exactly one way: {POSITIONS_KEY} + {YAWS_KEY} (the "
+            f"tutorial's lists), waypoints, or mission (a file); found {what}",
+            source=namespace.where,
+        )
         return None
     settings = read_settings(namespace, base_dir, problems)
     policy = fields.policy_values(namespace, None, problems)
     if given[0] == "mission" and _reading_named_file.get():
-        problems.add("a mission file named by a 'mission' parameter cannot itself name "
-                     "another one", source=namespace.value["mission"].where,
-                     subject="field mission")
+        problems.add(
+            "a mission file named by a 'mission' parameter cannot itself name another one",
+            source=namespace.value["mission"].where,
+            subject="field mission",
+        )
         return None
     if given[0] == "mission":
         base = _mission_from_file(namespace.value["mission"], base_dir, problems)
         if base is None or len(problems) > before:
             return None
-        return dataclasses.replace(base, defaults=base.defaults.with_overrides(policy),
-                                   **settings)
+        return dataclasses.replace(base, defaults=base.defaults.with_overrides(policy), **settings)
     waypoints: tuple[Waypoint, ...]
     if given[0] == "waypoints":
         waypoints = read_waypoints(namespace.value["waypoints"], problems)
@@ -107,8 +116,7 @@ def mission_from_namespace(namespace: Located, problems: Problems, *, base_dir: 
     return Mission(waypoints=waypoints, defaults=Policy(**policy), source=source, **settings)
 
 
-def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems
-                       ) -> Mission | None:
+def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems) -> Mission | None:
     from navseq.errors import NavseqError
     from navseq.mission.loader import load_mission  # the loader reads launch files via here
 
@@ -116,8 +124,11 @@ def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems
     if path is None:
         return None
     if "$(" in str(path):
-        problems.add(f"uses a roslaunch substitution ({node.value[:40]}) that navseq cannot "
-                     "resolve here", source=node.where, subject="field mission")
+        problems.add(
+            f"uses a roslaunch substitution ({node.value[:40]}) that navseq cannot resolve here",
+            source=node.where,
+            subject="field mission",
+        )
         return None
     token = _reading_named_file.set(True)
     try:

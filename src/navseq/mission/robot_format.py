@@ -22,6 +22,7 @@ with file:line and field; an unknown name names the closest known one.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -111,8 +112,13 @@ def read_robot(node: Located, subject: str = "field robot") -> RobotProfile:
             continue
         value = fields.attempt(
             problems,
-            lambda e=entry, k=key, u=unit: fields.bounded_number(
-                e, f"robot, field {k}", minimum=0.0, inclusive=k not in _POSITIVE_KEYS, unit=u
+            functools.partial(
+                fields.bounded_number,
+                entry,
+                f"robot, field {key}",
+                minimum=0.0,
+                inclusive=key not in _POSITIVE_KEYS,
+                unit=unit,
             ),
         )
         if value is not None:

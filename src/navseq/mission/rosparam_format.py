@@ -28,21 +28,28 @@ def find_mission_namespaces(tree: Located, name: str = "/") -> list[tuple[str, L
     return found
 
 
-def mission_from_tree(tree: Located, source: str, base_dir: Path | None, problems: Problems,
-                      *, not_followed: list[str] | None = None) -> Mission | None:
+def mission_from_tree(
+    tree: Located,
+    source: str,
+    base_dir: Path | None,
+    problems: Problems,
+    *,
+    not_followed: list[str] | None = None,
+) -> Mission | None:
     """The one mission in a parameter tree; ``not_followed`` names files navseq skipped."""
     namespaces = find_mission_namespaces(tree)
     if not namespaces:
         hint = ""
         if not_followed:
             hint = f" (navseq could not follow: {', '.join(not_followed)})"
-        problems.add(f"sets no p_seq/yea_seq, waypoints or mission parameter{hint}",
-                     source=source)
+        problems.add(f"sets no p_seq/yea_seq, waypoints or mission parameter{hint}", source=source)
         return None
     if len(namespaces) > 1:
         names = ", ".join(name for name, _ in namespaces)
-        problems.add(f"several namespaces give waypoints ({names}); navseq reads one mission "
-                     "per file", source=source)
+        problems.add(
+            f"several namespaces give waypoints ({names}); navseq reads one mission per file",
+            source=source,
+        )
         return None
     _, namespace = namespaces[0]
     mission = mission_from_namespace(namespace, problems, base_dir=base_dir, strict=False)

@@ -46,12 +46,12 @@ def _represent_text(dumper: yaml.SafeDumper, data: str) -> yaml.ScalarNode:
 _LINE_BREAKS = "\n\r\x85\u2028\u2029"
 _MissionDumper.add_representer(str, _represent_text)
 # The reader takes plain ``1e3`` as a number (YAML 1.2); text that looks like it is quoted.
-_MissionDumper.add_implicit_resolver("tag:yaml.org,2002:float", EXPONENT_FLOAT,
-                                     list("-+0123456789."))
+_MissionDumper.add_implicit_resolver(
+    "tag:yaml.org,2002:float", EXPONENT_FLOAT, list("-+0123456789.")
+)
 _MissionDumper.add_representer(
     _FlowMapping,
-    lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data,
-                                                  flow_style=True),
+    lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=True),
 )
 
 
@@ -70,12 +70,17 @@ def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
     doc["server_timeout"] = mission.server_timeout
     doc["defaults"] = _policy_values(mission.defaults, POLICY_FIELDS)
     doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
-    return HEADER + yaml.dump(doc, Dumper=_MissionDumper, sort_keys=False,
-                              default_flow_style=False, allow_unicode=True, width=4096)
+    return HEADER + yaml.dump(
+        doc,
+        Dumper=_MissionDumper,
+        sort_keys=False,
+        default_flow_style=False,
+        allow_unicode=True,
+        width=4096,
+    )
 
 
-def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: bool = False
-                  ) -> None:
+def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: bool = False) -> None:
     """Write ``mission`` to ``path`` as navseq YAML, atomically.
 
     Refuses to replace an existing file unless ``overwrite`` is true. The text goes
@@ -85,8 +90,7 @@ def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: boo
     target = Path(path)
     source = str(target)
     if target.is_dir():
-        raise NavseqError("is a folder; give the path of the mission file to write",
-                          source=source)
+        raise NavseqError("is a folder; give the path of the mission file to write", source=source)
     if not target.parent.is_dir():
         raise NavseqError(f"the folder {target.parent} does not exist", source=source)
     if target.exists() and not overwrite:
@@ -97,8 +101,7 @@ def write_mission(mission: Mission, path: str | os.PathLike[str], overwrite: boo
     except FileExistsError:
         raise NavseqError("exists already; not overwriting it", source=source) from None
     except OSError as error:
-        raise NavseqError(f"cannot be written: {error.strerror or error}",
-                          source=source) from None
+        raise NavseqError(f"cannot be written: {error.strerror or error}", source=source) from None
 
 
 def yaw_degrees_for_file(yaw: float) -> float | int:
@@ -155,8 +158,12 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
     if waypoint.z != 0.0:
         entry["z"] = waypoint.z
     entry.update(_yaw_entry(waypoint.yaw))
-    entry.update(_policy_values(Policy().with_overrides(waypoint.overrides),
-                                [key for key in POLICY_FIELDS if key in waypoint.overrides]))
+    entry.update(
+        _policy_values(
+            Policy().with_overrides(waypoint.overrides),
+            [key for key in POLICY_FIELDS if key in waypoint.overrides],
+        )
+    )
     return entry
 
 
@@ -164,6 +171,7 @@ def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
     values = {key: getattr(policy, key) for key in keys}
     if values.get("yaw_tolerance") is not None:
         values["yaw_tolerance"] = round(math.degrees(values["yaw_tolerance"]), 6)
-    return {key: value.value if isinstance(value, FailureAction) else value
-            for key, value in values.items()}
-
+    return {
+        key: value.value if isinstance(value, FailureAction) else value
+        for key, value in values.items()
+    }

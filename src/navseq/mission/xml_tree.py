@@ -45,8 +45,10 @@ def parse_xml(text: str, source: str) -> XmlElement:
         (stack[-1].children if stack else roots).append(element)
         stack.append(element)
         if len(stack) > MAX_DEPTH:
-            raise NavseqError(f"nests elements more than {MAX_DEPTH} deep",
-                              source=f"{source}:{parser.CurrentLineNumber}")
+            raise NavseqError(
+                f"nests elements more than {MAX_DEPTH} deep",
+                source=f"{source}:{parser.CurrentLineNumber}",
+            )
 
     def end(tag: str) -> None:
         stack.pop()
@@ -58,9 +60,11 @@ def parse_xml(text: str, source: str) -> XmlElement:
             stack[-1].text.append(data)
 
     def refuse_dtd(*args: object) -> None:
-        raise NavseqError("declares a DTD or entities; navseq's XML files have no use for them and "
-                          "navseq does not expand them",
-                          source=f"{source}:{parser.CurrentLineNumber}")
+        raise NavseqError(
+            "declares a DTD or entities; navseq's XML files have no use for them and "
+            "navseq does not expand them",
+            source=f"{source}:{parser.CurrentLineNumber}",
+        )
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
@@ -71,8 +75,9 @@ def parse_xml(text: str, source: str) -> XmlElement:
         parser.Parse(text, True)
     except expat.ExpatError as error:
         message = expat.errors.messages[error.code]
-        raise NavseqError(f"is not well-formed XML: {message}",
-                          source=f"{source}:{error.lineno}") from None
+        raise NavseqError(
+            f"is not well-formed XML: {message}", source=f"{source}:{error.lineno}"
+        ) from None
     if not roots:
         raise NavseqError("has no XML element", source=source)
     return roots[0]

@@ -1,7 +1,8 @@
 """Safe YAML parsing into :class:`Located` trees with line numbers.
 
-PyYAML's SafeLoader *composes* the document (syntax only, no object construction);
-navseq then walks the node graph itself so that every value keeps its line number.
+PyYAML *composes* the document (syntax only, no object construction; libyaml's C
+parser where installed); navseq then walks the node graph itself so that every value
+keeps its line number.
 Only plain YAML types are accepted (null, bool, int, float, str, lists, mappings):
 any other tag is an error. Aliases are allowed, but before anything is built the
 document's size *with aliases expanded* is computed on the node graph (linear in
@@ -27,12 +28,11 @@ from navseq.text import text_problem
 # hold at most this many values more than were written.
 MAX_ALIAS_EXPANSION = 100_000
 
-# About 10 000 waypoints written long-hand, 25 000 as [x, y, yaw]: far above a real
-# mission, and read in a few seconds.
-MAX_VALUES = 100_000
+# About 160 000 waypoints written long-hand: a 100 000-waypoint mission (recorded
+# patrols) still loads, while a 10 MiB file of tiny values is refused before composing.
+MAX_VALUES = 1_000_000
 MAX_VALUES_VARIABLE = "NAVSEQ_MAX_YAML_VALUES"
-_VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent,
-                 yaml.AliasEvent)
+_VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent, yaml.AliasEvent)
 _FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 _TAG = "tag:yaml.org,2002:"
@@ -44,8 +44,14 @@ _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 EXPONENT_FLOAT = re.compile(r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)[eE][-+]?+\d++")
 
 
-def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 1,
-               budget: ValueBudget | None = None) -> Located | None:
+def parse_yaml(
+    text: str,
+    source: str,
+    problems: Problems,
+    *,
+    first_line: int = 1,
+    budget: ValueBudget | None = None,
+) -> Located | None:
     """Parse one YAML document. Syntax errors raise; duplicate keys are recorded.
 
     ``first_line`` is the file line of the text's first line (YAML inside a launch
@@ -55,7 +61,7 @@ def parse_yaml(text: str, source: str, problems: Problems, *, first_line: int = 
     offset = first_line - 1
     try:
         _spend_values(text, source, offset, budget or ValueBudget())
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_FAST_LOADER)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = f"{source}:{mark.line + 1 + offset}" if mark is not None else source
@@ -88,8 +94,8 @@ class ValueBudget:
 def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> None:
     """Count the document's values against ``budget`` before composing it; refuse excess.
 
-    PyYAML composes some 15 000 values a second; the 10 MiB a file may hold can write
-    millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
+    Composing and checking cost some 20 µs a value; the 10 MiB a file may hold can
+    write millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
     parser where installed) is linear and quick, and stops at the limit. Syntax
     errors are left to the composer, which reports them with their lines.
     """
@@ -99,20 +105,23 @@ def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> N
             if isinstance(event, _VALUE_EVENTS):
                 count += 1
                 if count > budget.left:
-                    line = event.start_mark.line + 1 + offset
+                    mark = event.start_mark
+                    line = (mark.line if mark is not None else 0) + 1 + offset
                     raise TooManyValuesError(
                         f"holds more than {budget.limit:,} YAML values (with the documents "
                         "read before it); navseq refuses missions this large (write long "
                         "recorded paths as CSV, or set the environment variable "
                         f"{MAX_VALUES_VARIABLE} to raise the limit)",
-                        source=f"{source}:{line}")
+                        source=f"{source}:{line}",
+                    )
     except yaml.YAMLError:
         pass
     budget.left -= count
 
 
-def parse_yaml_value(text: str, source: str, *, first_line: int = 1,
-                     budget: ValueBudget | None = None) -> Located | None:
+def parse_yaml_value(
+    text: str, source: str, *, first_line: int = 1, budget: ValueBudget | None = None
+) -> Located | None:
     """A YAML value written inside another file (a launch file's attribute or body)."""
     problems = Problems()
     result = parse_yaml(text, source, problems, first_line=first_line, budget=budget)
@@ -140,11 +149,13 @@ class _Walker:
             if key in sizes:
                 return sizes[key]
             if key in in_progress:
-                raise NavseqError("an alias refers to a value that contains it (a loop)",
-                                  source=self.where(node))
+                raise NavseqError(
+                    "an alias refers to a value that contains it (a loop)", source=self.where(node)
+                )
             if depth > MAX_DEPTH:
-                raise NavseqError(f"is nested more than {MAX_DEPTH} levels deep",
-                                  source=self.where(node))
+                raise NavseqError(
+                    f"is nested more than {MAX_DEPTH} levels deep", source=self.where(node)
+                )
             in_progress.add(key)
             if isinstance(node, SequenceNode):
                 children: list[Node] = node.value
@@ -159,8 +170,11 @@ class _Walker:
 
         total = expanded_size(root, 0)
         if total > len(sizes) + MAX_ALIAS_EXPANSION:
-            raise NavseqError(f"has aliases that expand {len(sizes)} written values to {total}; "
-                              "refusing it (an alias bomb?)", source=self.where(root))
+            raise NavseqError(
+                f"has aliases that expand {len(sizes)} written values to {total}; "
+                "refusing it (an alias bomb?)",
+                source=self.where(root),
+            )
 
     def where(self, node: Node) -> str:
         return f"{self.source}:{node.start_mark.line + 1 + self.line_offset}"
@@ -185,37 +199,42 @@ class _Walker:
     def require_tag(self, node: Node, tag: str) -> None:
         if node.tag != tag:
             kind = str(node.tag).removeprefix(_TAG)
-            raise NavseqError(f"uses the YAML type '{kind}', which navseq does not accept",
-                              source=self.where(node))
+            raise NavseqError(
+                f"uses the YAML type '{kind}', which navseq does not accept",
+                source=self.where(node),
+            )
 
     def scalar(self, node: ScalarNode) -> Any:
         if node.tag not in _SCALAR_TAGS:
             kind = node.tag.removeprefix(_TAG)
-            raise NavseqError(f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
-                              "navseq does not accept (quote it if it is text)",
-                              source=self.where(node))
+            raise NavseqError(
+                f"the value {node.value[:40]!r} has the YAML type '{kind}', which "
+                "navseq does not accept (quote it if it is text)",
+                source=self.where(node),
+            )
         problem = text_problem(node.value, single_line=False)
         if problem is not None:  # also in keys: messages print them
             raise NavseqError(f"the text {node.value[:40]!r} {problem}", source=self.where(node))
-        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(
-            node.value
-        ):
+        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(node.value):
             return float(node.value)
         try:
             return self.constructor.construct_object(node)
         # PyYAML's constructors fail on some empty or odd values (``!!float ""``:
         # IndexError, ``!!bool maybe``: KeyError) with more than YAMLError.
         except (yaml.YAMLError, ValueError, OverflowError, LookupError, TypeError) as error:
-            raise NavseqError(f"cannot read the value {node.value[:40]!r}: {error}",
-                              source=self.where(node)) from None
+            raise NavseqError(
+                f"cannot read the value {node.value[:40]!r}: {error}", source=self.where(node)
+            ) from None
 
     def mapping(self, node: MappingNode, depth: int) -> Located:
         values: dict[str, Located] = {}
         key_where: dict[str, str] = {}
         for key_node, value_node in self.entries(node, depth):
             if not isinstance(key_node, ScalarNode):
-                raise NavseqError("has a key that is a list or mapping; keys must be names",
-                                  source=self.where(key_node))
+                raise NavseqError(
+                    "has a key that is a list or mapping; keys must be names",
+                    source=self.where(key_node),
+                )
             key = key_node.value
             problem = text_problem(key, single_line=False)
             if problem is not None:
@@ -244,8 +263,9 @@ class _Walker:
             sources = value_node.value if isinstance(value_node, SequenceNode) else [value_node]
             for source in sources:
                 if not isinstance(source, MappingNode):
-                    raise NavseqError("a merge key (<<) must refer to a mapping",
-                                      source=self.where(source))
+                    raise NavseqError(
+                        "a merge key (<<) must refer to a mapping", source=self.where(source)
+                    )
                 merged.extend(self.entries(source, depth + 1))
         names = {k.value for k, _ in explicit if isinstance(k, ScalarNode)}
         kept: list[tuple[Node, Node]] = []

@@ -30,6 +30,7 @@ from navseq.navigators.base import (
 from navseq.sim.navserver import NavParams, NavState
 from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
+from navseq.track import Track
 
 _TERMINAL = {NavState.SUCCEEDED: GoalStatus.SUCCEEDED, NavState.ABORTED: GoalStatus.ABORTED}
 
@@ -37,8 +38,9 @@ _TERMINAL = {NavState.SUCCEEDED: GoalStatus.SUCCEEDED, NavState.ABORTED: GoalSta
 class SimNavigator:
     """A :class:`navseq.navigators.base.Navigator` on an in-process simulated robot.
 
-    ``trajectory`` records ``(t, x, y)`` of the robot at the start and after every
-    step in which it moved, for reports and pictures.
+    ``trajectory`` records ``(t, x, y)`` of the robot at the start and whenever it
+    has moved 5 mm (or a 0.05 s step passed), for reports and pictures; it is a
+    :class:`~navseq.track.Track`, so it stays bounded on a patrol that runs for days.
     """
 
     def __init__(self, world: SimWorld, *, feedback_period: float = 0.2) -> None:
@@ -47,7 +49,8 @@ class SimNavigator:
         self.world = world
         self.feedback_period = feedback_period
         pose = world.robot.pose
-        self.trajectory: list[tuple[float, float, float]] = [(world.time, pose.x, pose.y)]
+        self.trajectory = Track(min_step=0.005, min_interval=0.05)
+        self.trajectory.append((world.time, pose.x, pose.y))
         self._events: list[NavEvent] = []
         self._active: Goal | None = None
         self._plan_version = world.server.plan_version

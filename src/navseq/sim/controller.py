@@ -137,8 +137,9 @@ class RegulatedPurePursuit:
             self.distance_remaining = distance_to_goal
             return 0.0, self._turn_to_goal_yaw(yaw, w)
 
-        lookahead = min(max(abs(v) * params.lookahead_time, params.min_lookahead),
-                        params.max_lookahead)
+        lookahead = min(
+            max(abs(v) * params.lookahead_time, params.min_lookahead), params.max_lookahead
+        )
         carrot_x, carrot_y = self._carrot_point(x, y, lookahead)
         dx, dy = carrot_x - x, carrot_y - y
         cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
@@ -246,8 +247,11 @@ class RegulatedPurePursuit:
                 angle -= math.copysign(2.0 * math.pi, angle)
             else:
                 self._long_way_sign = 0.0
-        rate = min(params.rotate_speed, params.limits.max_w,
-                   math.sqrt(2.0 * params.rotate_decel * abs(angle)))
+        rate = min(
+            params.rotate_speed,
+            params.limits.max_w,
+            math.sqrt(2.0 * params.rotate_decel * abs(angle)),
+        )
         return math.copysign(rate, angle)
 
 

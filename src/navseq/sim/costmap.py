@@ -73,8 +73,8 @@ class Costmap:
 
     grid: OccupancyGrid
     params: CostmapParams = field(default_factory=CostmapParams)
-    cost: np.ndarray = field(default=None)  # type: ignore[assignment]
-    clearance: np.ndarray = field(default=None)  # type: ignore[assignment]
+    cost: np.ndarray = field(default=None)  # type: ignore[arg-type]
+    clearance: np.ndarray = field(default=None)  # type: ignore[arg-type]
 
     def __post_init__(self) -> None:
         if self.cost is None:
@@ -119,16 +119,16 @@ class Costmap:
         """True if the cell under this point is traversable: the robot, centred there, can
         turn in place without touching anything (see the module docstring)."""
         row, col = self.grid.world_to_cell(x, y)
-        return self.grid.in_bounds(row, col) and bool(self._traversable[row, col])
+        return self.grid.in_bounds(row, col) and bool(self.free_mask()[row, col])
 
     def free_mask(self) -> np.ndarray:
         """Cells where the planner may put the robot centre (read-only)."""
-        return self._traversable  # type: ignore[attr-defined,no-any-return]
+        return self._traversable  # type: ignore[attr-defined]
 
     @property
     def planning_cost(self) -> np.ndarray:
         """``cost`` with every cell that is not traversable raised to ``INSCRIBED``."""
-        return self._planning_cost  # type: ignore[attr-defined,no-any-return]
+        return self._planning_cost  # type: ignore[attr-defined]
 
     def clearance_at(self, x: float, y: float) -> float:
         """The clearance (m) of the cell under a world point; 0 off the map."""

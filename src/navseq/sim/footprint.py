@@ -222,7 +222,7 @@ class _PlacedHull:
         separated = _separated(
             hull_min, hull_max, centre_projection - half_extent, centre_projection + half_extent
         )
-        return ~separated.any(axis=1)
+        return np.asarray(~separated.any(axis=1))
 
 
 _EPSILON = 1e-9

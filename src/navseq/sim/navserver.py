@@ -137,7 +137,7 @@ class NavigationServer:
         self._needs_plan = False
         self._since_plan = 0.0
         self._goal_time = 0.0
-        self._blocked_since = None
+        self._blocked_since: float | None = None  # goal time the controller was first blocked
         self._remaining_when_blocked = math.inf
         self._blocked_by_robot = False
         self._escape_command = (0.0, 0.0)
@@ -150,7 +150,7 @@ class NavigationServer:
         self._remaining_when_waiting = math.inf
         self._pending_recoveries: list[str] = []
         self._recovery_rounds_left = 0
-        self._recovery = None
+        self._recovery: _Recovery | None = None
         self._remaining_at_recovery = math.inf
         self.recoveries_run = 0
         self.costmap_version = 0
@@ -166,16 +166,16 @@ class NavigationServer:
         self.distance_remaining = None
         self._needs_plan = True
         self._goal_time = 0.0
-        self._blocked_since: float | None = None  # goal time the controller was first blocked
+        self._blocked_since = None  # goal time the controller was first blocked
         self._remaining_when_blocked = math.inf
         self._blocked_by_robot = False  # ... by another robot only, not by the map
         self._escape_time_left = 0.0
         self._waiting = False
-        self._waiting_since: float | None = None  # goal time another robot first blocked the way
+        self._waiting_since = None  # goal time another robot first blocked the way
         self._remaining_when_waiting = math.inf
         self._pending_recoveries = list(RECOVERY_BEHAVIOURS)
         self._recovery_rounds_left = self.params.recovery_rounds - 1
-        self._recovery: _Recovery | None = None
+        self._recovery = None
         self._remaining_at_recovery = math.inf
         self.recoveries_run = 0  # behaviours run for this goal (tests, reports)
 

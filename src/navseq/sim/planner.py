@@ -30,7 +30,7 @@ import numpy as np
 from navseq.sim.costmap import INSCRIBED, Costmap
 
 try:  # the optional compiled search; the fallback below gives the same plans
-    from navseq.sim import _astar as _compiled_astar
+    from navseq.sim import _astar as _compiled_astar  # type: ignore[attr-defined]
 except ImportError:  # pragma: no cover - depends on the build
     _compiled_astar = None
 
@@ -119,7 +119,7 @@ def search_cells(
     heuristic_scale = float(finite.min()) if finite.size else 1.0
     start_index = start[0] * width + start[1]
     goal_index = goal[0] * width + goal[1]
-    search = _compiled_astar.search if compiled else _search_python  # type: ignore[union-attr]
+    search = _compiled_astar.search if compiled else _search_python
     found = search(cost, width, lut, start_index, goal_index, heuristic_scale)
     if found is None:
         return None

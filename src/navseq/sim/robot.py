@@ -71,8 +71,9 @@ def integrate_arc(x: float, y: float, yaw: float, v: float, w: float, dt: float)
     sinc = math.sin(half) / half if half != 0.0 else 1.0
     chord = v * dt * sinc
     heading = yaw + half
-    return Pose2D(x + chord * math.cos(heading), y + chord * math.sin(heading),
-                  wrap_angle(yaw + turn))
+    return Pose2D(
+        x + chord * math.cos(heading), y + chord * math.sin(heading), wrap_angle(yaw + turn)
+    )
 
 
 class DiffDriveRobot:

@@ -66,8 +66,13 @@ class SimWorld:
         self.server = NavigationServer(self.costmap, nav_params, footprint)
         # A command arrives every step, so the body's command timeout (two steps, against
         # rounding) never applies.
-        self.body = SimulatedBase(start, grid, footprint=footprint,
-                                  limits=self.server.params.limits, cmd_vel_timeout=2 * dt)
+        self.body = SimulatedBase(
+            start,
+            grid,
+            footprint=footprint,
+            limits=self.server.params.limits,
+            cmd_vel_timeout=2 * dt,
+        )
         if self.body.collides(start):
             raise self._collision_error(start, "start")
         self.time = 0.0
@@ -141,4 +146,3 @@ def default_start(grid: OccupancyGrid, footprint: Footprint = TURTLEBOT3_BURGER)
     centres = grid.cells_to_world(rows, cols)
     nearest = int(np.argmin(np.hypot(centres[:, 0], centres[:, 1])))
     return Pose2D(float(centres[nearest, 0]), float(centres[nearest, 1]), 0.0)
-

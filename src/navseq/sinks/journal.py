@@ -166,7 +166,7 @@ class JournalWriter:
         # Refuse to append to something that is not an intact journal; go on with its chain.
         writer._chain = read_journal(writer.path).chain
         writer._open(0, fsync)
-        if not _ends_with_newline(writer.path):
+        if not _ends_with_newline(writer.path) and writer._fd is not None:
             os.write(writer._fd, b"\n")  # end the line a crash cut short
         writer._write(
             {
@@ -596,7 +596,7 @@ def _event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | 
         for spec in dataclasses.fields(cls):
             if spec.name in record:
                 values[spec.name] = _coerce(record[spec.name], hints[spec.name])
-        return cls(**values)  # type: ignore[no-any-return]
+        return cls(**values)
     except (TypeError, ValueError) as error:
         raise NavseqError(
             f"journal event {cls.__name__} is malformed: {error}", source=where

@@ -31,6 +31,7 @@ from navseq.text import printable
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
     from navseq.sim.occupancy import OccupancyGrid
@@ -203,7 +204,7 @@ def _draw_pose_arrow(
     )
 
 
-def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> object | None:
+def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> LineCollection | None:
     """Driven path coloured by mission time; returns the collection for a colour bar."""
     from matplotlib.collections import LineCollection
 
@@ -229,8 +230,11 @@ def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> 
     reached = sum(
         1 for visit in result.visits if WaypointOutcome(visit.outcome) == WaypointOutcome.REACHED
     )
-    verdict = "success" if result.success else (f"interrupted ({interrupted})"
-                                                if interrupted else result.reason)
+    verdict = (
+        "success"
+        if result.success
+        else (f"interrupted ({interrupted})" if interrupted else result.reason)
+    )
     return (
         f"{name} — {verdict}\n"
         f"{reached}/{len(result.visits)} visits reached · {result.duration:.1f} s · "
@@ -238,8 +242,9 @@ def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> 
     )
 
 
-def draw_mission_picture(path: Path, mission: Mission, result: MissionResult, **drawing: Any
-                         ) -> None:
+def draw_mission_picture(
+    path: Path, mission: Mission, result: MissionResult, **drawing: Any
+) -> None:
     """Draw the run into a PNG at ``path`` (written atomically: temp file, then rename).
 
     ``drawing`` takes the keyword arguments of :func:`mission_picture_png`.
@@ -325,8 +330,15 @@ def mission_figure(
     arrow_width = 0.0045 * scale
 
     for plan in plan_arrays:
-        ax.plot(plan[:, 0], plan[:, 1], linestyle=(0, (4, 3)), linewidth=1.0,
-                color=PLAN_COLOUR, alpha=0.85, zorder=2)
+        ax.plot(
+            plan[:, 0],
+            plan[:, 1],
+            linestyle=(0, (4, 3)),
+            linewidth=1.0,
+            color=PLAN_COLOUR,
+            alpha=0.85,
+            zorder=2,
+        )
     lines = _draw_trajectory(ax, traj)
 
     outcomes = waypoint_outcomes(result, len(waypoints))
@@ -336,50 +348,130 @@ def mission_figure(
         colour = OUTCOME_COLOURS[outcome]
         radius = mission.policy_for(index).pass_through
         if radius and index != last and mission.policy_for(index).dwell == 0:
-            ax.add_patch(Circle((waypoint.x, waypoint.y), radius, fill=False, edgecolor=colour,
-                                linestyle=(0, (2, 2)), linewidth=1.0, zorder=4))
+            ax.add_patch(
+                Circle(
+                    (waypoint.x, waypoint.y),
+                    radius,
+                    fill=False,
+                    edgecolor=colour,
+                    linestyle=(0, (2, 2)),
+                    linewidth=1.0,
+                    zorder=4,
+                )
+            )
             drew_radius = True
         _draw_pose_arrow(ax, waypoint.pose, arrow_length, colour, zorder=5, width=arrow_width)
-        ax.plot(waypoint.x, waypoint.y, marker="o", markersize=15, color=colour,
-                markeredgecolor="black", markeredgewidth=0.8, zorder=6)
-        ax.text(waypoint.x, waypoint.y, str(index + 1), ha="center", va="center",
-                fontsize=7.5, fontweight="bold", color="white", zorder=7)
+        ax.plot(
+            waypoint.x,
+            waypoint.y,
+            marker="o",
+            markersize=15,
+            color=colour,
+            markeredgecolor="black",
+            markeredgewidth=0.8,
+            zorder=6,
+        )
+        ax.text(
+            waypoint.x,
+            waypoint.y,
+            str(index + 1),
+            ha="center",
+            va="center",
+            fontsize=7.5,
+            fontweight="bold",
+            color="white",
+            zorder=7,
+        )
         if waypoint.name:
-            ax.annotate(printable(waypoint.name), (waypoint.x, waypoint.y), xytext=(9, -12),
-                        textcoords="offset points", fontsize=7, color="#222222", zorder=7,
-                        bbox={"boxstyle": "round,pad=0.15", "facecolor": "white",
-                              "edgecolor": "none", "alpha": 0.75})
+            ax.annotate(
+                printable(waypoint.name),
+                (waypoint.x, waypoint.y),
+                xytext=(9, -12),
+                textcoords="offset points",
+                fontsize=7,
+                color="#222222",
+                zorder=7,
+                bbox={
+                    "boxstyle": "round,pad=0.15",
+                    "facecolor": "white",
+                    "edgecolor": "none",
+                    "alpha": 0.75,
+                },
+            )
 
     if start is not None:
         # Under the waypoint markers and a little larger, so that a waypoint at the
         # start pose (a tour that returns home) stays visible with the square around it.
         _draw_pose_arrow(ax, start, arrow_length, START_COLOUR, zorder=4.5, width=arrow_width)
-        ax.plot(start.x, start.y, marker="s", markersize=17, color=START_COLOUR,
-                markeredgecolor="black", markeredgewidth=0.8, zorder=5.5)
+        ax.plot(
+            start.x,
+            start.y,
+            marker="s",
+            markersize=17,
+            color=START_COLOUR,
+            markeredgecolor="black",
+            markeredgewidth=0.8,
+            zorder=5.5,
+        )
 
     handles = [
-        Line2D([], [], marker="o", linestyle="none", markersize=9, color=OUTCOME_COLOURS[o],
-               markeredgecolor="black", label=OUTCOME_LABELS[o])
+        Line2D(
+            [],
+            [],
+            marker="o",
+            linestyle="none",
+            markersize=9,
+            color=OUTCOME_COLOURS[o],
+            markeredgecolor="black",
+            label=OUTCOME_LABELS[o],
+        )
         for o in WaypointOutcome
         if o in outcomes or o == WaypointOutcome.REACHED
     ]
     if start is not None:
-        handles.append(Line2D([], [], marker="s", linestyle="none", markersize=8,
-                              color=START_COLOUR, markeredgecolor="black", label="start"))
+        handles.append(
+            Line2D(
+                [],
+                [],
+                marker="s",
+                linestyle="none",
+                markersize=8,
+                color=START_COLOUR,
+                markeredgecolor="black",
+                label="start",
+            )
+        )
     if plan_arrays:
-        handles.append(Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR,
-                              label="planned path"))
+        handles.append(
+            Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR, label="planned path")
+        )
     if drew_radius:
-        handles.append(Line2D([], [], marker="o", markersize=11, fillstyle="none",
-                              linestyle="none", markeredgecolor="#555555",
-                              label="pass-through radius"))
+        handles.append(
+            Line2D(
+                [],
+                [],
+                marker="o",
+                markersize=11,
+                fillstyle="none",
+                linestyle="none",
+                markeredgecolor="#555555",
+                label="pass-through radius",
+            )
+        )
     if lines is not None:
         handles.append(Line2D([], [], linewidth=2.4, color="#21918c", label="driven path"))
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),
-              borderaxespad=0.0, fontsize=8, frameon=False)
+    ax.legend(
+        handles=handles,
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+        borderaxespad=0.0,
+        fontsize=8,
+        frameon=False,
+    )
     if lines is not None:
-        bar = fig.colorbar(lines, ax=ax, location="right", fraction=0.035, pad=0.02,
-                           anchor=(0.0, 0.0), shrink=0.55)
+        bar = fig.colorbar(
+            lines, ax=ax, location="right", fraction=0.035, pad=0.02, anchor=(0.0, 0.0), shrink=0.55
+        )
         bar.set_label("mission time [s]", fontsize=8)
         bar.ax.tick_params(labelsize=7)
 

@@ -190,8 +190,11 @@ class LiveProgress:
             Text.assemble(
                 *(
                     (f"{OUTCOME_MARK[o]} {view.totals[o]}  ", OUTCOME_STYLE[o])
-                    for o in (WaypointOutcome.REACHED, WaypointOutcome.SKIPPED,
-                              WaypointOutcome.FAILED)
+                    for o in (
+                        WaypointOutcome.REACHED,
+                        WaypointOutcome.SKIPPED,
+                        WaypointOutcome.FAILED,
+                    )
                 )
             ),
         )
@@ -226,8 +229,9 @@ class LiveProgress:
                 else:
                     marks.append(f"{index + 1}· ", "grey50")
             rows.append(marks)
-        rows.extend(Text(line, style="dim", overflow="ellipsis", no_wrap=True)
-                    for line in self.recent)
+        rows.extend(
+            Text(line, style="dim", overflow="ellipsis", no_wrap=True) for line in self.recent
+        )
         title = escape(f"navseq · {view.mission.source}")
         return Panel(Group(*rows), title=title, title_align="left", expand=False)
 
@@ -244,28 +248,39 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
             if event.resumed_from is not None
             else ""
         )
-        return (f"mission {printable(view.mission.source)}: "
-                f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}")
+        return (
+            f"mission {printable(view.mission.source)}: "
+            f"{_plural(event.waypoint_count, 'waypoint')}, {loops}{resumed}"
+        )
     if isinstance(event, LoopStarted):
         return view.loop_label() if view.loops != 1 else None
     if isinstance(event, WaypointStarted):
         yaw = math.degrees(event.yaw)
-        return (f"{view.waypoint_label(event.index)}: going to "
-                f"({event.x:.2f}, {event.y:.2f}, {yaw:.0f}°), attempt {event.attempt}")
+        return (
+            f"{view.waypoint_label(event.index)}: going to "
+            f"({event.x:.2f}, {event.y:.2f}, {yaw:.0f}°), attempt {event.attempt}"
+        )
     if isinstance(event, AttemptFailed):
         then = "will retry" if event.will_retry else "giving up"
-        return (f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
-                f"({_why(event.reason, event.text)}), {then}")
+        return (
+            f"{view.waypoint_label(event.index)}: attempt {event.attempt} failed "
+            f"({_why(event.reason, event.text)}), {then}"
+        )
     if isinstance(event, WaypointDwelling):
         return f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s"
     if isinstance(event, WaypointFinished):
         outcome = WaypointOutcome(event.outcome)
         how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
-        why = (f" ({printable(event.reason)})"
-               if event.reason and outcome != WaypointOutcome.REACHED else "")
-        return (f"{view.waypoint_label(event.index)}: {how}{why} after "
-                f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
-                f"{_plural(event.attempts, 'attempt')}")
+        why = (
+            f" ({printable(event.reason)})"
+            if event.reason and outcome != WaypointOutcome.REACHED
+            else ""
+        )
+        return (
+            f"{view.waypoint_label(event.index)}: {how}{why} after "
+            f"{event.duration:.1f} s, {event.distance_driven:.2f} m, "
+            f"{_plural(event.attempts, 'attempt')}"
+        )
     if isinstance(event, ServerStatusChanged):
         return view.status
     if isinstance(event, MissionFinished):
@@ -311,8 +326,10 @@ class LogProgress:
                     and math.isfinite(event.distance_remaining)
                     else ""
                 )
-                self._log(f"{view.waypoint_label(event.index)}: {to_go}"
-                          f"{event.distance_driven:.2f} m driven")
+                self._log(
+                    f"{view.waypoint_label(event.index)}: {to_go}"
+                    f"{event.distance_driven:.2f} m driven"
+                )
             return
         text = describe(event, view)
         if text is not None:
@@ -401,12 +418,14 @@ def summary_table(mission: Mission, result: MissionResult) -> Table:
         table.add_column("loop", justify="right")
     table.add_column("name")
     table.add_column("outcome", no_wrap=True)
-    table.add_column("attempts", justify="right",
-                     footer=str(sum(visit.attempts for visit in result.visits)))
+    table.add_column(
+        "attempts", justify="right", footer=str(sum(visit.attempts for visit in result.visits))
+    )
     # Brackets are rich markup: escape the unit.
     table.add_column(escape("time [s]"), justify="right", footer=f"{result.duration:.1f}")
-    table.add_column(escape("distance [m]"), justify="right",
-                     footer=f"{result.distance_driven:.2f}")
+    table.add_column(
+        escape("distance [m]"), justify="right", footer=f"{result.distance_driven:.2f}"
+    )
     reasons = [_visit_reason(visit) for visit in result.visits]
     any_reason = any(reasons)
     if any_reason:

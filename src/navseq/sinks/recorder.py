@@ -33,6 +33,7 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
+from navseq.track import Track
 
 Path2D = tuple[tuple[float, float], ...]
 VisitKey = tuple[int, int]  # (loop, index), both 0-based
@@ -41,25 +42,27 @@ TimedPoint = tuple[float, float, float]  # mission time t, x, y
 #: been moved (or the simulator restarted at the start pose) between them, so the
 #: picture must not draw a line from one to the other.
 SEGMENT_BREAK: TimedPoint = (math.nan, math.nan, math.nan)
+#: Legs (planned paths) kept for the picture: the latest ones of a long patrol.
+MAX_LEGS = 1000
 
 
 @dataclass
 class RunRecorder:
     """Collects a run for the report and the picture (call it with every event).
 
-    ``poses`` hold (mission time, x, y, yaw); ``segment_starts`` the position in
-    ``poses`` where each segment after the first begins.
+    What it keeps is bounded however long the run: the positions seen form a
+    :class:`~navseq.track.Track` (thinned evenly, a :data:`SEGMENT_BREAK` row between
+    run segments), and the legs' plans are the latest :data:`MAX_LEGS`.
     """
 
-    plans: dict[VisitKey, list[Path2D]] = field(default_factory=dict)
-    poses: list[tuple[float, float, float, float]] = field(default_factory=list)
-    segment_starts: list[int] = field(default_factory=list)
+    track: Track = field(default_factory=Track)
     started: MissionStarted | None = None  # of the current (last) segment
     finished: MissionFinished | None = None
     wall_started: float = field(default_factory=time.time)
     wall_finished: float | None = None
     _loop: int = 0
     _legs: dict[tuple[VisitKey, int], Path2D] = field(default_factory=dict)  # (visit, segment)
+    _segments_started: int = 0
     _time_before: float = 0.0  # mission time of the segments before the current one
     _last_t: float | None = None  # navigator time of the current segment's last event
 
@@ -78,7 +81,7 @@ class RunRecorder:
     @property
     def segments(self) -> int:
         """How many run segments (MissionStarted events) the recorder has seen."""
-        return len(self.segment_starts) + (self.started is not None)
+        return self._segments_started
 
     def mission_time(self, t: float) -> float:
         """The current segment's navigator time ``t`` as mission time (see module doc)."""
@@ -90,14 +93,15 @@ class RunRecorder:
         if isinstance(event, MissionStarted):
             self._start_segment(event)
         elif isinstance(event, WaypointProgress):
-            self.poses.append((self.mission_time(event.t), event.x, event.y, event.yaw))
+            self.track.append((self.mission_time(event.t), event.x, event.y))
         elif isinstance(event, WaypointPlan):
             if event.path:
                 key = (self._loop, event.index)
-                self.plans.setdefault(key, []).append(event.path)
                 # A visit resumed in a later segment gets its leg again: the robot may
                 # have set out from somewhere else.
                 self._legs.setdefault((key, self.segments), event.path)
+                if len(self._legs) > MAX_LEGS:
+                    del self._legs[next(iter(self._legs))]  # the oldest leg
         elif isinstance(event, (WaypointStarted, LoopStarted)):
             self._loop = event.loop
         elif isinstance(event, MissionFinished):
@@ -109,9 +113,10 @@ class RunRecorder:
         if self.started is not None:  # a resumed run: close the earlier segment
             if self._last_t is not None:
                 self._time_before += max(0.0, self._last_t - self.started.t)
-            self.segment_starts.append(len(self.poses))
+            self.track.append(SEGMENT_BREAK)
             self.finished = None
         self.started = event
+        self._segments_started += 1
         self._loop = 0
 
     def leg_plans(self) -> list[Path2D]:
@@ -123,7 +128,7 @@ class RunRecorder:
 
         A :data:`SEGMENT_BREAK` row (NaNs) separates run segments.
         """
-        return _with_breaks([(t, x, y) for t, x, y, _ in self.poses], self.segment_starts)
+        return [(row[0], row[1], row[2]) for row in self.track]
 
     def earlier_trajectory(self) -> list[TimedPoint]:
         """:meth:`trajectory` of the segments before the current one, ending in a break.
@@ -131,18 +136,6 @@ class RunRecorder:
         Empty for a run that was not resumed. For a navigator that records its own,
         finer trajectory of the current segment (the simulator): put this in front.
         """
-        if not self.segment_starts:
-            return []
-        current = self.segment_starts[-1]
-        points = [(t, x, y) for t, x, y, _ in self.poses[:current]]
-        return [*_with_breaks(points, self.segment_starts[:-1]), SEGMENT_BREAK] if points else []
-
-
-def _with_breaks(points: list[TimedPoint], starts: list[int]) -> list[TimedPoint]:
-    """``points`` with a :data:`SEGMENT_BREAK` before each position in ``starts``."""
-    out: list[TimedPoint] = []
-    for position, point in enumerate(points):
-        if position in starts and out and out[-1] is not SEGMENT_BREAK:
-            out.append(SEGMENT_BREAK)
-        out.append(point)
-    return out
+        points = self.trajectory()
+        breaks = [i for i, row in enumerate(points) if math.isnan(row[1])]
+        return points[: breaks[-1] + 1] if breaks else []

@@ -122,6 +122,8 @@ def build_report(
     simulator's default) and ``start_source`` says which; the report's ``start`` is
     the robot's own first pose (``result.start_pose``) whenever the run saw one.
     """
+    actual: Pose2D | None
+    actual_source: str | None
     if result.start_pose is not None:
         actual, actual_source = result.start_pose, START_FROM_ROBOT
     else:
