@@ -112,7 +112,9 @@ def test_log_progress_lines_are_throttled_to_the_period():
         sink(event)
     progress_lines = [line for line in out.getvalue().splitlines() if "m to go" in line]
     # Feedback at 0.5 s and 3 s is within 10 s of the goal being sent; 12 s is not.
-    assert progress_lines == ["[    12.0 s] waypoint 1/3 'dock': 0.10 m to go, 0.90 m driven"]
+    assert progress_lines == [
+        "[    12.0 s] waypoint 1/3 'dock': 0.10 m to go (~0 s at 0.22 m/s), 0.90 m driven"
+    ]
 
 
 def test_json_lines_are_one_parseable_object_per_event():
@@ -183,3 +185,19 @@ def test_summary_table_lists_every_visit_with_totals():
     ):
         assert expected in text
     assert "loop" not in text  # a single loop needs no loop column
+
+
+def test_log_lines_give_the_time_still_to_go_at_the_robots_top_speed() -> None:
+    from navseq.executor.events import WaypointProgress, WaypointStarted
+    from navseq.mission.robot import TURTLEBOT3_WAFFLE
+    from navseq.sinks.progress import LogProgress
+
+    stream = io.StringIO()
+    log = LogProgress(MISSION, stream, progress_period=1.0, robot=TURTLEBOT3_WAFFLE)
+    log(WaypointStarted(t=0.0, index=0, loop=0, attempt=1, goal_id=1, x=1.0, y=0.0, yaw=0.0))
+    log(
+        WaypointProgress(
+            t=2.0, index=0, x=0.0, y=0.0, yaw=0.0, distance_remaining=2.6, distance_driven=0.5
+        )
+    )
+    assert "2.60 m to go (~10 s at 0.26 m/s)" in stream.getvalue()

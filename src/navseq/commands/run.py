@@ -566,7 +566,7 @@ def _run_with_sinks(
                 journal_path, source, setup.digest, run_options=setup.run_options
             )
         recorder = new_recorder(setup)
-        progress = make_progress(setup.mission, json_lines=args.json)
+        progress = make_progress(setup.mission, json_lines=args.json, robot=setup.robot)
         with progress, journal:
             try:
                 result = run_mission(

@@ -44,6 +44,7 @@ from navseq.executor.events import (
 )
 from navseq.executor.result import MissionResult, WaypointResult
 from navseq.mission.model import Mission
+from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.text import printable
 
 OUTCOME_STYLE = {
@@ -70,6 +71,14 @@ def _why(reason: str, text: str) -> str:
     if not text or text == reason:
         return reason
     return f"{reason}: {text}" if reason else text
+
+
+def eta_text(remaining: float, robot: RobotProfile) -> str:
+    """``~12 s`` to cover ``remaining`` metres at the robot's top speed (a lower bound)."""
+    speed = robot.max_linear_speed
+    if speed <= 0.0 or not math.isfinite(remaining):
+        return ""
+    return f"~{remaining / speed:.0f} s at {speed:.2f} m/s"
 
 
 class RunView:
@@ -156,8 +165,16 @@ class LiveProgress:
     simulator does not pay for rendering every event.
     """
 
-    def __init__(self, mission: Mission, console: Console, *, recent_lines: int = 4):
+    def __init__(
+        self,
+        mission: Mission,
+        console: Console,
+        *,
+        recent_lines: int = 4,
+        robot: RobotProfile = DEFAULT_PROFILE,
+    ):
         self.view = RunView(mission)
+        self.robot = robot
         self.console = console
         self.recent: deque[str] = deque(maxlen=recent_lines)
         self._live = Live(
@@ -213,7 +230,10 @@ class LiveProgress:
                 bar = Table.grid(padding=(0, 2))
                 bar.add_row(
                     ProgressBar(total=total, completed=view.distance_driven, width=40),
-                    Text(f"{remaining:6.2f} m to go, {view.distance_driven:6.2f} m driven"),
+                    Text(
+                        f"{remaining:6.2f} m to go ({eta_text(remaining, self.robot)}), "
+                        f"{view.distance_driven:6.2f} m driven"
+                    ),
                 )
                 rows.append(bar)
         else:
@@ -296,8 +316,16 @@ class LogProgress:
     of mission time, so a log of a long run stays readable.
     """
 
-    def __init__(self, mission: Mission, stream: IO[str], *, progress_period: float = 10.0):
+    def __init__(
+        self,
+        mission: Mission,
+        stream: IO[str],
+        *,
+        progress_period: float = 10.0,
+        robot: RobotProfile = DEFAULT_PROFILE,
+    ):
         self.view = RunView(mission)
+        self.robot = robot
         self.stream = stream
         self.progress_period = progress_period
         self._last_progress_t = -math.inf
@@ -321,7 +349,8 @@ class LogProgress:
             if event.t - self._last_progress_t >= self.progress_period:
                 self._last_progress_t = event.t
                 to_go = (
-                    f"{event.distance_remaining:.2f} m to go, "
+                    f"{event.distance_remaining:.2f} m to go "
+                    f"({eta_text(event.distance_remaining, self.robot)}), "
                     if event.distance_remaining is not None
                     and math.isfinite(event.distance_remaining)
                     else ""
@@ -382,16 +411,23 @@ ProgressSink = LiveProgress | LogProgress | JsonProgress
 
 
 def make_progress(
-    mission: Mission, *, json_lines: bool, stream: IO[str] | None = None
+    mission: Mission,
+    *,
+    json_lines: bool,
+    stream: IO[str] | None = None,
+    robot: RobotProfile = DEFAULT_PROFILE,
 ) -> ProgressSink:
-    """JSON lines if asked, a live panel on a terminal, plain log lines otherwise."""
+    """JSON lines if asked, a live panel on a terminal, plain log lines otherwise.
+
+    ``robot``'s top speed gives the time still to go (at least) shown with the distance.
+    """
     stream = stream if stream is not None else sys.stdout
     if json_lines:
         return JsonProgress(stream)
     console = Console(file=stream)
     if console.is_terminal:
-        return LiveProgress(mission, console)
-    return LogProgress(mission, stream)
+        return LiveProgress(mission, console, robot=robot)
+    return LogProgress(mission, stream, robot=robot)
 
 
 def _visit_reason(visit: WaypointResult) -> str:
