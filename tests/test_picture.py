@@ -207,3 +207,22 @@ def test_a_nan_row_breaks_the_driven_path_between_resumed_segments():
     segments = [tuple(map(tuple, s)) for s in driven.get_segments()]
     assert segments == [((0.0, 0.0), (1.0, 0.0)), ((0.0, 0.0), (0.0, 1.0))]
     assert list(driven.get_array()) == [0.0, 2.0]  # one mission clock across the break
+
+
+def test_the_robot_outline_is_drawn_to_scale_at_the_start() -> None:
+    from matplotlib.patches import Polygon
+
+    from navseq.mission.robot import TURTLEBOT3_WAFFLE
+    from navseq.sinks.picture import mission_figure
+
+    start = Pose2D(1.0, 2.0, math.pi / 2)
+    fig = mission_figure(
+        MISSION, result_of(WaypointOutcome.REACHED), start=start, robot=TURTLEBOT3_WAFFLE
+    )
+    outlines = [p for p in fig.axes[0].patches if type(p) is Polygon]  # not the arrows
+    assert len(outlines) == 1
+    corners = outlines[0].get_xy()[:4]
+    # The waffle's rear-left corner (-0.205, 0.155), turned to face +y.
+    assert np.allclose(corners[1], (1.0 - 0.155, 2.0 - 0.205))
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert "turtlebot3_waffle outline" in labels

@@ -726,6 +726,7 @@ def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:
         plans=outcome.recorder.leg_plans(),
         trajectory=picture_trajectory(outcome),
         interrupted=outcome.interrupted,
+        robot=setup.robot,
     )
 
 

@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
+    from navseq.mission.robot import RobotProfile
     from navseq.sim.occupancy import OccupancyGrid
 
 OUTCOME_COLOURS = {
@@ -264,6 +265,7 @@ def mission_picture_png(
     trajectory: Sequence[tuple[float, float, float]] = (),
     interrupted: str | None = None,
     dpi: int = 150,
+    robot: RobotProfile | None = None,
 ) -> bytes:
     """The picture of the run as PNG bytes.
 
@@ -280,11 +282,18 @@ def mission_picture_png(
         trajectory=trajectory,
         interrupted=interrupted,
         dpi=dpi,
+        robot=robot,
     )
     png = io.BytesIO()
     # "tight" keeps the legend and axis labels that sit outside the axes.
     fig.savefig(png, format="png", bbox_inches="tight", pad_inches=0.15)
     return png.getvalue()
+
+
+def _placed_outline(robot: RobotProfile, pose: Pose2D) -> list[tuple[float, float]]:
+    """The robot's footprint polygon at ``pose``, world coordinates."""
+    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    return [(pose.x + c * x - s * y, pose.y + s * x + c * y) for x, y in robot.footprint]
 
 
 def mission_figure(
@@ -297,8 +306,13 @@ def mission_figure(
     trajectory: Sequence[tuple[float, float, float]] = (),
     interrupted: str | None = None,
     dpi: int = 150,
+    robot: RobotProfile | None = None,
 ) -> Figure:
-    """The picture as a matplotlib Figure on an Agg canvas (its first axes is the map)."""
+    """The picture as a matplotlib Figure on an Agg canvas (its first axes is the map).
+
+    With ``robot``, its outline is drawn to scale at the start pose, so a reader sees
+    how much room the robot needs in the map's corridors.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
@@ -399,6 +413,13 @@ def mission_figure(
                 },
             )
 
+    if start is not None and robot is not None:
+        from matplotlib.patches import Polygon
+
+        outline = _placed_outline(robot, start)
+        ax.add_patch(
+            Polygon(outline, closed=True, fill=False, edgecolor="black", linewidth=0.9, zorder=6.5)
+        )
     if start is not None:
         # Under the waypoint markers and a little larger, so that a waypoint at the
         # start pose (a tour that returns home) stays visible with the square around it.
@@ -441,6 +462,8 @@ def mission_figure(
                 label="start",
             )
         )
+    if start is not None and robot is not None:
+        handles.append(Line2D([], [], color="black", linewidth=0.9, label=f"{robot.name} outline"))
     if plan_arrays:
         handles.append(
             Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR, label="planned path")
