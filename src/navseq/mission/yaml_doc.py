@@ -61,7 +61,7 @@ def parse_yaml(
     offset = first_line - 1
     try:
         _spend_values(text, source, offset, budget or ValueBudget())
-        root = yaml.compose(text, Loader=_FAST_LOADER)
+        root = _compose(text)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = f"{source}:{mark.line + 1 + offset}" if mark is not None else source
@@ -76,6 +76,21 @@ def parse_yaml(
     walker = _Walker(source, problems, offset)
     walker.check_expansion(root)
     return walker.walk(root, 0)
+
+
+def _compose(text: str) -> Node | None:
+    """The document's node graph, composed by libyaml (fast) where installed.
+
+    On a syntax error the pure-Python composer reads the text again: its error names
+    the line where the construct went wrong, libyaml's the line where it noticed.
+    """
+    try:
+        return yaml.compose(text, Loader=_FAST_LOADER)
+    except yaml.MarkedYAMLError:
+        if _FAST_LOADER is yaml.SafeLoader:
+            raise
+        yaml.compose(text, Loader=yaml.SafeLoader)
+        raise
 
 
 class TooManyValuesError(NavseqError):
@@ -215,7 +230,8 @@ class _Walker:
         problem = text_problem(node.value, single_line=False)
         if problem is not None:  # also in keys: messages print them
             raise NavseqError(f"the text {node.value[:40]!r} {problem}", source=self.where(node))
-        if node.tag == _TAG + "str" and node.style is None and EXPONENT_FLOAT.fullmatch(node.value):
+        # A plain scalar's style is None from PyYAML's composer, "" from libyaml's.
+        if node.tag == _TAG + "str" and not node.style and EXPONENT_FLOAT.fullmatch(node.value):
             return float(node.value)
         try:
             return self.constructor.construct_object(node)
