@@ -72,3 +72,24 @@ def write_mission(path: Path, waypoints: str, header: str = "") -> Path:
     """A navseq YAML mission at ``path``: ``header`` lines, then the ``waypoints`` list."""
     path.write_text(f"navseq: 1\n{header}waypoints:\n{waypoints}")
     return path
+
+
+def start_scripted_run(
+    mission: Path, out: Path, *extra: Any, realtime: float, cwd: Path
+) -> subprocess.Popen[str]:
+    """``navseq run MISSION --navigator scripted`` in the background, paced at ``realtime``."""
+    return start_navseq(
+        "run", mission, "--navigator", "scripted", "--out", out,
+        "--scripted-realtime", realtime, *extra, cwd=cwd,
+    )  # fmt: skip
+
+
+def kill_9_when(
+    process: subprocess.Popen[str], predicate: Callable[[], Any], timeout: float, what: str
+) -> None:
+    """``kill -9`` the run once ``predicate`` holds (no chance to clean up); reap it."""
+    try:
+        wait_for(predicate, timeout, what)
+    finally:
+        process.kill()
+        process.communicate(timeout=30)

@@ -25,8 +25,10 @@ from cli_support import (
     assert_clean_error,
     journal_events,
     journal_records,
+    kill_9_when,
     navseq,
     start_navseq,
+    start_scripted_run,
     wait_for,
     write_mission,
 )
@@ -361,25 +363,14 @@ def test_resume_after_kill_runs_only_what_is_left(tmp_path):
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     log = tmp_path / "nav.log"
     out = tmp_path / "out"
-    process = start_navseq(
-        "run",
-        mission,
-        "--navigator",
-        "scripted",
-        "--out",
-        out,
-        "--scripted-realtime",
-        "4",
-        "--scripted-log",
-        log,
-        cwd=tmp_path,
-    )
+    process = start_scripted_run(mission, out, "--scripted-log", log, realtime=4, cwd=tmp_path)
     journal = out / "journal.jsonl"
-    wait_for(
-        lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60, "two waypoints reached"
+    kill_9_when(
+        process,
+        lambda: len(journal_events(journal, "WaypointFinished")) >= 2,
+        60,
+        "two waypoints reached",
     )
-    process.kill()  # kill -9: no chance to clean up
-    process.communicate(timeout=30)
     reached = {e["index"] for e in journal_events(journal, "WaypointFinished")}
 
     resumed_log = tmp_path / "resumed.log"
@@ -414,23 +405,14 @@ def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkey
 
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     out = tmp_path / "out"
-    process = start_navseq(
-        "run",
-        mission,
-        "--navigator",
-        "scripted",
-        "--out",
-        out,
-        "--scripted-realtime",
-        "4",
-        cwd=tmp_path,
-    )
+    process = start_scripted_run(mission, out, realtime=4, cwd=tmp_path)
     journal = out / "journal.jsonl"
-    wait_for(
-        lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60, "two waypoints reached"
+    kill_9_when(
+        process,
+        lambda: len(journal_events(journal, "WaypointFinished")) >= 2,
+        60,
+        "two waypoints reached",
     )
-    process.kill()
-    process.communicate(timeout=30)
     before = read_journal(journal)
     driven_before = [(e["x"], e["y"]) for e in journal_events(journal, "WaypointProgress")]
     assert len(driven_before) >= 2  # the scripted robot drove 2 m, journaled once a second

@@ -13,8 +13,10 @@ from cli_support import (
     assert_clean_error,
     journal_events,
     journal_records,
+    kill_9_when,
     navseq,
     start_navseq,
+    start_scripted_run,
     wait_for,
     write_mission,
 )
@@ -36,28 +38,14 @@ def killed_run(tmp_path: Path, *extra: Any, visits: int = 2) -> tuple[Path, Path
     """A patrol run killed with -9 after ``visits`` finished visits: (mission, journal, pid)."""
     mission = write_mission(tmp_path / "patrol.yaml", PATROL, header="loops: forever\n")
     out = tmp_path / "out"
-    process = start_navseq(
-        "run",
-        mission,
-        "--navigator",
-        "scripted",
-        "--out",
-        out,
-        "--scripted-realtime",
-        "4",
-        *extra,
-        cwd=tmp_path,
-    )
+    process = start_scripted_run(mission, out, *extra, realtime=4, cwd=tmp_path)
     journal = out / "journal.jsonl"
-    try:
-        wait_for(
-            lambda: len(journal_events(journal, "WaypointFinished")) >= visits,
-            60,
-            f"{visits} visits finished",
-        )
-    finally:
-        process.kill()
-        process.communicate(timeout=30)
+    kill_9_when(
+        process,
+        lambda: len(journal_events(journal, "WaypointFinished")) >= visits,
+        60,
+        f"{visits} visits finished",
+    )
     return mission, journal, process.pid
 
 

@@ -16,8 +16,9 @@ from cli_support import (
     assert_clean_error,
     journal_events,
     journal_records,
+    kill_9_when,
     navseq,
-    start_navseq,
+    start_scripted_run,
     wait_for,
     write_mission,
 )
@@ -94,17 +95,7 @@ def test_signals_at_the_end_of_a_run_never_lose_the_report(tmp_path: Path, delay
     """Signals around the moment the mission finishes (while outputs are written)."""
     out = tmp_path / "out"
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
-    process = start_navseq(
-        "run",
-        mission,
-        "--navigator",
-        "scripted",
-        "--out",
-        out,
-        "--scripted-realtime",
-        "8",
-        cwd=tmp_path,
-    )
+    process = start_scripted_run(mission, out, realtime=8, cwd=tmp_path)
     journal = out / "journal.jsonl"
     wait_for(lambda: journal_events(journal, "MissionFinished"), 60, "the mission to finish")
     time.sleep(delay)
@@ -186,28 +177,15 @@ def test_kill_9_at_any_journal_line_then_resume_finishes_with_a_true_report(
 ) -> None:
     out = tmp_path / "out"
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
-    process = start_navseq(
-        "run",
-        mission,
-        "--navigator",
-        "scripted",
-        "--out",
-        out,
-        "--scripted-realtime",
-        "4",
-        cwd=tmp_path,
-    )
+    process = start_scripted_run(mission, out, realtime=4, cwd=tmp_path)
     journal = out / "journal.jsonl"
-    try:
-        wait_for(
-            lambda: len(journal_records(journal)) >= cut or process.poll() is not None,
-            120,
-            f"{cut} journal lines",
-        )
-    finally:
-        process.kill()
-        _, stderr = process.communicate(timeout=30)
-    assert process.returncode == -signal.SIGKILL, stderr  # killed mid-run, not finished
+    kill_9_when(
+        process,
+        lambda: len(journal_records(journal)) >= cut or process.poll() is not None,
+        120,
+        f"{cut} journal lines",
+    )
+    assert process.returncode == -signal.SIGKILL  # killed mid-run, not finished
     resumed = navseq("run", "--resume", journal, cwd=tmp_path)
     assert resumed.returncode == 0, resumed.stderr
     report = assert_report_agrees(out, 0)
