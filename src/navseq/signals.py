@@ -52,10 +52,6 @@ class SignalGuard:
         self._original: dict[int, Any] = {}
         self._abort_at: int | None = None
 
-    @property
-    def deferring(self) -> bool:
-        return bool(self._original) and signal.getsignal(signal.SIGINT) == self._count
-
     def arm(self) -> SignalGuard:
         """From now on a shutdown signal raises (and defers the ones after it)."""
         if self._save_originals():

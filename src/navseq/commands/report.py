@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -40,25 +41,31 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
-    from navseq.errors import NavseqError
     from navseq.runlock import RunLock
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
     require_file(journal, "RUN")
     with RunLock(journal.parent):  # not while a live run writes them
-        written = rebuild_outputs(journal)
-    if not written:
+        rebuilt = rebuild_outputs(journal)
+    if not rebuilt.written:
         print(f"navseq report: the report in {journal.parent} is complete; nothing to rebuild")
         return 0
-    for role, path in written.items():
+    for role, path in rebuilt.written.items():
         print(f"{role:>8}: {path}")
-    if "report" not in written and "picture" not in written:
-        raise NavseqError("nothing could be rebuilt", source=str(journal))
     return 0
 
 
-def rebuild_outputs(journal: Path) -> dict[str, str]:
-    """Write the missing or broken report / picture of the run in ``journal``; role -> path."""
+@dataclass(frozen=True)
+class Rebuilt:
+    """What :func:`rebuild_outputs` wrote (role -> path) and the run's own exit status
+    (None when the journal ends before the mission did)."""
+
+    written: dict[str, str]
+    exit_code: int | None
+
+
+def rebuild_outputs(journal: Path) -> Rebuilt:
+    """Write the missing or broken report / picture of the run in ``journal``."""
     from navseq.commands.run_outputs import output_error
     from navseq.files import write_atomically
     from navseq.sinks.journal import read_journal
@@ -84,7 +91,7 @@ def rebuild_outputs(journal: Path) -> dict[str, str]:
         except OSError as error:
             raise output_error(picture_path, error) from None
         written["picture"] = str(picture_path)
-    return written
+    return Rebuilt(written, exit_code_of(result, state.finish_reason is not None))
 
 
 def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:

@@ -761,22 +761,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _rebuild_finished(journal: Path) -> int | None:
     """Rebuild a finished run's missing report/picture; its exit status, or None if complete."""
-    from navseq.commands.report import (
-        exit_code_of,
-        journaled_mission,
-        rebuild_outputs,
-        result_from_journal,
-    )
+    from navseq.commands.report import rebuild_outputs
     from navseq.runlock import RunLock
-    from navseq.sinks.journal import read_journal
 
     with RunLock(journal.parent):
-        written = rebuild_outputs(journal)
-    if not written:
+        rebuilt = rebuild_outputs(journal)
+    if not rebuilt.written:
         return None
-    for role, path in written.items():
+    for role, path in rebuilt.written.items():
         print(f"navseq run: nothing left to run; rebuilt the {role}: {path}", file=sys.stderr)
-    state = read_journal(journal)
-    result = result_from_journal(state, journaled_mission(state))
-    code = exit_code_of(result, state.finish_reason is not None)
-    return 1 if code is None else code
+    return 1 if rebuilt.exit_code is None else rebuilt.exit_code
