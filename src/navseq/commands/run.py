@@ -443,7 +443,6 @@ def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
 def _scripted_behaviours(script: str) -> list[Any]:
     """Test-only: ``succeed,aborted@2,stall@1,hang,falsesuccess`` -> ScriptedNavigator
     behaviours."""
-    from navseq.navigators.base import GoalStatus
     from navseq.navigators.scripted import FalseSuccess, Finish, Hang, Stall, Succeed
 
     behaviours: list[Any] = []
@@ -459,7 +458,7 @@ def _scripted_behaviours(script: str) -> list[Any]:
         elif name == "falsesuccess":
             behaviours.append(FalseSuccess(after=seconds))
         else:
-            behaviours.append(Finish(GoalStatus(name.upper()), after=seconds))
+            behaviours.append(Finish(name.upper(), after=seconds))
     return behaviours
 
 

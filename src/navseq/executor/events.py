@@ -67,11 +67,12 @@ class WaypointPlan:
 class AttemptFailed:
     """One attempt at a waypoint failed; ``will_retry`` says whether another follows.
 
-    ``reason`` is navseq's verdict: a GoalStatus value (``"ABORTED"``), ``"timeout"``,
-    ``"stalled"``, or ``"succeeded far from goal (2.38 m)"`` / ``"succeeded 35° off the
-    goal yaw"`` when the stack said SUCCEEDED but the robot is not there. ``status`` is
-    the terminal status the navigation stack gave (None when navseq gave up on the goal
-    itself), ``text`` the stack's own words (move_base's result text, may be empty).
+    ``reason`` is navseq's verdict: the stack's failure status (``"ABORTED"``,
+    Nav2's ``"CANCELED"`` ...), ``"timeout"``, ``"stalled"``, or ``"succeeded far from
+    goal (2.38 m)"`` / ``"succeeded 35° off the goal yaw"`` when the stack said
+    SUCCEEDED but the robot is not there. ``status`` is the terminal status the
+    navigation stack gave (None when navseq gave up on the goal itself), ``text``
+    the stack's own words (move_base's result text, may be empty).
     ``duration`` (s) and ``distance_driven`` (m) are the attempt's own. Fields after
     ``will_retry`` default so that journals written before them still read.
     """

@@ -73,8 +73,8 @@ from navseq.navigators.base import (
     Goal,
     GoalDone,
     GoalFeedback,
+    GoalOutcome,
     GoalPlan,
-    GoalStatus,
     NavEvent,
     ServerBack,
     ServerLost,
@@ -567,7 +567,7 @@ class MissionExecutor:
         reason: str,
         *,
         cancel: bool,
-        status: GoalStatus | None = None,
+        status: str | None = None,
         text: str = "",
     ) -> list[Command]:
         visit = self._current
@@ -580,7 +580,7 @@ class MissionExecutor:
         record = self._close_attempt(
             now,
             reached=False,
-            status=status.value if status is not None else None,
+            status=status,
             reason=reason,
             text=text,
         )
@@ -612,25 +612,22 @@ class MissionExecutor:
         return commands
 
     def _on_goal_done(self, now: float, event: GoalDone) -> list[Command]:
-        if event.status is GoalStatus.SUCCEEDED:
+        # The stack's own name for how the goal ended goes into the record as is.
+        if event.outcome is GoalOutcome.SUCCEEDED:
+            status = event.status or "SUCCEEDED"
             miss = self._arrival_miss()
             if miss is None:
-                return self._reached(
-                    now, passed_through=False, status=event.status.value, text=event.text
-                )
-            return self._attempt_failed(
-                now, miss, cancel=False, status=event.status, text=event.text
-            )
-        if event.status is GoalStatus.LOST:
+                return self._reached(now, passed_through=False, status=status, text=event.text)
+            return self._attempt_failed(now, miss, cancel=False, status=status, text=event.text)
+        if event.outcome is GoalOutcome.LOST:
             # Not the waypoint's fault: the stack lost track of the goal. Treat it as
             # a vanished server and resend once it reports back.
-            self._mark_server_lost(now, event.text or "goal LOST")
+            self._mark_server_lost(now, event.text or f"goal {event.status or 'LOST'}")
             self._state = ExecutorState.WAITING_SERVER
             self._attempt = None
             return self._check_clock(now)
-        return self._attempt_failed(
-            now, event.status.value, cancel=False, status=event.status, text=event.text
-        )
+        status = event.status or "FAILED"
+        return self._attempt_failed(now, status, cancel=False, status=status, text=event.text)
 
     def _arrival_miss(self) -> str | None:
         """Why a SUCCEEDED is not believed (the robot is not there), or None.

@@ -13,10 +13,11 @@ from navseq.geometry import Pose2D
 class AttemptResult:
     """One goal sent for a visit, and how it ended.
 
-    ``status`` is the terminal status the navigation stack reported (a GoalStatus
-    value), or None when navseq ended the attempt itself (timeout, stalled, skip,
-    interrupt). ``reason`` is empty for the attempt that reached the waypoint, else
-    why it failed; ``text`` is the stack's own result text.
+    ``status`` is the terminal status the navigation stack reported, in its own
+    words (``SUCCEEDED``, ``ABORTED``, ``CANCELED`` ...), or None when navseq ended
+    the attempt itself (timeout, stalled, skip, interrupt). ``reason`` is empty for
+    the attempt that reached the waypoint, else why it failed; ``text`` is the
+    stack's own result text.
     """
 
     number: int  # 1-based

@@ -5,10 +5,12 @@ interface with its own simulated clock. The robot drives in a straight line to t
 goal at a fixed speed, then turns in place to the goal yaw, and sends feedback every
 step. What each goal does is scripted, in the order goals are sent::
 
-    nav = ScriptedNavigator([Succeed(), Finish(GoalStatus.ABORTED, after=2.0), Stall()])
+    nav = ScriptedNavigator([Succeed(), Finish("ABORTED", after=2.0), Stall()])
 
 The first goal succeeds on arrival, the second is aborted after 2 s, the third stops
-moving and never finishes; goals beyond the script succeed. :class:`FalseSuccess`
+moving and never finishes; goals beyond the script succeed. Statuses are actionlib's
+names (the double plays move_base): ``SUCCEEDED`` ends a goal succeeded, ``LOST`` lost,
+any other name failed with that name as the stack's status. :class:`FalseSuccess`
 plays move_base's plan race (ros-planning/navigation #949): SUCCEEDED at once, with
 the robot still where it was. A goal resent after a
 server loss is a new goal and takes the next behaviour.
@@ -35,7 +37,7 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
-    GoalStatus,
+    GoalOutcome,
     NavEvent,
     ServerBack,
     ServerLost,
@@ -51,10 +53,11 @@ class Succeed:
 class Finish:
     """Report ``status`` ``after`` seconds after the goal was sent; drive meanwhile.
 
+    ``status`` is a stack's status name (``"ABORTED"``, ``"CANCELED"`` ...).
     ``REJECTED`` and ``RECALLED`` goals are never accepted, like in actionlib.
     """
 
-    status: GoalStatus
+    status: str
     after: float = 0.0
     text: str = ""
 
@@ -98,7 +101,17 @@ class FalseSuccess:
 
 Behaviour = Succeed | Finish | LoseServer | Hang | Stall | FalseSuccess
 
-_UNACCEPTED = (GoalStatus.REJECTED, GoalStatus.RECALLED)
+_UNACCEPTED = ("REJECTED", "RECALLED")
+
+
+def scripted_done(goal_id: int, status: str, text: str = "") -> GoalDone:
+    """How the double ends a goal with an actionlib status name."""
+    outcome = {"SUCCEEDED": GoalOutcome.SUCCEEDED, "LOST": GoalOutcome.LOST}.get(
+        status, GoalOutcome.FAILED
+    )
+    return GoalDone(goal_id, outcome, status, text)
+
+
 _ARRIVED_YAW = 1e-3
 
 
@@ -164,7 +177,7 @@ class ScriptedNavigator:
         if self._server_down_until is not None:
             return  # nobody listening: the goal goes nowhere
         if self._active is not None:
-            self._events.append(GoalDone(self._active.goal.goal_id, GoalStatus.PREEMPTED))
+            self._events.append(GoalDone.failed(self._active.goal.goal_id, "PREEMPTED"))
         index = len(self.sent_goals) - 1
         behaviour = self.script[index] if index < len(self.script) else Succeed()
         self._active = _ActiveGoal(goal, behaviour, self._t)
@@ -176,7 +189,7 @@ class ScriptedNavigator:
         self.cancels.append((self._t, active_id))
         self._record("cancel_goal", goal_id=active_id)
         if self._active is not None and self._server_down_until is None:
-            self._events.append(GoalDone(self._active.goal.goal_id, GoalStatus.PREEMPTED))
+            self._events.append(GoalDone.failed(self._active.goal.goal_id, "PREEMPTED"))
         self._active = None
 
     def clear_costmaps(self) -> None:
@@ -228,17 +241,17 @@ class ScriptedNavigator:
             self._server_down_until = self._t + down_for
             self._active = None
             if behaviour.as_goal_status:
-                self._events.append(GoalDone(goal_id, GoalStatus.LOST))
+                self._events.append(GoalDone.lost(goal_id))
             else:
                 self._events.append(ServerLost("scripted server loss"))
             return
         if isinstance(behaviour, Finish) and elapsed >= behaviour.after:
-            self._events.append(GoalDone(goal_id, behaviour.status, behaviour.text))
+            self._events.append(scripted_done(goal_id, behaviour.status, behaviour.text))
             self._active = None
             return
         if isinstance(behaviour, FalseSuccess):
             if elapsed >= behaviour.after:
-                self._events.append(GoalDone(goal_id, GoalStatus.SUCCEEDED, behaviour.text))
+                self._events.append(GoalDone.succeeded(goal_id, behaviour.text))
                 self._active = None
             return  # the robot never moves
         stalled = isinstance(behaviour, Stall) and elapsed >= behaviour.after
@@ -246,7 +259,7 @@ class ScriptedNavigator:
         remaining = self._pose.distance_to(active.goal.pose) if self.report_distance else None
         self._events.append(GoalFeedback(goal_id, self._pose, remaining))
         if arrived and isinstance(behaviour, Succeed):
-            self._events.append(GoalDone(goal_id, GoalStatus.SUCCEEDED))
+            self._events.append(GoalDone.succeeded(goal_id))
             self._active = None
 
     def _move_towards(self, target: Pose2D, dt: float) -> bool:

@@ -8,8 +8,9 @@ Events follow what an actionlib client of move_base would see:
 - ``GoalPlan`` each time the navigation server adopts a new plan for it;
 - ``GoalFeedback`` (pose, distance remaining along the plan) every ``feedback_period``
   seconds of simulated time while the goal is active;
-- ``GoalDone`` with SUCCEEDED or ABORTED (the server's verdict and its reason), or
-  PREEMPTED for a goal that was cancelled or replaced by a newer one.
+- ``GoalDone`` succeeded (status SUCCEEDED) or failed (ABORTED), the server's verdict
+  and its reason, or failed (PREEMPTED) for a goal that was cancelled or replaced by
+  a newer one.
 """
 
 from __future__ import annotations
@@ -24,7 +25,6 @@ from navseq.navigators.base import (
     GoalDone,
     GoalFeedback,
     GoalPlan,
-    GoalStatus,
     NavEvent,
 )
 from navseq.sim.navserver import NavParams, NavState
@@ -32,7 +32,8 @@ from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
 from navseq.track import Track
 
-_TERMINAL = {NavState.SUCCEEDED: GoalStatus.SUCCEEDED, NavState.ABORTED: GoalStatus.ABORTED}
+# The simulated server plays move_base, so its results carry actionlib's status names.
+_SUCCEEDED, _ABORTED, _PREEMPTED = "SUCCEEDED", "ABORTED", "PREEMPTED"
 
 
 class SimNavigator:
@@ -87,7 +88,7 @@ class SimNavigator:
     def send_goal(self, goal: Goal) -> None:
         if self._active is not None:
             self._events.append(
-                GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "replaced by a new goal")
+                GoalDone.failed(self._active.goal_id, _PREEMPTED, "replaced by a new goal")
             )
         self._active = goal
         self.world.server.set_goal(goal.pose)
@@ -98,7 +99,7 @@ class SimNavigator:
         if self._active is None:
             return
         self.world.server.cancel()
-        self._events.append(GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "canceled"))
+        self._events.append(GoalDone.failed(self._active.goal_id, _PREEMPTED, "canceled"))
         self._active = None
 
     def clear_costmaps(self) -> None:
@@ -142,9 +143,12 @@ class SimNavigator:
             self._plan_version = server.plan_version
             path = tuple((float(x), float(y)) for x, y in server.plan.points)
             self._events.append(GoalPlan(goal.goal_id, path))
-        status = _TERMINAL.get(server.state)
-        if status is not None:
-            self._events.append(GoalDone(goal.goal_id, status, server.status_text))
+        if server.state in (NavState.SUCCEEDED, NavState.ABORTED):
+            if server.state is NavState.SUCCEEDED:
+                done = GoalDone.succeeded(goal.goal_id, server.status_text, _SUCCEEDED)
+            else:
+                done = GoalDone.failed(goal.goal_id, _ABORTED, server.status_text)
+            self._events.append(done)
             self._active = None
         elif world.time >= self._next_feedback - 1e-9:
             self._next_feedback += self.feedback_period

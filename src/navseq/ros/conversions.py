@@ -18,22 +18,23 @@ from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, quaternion_to_yaw, yaw_to_quaternion
-from navseq.navigators.base import GoalStatus
+from navseq.navigators.base import GoalOutcome
 from navseq.sim.occupancy import OccupancyGrid
 
-# actionlib_msgs/GoalStatus values that end a goal, and what the executor calls them.
-TERMINAL_STATUSES: dict[int, GoalStatus] = {
-    GoalStatusMsg.SUCCEEDED: GoalStatus.SUCCEEDED,
-    GoalStatusMsg.ABORTED: GoalStatus.ABORTED,
-    GoalStatusMsg.REJECTED: GoalStatus.REJECTED,
-    GoalStatusMsg.PREEMPTED: GoalStatus.PREEMPTED,
-    GoalStatusMsg.RECALLED: GoalStatus.RECALLED,
-    GoalStatusMsg.LOST: GoalStatus.LOST,
+# actionlib_msgs/GoalStatus values that end a goal: the executor's outcome and the name
+# the report gives the status.
+TERMINAL_STATUSES: dict[int, tuple[GoalOutcome, str]] = {
+    GoalStatusMsg.SUCCEEDED: (GoalOutcome.SUCCEEDED, "SUCCEEDED"),
+    GoalStatusMsg.ABORTED: (GoalOutcome.FAILED, "ABORTED"),
+    GoalStatusMsg.REJECTED: (GoalOutcome.FAILED, "REJECTED"),
+    GoalStatusMsg.PREEMPTED: (GoalOutcome.FAILED, "PREEMPTED"),
+    GoalStatusMsg.RECALLED: (GoalOutcome.FAILED, "RECALLED"),
+    GoalStatusMsg.LOST: (GoalOutcome.LOST, "LOST"),
 }
 
 
-def terminal_status(code: int) -> GoalStatus | None:
-    """The executor's name for a terminal actionlib status, None while the goal is alive.
+def terminal_status(code: int) -> tuple[GoalOutcome, str] | None:
+    """The outcome and name of a terminal actionlib status, None while the goal is alive.
 
     PENDING, ACTIVE, PREEMPTING and RECALLING are not terminal: a result still follows.
     """
