@@ -117,6 +117,29 @@ class ServerStatusChanged:
 
 
 @dataclass(frozen=True)
+class MissionPaused:
+    """The operator paused the mission: the active goal is cancelled, the clock held.
+
+    ``state`` is what the run was doing (``active``, ``dwelling`` ...), ``index`` the
+    waypoint it was at.
+    """
+
+    t: float
+    index: int
+    reason: str = ""
+    state: str = ""
+
+
+@dataclass(frozen=True)
+class MissionResumed:
+    """The pause ended; every deadline of the run moved on by ``paused_for`` seconds."""
+
+    t: float
+    index: int
+    paused_for: float
+
+
+@dataclass(frozen=True)
 class MissionFinished:
     t: float
     success: bool  # every waypoint reached
@@ -133,5 +156,7 @@ MissionEvent = (
     | WaypointDwelling
     | WaypointFinished
     | ServerStatusChanged
+    | MissionPaused
+    | MissionResumed
     | MissionFinished
 )

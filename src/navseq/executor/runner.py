@@ -20,7 +20,7 @@ from collections.abc import Iterable
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
-from navseq.executor.control import MissionControl
+from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
@@ -80,7 +80,8 @@ def run_mission(
     ``resume`` continues an earlier run (see :mod:`navseq.sinks.journal`). ``tick`` is
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
-    ``control`` lets other threads file operator requests (skip the current waypoint).
+    ``control`` lets other threads file operator requests (skip, pause, resume,
+    cancel) and tells the run when its process is being shut down (``stop_reason``).
     ``signals`` is the run's :class:`~navseq.signals.SignalGuard`: armed for the run
     (SIGINT, SIGTERM and SIGHUP end it, also where SIGINT was ignored), deferring from
     the moment the run is stopped or ends, so that the caller can finish its outputs
@@ -90,7 +91,9 @@ def run_mission(
     ``robot:``, else the TurtleBot3 burger).
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
-    :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP, :class:`MissionAborted` when
+    :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP,
+    :class:`~navseq.executor.control.StopRequested` when ``control``'s ``stop_reason``
+    gives a reason (the result then says ``interrupted (<reason>)``), :class:`MissionAborted` when
     a NavseqError (a sink that cannot write) stops the run, and re-raises any other
     exception;
     in the last two cases only after cancelling the active goal and telling the
@@ -114,6 +117,10 @@ def run_mission(
         name = signalled.signal_name
         result = _abort(executor, navigator, f"interrupted: {name}")
         raise MissionInterrupted(name, result) from None
+    except StopRequested as stop:
+        guard.defer()
+        _abort(executor, navigator, f"interrupted ({stop})")
+        raise
     except NavseqError as error:
         # A sink could not do its job (the journal on a full disk): stop, then say why.
         guard.defer()
@@ -124,6 +131,8 @@ def run_mission(
         _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
         raise
     finally:
+        if control is not None:
+            control.close("the mission has ended")
         if signals is None:
             guard.restore()
         else:
@@ -143,15 +152,48 @@ def _drive(
     """The loop: navigator events, operator requests and the clock in; commands out."""
     _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
-        for event in navigator.poll():
+        events = navigator.poll()
+        if control is not None and control.stop_reason is not None:
+            # Asked after taking the events: a shutdown is announced before the goal is
+            # cancelled under us, so that cancel's result is never a failed waypoint.
+            stop = control.stop_reason()
+            if stop is not None:
+                raise StopRequested(stop)
+        for event in events:
             _apply(navigator, executor.on_event(event, navigator.now(), navigator.robot_pose()))
         if control is not None:
-            for reason in control.take_skips():
-                _apply(navigator, executor.skip(navigator.now(), reason))
+            for request in control.take_requests():
+                _apply(navigator, _operate(executor, request, navigator.now()))
         pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
         _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
         if not executor.finished:
             navigator.spin(tick)
+
+
+def _operate(executor: MissionExecutor, request: OperatorRequest, now: float) -> list[Command]:
+    """Carry out one operator request as an executor input, and answer it."""
+    if executor.finished:
+        request.answer(False, f"nothing to {request.kind}: the mission has ended")
+        return []
+    if request.kind == "skip":
+        commands = executor.skip(now, request.reason or "skipped by operator")
+        request.answer(True, "skipped; going on with the next waypoint")
+    elif request.kind == "pause":
+        if executor.paused:
+            request.answer(False, "already paused")
+            return []
+        commands = executor.pause(now, request.reason or "paused by operator")
+        request.answer(True, "paused; the active goal was cancelled")
+    elif request.kind == "resume":
+        if not executor.paused:
+            request.answer(False, "not paused")
+            return []
+        commands = executor.resume(now)
+        request.answer(True, "resumed")
+    else:  # cancel
+        commands = executor.cancel(now, request.reason or "cancelled by operator")
+        request.answer(True, "mission cancelled; the active goal was cancelled")
+    return commands
 
 
 def _odometry_pose(navigator: Navigator) -> Pose2D | None:

@@ -6,7 +6,6 @@
 - :mod:`navseq.ros.mission_topics`: a mission listener publishing markers and a JSON status;
 - :mod:`navseq.ros.navstack_params`: the robot profile from a running move_base's params;
 - :mod:`navseq.ros.run_setup`: ``navseq run --navigator ros1``'s connection to the stack;
-- :mod:`navseq.ros.operator`: pause/resume/cancel on top of any navigator (no ROS);
 - :mod:`navseq.ros.conversions`: navseq types <-> ROS messages, shared by all nodes;
 - :mod:`navseq.ros.params`: typed private parameters with errors naming the parameter;
 - :mod:`navseq.ros.fleet`: the other robots of a simulated fleet, their poses from TF;

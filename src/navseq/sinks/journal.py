@@ -83,6 +83,8 @@ _EVENT_TYPES: dict[str, type] = {
         ev.AttemptFailed,
         ev.WaypointDwelling,
         ev.WaypointFinished,
+        ev.MissionPaused,
+        ev.MissionResumed,
         ev.ServerStatusChanged,
         ev.MissionFinished,
     )

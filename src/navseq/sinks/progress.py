@@ -34,6 +34,8 @@ from navseq.executor.events import (
     LoopStarted,
     MissionEvent,
     MissionFinished,
+    MissionPaused,
+    MissionResumed,
     MissionStarted,
     ServerStatusChanged,
     WaypointDwelling,
@@ -151,6 +153,10 @@ class RunView:
                 + (f": {printable(event.reason)}" if event.reason else "")
                 + ", waiting"
             )
+        elif isinstance(event, MissionPaused):
+            self.status = f"paused ({printable(event.reason)})" if event.reason else "paused"
+        elif isinstance(event, MissionResumed):
+            self.status = "resumed"
         elif isinstance(event, MissionFinished):
             self.finished = event
             self.status = printable(event.reason)
@@ -303,6 +309,11 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
         )
     if isinstance(event, ServerStatusChanged):
         return view.status
+    if isinstance(event, MissionPaused):
+        why = f" ({printable(event.reason)})" if event.reason else ""
+        return f"{view.waypoint_label(event.index)}: paused{why}, the robot stopped"
+    if isinstance(event, MissionResumed):
+        return f"{view.waypoint_label(event.index)}: resumed after {event.paused_for:.1f} s"
     if isinstance(event, MissionFinished):
         verdict = "success" if event.success else "not every waypoint reached"
         return f"mission finished: {event.reason} ({verdict})"
