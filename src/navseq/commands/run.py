@@ -19,6 +19,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.commands.common import add_robot_option, format_pose, parse_loops, parse_pose
+from navseq.navigators.registry import (
+    NavigatorDraft,
+    add_navigator_choice,
+    add_navigator_options,
+    journaled_options,
+    navigator_kind,
+)
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -30,14 +37,10 @@ if TYPE_CHECKING:
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
     from navseq.sinks.progress import JsonProgress
     from navseq.sinks.recorder import RunRecorder
-
-NAVIGATORS = ("sim", "ros1")
-TEST_NAVIGATORS = ("scripted",)  # a deterministic stand-in, for tests of the plumbing
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -49,13 +52,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="mission file (navseq YAML, launch, rosparam YAML, CSV); "
         "optional with --resume (taken from the journal)",
     )
-    parser.add_argument(
-        "--navigator",
-        choices=NAVIGATORS + TEST_NAVIGATORS,
-        default=None,  # None: sim, or the journal's when resuming
-        metavar="{sim,ros1}",
-        help="sim: the embedded simulator (default); ros1: move_base over actionlib",
-    )
+    add_navigator_choice(parser, default=None)  # None: sim, or the journal's when resuming
     parser.add_argument(
         "--map", type=Path, metavar="MAP", help="map_server YAML (default: the mission's map:)"
     )
@@ -94,25 +91,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="run the waypoint list N times, or until interrupted (default: the mission's loops:)",
     )
     add_robot_option(parser)
-    ros1 = parser.add_argument_group("ros1 navigator")
-    ros1.add_argument(
-        "--action", default=None, help="MoveBaseAction server name (default: move_base)"
-    )
-    ros1.add_argument("--frame", help="goal frame (default: the mission's frame:, usually map)")
-    ros1.add_argument("--ns", default=None, help="robot namespace, e.g. robot1 (default: none)")
-    ros1.add_argument(
-        "--settle",
-        type=float,
-        default=None,  # 0.05, or the journal's when resuming
-        metavar="S",
-        help="wall seconds between a goal's result and the next goal, against move_base's "
-        "SUCCEEDED race (navigation #949); 0: off (default 0.05)",
-    )
-    # Options of the scripted test navigator, hidden from --help.
-    parser.add_argument("--scripted-speed", type=float, default=0.5, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-realtime", type=float, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-log", type=Path, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-script", default="", help=argparse.SUPPRESS)
+    # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
+    add_navigator_options(parser)
 
 
 @dataclass
@@ -169,33 +149,6 @@ def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
     }
 
 
-def _check_against_map(
-    mission: Mission, costmap: Costmap, start: Pose2D | None, robot: RobotProfile
-) -> None:
-    """Pre-flight: every problem of the mission on this map, raised together."""
-    from navseq.commands.common import preflight_errors
-    from navseq.errors import MissionErrors
-
-    problems = preflight_errors(mission, costmap, start, robot=robot)
-    if problems:
-        raise MissionErrors(problems)
-
-
-def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyGrid | None:
-    """The map, if one is known, with the mission checked against it."""
-    from navseq.commands.common import costmap_for_robot
-    from navseq.sim.occupancy import load_map
-
-    if setup["map_path"] is None:
-        return None
-    grid = load_map(setup["map_path"])
-    if not args.no_preflight:
-        robot = setup["robot"]
-        costmap = costmap_for_robot(grid, robot)
-        _check_against_map(setup["mission"], costmap, setup["start"], robot)
-    return grid
-
-
 def prepare(args: argparse.Namespace) -> RunSetup:
     """Load and check the user's input; raise NavseqError on any problem."""
     from navseq.commands.common import choose_robot, require_file
@@ -229,43 +182,57 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     start_source = (
         "--start" if args.start is not None else "mission start:" if start is not None else None
     )
-    setup_kwargs: dict[str, Any] = {
-        "mission": mission,
-        "mission_path": mission_path,
-        "digest": mission_digest(mission_path),
-        "resume": resume,
-        "journal": args.resume,
-        "history": history,
-        "map_path": map_path,
-        "start": start,
-        "robot": choose_robot(args.robot, mission),
-        "start_source": start_source,
-    }
-    if args.navigator == "sim":
-        setup = _prepare_sim(args, setup_kwargs)
-    elif args.navigator == "ros1":
-        setup = _prepare_ros1(args, setup_kwargs)
-    else:
-        setup = _prepare_scripted(args, setup_kwargs)
-    setup.notes[:0] = notes
+    kind = navigator_kind(args.navigator)
+    draft = NavigatorDraft(
+        mission=mission,
+        map_path=map_path,
+        start=start,
+        start_source=start_source,
+        robot=choose_robot(args.robot, mission),
+        preflight=not args.no_preflight,
+    )
+    made = kind.create(args, draft)
+    setup = RunSetup(
+        mission=mission,
+        mission_path=mission_path,
+        digest=mission_digest(mission_path),
+        make_navigator=made.make_navigator,
+        navigator_info=made.info,
+        robot=draft.robot,
+        start=draft.start,
+        start_source=draft.start_source,
+        grid=made.grid,
+        map_path=map_path,
+        resume=resume,
+        journal=args.resume,
+        history=history,
+        notes=[*notes, *made.notes],
+        listeners=made.listeners,
+    )
     setup.run_options = run_options(args, setup)
     return setup
 
 
 #: Options a run records in its journal, with their defaults; a resume continues with
 #: the recorded value of each one the command line does not give again.
+#: The chosen navigator kind's options are journaled too (NavigatorKind.journaled).
 RUN_OPTION_DEFAULTS: dict[str, Any] = {
     "navigator": "sim",
-    "action": "move_base",
-    "ns": "",
-    "frame": None,
-    "settle": 0.05,
 }
 
 
 def apply_run_defaults(args: argparse.Namespace) -> None:
-    """Fill the options left out (None) with their defaults."""
+    """Fill the options left out (None) with their defaults, the navigator's included."""
+    from navseq.errors import NavseqError
+
     for name, default in RUN_OPTION_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, default)
+    try:
+        kind = navigator_kind(args.navigator)
+    except KeyError:  # a journal naming a navigator this navseq does not have
+        raise NavseqError(f"unknown navigator {args.navigator!r}", source="--navigator") from None
+    for name, default in kind.option_defaults().items():
         if getattr(args, name, None) is None:
             setattr(args, name, default)
 
@@ -292,7 +259,7 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
         return getattr(args, name, None) is not None
 
     for name, value in recorded.items():
-        if name not in (*RUN_OPTION_DEFAULTS, "loops", "map", "start"):
+        if name not in (*RUN_OPTION_DEFAULTS, *journaled_options(), "loops", "map", "start"):
             continue
         try:
             if name == "loops":
@@ -331,158 +298,13 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
     start = setup.start
     return {
         "navigator": args.navigator,
-        "action": args.action,
-        "ns": args.ns,
-        "frame": args.frame,
-        "settle": args.settle,
+        **{name: getattr(args, name) for name in navigator_kind(args.navigator).journaled()},
         "loops": setup.mission.loops,
         "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
         "start": None
         if start is None
         else [round(start.x, 6), round(start.y, 6), round(math.degrees(start.yaw), 6)],
     }
-
-
-def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.errors import NavseqError
-    from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
-    from navseq.sim.occupancy import load_map
-    from navseq.sim.profile import SimSettings
-    from navseq.sim.world import SimWorld, default_start
-
-    mission: Mission = setup["mission"]
-    map_path: Path | None = setup["map_path"]
-    start: Pose2D | None = setup["start"]
-    if map_path is None:
-        raise NavseqError(
-            "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
-            source=mission.source,
-        )
-    grid = load_map(map_path)
-    robot: RobotProfile = setup["robot"]
-    settings = SimSettings.of(robot)
-    notes = []
-    if start is None:
-        start = default_start(grid, settings.footprint)
-        setup["start"] = start
-        setup["start_source"] = "simulator default"
-        notes.append(
-            f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(start)}, the roomy point nearest the map origin"
-        )
-    # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    if not args.no_preflight:
-        _check_against_map(mission, costmap, start, robot)
-    world = SimWorld(
-        grid,
-        start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=lambda: SimNavigator(world),
-        navigator_info={"kind": "sim", "robot": robot.name},
-        notes=notes,
-    )
-
-
-def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.errors import NavseqError
-
-    mission: Mission = setup["mission"]
-    frame = args.frame or mission.frame
-    try:
-        from navseq.ros.run_setup import connect_for_run
-    except ImportError as error:
-        raise NavseqError(
-            f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
-            f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
-            "from the project's venv",
-            source="--navigator ros1",
-        ) from None
-    # Before anything is written: the server must answer and its clock run; the robot
-    # comes from move_base's parameters unless the user named one.
-    connection = connect_for_run(
-        mission,
-        action=args.action,
-        frame=frame,
-        namespace=args.ns,
-        settle=args.settle,
-        read_robot=getattr(args, "robot", None) is None and mission.robot is None,
-    )
-    info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
-    notes = []
-    if connection.robot is not None and connection.robot_note is not None:
-        # The stack's own robot: what pre-flight checks against, as move_base plans with it.
-        setup["robot"] = connection.robot
-        info["robot_source"] = connection.robot_note
-        notes.append(connection.robot_note)
-    info["robot"] = setup["robot"].name
-    try:
-        grid = _optional_map(args, setup)
-    except BaseException:
-        connection.navigator.close()
-        raise
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=lambda: connection.navigator,
-        navigator_info=info,
-        notes=notes,
-        listeners=[connection.topics],
-    )
-
-
-def _scripted_behaviours(script: str) -> list[Any]:
-    """Test-only: ``succeed,aborted@2,stall@1,hang,falsesuccess`` -> ScriptedNavigator
-    behaviours."""
-    from navseq.navigators.scripted import FalseSuccess, Finish, Hang, Stall, Succeed
-
-    behaviours: list[Any] = []
-    for token in filter(None, (part.strip() for part in script.split(","))):
-        name, _, after = token.partition("@")
-        seconds = float(after) if after else 0.0
-        if name == "succeed":
-            behaviours.append(Succeed())
-        elif name == "hang":
-            behaviours.append(Hang())
-        elif name == "stall":
-            behaviours.append(Stall(after=seconds))
-        elif name == "falsesuccess":
-            behaviours.append(FalseSuccess(after=seconds))
-        else:
-            behaviours.append(Finish(name.upper(), after=seconds))
-    return behaviours
-
-
-def _prepare_scripted(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.navigators.scripted import ScriptedNavigator
-
-    start: Pose2D | None = setup["start"]
-    grid = _optional_map(args, setup)
-
-    def make_navigator() -> Navigator:
-        return ScriptedNavigator(
-            _scripted_behaviours(args.scripted_script),
-            start=start,
-            speed=args.scripted_speed,
-            realtime=args.scripted_realtime,
-            log_path=args.scripted_log,
-        )
-
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=make_navigator,
-        navigator_info={"kind": "scripted", "speed": args.scripted_speed},
-    )
 
 
 @dataclass

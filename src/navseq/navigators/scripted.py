@@ -23,6 +23,7 @@ so that simulated time runs at that multiple of wall time (for signal tests).
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import time
@@ -42,6 +43,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
 
 
 @dataclass(frozen=True)
@@ -102,6 +104,9 @@ class FalseSuccess:
 Behaviour = Succeed | Finish | LoseServer | Hang | Stall | FalseSuccess
 
 _UNACCEPTED = ("REJECTED", "RECALLED")
+#: Status names a ``--scripted-script`` may end a goal with: actionlib's, and Nav2's
+#: CANCELED.
+SCRIPT_STATUSES = ("SUCCEEDED", "ABORTED", "REJECTED", "PREEMPTED", "RECALLED", "LOST", "CANCELED")
 
 
 def scripted_done(goal_id: int, status: str, text: str = "") -> GoalDone:
@@ -290,6 +295,52 @@ class ScriptedNavigator:
             self._log.flush()
 
 
+def behaviours_of(script: str) -> list[Behaviour]:
+    """``succeed,aborted@2,stall@1,hang,falsesuccess`` as behaviours (``--scripted-script``).
+
+    A status name ends the goal with that status (``aborted@2``: ABORTED after 2 s);
+    anything else is a ValueError (test-only input: an internal error, not a user's).
+    """
+    behaviours: list[Behaviour] = []
+    for token in filter(None, (part.strip() for part in script.split(","))):
+        name, _, after = token.partition("@")
+        seconds = float(after) if after else 0.0
+        if name == "succeed":
+            behaviours.append(Succeed())
+        elif name == "hang":
+            behaviours.append(Hang())
+        elif name == "stall":
+            behaviours.append(Stall(after=seconds))
+        elif name == "falsesuccess":
+            behaviours.append(FalseSuccess(after=seconds))
+        elif name.upper() in SCRIPT_STATUSES:
+            behaviours.append(Finish(name.upper(), after=seconds))
+        else:
+            raise ValueError(f"{name!r} is no scripted behaviour or status")
+    return behaviours
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """``navseq run --navigator scripted`` (hidden): the double, for the CLI's tests."""
+    grid = draft.optional_map()
+    start = draft.start
+
+    def make_navigator() -> ScriptedNavigator:
+        return ScriptedNavigator(
+            behaviours_of(args.scripted_script),
+            start=start,
+            speed=args.scripted_speed,
+            realtime=args.scripted_realtime,
+            log_path=args.scripted_log,
+        )
+
+    return NavigatorSetup(
+        make_navigator=make_navigator,
+        info={"kind": "scripted", "speed": args.scripted_speed},
+        grid=grid,
+    )
+
+
 __all__ = [
     "Behaviour",
     "FalseSuccess",
@@ -299,4 +350,7 @@ __all__ = [
     "ScriptedNavigator",
     "Stall",
     "Succeed",
+    "behaviours_of",
+    "create",
+    "scripted_done",
 ]

@@ -15,6 +15,7 @@ Events follow what an actionlib client of move_base would see:
 
 from __future__ import annotations
 
+import argparse
 import math
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from navseq.navigators.base import (
     GoalPlan,
     NavEvent,
 )
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
 from navseq.sim.navserver import NavParams, NavState
 from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
@@ -155,3 +157,48 @@ class SimNavigator:
             self._events.append(
                 GoalFeedback(goal.goal_id, world.robot.pose, server.distance_remaining)
             )
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """``navseq run --navigator sim``: the simulated world on the mission's map.
+
+    With no start pose given, the robot starts at the roomy point nearest the map
+    origin (said in a note). One costmap serves pre-flight and the simulated server.
+    """
+    from navseq.commands.common import format_pose
+    from navseq.errors import NavseqError
+    from navseq.sim.costmap import Costmap
+    from navseq.sim.profile import SimSettings
+
+    if draft.map_path is None:
+        raise NavseqError(
+            "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
+            source=draft.mission.source,
+        )
+    grid = load_map(draft.map_path)
+    settings = SimSettings.of(draft.robot)
+    notes = []
+    if draft.start is None:
+        draft.start = default_start(grid, settings.footprint)
+        draft.start_source = "simulator default"
+        notes.append(
+            f"no start pose given (--start or start:): the robot starts at "
+            f"{format_pose(draft.start)}, the roomy point nearest the map origin"
+        )
+    costmap = Costmap.from_grid(grid, settings.costmap_params)
+    # Pre-flight first: it lists every problem, where building the world would stop at
+    # the first (a start pose inside an obstacle).
+    draft.check_against(costmap)
+    world = SimWorld(
+        grid,
+        draft.start,
+        costmap=costmap,
+        nav_params=settings.nav_params,
+        footprint=settings.footprint,
+    )
+    return NavigatorSetup(
+        make_navigator=lambda: SimNavigator(world),
+        info={"kind": "sim", "robot": draft.robot.name},
+        grid=grid,
+        notes=notes,
+    )
