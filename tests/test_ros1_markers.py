@@ -13,7 +13,7 @@ from navseq.mission import Mission, Waypoint
 
 def test_markers_show_every_waypoint_with_heading_number_and_status_colour():
     pytest.importorskip("visualization_msgs.msg", reason="ROS 1 messages not installed")
-    from navseq.ros.markers import STATUS_COLOURS, MarkerStatus, waypoint_markers
+    from navseq.ros1.markers import STATUS_COLOURS, MarkerStatus, waypoint_markers
 
     mission = Mission(
         waypoints=(

@@ -64,7 +64,7 @@ POSE_PUBLISHER = textwrap.dedent(
 def start_recorder(master: RosMaster, out: Path, **params) -> RosProcess:
     for key, value in {"out": str(out), **params}.items():
         master.set_param(f"/navseq_record/{key}", value)
-    recorder = master.start_python("-m", "navseq.ros.record", label="recorder")
+    recorder = master.start_python("-m", "navseq.ros1.record", label="recorder")
     return recorder
 
 

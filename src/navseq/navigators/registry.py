@@ -153,7 +153,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
     NavigatorKind(
         "ros1",
         "move_base over actionlib",
-        "navseq.ros.run_setup",
+        "navseq.ros1.run_setup",
         options=(
             NavigatorOption(
                 "--action", "MoveBaseAction server name (default: move_base)", "move_base"

@@ -13,8 +13,8 @@ import rospy
 import tf2_ros
 
 from navseq.geometry import Pose2D
-from navseq.ros.conversions import pose2d_from_transform
-from navseq.ros.params import param_error, str_list_param
+from navseq.ros1.conversions import pose2d_from_transform
+from navseq.ros1.params import param_error, str_list_param
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
 
 WARN_PERIOD = 10.0  # s between two warnings about other robots without a pose

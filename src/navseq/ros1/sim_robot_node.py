@@ -1,7 +1,7 @@
 """The simulated robot as a ROS 1 node: a TurtleBot3-like base that obeys ``cmd_vel``.
 
 This is the body half of navseq's embedded simulator (the navigation half is
-:mod:`navseq.ros.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
+:mod:`navseq.ros1.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
 physics beyond differential-drive kinematics: the ROS-free body,
 :class:`navseq.sim.base.SimulatedBase`, integrates velocity commands and refuses any step
 that would put its footprint on an occupied or unknown cell of the map (it stops as if
@@ -29,7 +29,7 @@ Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
 In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
 ``[robot2/base_footprint]``): their poses come from TF in ``~global_frame`` every
 step, and the body refuses to overlap them as it refuses to overlap walls (see
-:mod:`navseq.ros.fleet`).
+:mod:`navseq.ros1.fleet`).
 
 Odometry behaves like a real robot's: the ``odom`` frame starts at the start pose and
 odometry is continuous; a teleport moves the robot in the map and shifts the
@@ -52,15 +52,15 @@ from rosgraph_msgs.msg import Clock
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
-from navseq.ros.conversions import (
+from navseq.ros1.conversions import (
     grid_from_msg,
     grid_to_msg,
     pose2d_from_pose,
     pose_from_pose2d,
     transform_stamped,
 )
-from navseq.ros.fleet import OtherRobots, other_robots_param
-from navseq.ros.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.fleet import OtherRobots, other_robots_param
+from navseq.ros1.params import bool_param, float_param, param_error, str_param
 from navseq.sim.base import SimulatedBase
 from navseq.sim.occupancy import load_map
 

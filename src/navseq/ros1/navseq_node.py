@@ -57,9 +57,9 @@ from navseq.executor.events import (
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
-from navseq.navigators.ros1 import CANCEL_FLUSH, Ros1Navigator, ensure_node
-from navseq.ros.mission_topics import MissionTopics
-from navseq.ros.params import bool_param
+from navseq.ros1.mission_topics import MissionTopics
+from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
+from navseq.ros1.params import bool_param
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.

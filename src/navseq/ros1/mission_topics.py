@@ -28,7 +28,7 @@ from navseq.executor.events import (
     WaypointStarted,
 )
 from navseq.mission.model import Mission
-from navseq.ros.markers import MarkerStatus, waypoint_markers
+from navseq.ros1.markers import MarkerStatus, waypoint_markers
 
 PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 RUN_TOPICS_NS = "navseq"  # where `navseq run` publishes, like the node named navseq

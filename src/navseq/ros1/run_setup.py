@@ -16,9 +16,9 @@ from dataclasses import dataclass
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
-from navseq.navigators.ros1 import DEFAULT_SETTLE, Ros1Navigator
-from navseq.ros.mission_topics import MissionTopics, run_topics_namespace
-from navseq.ros.navstack_params import read_navstack_profile
+from navseq.ros1.mission_topics import MissionTopics, run_topics_namespace
+from navseq.ros1.navigator import DEFAULT_SETTLE, Ros1Navigator
+from navseq.ros1.navstack_params import read_navstack_profile
 
 SERVER_WAIT = 30.0  # s of wall time for the action server, as the navseq node waits
 

@@ -117,8 +117,8 @@ def record_main(
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
     from std_srvs.srv import Trigger, TriggerResponse
 
-    from navseq.navigators.ros1 import ensure_node
-    from navseq.ros.conversions import pose2d_from_pose, pose2d_from_transform
+    from navseq.ros1.conversions import pose2d_from_pose, pose2d_from_transform
+    from navseq.ros1.navigator import ensure_node
 
     try:
         ensure_node(NODE_NAME)
@@ -235,8 +235,8 @@ def main() -> None:
     """ROS node: ``~out`` (required), ``~topic``, ``~overwrite``, ``~from_tf``, ``~base_frame``."""
     import rospy
 
-    from navseq.navigators.ros1 import ensure_node
-    from navseq.ros.params import bool_param
+    from navseq.ros1.navigator import ensure_node
+    from navseq.ros1.params import bool_param
 
     try:
         ensure_node(NODE_NAME, anonymous=False)

@@ -80,8 +80,8 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
-from navseq.ros.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
-from navseq.ros.conversions import terminal_status as terminal_status_of
+from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
+from navseq.ros1.conversions import terminal_status as terminal_status_of
 
 DEFAULT_NODE_NAME = "navseq"
 MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up

@@ -42,7 +42,7 @@ empty, from the first message on the ``map`` topic.
 In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
 ``[robot2/base_footprint]``); their poses come from TF every control step and the
 server plans around them, stops short of them, and waits for one that blocks the only
-way (see :mod:`navseq.sim.navserver` and :mod:`navseq.ros.fleet`).
+way (see :mod:`navseq.sim.navserver` and :mod:`navseq.ros1.fleet`).
 
 Control runs at ``~controller_frequency`` Hz of ROS time, so under ``use_sim_time`` the
 whole stack follows the simulated clock and its speed factor.
@@ -77,15 +77,15 @@ from std_srvs.srv import Empty, EmptyRequest, EmptyResponse
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, compose
-from navseq.ros.conversions import (
+from navseq.ros1.conversions import (
     grid_from_msg,
     grid_to_msg,
     pose2d_from_pose,
     pose2d_from_transform,
     pose_from_pose2d,
 )
-from navseq.ros.fleet import OtherRobots, other_robots_param
-from navseq.ros.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.fleet import OtherRobots, other_robots_param
+from navseq.ros1.params import bool_param, float_param, param_error, str_param
 from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap, CostmapParams
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid, load_map
