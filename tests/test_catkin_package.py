@@ -63,7 +63,7 @@ def test_every_node_script_is_an_executable_relay_to_a_main_and_is_installed():
         text = script.read_text()
         assert text.startswith("#!/usr/bin/env python3\n"), script
         assert os.access(script, os.X_OK), f"{script} is not executable"
-        module = re.search(r"^from (navseq\.ros\.\w+) import main$", text, re.M)
+        module = re.search(r"^from (navseq\.ros1\.\w+) import main$", text, re.M)
         assert module, f"{script} should only import and call navseq.ros1.<module>.main"
         assert f"nodes/{script.name}" in install_block.group(1), f"{script} not installed"
 

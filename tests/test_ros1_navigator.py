@@ -81,8 +81,8 @@ def _drive(argv: list[str]) -> int:
             for event in events:
                 record = {"type": type(event).__name__, **vars(event)}
                 record.pop("pose", None)
-                if "status" in record:
-                    record["status"] = event.status.value
+                if "outcome" in record:
+                    record["outcome"] = event.outcome.value
                 _emit(record)
                 if isinstance(event, GoalDone) and event.goal_id == goal.goal_id:
                     done = True
