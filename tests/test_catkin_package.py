@@ -157,7 +157,7 @@ def test_catkin_make_builds_a_workspace_where_rosrun_and_roslaunch_find_the_node
         assert os.access(installed, os.X_OK), installed
         assert installed.read_text().startswith("#!/usr/bin/env python3\n")
     python_dir = install / "lib" / "python3" / "dist-packages" / "navseq"
-    assert (python_dir / "ros" / "sim_nav_node.py").is_file()
+    assert (python_dir / "ros1" / "sim_nav_node.py").is_file()
     assert (python_dir / "sim" / "navserver.py").is_file()
     share = install / "share" / "navseq"
     for relative in ("package.xml", "launch/sim.launch", "maps/turtlebot3_world.yaml"):
