@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import errno
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -143,15 +143,28 @@ def write_outputs(
     return exit_code
 
 
-def print_summary(mission: Mission, result: MissionResult, files: RunFiles) -> None:
-    """The final table and the files, on stdout; a reader gone away is not an error."""
+def print_summary(
+    mission: Mission,
+    result: MissionResult,
+    files: RunFiles,
+    *,
+    numbers: Sequence[int] | None = None,
+    part: str | None = None,
+    notes: Sequence[str] = (),
+) -> None:
+    """The final table, ``notes`` and the files, on stdout; a reader gone away is not an error.
+
+    ``numbers`` and ``part``: see :func:`~navseq.sinks.summary.summary_table`.
+    """
     from rich.console import Console
 
-    from navseq.sinks.progress import summary_table
+    from navseq.sinks.summary import print_table, summary_table
 
     try:
         console = Console()
-        console.print(summary_table(mission, result))
+        print_table(summary_table(mission, result, numbers=numbers, part=part), console)
+        for note in notes:
+            console.print(note, highlight=False)
         for role, path in files.paths.items():
             if role not in files.failed:
                 console.print(f"{role:>8}: {path}", highlight=False)
