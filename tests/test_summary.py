@@ -159,7 +159,7 @@ def test_part_of_a_mission_is_numbered_as_in_the_file():
     text = text_of(table)
     rows = data_rows(text)
     assert rows[0].split()[0] == "5" and rows[1].split()[0] == "7"
-    assert "(--only 5,7)" in text
+    assert "(--only 5,7)" in text  # the part, as the caller describes it
 
 
 def test_in_a_pipe_names_are_never_cut():

@@ -88,7 +88,7 @@ def write_outputs(
     folder: Path,
     files: RunFiles,
     build_report: Callable[[dict[str, str], int], dict[str, Any]],
-    render_picture: Callable[[], bytes],
+    render_picture: Callable[[], bytes] | None,
     signals: SignalGuard | None,
     exit_code: int,
 ) -> int:
@@ -96,7 +96,8 @@ def write_outputs(
 
     ``build_report(paths, exit_code)`` makes the report given every file's path (the
     picture's name is chosen first so that the report can name it); ``render_picture()``
-    the PNG. A picture given up by the operator is only noted. A picture that cannot be
+    the PNG, or None for no picture (``--no-picture``: the report names none). A picture
+    given up by the operator is only noted. A picture that cannot be
     written (disk full) makes the run's status 2, and the report is written again to say
     so, if it can be.
     """
@@ -104,8 +105,9 @@ def write_outputs(
 
     from navseq.signals import StepAbandoned
 
-    picture_path = free_name(folder, "mission.png")
-    files.paths["picture"] = str(picture_path)
+    if render_picture is not None:
+        picture_path = free_name(folder, "mission.png")
+        files.paths["picture"] = str(picture_path)
 
     def report_text(path: Path) -> str:
         files.paths["report"] = str(path)
@@ -121,6 +123,8 @@ def write_outputs(
     except NavseqError as error:
         report_path = None
         files.failed["report"] = str(error)
+    if render_picture is None:
+        return exit_code
     try:
         if signals is not None:
             with signals.abortable():

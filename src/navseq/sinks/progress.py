@@ -18,7 +18,7 @@ import json
 import math
 import sys
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from typing import IO, Any
 
@@ -84,8 +84,10 @@ def eta_text(remaining: float, robot: RobotProfile) -> str:
 class RunView:
     """The state of a run as a watcher sees it, folded from mission events."""
 
-    def __init__(self, mission: Mission):
+    def __init__(self, mission: Mission, numbers: Sequence[int] | None = None):
         self.mission = mission
+        # The waypoints' positions in the file when the mission is a part of it.
+        self.numbers = numbers
         self.count = len(mission.waypoints)
         self.loops = mission.loops
         self.t = 0.0
@@ -106,7 +108,10 @@ class RunView:
 
     def waypoint_label(self, index: int) -> str:
         name = self.mission.waypoints[index].name if index < self.count else None
-        return f"waypoint {index + 1}/{self.count}" + (f" '{printable(name)}'" if name else "")
+        named = f" '{printable(name)}'" if name else ""
+        if self.numbers is not None and index < len(self.numbers):  # a part: file numbers
+            return f"waypoint {self.numbers[index] + 1}{named} ({index + 1}/{self.count})"
+        return f"waypoint {index + 1}/{self.count}{named}"
 
     def loop_label(self) -> str:
         total = "∞" if self.loops is None else str(self.loops)
@@ -172,8 +177,9 @@ class LiveProgress:
         *,
         recent_lines: int = 4,
         robot: RobotProfile = DEFAULT_PROFILE,
+        numbers: Sequence[int] | None = None,
     ):
-        self.view = RunView(mission)
+        self.view = RunView(mission, numbers)
         self.robot = robot
         self.console = console
         self.recent: deque[str] = deque(maxlen=recent_lines)
@@ -336,8 +342,9 @@ class LogProgress:
         *,
         progress_period: float = 10.0,
         robot: RobotProfile = DEFAULT_PROFILE,
+        numbers: Sequence[int] | None = None,
     ):
-        self.view = RunView(mission)
+        self.view = RunView(mission, numbers)
         self.robot = robot
         self.stream = stream
         self.progress_period = progress_period
@@ -429,15 +436,17 @@ def make_progress(
     json_lines: bool,
     stream: IO[str] | None = None,
     robot: RobotProfile = DEFAULT_PROFILE,
+    numbers: Sequence[int] | None = None,
 ) -> ProgressSink:
     """JSON lines if asked, a live panel on a terminal, plain log lines otherwise.
 
     ``robot``'s top speed gives the time still to go (at least) shown with the distance.
+    ``numbers``: the waypoints' positions in the file when ``mission`` is a part of it.
     """
     stream = stream if stream is not None else sys.stdout
     if json_lines:
         return JsonProgress(stream)
     console = Console(file=stream)
     if console.is_terminal:
-        return LiveProgress(mission, console, robot=robot)
-    return LogProgress(mission, stream, robot=robot)
+        return LiveProgress(mission, console, robot=robot, numbers=numbers)
+    return LogProgress(mission, stream, robot=robot, numbers=numbers)

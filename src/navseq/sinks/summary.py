@@ -210,7 +210,9 @@ def summary_table(
     rows, rest = summary_rows(stats, max_rows=max_rows, max_problems=max_problems)
     loops = any(row.ran + row.not_run > 1 for row in stats)
     title = f"mission {mission.source}" + (f" ({part})" if part else "") + f": {result.reason}"
-    table = Table(title=Text(printable(title)), show_footer=True)
+    title_text = Text(printable(title))
+    # At least as wide as its title: rich wraps a title to the table's width.
+    table = Table(title=title_text, show_footer=True, min_width=title_text.cell_len)
 
     def number(index: int) -> str:
         return str((numbers[index] if numbers is not None else index) + 1)
@@ -345,5 +347,6 @@ def print_table(table: Table, console: Console) -> None:
     """
     if not console.is_terminal:
         wide = console.options.update_width(100_000)
-        console.width = max(Measurement.get(console, wide, table).maximum, 20)
+        parts = [table, *([table.title] if table.title is not None else [])]
+        console.width = max(max(Measurement.get(console, wide, p).maximum for p in parts), 20)
     console.print(table)
