@@ -276,7 +276,7 @@ def test_no_message_of_the_cli_repeats_its_prefix(tmp_path):
         ("run", mission, "--map", "/nope.yaml"),
         ("validate", "nope.yaml"),
         ("report", tmp_path),
-        ("convert", "nope.yaml", "-o", tmp_path / "x.yaml"),
+        ("convert", "nope.yaml", tmp_path / "x.yaml"),
     ):
         result = navseq(*args, cwd=tmp_path)
         assert result.returncode != 0
@@ -293,3 +293,20 @@ def test_summary_in_a_pipe_keeps_long_names_whole(tmp_path):
     assert name in result.stdout
     assert "…" not in result.stdout
     assert "mission finished: stopped" in result.stdout
+
+
+def test_report_of_a_folder_that_is_no_run_says_what_to_give(tmp_path):
+    result = navseq("report", tmp_path, cwd=tmp_path)
+    assert_clean_error(result)
+    assert "is not a run's output folder (it has no journal.jsonl)" in result.stderr
+    assert "navseq-out/" in result.stderr
+
+
+def test_a_file_that_is_no_robot_is_quoted_short_and_the_robots_listed_once(tmp_path):
+    not_a_robot = tmp_path / "notes.yaml"
+    not_a_robot.write_text("x" * 5000 + "\n")
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: 0.5, y: 0.5, yaw: 0}\n")
+    result = navseq("validate", mission, "--robot", not_a_robot, cwd=tmp_path)
+    assert_clean_error(result)
+    assert len(result.stderr) < 400
+    assert result.stderr.count("turtlebot3_waffle_pi") == 1

@@ -43,8 +43,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
     from navseq.runlock import RunLock
+    from navseq.text import printable
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
+    if args.run.is_dir() and not journal.exists():
+        from navseq.errors import NavseqError
+
+        raise NavseqError(
+            f"{printable(str(args.run))} is not a run's output folder (it has no "
+            f"{JOURNAL_NAME}); give the folder navseq run wrote (navseq-out/...) or its "
+            f"{JOURNAL_NAME}",
+            source="RUN",
+        )
     require_file(journal, "RUN")
     with RunLock(journal.parent):  # not while a live run writes them
         rebuilt = rebuild_outputs(journal)
