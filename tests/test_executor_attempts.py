@@ -23,8 +23,9 @@ from navseq.mission.model import FailureAction
 from navseq.navigators.base import GoalStatus
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Stall, Succeed
 from navseq.sinks.journal import JournalWriter, read_journal, resume_point
-from navseq.sinks.progress import JsonProgress, LogProgress, summary_table
+from navseq.sinks.progress import JsonProgress, LogProgress
 from navseq.sinks.report import build_report
+from navseq.sinks.summary import summary_table
 
 NO_PLAN = "Failed to find a valid plan. Even after executing recovery behaviors."
 

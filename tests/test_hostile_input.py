@@ -36,7 +36,8 @@ from navseq.mission import load_mission
 from navseq.mission.model import Mission, Waypoint
 from navseq.sim.occupancy import load_map
 from navseq.sinks.journal import read_journal
-from navseq.sinks.progress import LogProgress, summary_table
+from navseq.sinks.progress import LogProgress
+from navseq.sinks.summary import summary_table
 from navseq.text import printable, text_problem
 
 # Long enough to never cut a healthy run short on a loaded machine; short enough that

@@ -65,6 +65,34 @@ def parse_loops(text: str) -> int | None:
     return loops
 
 
+def parse_waypoint_number(text: str) -> int:
+    """A whole number: a 1-based waypoint number, as the summary table prints it.
+
+    Whether the waypoint exists is checked against the mission, whose size says the
+    valid range (:class:`navseq.mission.part.PartSpec`).
+    """
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a waypoint number (1 for the first), got {text!r}"
+        ) from None
+
+
+def parse_realtime(text: str) -> float:
+    """A real-time factor > 0 (``--realtime 2``: twice as fast as real time)."""
+    try:
+        factor = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a speed factor such as 1 or 0.5, got {text!r} (its FACTOR is optional: "
+            "put MISSION before --realtime, or give one, e.g. --realtime 1)"
+        ) from None
+    if not (math.isfinite(factor) and factor > 0):
+        raise argparse.ArgumentTypeError(f"the factor must be a number above 0, got {text!r}")
+    return factor
+
+
 def format_pose(pose: Pose2D) -> str:
     return f"({pose.x:.2f}, {pose.y:.2f}, {math.degrees(pose.yaw):.0f}°)"
 

@@ -44,18 +44,31 @@ def run(args: argparse.Namespace) -> int:
     from navseq.mission import inspect_mission_file
     from navseq.mission.robot_format import robot_from_option
 
+    # Every problem of every input, in one list: a bad --map or --robot does not hide
+    # the mission's problems, nor the other way round.
+    option_errors: list[NavseqError] = []
     if args.map is not None:
-        require_file(args.map, "--map")
+        try:
+            require_file(args.map, "--map")
+        except NavseqError as error:
+            option_errors.append(error)
     if args.robot is not None:
-        robot_from_option(args.robot)  # a bad --robot is reported before the mission
+        try:
+            robot_from_option(args.robot)
+        except NavseqError as error:
+            option_errors.append(error)
     mission, problems = inspect_mission_file(args.mission)
     errors = list(problems.errors)
-    if mission is None and problems.salvage is not None:
+    if option_errors:
+        errors += option_errors  # the map cannot be checked without them
+    elif mission is None and problems.salvage is not None:
         # Check the waypoints that did read against the map as well, so that one run
         # of validate lists everything to fix.
         errors += _map_problems(args, problems.salvage.mission, problems.salvage.numbers)
     elif mission is not None:
         errors += _map_problems(args, mission)
+    elif args.map is not None:  # no waypoints to check, but the map can still be read
+        errors += _map_problems(args, None)
     if errors:
         raise MissionErrors(errors)
     assert mission is not None
@@ -75,14 +88,19 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _map_path(args: argparse.Namespace, mission: Mission) -> Path | None:
-    return args.map if args.map is not None else mission.map
+def _map_path(args: argparse.Namespace, mission: Mission | None) -> Path | None:
+    if args.map is not None:
+        return Path(args.map)
+    return mission.map if mission is not None else None
 
 
 def _map_problems(
-    args: argparse.Namespace, mission: Mission, numbers: Sequence[int] | None = None
+    args: argparse.Namespace, mission: Mission | None, numbers: Sequence[int] | None = None
 ) -> list[NavseqError]:
-    """The pre-flight problems of ``mission`` on the map given or named, if any."""
+    """The pre-flight problems of ``mission`` on the map given or named, if any.
+
+    Without a mission (a file that did not read at all) only the map itself is checked.
+    """
     from navseq.commands.common import choose_robot, costmap_for_map, preflight_errors
 
     map_path = _map_path(args, mission)
@@ -93,5 +111,7 @@ def _map_problems(
         costmap = costmap_for_map(map_path, robot)
     except NavseqError as error:  # an unreadable map is one more problem to list
         return [error]
+    if mission is None:
+        return []
     start = args.start if args.start is not None else mission.start
     return preflight_errors(mission, costmap, start, numbers, robot)

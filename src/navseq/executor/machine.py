@@ -495,7 +495,8 @@ class MissionExecutor:
                 self._finish_mission(now, "completed")
             else:
                 missed = sum(v.outcome is not WaypointOutcome.REACHED for v in self._all_visits())
-                self._finish_mission(now, f"completed: {missed} waypoint visit(s) not reached")
+                visits = "waypoint visit" if missed == 1 else "waypoint visits"
+                self._finish_mission(now, f"completed: {missed} {visits} not reached")
             return []
         loop, index = following
         if loop != visit.loop:

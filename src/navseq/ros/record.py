@@ -213,8 +213,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="also offer the ~record service that records the robot's current TF pose",
     )
-    parser.add_argument("--base-frame", default="base_footprint")
-    parser.add_argument("--frame", default="map", help="frame of TF-recorded poses")
+    parser.add_argument(
+        "--base-frame",
+        default="base_footprint",
+        help="the robot's TF frame whose pose --from-tf records (default base_footprint)",
+    )
+    parser.add_argument("--frame", default="map", help="frame of TF-recorded poses (default map)")
 
 
 def run(args: argparse.Namespace) -> int:
