@@ -93,7 +93,7 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "name": visit.name,
         "x": _rounded(visit.x),
         "y": _rounded(visit.y),
-        "yaw_deg": _rounded(math.degrees(visit.yaw), 1),
+        "yaw_deg": _rounded(math.degrees(visit.yaw_rad), 1),
         "outcome": WaypointOutcome(visit.outcome).value,
         "attempts": [_attempt_dict(attempt) for attempt in visit.attempt_results],
         "duration_s": _rounded(visit.duration, 2),
