@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
-    from navseq.sinks.progress import JsonProgress
+    from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
 NAVIGATORS = ("sim", "ros1")
@@ -160,13 +160,9 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
-    return {
-        "source": str(map_path),
-        "resolution": grid.resolution,
-        "width": grid.width,
-        "height": grid.height,
-        "origin": [grid.origin.x, grid.origin.y, grid.origin.yaw],
-    }
+    from navseq.sinks.report import map_summary
+
+    return map_summary(grid, map_path)
 
 
 def _check_against_map(
@@ -552,7 +548,8 @@ def _run_with_sinks(
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
-    from navseq.sinks.progress import JsonProgress, make_progress
+    from navseq.sinks.json_events import JsonProgress
+    from navseq.sinks.progress import make_progress
 
     navigator = setup.make_navigator()
     error: NavseqError | None = None
@@ -658,15 +655,12 @@ def _execute_locked(
     )
     if outcome.json_lines is not None:
         try:
-            outcome.json_lines.emit(
-                "RunFinished",
-                {
-                    "success": outcome.result.success,
-                    "reason": outcome.result.reason,
-                    "exit_code": exit_code,
-                    "interrupted": outcome.interrupted,
-                    **files.paths,
-                },
+            outcome.json_lines.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=exit_code,
+                interrupted=outcome.interrupted,
+                files=files.paths,
             )
         except BrokenPipeError:
             silence_stdout()
