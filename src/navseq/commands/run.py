@@ -342,14 +342,11 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.errors import NavseqError
     from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
-    from navseq.sim.profile import SimSettings
-    from navseq.sim.world import SimWorld, default_start
+    from navseq.simrun import prepare_sim_world
 
     mission: Mission = setup["mission"]
     map_path: Path | None = setup["map_path"]
-    start: Pose2D | None = setup["start"]
     if map_path is None:
         raise NavseqError(
             "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
@@ -357,29 +354,16 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
         )
     grid = load_map(map_path)
     robot: RobotProfile = setup["robot"]
-    settings = SimSettings.of(robot)
+    ready = prepare_sim_world(mission, grid, setup["start"], robot, preflight=not args.no_preflight)
     notes = []
-    if start is None:
-        start = default_start(grid, settings.footprint)
-        setup["start"] = start
+    if ready.start_defaulted:
+        setup["start"] = ready.start
         setup["start_source"] = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(start)}, the roomy point nearest the map origin"
+            f"{format_pose(ready.start)}, the roomy point nearest the map origin"
         )
-    # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    if not args.no_preflight:
-        _check_against_map(mission, costmap, start, robot)
-    world = SimWorld(
-        grid,
-        start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
+    world = ready.world
     return RunSetup(
         **setup,
         grid=grid,
