@@ -11,25 +11,34 @@ from pathlib import Path
 import pytest
 
 import navseq
-from cli_support import REPO, TURTLEBOT3_MAP, navseq as navseq_cli
-from cli_support import write_mission
+from cli_support import REPO, TURTLEBOT3_MAP, write_mission
+from cli_support import navseq as navseq_cli
 
 API_DOC = REPO / "docs" / "api.md"
-BLOCKS = re.findall(r"^```python\n(.*?)^```", API_DOC.read_text(), flags=re.S | re.M)
 
 
-@pytest.mark.parametrize("number", range(len(BLOCKS)), ids=lambda n: f"block{n + 1}")
-def test_every_python_example_in_api_md_runs(number, tmp_path, monkeypatch, capsys):
+def python_blocks(doc: Path) -> list[tuple[str, str]]:
+    """``(name, code)`` of every fenced python block of ``doc``."""
+    code = re.findall(r"^```python\n(.*?)^```", doc.read_text(), flags=re.S | re.M)
+    return [(f"{doc.name}:block{number + 1}", text) for number, text in enumerate(code)]
+
+
+BLOCKS = python_blocks(API_DOC) + python_blocks(REPO / "README.md")
+
+
+@pytest.mark.parametrize("name,code", BLOCKS, ids=[name for name, _ in BLOCKS])
+def test_every_python_example_in_the_docs_runs(name, code, tmp_path, monkeypatch, capsys):
     # Each block on its own, in a fresh folder holding the repository's examples and maps.
-    for name in ("examples", "maps"):
-        (tmp_path / name).symlink_to(REPO / name)
+    for folder in ("examples", "maps"):
+        (tmp_path / folder).symlink_to(REPO / folder)
     monkeypatch.chdir(tmp_path)
-    exec(compile(BLOCKS[number], f"{API_DOC}:block{number + 1}", "exec"), {})
+    exec(compile(code, name, "exec"), {})
     assert capsys.readouterr().out  # every example shows something
 
 
-def test_api_md_has_the_examples_it_promises():
-    assert len(BLOCKS) >= 6
+def test_the_docs_have_the_examples_they_promise():
+    assert len([name for name, _ in BLOCKS if name.startswith("api.md")]) >= 6
+    assert any(name.startswith("README.md") for name, _ in BLOCKS)
 
 
 def test_every_public_name_resolves_and_nothing_else_does():
@@ -41,7 +50,7 @@ def test_every_public_name_resolves_and_nothing_else_does():
 
 
 def test_a_yaw_without_a_unit_is_refused_with_a_clear_message():
-    with pytest.raises(TypeError, match="yaw_deg= .* or yaw_rad="):
+    with pytest.raises(TypeError, match=r"yaw_deg= .* or yaw_rad="):
         navseq.Waypoint(1.0, 2.0, yaw=90)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="has no unit"):
         navseq.Waypoint(1.0, 2.0, 90)  # type: ignore[arg-type]
@@ -85,7 +94,9 @@ def test_validate_file_finds_what_navseq_validate_finds(tmp_path):
 def test_simulate_gives_the_run_navseq_run_gives(tmp_path):
     text = "  - {name: south, x: 0.5, y: -1.6, yaw: 0}\n  - {name: east, x: 1.6, y: 0.5, yaw: 90}\n"
     path = write_mission(
-        tmp_path / "arena.yaml", text, f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2.0, y: -0.5, yaw: 0}}\n"
+        tmp_path / "arena.yaml",
+        text,
+        f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2.0, y: -0.5, yaw: 0}}\n",
     )
     cli = navseq_cli("run", path, "--out", tmp_path / "out", cwd=tmp_path)
     assert cli.returncode == 0, cli.stderr

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -37,7 +36,9 @@ def validator(name: str) -> Draft202012Validator:
 
 
 def problems(check: Draft202012Validator, record: Any) -> list[str]:
-    return [f"{'/'.join(map(str, e.absolute_path))}: {e.message}" for e in check.iter_errors(record)]
+    return [
+        f"{'/'.join(map(str, e.absolute_path))}: {e.message}" for e in check.iter_errors(record)
+    ]
 
 
 @pytest.fixture(scope="module")
