@@ -166,7 +166,7 @@ def run_one(
     leg_start: Pose2D | None = mission.start  # None: where the robot gave up, unknown
     failed = False
     for visit in result.visits:
-        goal = Pose2D(visit.x, visit.y, visit.yaw)
+        goal = Pose2D(visit.x, visit.y, visit.yaw_rad)
         if visit.outcome is WaypointOutcome.REACHED:
             stats.reached += 1
             if leg_start is not None:
