@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -42,17 +44,19 @@ def problems(check: Draft202012Validator, record: Any) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+def run(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> tuple[list[dict[str, Any]], dict[str, Any], Path]:
     folder = tmp_path_factory.mktemp("schema_run")
     mission = write_mission(folder / "lap.yaml", MISSION, HEADER)
     done = navseq("run", mission, "--json", "--out", folder / "out", cwd=folder)
     assert done.returncode == 1, done.stderr  # "far" is skipped: not every visit reached
     records = [json.loads(line) for line in done.stdout.splitlines()]
-    return records, json.loads((folder / "out" / "report.json").read_text())
+    return records, json.loads((folder / "out" / "report.json").read_text()), folder
 
 
 def test_every_event_record_of_a_real_run_matches_the_events_schema(run):
-    records, _ = run
+    records, _, _ = run
     check = validator("events")
     kinds = {record["event"] for record in records}
     # Every kind a simulator run can emit (the server never vanishes in process).
@@ -79,12 +83,12 @@ def test_server_status_records_match_the_schema_too():
 
 
 def test_the_report_of_a_real_run_matches_the_report_schema(run):
-    _, written = run
+    _, written, _ = run
     assert problems(validator("report"), written) == []
 
 
 def test_events_and_report_use_the_same_names_and_units_for_the_same_things(run):
-    records, written = run
+    records, written, _ = run
     started = next(r for r in records if r["event"] == "WaypointStarted" and r["index"] == 1)
     visit = written["visits"][1]
     assert started["yaw_deg"] == visit["yaw_deg"] == 90.0  # degrees in both, not radians
@@ -110,9 +114,19 @@ def test_the_schemas_say_the_versions_the_code_writes():
 
 
 def test_the_schemas_catch_drift(run):
-    records, written = run
+    records, written, _ = run
     renamed = {**records[2], "duration": 1.0}  # an old, unit-less name
     assert problems(validator("events"), renamed)
     visit = {**written["visits"][0], "yaw": math.pi / 2}
     assert problems(validator("report"), {**written, "visits": [visit]})
     assert problems(validator("report"), {**written, "schema_version": 2})
+
+
+def test_a_report_rebuilt_from_the_journal_matches_the_schema(run, tmp_path):
+    _, _, folder = run
+    copy = shutil.copytree(folder / "out", tmp_path / "out")
+    (copy / "report.json").unlink()
+    done = navseq("report", copy, cwd=tmp_path)
+    assert done.returncode in (0, 1), done.stderr
+    rebuilt = json.loads((copy / "report.json").read_text())
+    assert problems(validator("report"), rebuilt) == []
