@@ -391,7 +391,7 @@ def test_a_yaw_of_many_turns_is_driven_as_the_direction_it_means(tmp_path):
         f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2, y: -0.5}}\n"
         "waypoints:\n  - {x: -1.9, y: -0.5, yaw: 3590}\n",
     )
-    assert load_mission(path).waypoints[0].yaw_degrees == pytest.approx(-10.0)
+    assert load_mission(path).waypoints[0].yaw_deg == pytest.approx(-10.0)
     result = navseq("run", path, "--out", tmp_path / "out", cwd=tmp_path, timeout=60)
     assert result.returncode == 0, result.stderr
 
@@ -468,7 +468,7 @@ def test_summary_table_escapes_names_and_reasons():
         name="\x1b[2Jdock",
         x=1.0,
         y=0.0,
-        yaw=0.0,
+        yaw_rad=0.0,
         outcome=WaypointOutcome.FAILED,
         attempts=1,
         duration=1.0,

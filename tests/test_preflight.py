@@ -38,7 +38,9 @@ def pocket_map() -> Costmap:
 
 def mission_of(points, *, names=None, loops: int | None = 1, start=None) -> Mission:
     waypoints = tuple(
-        Waypoint(x, y, 0.0, name=(names[i] if names else None), where=f"mission.yaml:{10 + i}")
+        Waypoint(
+            x, y, yaw_rad=0.0, name=(names[i] if names else None), where=f"mission.yaml:{10 + i}"
+        )
         for i, (x, y) in enumerate(points)
     )
     return Mission(waypoints=waypoints, loops=loops, start=start, source="mission.yaml")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import io
-import json
 import math
 
 from rich.console import Console
@@ -22,8 +21,8 @@ from navseq.executor.events import (
     WaypointStarted,
 )
 from navseq.mission.model import Mission, Waypoint
+from navseq.sinks.json_events import JsonProgress
 from navseq.sinks.progress import (
-    JsonProgress,
     LiveProgress,
     LogProgress,
     RunView,
@@ -32,9 +31,9 @@ from navseq.sinks.progress import (
 
 MISSION = Mission(
     waypoints=(
-        Waypoint(1.0, 0.0, 0.0, name="dock"),
-        Waypoint(2.0, 0.0, math.pi / 2),
-        Waypoint(2.0, 2.0, math.pi, name="desk"),
+        Waypoint(1.0, 0.0, yaw_rad=0.0, name="dock"),
+        Waypoint(2.0, 0.0, yaw_rad=math.pi / 2),
+        Waypoint(2.0, 2.0, yaw_rad=math.pi, name="desk"),
     ),
     loops=2,
     source="office.yaml",
@@ -113,21 +112,6 @@ def test_log_progress_lines_are_throttled_to_the_period():
     assert progress_lines == [
         "[    12.0 s] waypoint 1/3 'dock': 0.10 m to go (~0 s at 0.22 m/s), 0.90 m driven"
     ]
-
-
-def test_json_lines_are_one_parseable_object_per_event():
-    out = io.StringIO()
-    sink = JsonProgress(out)
-    events = run_events()
-    for event in events:
-        sink(event)
-    sink.emit("RunFinished", {"exit_code": 130, "bad": math.inf})
-    records = [json.loads(line) for line in out.getvalue().splitlines()]
-    assert [r["event"] for r in records[:-1]] == [type(e).__name__ for e in events]
-    finished = records[events.index(events[7])]
-    assert finished["outcome"] == "reached" and finished["index"] == 0
-    assert records[3]["path"] == [[0.0, 0.0], [1.0, 0.0]]
-    assert records[-1] == {"event": "RunFinished", "exit_code": 130, "bad": None}
 
 
 def test_make_progress_is_plain_when_not_a_terminal_and_json_when_asked():

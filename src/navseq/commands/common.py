@@ -139,15 +139,18 @@ def add_robot_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def choose_robot(option: str | None, mission: Mission | None) -> RobotProfile:
+def choose_robot(option: str | RobotProfile | None, mission: Mission | None) -> RobotProfile:
     """The robot to plan and check for: ``--robot`` > the mission's ``robot:`` > default.
 
-    ``--robot`` is read here, not by argparse, so that a bad name or file is one
-    NavseqError (exit 2) like every other input problem.
+    ``--robot`` (a built-in name or a file) is read here, not by argparse, so that a bad
+    name or file is one NavseqError (exit 2) like every other input problem. The Python
+    API may pass a :class:`RobotProfile` itself.
     """
-    from navseq.mission.robot import DEFAULT_PROFILE
+    from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
     from navseq.mission.robot_format import robot_from_option
 
+    if isinstance(option, RobotProfile):
+        return option
     if option is not None:
         return robot_from_option(option)
     if mission is not None and mission.robot is not None:

@@ -120,8 +120,10 @@ def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
         waypoint = mission.waypoints[index]
         known = state.visits.get((loop, index))
         if known is not None:
-            return replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw)
-        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw)
+            return replace(
+                known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad
+            )
+        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw_rad)
 
     count = len(mission.waypoints)
     started = state.mission_started

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
-    from navseq.sinks.progress import JsonProgress
+    from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
 NAVIGATORS = ("sim", "ros1")
@@ -203,13 +203,9 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
-    return {
-        "source": str(map_path),
-        "resolution": grid.resolution,
-        "width": grid.width,
-        "height": grid.height,
-        "origin": [grid.origin.x, grid.origin.y, grid.origin.yaw],
-    }
+    from navseq.sinks.report import map_summary
+
+    return map_summary(grid, map_path)
 
 
 def _check_against_map(
@@ -468,14 +464,11 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.errors import NavseqError
     from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
-    from navseq.sim.profile import SimSettings
-    from navseq.sim.world import SimWorld, default_start
+    from navseq.simrun import prepare_sim_world
 
     mission: Mission = setup["mission"]
     map_path: Path | None = setup["map_path"]
-    start: Pose2D | None = setup["start"]
     if map_path is None:
         raise NavseqError(
             "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
@@ -483,29 +476,24 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
         )
     grid = load_map(map_path)
     robot: RobotProfile = setup["robot"]
-    settings = SimSettings.of(robot)
+    part = setup["part"]
+    ready = prepare_sim_world(
+        mission,
+        grid,
+        setup["start"],
+        robot,
+        preflight=not args.no_preflight,
+        numbers=part.numbers if part is not None else None,
+    )
     notes = []
-    if start is None:
-        start = default_start(grid, settings.footprint)
-        setup["start"] = start
+    if ready.start_defaulted:
+        setup["start"] = ready.start
         setup["start_source"] = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(start)}, the roomy point nearest the map origin"
+            f"{format_pose(ready.start)}, the roomy point nearest the map origin"
         )
-    # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    if not args.no_preflight:
-        _check_against_map(mission, costmap, start, robot, setup["part"])
-    world = SimWorld(
-        grid,
-        start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
+    world = ready.world
     return RunSetup(
         **setup,
         grid=grid,
@@ -679,7 +667,8 @@ def _run_with_sinks(
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
-    from navseq.sinks.progress import JsonProgress, make_progress
+    from navseq.sinks.json_events import JsonProgress
+    from navseq.sinks.progress import make_progress
 
     navigator = setup.make_navigator()
     error: NavseqError | None = None
@@ -813,15 +802,12 @@ def _execute_locked(
         notes.append(real_time_text(outcome.navigator_seconds, outcome.wall_seconds))
     if outcome.json_lines is not None:
         try:
-            outcome.json_lines.emit(
-                "RunFinished",
-                {
-                    "success": outcome.result.success,
-                    "reason": outcome.result.reason,
-                    "exit_code": exit_code,
-                    "interrupted": outcome.interrupted,
-                    **files.paths,
-                },
+            outcome.json_lines.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=exit_code,
+                interrupted=outcome.interrupted,
+                files=files.paths,
             )
         except BrokenPipeError:
             silence_stdout()

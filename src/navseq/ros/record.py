@@ -81,7 +81,7 @@ class WaypointRecorder:
                     subject=f"waypoint {len(self._waypoints) + 1}",
                 )
             self._frame = frame
-            self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw=pose.yaw, z=z))
+            self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw_rad=pose.yaw, z=z))
             mission = Mission(waypoints=tuple(self._waypoints), frame=frame, source=str(self.out))
             # The first write may replace a user's file only when asked; later ones
             # replace the file we wrote ourselves.

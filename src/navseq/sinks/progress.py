@@ -5,7 +5,8 @@ Three listeners share one model of the run, :class:`RunView`:
 - :class:`LiveProgress`: a rich live panel for terminals (current waypoint n/N and
   name, status, distance remaining, mission-clock elapsed time, loop, attempt);
 - :class:`LogProgress`: one plain line per thing that happened, for logs and pipes;
-- :class:`JsonProgress`: one JSON object per event, for programs (``--json``).
+- :class:`~navseq.sinks.json_events.JsonProgress`: one JSON object per event, for
+  programs (``--json``; its own module).
 
 :func:`make_progress` picks one; the table printed at the end is
 :mod:`navseq.sinks.summary`'s. Elapsed time is the navigator's clock (simulated time
@@ -14,13 +15,11 @@ on the simulator).
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 from collections import deque
-from collections.abc import Mapping, Sequence
-from dataclasses import asdict
-from typing import IO, Any
+from collections.abc import Sequence
+from typing import IO
 
 from rich.console import Console, Group, RenderableType
 from rich.live import Live
@@ -45,6 +44,7 @@ from navseq.executor.events import (
 )
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.sinks.json_events import JsonProgress
 from navseq.text import printable
 
 OUTCOME_STYLE = {
@@ -383,48 +383,6 @@ class LogProgress:
         text = describe(event, view)
         if text is not None:
             self._log(text)
-
-
-def _json_safe(value: Any) -> Any:
-    """Replace non-finite floats (not valid JSON) by None, recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    return value
-
-
-def event_to_json(event: MissionEvent) -> str:
-    """One event as a single-line JSON object: ``{"event": "<ClassName>", ...fields}``."""
-    return json.dumps(
-        {"event": type(event).__name__, **_json_safe(asdict(event))},
-        ensure_ascii=False,
-        separators=(",", ":"),
-    )
-
-
-class JsonProgress:
-    """One JSON object per event on ``stream`` (``navseq run --json``)."""
-
-    def __init__(self, stream: IO[str]):
-        self.stream = stream
-
-    def __enter__(self) -> JsonProgress:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stream.flush()
-
-    def __call__(self, event: MissionEvent) -> None:
-        self.stream.write(event_to_json(event) + "\n")
-        self.stream.flush()
-
-    def emit(self, kind: str, fields: Mapping[str, Any]) -> None:
-        """A record that is not a mission event (e.g. the final ``RunFinished``)."""
-        self.stream.write(json.dumps({"event": kind, **_json_safe(dict(fields))}) + "\n")
-        self.stream.flush()
 
 
 ProgressSink = LiveProgress | LogProgress | JsonProgress
