@@ -22,9 +22,9 @@ REACHED, FAILED, SKIPPED, NOT_RUN = (
 
 MISSION = Mission(
     waypoints=(
-        Waypoint(1.0, 0.0, 0.0, name="dock"),
-        Waypoint(2.0, 0.0, math.pi / 2),
-        Waypoint(2.0, 2.0, math.pi, name="desk"),
+        Waypoint(1.0, 0.0, yaw_rad=0.0, name="dock"),
+        Waypoint(2.0, 0.0, yaw_rad=math.pi / 2),
+        Waypoint(2.0, 2.0, yaw_rad=math.pi, name="desk"),
     ),
     loops=2,
     source="office.yaml",
