@@ -92,7 +92,7 @@ def test_a_shutdown_ends_the_mission_as_interrupted_not_as_a_preempted_waypoint(
         return stop[0] if stop else None
 
     seen: list = []
-    mission = Mission([Waypoint(3.0, 0.0, 0.0), Waypoint(0.0, 0.0, 0.0)])
+    mission = Mission([Waypoint(3.0, 0.0, yaw_rad=0.0), Waypoint(0.0, 0.0, yaw_rad=0.0)])
     operator = OperatorNavigator(inner, stop_reason=stop_reason)
     with pytest.raises(NodeShutdown, match="killed"):
         run_mission(mission, operator, [seen.append], tick=0.5)
@@ -110,9 +110,9 @@ def test_markers_show_every_waypoint_with_heading_number_and_status_colour():
 
     mission = Mission(
         waypoints=(
-            Waypoint(1.0, 2.0, math.pi / 2, name="dock"),
-            Waypoint(-1.0, 0.5, 0.0),
-            Waypoint(0.0, -1.5, math.pi),
+            Waypoint(1.0, 2.0, yaw_rad=math.pi / 2, name="dock"),
+            Waypoint(-1.0, 0.5, yaw_rad=0.0),
+            Waypoint(0.0, -1.5, yaw_rad=math.pi),
         ),
         frame="map",
     )

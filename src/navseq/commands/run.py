@@ -18,7 +18,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from navseq.commands.common import add_robot_option, format_pose, parse_loops, parse_pose
+from navseq.commands.common import (
+    add_robot_option,
+    format_pose,
+    parse_loops,
+    parse_pose,
+    parse_realtime,
+    parse_waypoint_number,
+)
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -27,13 +34,14 @@ if TYPE_CHECKING:
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
+    from navseq.mission.part import MissionPart
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
-    from navseq.sinks.progress import JsonProgress
+    from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
 NAVIGATORS = ("sim", "ros1")
@@ -93,6 +101,40 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N|forever",
         help="run the waypoint list N times, or until interrupted (default: the mission's loops:)",
     )
+    parser.add_argument(
+        "--from",
+        dest="from_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="start at waypoint N (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--to",
+        dest="to_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="end at waypoint N, inclusive (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--only",
+        metavar="NAME_OR_NUMBER,...",
+        help="run only these waypoints, in the mission's order (names or 1-based numbers)",
+    )
+    parser.add_argument(
+        "--realtime",
+        type=parse_realtime,
+        nargs="?",
+        const=1.0,
+        metavar="FACTOR",
+        help="pace the simulator at FACTOR times real time (1 when no FACTOR is given), to "
+        "watch it or drive RViz; without it the simulator runs as fast as it can",
+    )
+    parser.add_argument(
+        "--no-picture",
+        action="store_true",
+        default=None,  # None: not given (a resume takes the journal's)
+        help="do not draw mission.png",
+    )
     add_robot_option(parser)
     ros1 = parser.add_argument_group("ros1 navigator")
     ros1.add_argument(
@@ -135,6 +177,7 @@ class RunSetup:
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
     run_options: dict[str, Any] = field(default_factory=dict)  # journaled for a resume
+    part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
 
@@ -160,23 +203,27 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
-    return {
-        "source": str(map_path),
-        "resolution": grid.resolution,
-        "width": grid.width,
-        "height": grid.height,
-        "origin": [grid.origin.x, grid.origin.y, grid.origin.yaw],
-    }
+    from navseq.sinks.report import map_summary
+
+    return map_summary(grid, map_path)
 
 
 def _check_against_map(
-    mission: Mission, costmap: Costmap, start: Pose2D | None, robot: RobotProfile
+    mission: Mission,
+    costmap: Costmap,
+    start: Pose2D | None,
+    robot: RobotProfile,
+    part: MissionPart | None = None,
 ) -> None:
-    """Pre-flight: every problem of the mission on this map, raised together."""
+    """Pre-flight: every problem of the mission on this map, raised together.
+
+    Waypoints of a ``part`` are named by their number in the file.
+    """
     from navseq.commands.common import preflight_errors
     from navseq.errors import MissionErrors
 
-    problems = preflight_errors(mission, costmap, start, robot=robot)
+    numbers = part.numbers if part is not None else None
+    problems = preflight_errors(mission, costmap, start, numbers, robot=robot)
     if problems:
         raise MissionErrors(problems)
 
@@ -192,7 +239,7 @@ def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyG
     if not args.no_preflight:
         robot = setup["robot"]
         costmap = costmap_for_robot(grid, robot)
-        _check_against_map(setup["mission"], costmap, setup["start"], robot)
+        _check_against_map(setup["mission"], costmap, setup["start"], robot, setup["part"])
     return grid
 
 
@@ -201,24 +248,34 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     from navseq.commands.common import choose_robot, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
+    from navseq.mission.part import PartSpec
     from navseq.sinks.journal import mission_digest
 
     resume = history = None
     notes: list[str] = []
+    start_given = args.start is not None  # on this command line, not from a journal
     if args.resume is not None:
         mission_path, resume, history = _read_resume(args.resume, args.mission)
         notes = continue_as_journaled(args, history)
     elif args.mission is None:
-        raise NavseqError("give a MISSION file (or --resume JOURNAL)", source="navseq run")
+        raise NavseqError(
+            "no mission given: name the mission file to run (navseq run MISSION), "
+            "or the journal of a run to continue (--resume JOURNAL)"
+        )
     else:
         mission_path = args.mission
         require_file(mission_path, "MISSION")
     if args.map is not None:
         require_file(args.map, "--map")
     apply_run_defaults(args)
+    _refuse_sim_options(args, start_given)
     mission = load_mission(mission_path)
     if "loops" in vars(args):  # given on the command line (None = forever)
         mission = dataclasses.replace(mission, loops=args.loops)
+    spec = PartSpec(args.from_waypoint, args.to_waypoint, args.only)
+    part = None if spec.whole else spec.select(mission)
+    if part is not None:
+        mission = part.apply(mission)
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
@@ -240,6 +297,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         "start": start,
         "robot": choose_robot(args.robot, mission),
         "start_source": start_source,
+        "part": part,
     }
     if args.navigator == "sim":
         setup = _prepare_sim(args, setup_kwargs)
@@ -260,7 +318,32 @@ RUN_OPTION_DEFAULTS: dict[str, Any] = {
     "ns": "",
     "frame": None,
     "settle": 0.05,
+    "no_picture": False,
 }
+#: The options that choose the part of the mission run: a resume must run the same part
+#: (the journal's waypoint positions are positions in it).
+PART_OPTIONS = ("from_waypoint", "to_waypoint", "only")
+#: How the journal's option names are typed on the command line, where they differ.
+OPTION_FLAGS = {"from_waypoint": "--from", "to_waypoint": "--to", "no_picture": "--no-picture"}
+
+
+def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
+    """Options that only the embedded simulator can honour, refused for a real robot."""
+    from navseq.errors import NavseqError
+
+    if args.navigator == "ros1" and start_given:
+        raise NavseqError(
+            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
+            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
+            "which publishes /initialpose)",
+            source="--start",
+        )
+    if args.navigator != "sim" and args.realtime is not None:
+        raise NavseqError(
+            f"paces the embedded simulator; --navigator {args.navigator} keeps its own "
+            "time. Leave --realtime out",
+            source="--realtime",
+        )
 
 
 def apply_run_defaults(args: argparse.Namespace) -> None:
@@ -291,10 +374,16 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
             return "loops" in vars(args)
         return getattr(args, name, None) is not None
 
+    _refuse_another_part(args, recorded, history)
     for name, value in recorded.items():
-        if name not in (*RUN_OPTION_DEFAULTS, "loops", "map", "start"):
+        if name not in (*RUN_OPTION_DEFAULTS, *PART_OPTIONS, "loops", "map", "start"):
             continue
         try:
+            if name in PART_OPTIONS:
+                setattr(args, name, value)  # checked by _refuse_another_part
+                continue
+            if name == "no_picture":
+                value = bool(value)
             if name == "loops":
                 value = None if value in (None, "forever") else parse_loops(str(value))
             elif name == "map":
@@ -309,11 +398,36 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
         if not given(name):
             setattr(args, name, value)
         elif getattr(args, name) != value:
+            flag = OPTION_FLAGS.get(name, f"--{name}")
             notes.append(
-                f"resuming with --{name} {_option_text(getattr(args, name))} instead of the "
+                f"resuming with {flag} {_option_text(getattr(args, name))} instead of the "
                 f"journal's {_option_text(value)}"
             )
     return notes
+
+
+def _refuse_another_part(
+    args: argparse.Namespace, recorded: dict[str, Any], history: JournalState
+) -> None:
+    """A resume runs the part of the mission the journal's run ran, or nothing."""
+    from navseq.errors import NavseqError
+    from navseq.mission.part import part_from_options
+
+    journaled = part_from_options(recorded, f"{history.path}:1")
+    asked = {name: getattr(args, name, None) for name in PART_OPTIONS}
+    if all(value is None for value in asked.values()):
+        return
+    if asked != {
+        "from_waypoint": journaled.first,
+        "to_waypoint": journaled.last,
+        "only": journaled.only,
+    }:
+        ran = journaled.describe() or "the whole mission"
+        raise NavseqError(
+            f"a resume continues the part of the mission its run started with ({ran}); "
+            "leave out --from, --to and --only, or start a new run without --resume",
+            source="--resume",
+        )
 
 
 def _option_text(value: Any) -> str:
@@ -335,6 +449,10 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
         "ns": args.ns,
         "frame": args.frame,
         "settle": args.settle,
+        "no_picture": bool(args.no_picture),
+        "from_waypoint": args.from_waypoint,
+        "to_waypoint": args.to_waypoint,
+        "only": args.only,
         "loops": setup.mission.loops,
         "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
         "start": None
@@ -346,14 +464,11 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
 def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
     from navseq.errors import NavseqError
     from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import load_map
-    from navseq.sim.profile import SimSettings
-    from navseq.sim.world import SimWorld, default_start
+    from navseq.simrun import prepare_sim_world
 
     mission: Mission = setup["mission"]
     map_path: Path | None = setup["map_path"]
-    start: Pose2D | None = setup["start"]
     if map_path is None:
         raise NavseqError(
             "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
@@ -361,33 +476,28 @@ def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
         )
     grid = load_map(map_path)
     robot: RobotProfile = setup["robot"]
-    settings = SimSettings.of(robot)
+    part = setup["part"]
+    ready = prepare_sim_world(
+        mission,
+        grid,
+        setup["start"],
+        robot,
+        preflight=not args.no_preflight,
+        numbers=part.numbers if part is not None else None,
+    )
     notes = []
-    if start is None:
-        start = default_start(grid, settings.footprint)
-        setup["start"] = start
+    if ready.start_defaulted:
+        setup["start"] = ready.start
         setup["start_source"] = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(start)}, the roomy point nearest the map origin"
+            f"{format_pose(ready.start)}, the roomy point nearest the map origin"
         )
-    # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    if not args.no_preflight:
-        _check_against_map(mission, costmap, start, robot)
-    world = SimWorld(
-        grid,
-        start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
+    world = ready.world
     return RunSetup(
         **setup,
         grid=grid,
-        make_navigator=lambda: SimNavigator(world),
+        make_navigator=lambda: SimNavigator(world, realtime=args.realtime),
         navigator_info={"kind": "sim", "robot": robot.name},
         notes=notes,
     )
@@ -497,6 +607,9 @@ class RunOutcome:
     recorder: RunRecorder
     json_lines: JsonProgress | None
     error: NavseqError | None = None  # what stopped the run, if an output failed
+    # The navigator's clock and the wall clock over the run, for the real-time factor.
+    navigator_seconds: float = 0.0
+    wall_seconds: float = 0.0
 
 
 def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, bool]:
@@ -549,13 +662,17 @@ def _run_with_sinks(
     setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
 ) -> RunOutcome:
     """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    import time
+
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
-    from navseq.sinks.progress import JsonProgress, make_progress
+    from navseq.sinks.json_events import JsonProgress
+    from navseq.sinks.progress import make_progress
 
     navigator = setup.make_navigator()
     error: NavseqError | None = None
+    navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
         if setup.resume is not None:
             journal = JournalWriter.resume(journal_path, setup.resume)
@@ -566,7 +683,12 @@ def _run_with_sinks(
                 journal_path, source, setup.digest, run_options=setup.run_options
             )
         recorder = new_recorder(setup)
-        progress = make_progress(setup.mission, json_lines=args.json, robot=setup.robot)
+        progress = make_progress(
+            setup.mission,
+            json_lines=args.json,
+            robot=setup.robot,
+            numbers=setup.part.numbers if setup.part is not None else None,
+        )
         with progress, journal:
             try:
                 result = run_mission(
@@ -588,7 +710,26 @@ def _run_with_sinks(
         signals.defer()  # the goal is reached or cancelled: the report comes first now
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
-    return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines, error)
+    return RunOutcome(
+        result,
+        exit_code,
+        interrupted,
+        navigator,
+        recorder,
+        json_lines,
+        error,
+        navigator_seconds=navigator.now() - navigator_start,
+        wall_seconds=time.monotonic() - wall_start,
+    )
+
+
+def real_time_text(simulated: float, wall: float) -> str:
+    """``simulated 62.4 s in 0.9 s: 69x real time``: how fast the simulator ran."""
+    if wall <= 0.0:
+        return f"simulated {simulated:.1f} s"
+    factor = simulated / wall
+    shown = f"{factor:.0f}" if factor >= 10 else f"{factor:.2g}"
+    return f"simulated {simulated:.1f} s in {wall:.1f} s: {shown}x real time"
 
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
@@ -652,26 +793,35 @@ def _execute_locked(
         folder,
         files,
         lambda paths, code: _report(setup, outcome, paths, code),
-        lambda: _picture_png(setup, outcome),
+        None if args.no_picture else lambda: _picture_png(setup, outcome),
         signals,
         outcome.exit_code,
     )
+    notes = []
+    if setup.navigator_info.get("kind") == "sim":
+        notes.append(real_time_text(outcome.navigator_seconds, outcome.wall_seconds))
     if outcome.json_lines is not None:
         try:
-            outcome.json_lines.emit(
-                "RunFinished",
-                {
-                    "success": outcome.result.success,
-                    "reason": outcome.result.reason,
-                    "exit_code": exit_code,
-                    "interrupted": outcome.interrupted,
-                    **files.paths,
-                },
+            outcome.json_lines.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=exit_code,
+                interrupted=outcome.interrupted,
+                files=files.paths,
             )
         except BrokenPipeError:
             silence_stdout()
+        for note in notes:  # stdout is for programs here
+            print(f"navseq run: {note}", file=sys.stderr)
     else:
-        print_summary(setup.mission, outcome.result, files)
+        print_summary(
+            setup.mission,
+            outcome.result,
+            files,
+            numbers=setup.part.numbers if setup.part is not None else None,
+            part=setup.part.describe() if setup.part is not None else None,
+            notes=notes,
+        )
     report_failures(files)
     if outcome.error is not None:
         raise outcome.error
@@ -680,22 +830,22 @@ def _execute_locked(
 
         raise NavseqError(
             f"the report could not be written ({files.failed['report']}); the journal "
-            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it",
-            source="navseq run",
+            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it"
         )
     if exit_code == 2:
         from navseq.errors import NavseqError
 
-        raise NavseqError(files.failed["picture"], source="navseq run")
+        raise NavseqError(f"the picture could not be written: {files.failed['picture']}")
     return exit_code
 
 
 def _report(
     setup: RunSetup, outcome: RunOutcome, files: dict[str, str], exit_code: int
 ) -> dict[str, Any]:
+    from navseq.mission.part import number_visits
     from navseq.sinks.report import build_report
 
-    return build_report(
+    report = build_report(
         setup.mission,
         outcome.result,
         exit_code=exit_code,
@@ -709,6 +859,8 @@ def _report(
         start_source=setup.start_source,
         files=files,
     )
+    number_visits(report, setup.part)
+    return report
 
 
 def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:

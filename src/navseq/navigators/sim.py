@@ -1,7 +1,9 @@
 """The ``sim`` navigator: navseq's embedded simulator behind the Navigator interface.
 
 It drives a :class:`navseq.sim.world.SimWorld` in simulated time, as fast as the CPU
-allows: :meth:`SimNavigator.spin` steps the world, and ``now()`` is the world's clock.
+allows, or paced against the wall clock at a chosen factor (``realtime``: 1 to watch
+it or to drive RViz in real time): :meth:`SimNavigator.spin` steps the world, and
+``now()`` is the world's clock.
 Events follow what an actionlib client of move_base would see:
 
 - ``GoalAccepted`` as soon as a goal is sent;
@@ -15,6 +17,8 @@ Events follow what an actionlib client of move_base would see:
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 from navseq.geometry import Pose2D
@@ -41,12 +45,32 @@ class SimNavigator:
     ``trajectory`` records ``(t, x, y)`` of the robot at the start and whenever it
     has moved 5 mm (or a 0.05 s step passed), for reports and pictures; it is a
     :class:`~navseq.track.Track`, so it stays bounded on a patrol that runs for days.
+
+    ``realtime`` (a factor > 0, or None for as fast as possible) paces simulated time
+    against ``wall_clock``: after each step the navigator sleeps until the wall clock has
+    caught up with simulated time / ``realtime`` since the first step. Pacing is against
+    that first step, not per step, so rounding does not add up over a long run, and a
+    slow step is caught up rather than lost.
     """
 
-    def __init__(self, world: SimWorld, *, feedback_period: float = 0.2) -> None:
+    def __init__(
+        self,
+        world: SimWorld,
+        *,
+        feedback_period: float = 0.2,
+        realtime: float | None = None,
+        wall_clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> None:
         if not feedback_period > 0:
             raise ValueError(f"feedback_period must be positive, got {feedback_period}")
+        if realtime is not None and not (math.isfinite(realtime) and realtime > 0):
+            raise ValueError(f"realtime must be a factor above 0, got {realtime}")
         self.world = world
+        self.realtime = realtime
+        self._wall_clock = wall_clock
+        self._sleep = sleep
+        self._pace_origin: tuple[float, float] | None = None  # (simulated, wall) time
         self.feedback_period = feedback_period
         pose = world.robot.pose
         self.trajectory = Track(min_step=0.005, min_interval=0.05)
@@ -128,11 +152,25 @@ class SimNavigator:
                 trajectory.append((world.time, robot.pose.x, robot.pose.y))
             if self._active is not None:
                 self._report(self._active)
+            if self.realtime is not None:
+                self._pace()
 
     def close(self) -> None:
         self.cancel_goal()
 
     # -- internals ---------------------------------------------------------------------
+
+    def _pace(self) -> None:
+        """Sleep until the wall clock is where simulated time says it should be."""
+        assert self.realtime is not None
+        now = self._wall_clock()
+        if self._pace_origin is None:
+            self._pace_origin = (self.world.time, now)
+            return
+        sim_origin, wall_origin = self._pace_origin
+        due = wall_origin + (self.world.time - sim_origin) / self.realtime
+        if due > now:
+            self._sleep(due - now)
 
     def _report(self, goal: Goal) -> None:
         """Turn what the server did during the last step into events."""
