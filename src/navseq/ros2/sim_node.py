@@ -559,6 +559,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         previous[signum] = signal.signal(signum, request_stop)
     sim: SimNode | None = None
     node: Node | None = None
+    spinner: threading.Thread | None = None
     executor = MultiThreadedExecutor(num_threads=8)
     try:
         overrides = [Parameter("use_sim_time", value=True)] if config.sim_time else []
@@ -569,7 +570,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             print(f"navseq sim: {error}", file=sys.stderr)
             return 2
         executor.add_node(node)
-        spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2", daemon=True)
+        spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2")
         spinner.start()
         sim.start()
         pose = sim.standin.world.robot.pose
@@ -587,6 +588,8 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         if sim is not None:
             sim.stop()
         executor.shutdown(timeout_sec=5.0)
+        if spinner is not None:
+            spinner.join(timeout=5.0)
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
