@@ -593,8 +593,8 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def _spin(executor: MultiThreadedExecutor) -> None:
