@@ -392,14 +392,15 @@ class Nav2StandIn:
                 )
                 self.waypoints = None
                 return
-        run.current += 1
-        if run.current >= len(run.poses):
+        following = run.current + 1
+        if following >= len(run.poses):
             if run.loop >= run.loops:
                 run.end(Ending(Outcome.SUCCEEDED))
                 self.waypoints = None
                 return
             run.loop += 1
-            run.current = 0
+            following = 0
+        run.current = following
         self._next_waypoint_task(run)
 
 
