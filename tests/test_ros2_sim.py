@@ -239,3 +239,26 @@ def test_a_namespaced_robot_serves_under_its_namespace(env: dict[str, str]):
     assert ready["bt_navigator"] == "active"
     assert late["map"] == [384, 384, 0.05]
     assert code == 0, err
+
+
+def test_the_ros2_cli_command_of_the_docs_drives_it(sim: SimProcess):
+    """docs/ros2.md's `ros2 action send_goal` line, as a user would type it."""
+    done = subprocess.run(
+        [
+            "ros2",
+            "action",
+            "send_goal",
+            "/navigate_to_pose",
+            "nav2_msgs/action/NavigateToPose",
+            "{pose: {header: {frame_id: map}, pose: {position: {x: -1.5, y: -0.5}, "
+            "orientation: {w: 1.0}}}}",
+        ],
+        env=sim.env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "Goal finished with status: SUCCEEDED" in done.stdout
+    docs = (REPO / "docs" / "ros2.md").read_text()
+    assert "ros2 action send_goal /navigate_to_pose nav2_msgs/action/NavigateToPose" in docs
