@@ -17,7 +17,8 @@ NO_ROS_PRELUDE = textwrap.dedent(
     import importlib.abc, sys
 
     ROS = ("rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "geometry_msgs",
-           "nav_msgs", "std_srvs", "tf2_ros", "visualization_msgs", "genpy", "roslib")
+           "nav_msgs", "std_srvs", "tf2_ros", "visualization_msgs", "genpy", "roslib",
+           "rclpy", "nav2_msgs", "lifecycle_msgs", "builtin_interfaces", "tf2_msgs")
 
     class NoRos(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path=None, target=None):
@@ -34,6 +35,10 @@ CORE_MODULES = [
     "navseq.commands.run",
     "navseq.commands.validate",
     "navseq.commands.convert",
+    "navseq.commands.sim",
+    "navseq.ros2",
+    "navseq.ros2.standin",
+    "navseq.ros2.sim_config",
     "navseq.mission",
     "navseq.executor.machine",
     "navseq.executor.runner",
@@ -108,3 +113,28 @@ def test_asking_for_ros_without_ros_is_one_clear_error(tmp_path: Path):
     assert done.returncode == 2
     assert "Traceback" not in done.stderr
     assert "ros" in done.stderr.lower()
+
+
+def test_only_navseq_ros2_imports_rclpy():
+    """ROS 2's client library and messages are imported in navseq.ros2 alone."""
+    import ast
+
+    ros2_only = {"rclpy", "nav2_msgs", "lifecycle_msgs", "builtin_interfaces"}
+    offenders = []
+    for path in sorted((REPO / "src" / "navseq").rglob("*.py")):
+        if path.parent.name == "ros2":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            names = (
+                [alias.name for alias in node.names]
+                if isinstance(node, ast.Import)
+                else [node.module or ""]
+                if isinstance(node, ast.ImportFrom)
+                else []
+            )
+            offenders += [
+                f"{path.relative_to(REPO)}: {name}"
+                for name in names
+                if name.split(".")[0] in ros2_only
+            ]
+    assert offenders == []
