@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import re
+import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -64,6 +65,14 @@ def _strip_comment(line: str) -> str:
     return line.rstrip()
 
 
+def _open_quote(command: str) -> bool:
+    try:
+        shlex.split(command)
+    except ValueError:
+        return True
+    return False
+
+
 def _shell_commands(path: Path, start: int, lines: list[str]) -> list[Example]:
     examples: list[Example] = []
     pending = ""
@@ -76,6 +85,9 @@ def _shell_commands(path: Path, start: int, lines: list[str]) -> list[Example]:
             pending += text[:-1] + " "
             continue
         command = (pending + _strip_comment(text)).strip()
+        if _open_quote(command):  # a quoted argument goes on on the next line
+            pending = command + " "
+            continue
         pending = ""
         if command:
             examples.append(Example(path, pending_line, " ".join(command.split())))
@@ -141,7 +153,7 @@ def output_matches(expected: list[str], actual: list[str]) -> bool:
     want = [normalise(line) for line in expected]
     got = [normalise(line) for line in actual]
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache
     def match(i: int, j: int) -> bool:
         while i < len(want):
             if want[i] == "...":

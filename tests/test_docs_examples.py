@@ -55,7 +55,53 @@ RULES: tuple[Rule, ...] = (
     Rule(r"^make demo\b", "make"),
     Rule(r"(^|/)pytest\b", "collect"),
     Rule(
-        r"catkin_make|rosdep|^source |^cd ~|^mkdir -p ~",
+        r"^source /opt/ros/",
+        "ros",
+        "tests/test_ros2_environment.py::test_a_ros2_process_talks_to_itself_on_a_private_domain",
+    ),
+    Rule(
+        r"navseq sim --ros2",
+        "ros",
+        "tests/test_ros2_cli.py::test_navseq_sim_ros2_serves_until_a_signal_and_exits_0",
+    ),
+    Rule(
+        r"-m navseq\.ros2\.sim_node .*stop_on_failure",
+        "ros",
+        "tests/test_ros2_sim.py::test_follow_waypoints_goes_on_without_stop_on_failure",
+    ),
+    Rule(
+        r"^ros2 launch launch/sim\.launch\.py",
+        "ros",
+        "tests/test_ros2_sim.py::test_the_launch_file_of_the_docs_starts_a_namespaced_robot",
+    ),
+    Rule(
+        r"^ros2 action send_goal /navigate_to_pose",
+        "ros",
+        "tests/test_ros2_sim.py::test_the_ros2_cli_command_of_the_docs_drives_it",
+    ),
+    Rule(
+        r"^ros2 action send_goal /follow_waypoints",
+        "ros",
+        "tests/test_ros2_sim.py::test_follow_waypoints_lists_a_missed_waypoint",
+    ),
+    Rule(
+        r"^ros2 topic echo /odom",
+        "ros",
+        "tests/test_ros2_sim.py::test_a_client_cancel_ends_canceled_and_the_robot_stops",
+    ),
+    Rule(
+        r"^ros2 service call /bt_navigator/get_state",
+        "ros",
+        "tests/test_ros2_sim.py::test_nav2_clients_find_it_ready_localized_and_can_clear_costmaps",
+    ),
+    Rule(
+        r"rosrun navseq sim_robot_node .*_robot:=",
+        "ros",
+        "tests/test_ros_sim_robot_profile.py::"
+        "test_a_waffle_is_simulated_with_its_outline_its_speed_and_its_room_to_turn",
+    ),
+    Rule(
+        r"catkin_make|rosdep|^source devel/|^cd ~|^mkdir -p ~",
         "ros",
         "tests/test_catkin_package.py::"
         "test_catkin_make_builds_a_workspace_where_rosrun_and_roslaunch_find_the_nodes",
@@ -101,7 +147,8 @@ RULES: tuple[Rule, ...] = (
         "ros",
         "tests/test_ros_record.py::test_every_goal_pose_becomes_a_waypoint_and_survives_ctrl_c",
     ),
-    Rule(r"--loops forever", "interrupt"),
+    # A patrol runs until stopped, and so does its resume (it continues as journaled).
+    Rule(r"--loops forever|--resume navseq-out/patrol-", "interrupt"),
     Rule(r"(^|/)navseq\b", "run"),
 )
 
@@ -217,7 +264,8 @@ def _collect(example: Example, cwd: Path) -> None:
     argv += [arg for arg in shlex.split(example.command)[1:]]
     done = subprocess.run(argv, cwd=REPO, capture_output=True, text=True, timeout=TIMEOUT_S)
     assert done.returncode == 0, (
-        f"{example.where}: `{example.command}` does not collect:\n{done.stdout[-2000:]}{done.stderr[-2000:]}"
+        f"{example.where}: `{example.command}` does not collect:\n"
+        f"{done.stdout[-2000:]}{done.stderr[-2000:]}"
     )
 
 
@@ -225,7 +273,8 @@ def _covered(rule: Rule, example: Example) -> None:
     test_file, test_name = rule.covered_by.split("::")
     source = (REPO / test_file).read_text()
     assert re.search(rf"^def {test_name}\(", source, re.MULTILINE), (
-        f"{example.where}: `{example.command}` is said to be tested by {rule.covered_by}, which does not exist"
+        f"{example.where}: `{example.command}` is said to be tested by {rule.covered_by}, "
+        "which does not exist"
     )
 
 

@@ -262,3 +262,30 @@ def test_the_ros2_cli_command_of_the_docs_drives_it(sim: SimProcess):
     assert "Goal finished with status: SUCCEEDED" in done.stdout
     docs = (REPO / "docs" / "ros2.md").read_text()
     assert "ros2 action send_goal /navigate_to_pose nav2_msgs/action/NavigateToPose" in docs
+
+
+def test_the_launch_file_of_the_docs_starts_a_namespaced_robot(env: dict[str, str]):
+    """docs/ros2.md's `ros2 launch launch/sim.launch.py speed:=2 ns:=robot1`."""
+    python = sys.executable  # the venv's, which imports navseq
+    launch = subprocess.Popen(
+        ["ros2", "launch", "launch/sim.launch.py", "speed:=2", "ns:=robot1", f"python:={python}"],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        command = client_command("navigate", ("-1.6,-0.5,0",), {"ns": "robot1", "timeout": 90})
+        done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=150)
+    finally:
+        launch.send_signal(signal.SIGINT)
+        try:
+            output, _ = launch.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            launch.kill()
+            output, _ = launch.communicate()
+    assert done.returncode == 0, f"{done.stderr}\n{output}"
+    assert json.loads(done.stdout.strip().splitlines()[-1])["status"] == "SUCCEEDED"
+    assert launch.returncode == 0, output
+    assert "Traceback" not in output
