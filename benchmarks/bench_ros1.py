@@ -138,7 +138,7 @@ def role_navseq_client(goals: int, tick: float, settle: float) -> None:
     from navseq.ros1.navigator import Ros1Navigator
 
     mission = Mission(
-        waypoints=tuple(Waypoint(x, y, yaw) for x, y, yaw in bench_goals(goals)),
+        waypoints=tuple(Waypoint(x, y, yaw_rad=yaw) for x, y, yaw in bench_goals(goals)),
         defaults=Policy(goal_timeout=10.0, on_failure=FailureAction.STOP),
         source="<bench_ros1>",
     )

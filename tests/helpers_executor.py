@@ -29,7 +29,7 @@ def line_mission(
     **policy: Any,
 ) -> Mission:
     """``count`` waypoints 1 m apart along +x (1,0), (2,0), ..., all facing +x."""
-    waypoints = tuple(Waypoint(float(i + 1), 0.0, 0.0, name=f"p{i + 1}") for i in range(count))
+    waypoints = tuple(Waypoint(float(i + 1), 0.0, name=f"p{i + 1}") for i in range(count))
     return Mission(
         waypoints=waypoints,
         defaults=Policy(**policy),

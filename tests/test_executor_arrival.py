@@ -91,7 +91,9 @@ def test_with_no_pose_at_all_the_success_is_believed() -> None:
 
 
 def _one_waypoint(**overrides: float) -> Mission:
-    return Mission(waypoints=(Waypoint(1.0, 0.0, 0.0, overrides=overrides),), defaults=Policy())
+    return Mission(
+        waypoints=(Waypoint(1.0, 0.0, yaw_rad=0.0, overrides=overrides),), defaults=Policy()
+    )
 
 
 def test_the_robot_profiles_tolerance_applies_where_the_waypoint_sets_none() -> None:

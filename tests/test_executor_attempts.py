@@ -22,8 +22,10 @@ from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Stall, Succeed
 from navseq.sinks.journal import JournalWriter, read_journal, resume_point
-from navseq.sinks.progress import JsonProgress, LogProgress, summary_table
+from navseq.sinks.json_events import JsonProgress
+from navseq.sinks.progress import LogProgress
 from navseq.sinks.report import build_report
+from navseq.sinks.summary import summary_table
 
 NO_PLAN = "Failed to find a valid plan. Even after executing recovery behaviors."
 
@@ -99,7 +101,7 @@ def test_progress_lines_and_json_carry_the_stacks_text() -> None:
         if record["event"] == "AttemptFailed"
     ]
     assert failed[0]["text"] == NO_PLAN and failed[0]["status"] == "ABORTED"
-    assert failed[0]["duration"] == pytest.approx(2.0, abs=0.11)
+    assert failed[0]["duration_s"] == pytest.approx(2.0, abs=0.11)
 
 
 # ---------------------------------------------------------------- journal

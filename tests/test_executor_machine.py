@@ -444,7 +444,7 @@ def test_operator_skip_goes_on_without_cancel_but_cancels_the_last_goal() -> Non
 
 def test_resume_starts_at_the_resume_point_and_keeps_earlier_visits() -> None:
     done = tuple(
-        WaypointResult(index=i, loop=0, name=None, x=0, y=0, yaw=0, outcome=REACHED, attempts=1)
+        WaypointResult(index=i, loop=0, name=None, x=0, y=0, yaw_rad=0, outcome=REACHED, attempts=1)
         for i in range(2)
     )
     h = Harness(line_mission(3), resume=ResumePoint(loop=0, index=2, done=done))

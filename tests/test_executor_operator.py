@@ -211,7 +211,7 @@ def test_a_shutdown_ends_the_mission_as_interrupted_not_as_a_preempted_waypoint(
         return stop[0] if stop else None
 
     seen: list[object] = []
-    mission = Mission((Waypoint(3.0, 0.0, 0.0), Waypoint(0.0, 0.0, 0.0)))
+    mission = Mission((Waypoint(3.0, 0.0, yaw_rad=0.0), Waypoint(0.0, 0.0, yaw_rad=0.0)))
     control = MissionControl(stop_reason=stop_reason)
     with pytest.raises(StopRequested, match="killed"):
         run_mission(mission, inner, [seen.append], tick=0.5, control=control)

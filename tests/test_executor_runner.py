@@ -87,7 +87,8 @@ def test_slow_turn_at_the_goal_is_not_a_stall() -> None:
     # 3 rad at 0.1 rad/s takes 30 s, ten times the stall timeout.
     mission = line_mission(1, stall_timeout=3.0)
     mission = mission.__class__(
-        waypoints=(mission.waypoints[0].__class__(1.0, 0.0, 3.0),), defaults=mission.defaults
+        waypoints=(mission.waypoints[0].__class__(1.0, 0.0, yaw_rad=3.0),),
+        defaults=mission.defaults,
     )
     nav = ScriptedNavigator(turn_rate=0.1)
     result, events = run(mission, nav)

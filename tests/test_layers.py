@@ -20,7 +20,8 @@ NO_ROS_PRELUDE = textwrap.dedent(
 
     ROS = ("rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "geometry_msgs",
            "nav_msgs", "std_srvs", "tf2_ros", "visualization_msgs", "genpy", "roslib",
-           "rclpy", "nav2_msgs", "action_msgs", "rosgraph", "rosgraph_msgs", "std_msgs")
+           "rclpy", "nav2_msgs", "action_msgs", "rosgraph", "rosgraph_msgs", "std_msgs",
+           "lifecycle_msgs", "builtin_interfaces", "tf2_msgs")
 
     class NoRos(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path=None, target=None):
@@ -37,6 +38,10 @@ CORE_MODULES = [
     "navseq.commands.run",
     "navseq.commands.validate",
     "navseq.commands.convert",
+    "navseq.commands.sim",
+    "navseq.ros2",
+    "navseq.ros2.standin",
+    "navseq.ros2.sim_config",
     "navseq.mission",
     "navseq.executor.machine",
     "navseq.executor.runner",
@@ -122,7 +127,9 @@ SRC = REPO / "src" / "navseq"
 ROS1_ONLY = {"rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "genpy", "roslib"}
 ROS1_ONLY |= {"rosgraph", "rosgraph_msgs", "roslaunch", "rosbag", "tf", "tf2_ros"}
 ROS2_ONLY = {"rclpy", "nav2_msgs", "action_msgs", "rosidl_runtime_py", "lifecycle_msgs"}
+ROS2_ONLY |= {"builtin_interfaces", "launch", "launch_ros"}
 SHARED_MSGS = {"geometry_msgs", "nav_msgs", "std_msgs", "std_srvs", "visualization_msgs"}
+SHARED_MSGS |= {"tf2_msgs"}
 
 
 def imported_roots(path: Path) -> set[str]:

@@ -33,9 +33,9 @@ def make_grid(origin: Pose2D = ORIGIN) -> OccupancyGrid:
 
 
 WAYPOINTS = (
-    Waypoint(1.0, -1.0, 0.0, name="a"),
-    Waypoint(2.0, 0.0, 0.0),
-    Waypoint(1.0, 1.0, 0.0, name="c"),
+    Waypoint(1.0, -1.0, yaw_rad=0.0, name="a"),
+    Waypoint(2.0, 0.0, yaw_rad=0.0),
+    Waypoint(1.0, 1.0, yaw_rad=0.0, name="c"),
 )
 MISSION = Mission(WAYPOINTS, defaults=Policy(pass_through=0.3), source="demo.yaml")
 
@@ -81,7 +81,9 @@ def test_map_origin_yaw_rotates_the_map_about_its_origin():
     # Rotated by +90°, the map's x axis points along world +y: the obstacle block at
     # map (0..1, 0..1) m lies at world x in (-2, -1), y in (-2, -1) from origin (-1, -2).
     grid = make_grid(Pose2D(-1.0, -2.0, math.pi / 2))
-    mission = Mission((Waypoint(-3.0, 0.0, 0.0), Waypoint(-1.5, 2.5, 0.0)), source="r.yaml")
+    mission = Mission(
+        (Waypoint(-3.0, 0.0, yaw_rad=0.0), Waypoint(-1.5, 2.5, yaw_rad=0.0)), source="r.yaml"
+    )
     fig = mission_figure(mission, MissionResult(False, "x"), grid=grid)
     assert pixel(fig, -1.4, -1.4).max() < 0.2
     # Where the block would be if the yaw were ignored, there is no map at all (white).
@@ -185,7 +187,7 @@ def test_picture_without_a_map_still_shows_the_mission(tmp_path):
 
 @pytest.mark.parametrize("count", [1, 2])
 def test_degenerate_missions_do_not_break_the_picture(tmp_path, count):
-    mission = Mission((Waypoint(0.0, 0.0, 0.0),) * count, source="one.yaml")
+    mission = Mission((Waypoint(0.0, 0.0, yaw_rad=0.0),) * count, source="one.yaml")
     draw_mission_picture(tmp_path / "one.png", mission, MissionResult(True, "completed"))
     assert (tmp_path / "one.png").exists()
 

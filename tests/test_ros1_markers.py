@@ -17,9 +17,9 @@ def test_markers_show_every_waypoint_with_heading_number_and_status_colour():
 
     mission = Mission(
         waypoints=(
-            Waypoint(1.0, 2.0, math.pi / 2, name="dock"),
-            Waypoint(-1.0, 0.5, 0.0),
-            Waypoint(0.0, -1.5, math.pi),
+            Waypoint(1.0, 2.0, yaw_rad=math.pi / 2, name="dock"),
+            Waypoint(-1.0, 0.5, yaw_rad=0.0),
+            Waypoint(0.0, -1.5, yaw_rad=math.pi),
         ),
         frame="map",
     )

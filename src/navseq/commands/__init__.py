@@ -54,6 +54,11 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "write any supported mission format as navseq YAML",
         "navseq.commands.convert",
     ),
+    Subcommand(
+        "sim",
+        "run the simulated robot with a Nav2 stand-in as ROS 2 nodes (--ros2)",
+        "navseq.commands.sim",
+    ),
     # Lives with the ROS code; it imports rospy only when recording starts.
     Subcommand(
         "record",

@@ -18,7 +18,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from navseq.commands.common import add_robot_option, format_pose, parse_loops, parse_pose
+from navseq.commands.common import (
+    add_robot_option,
+    format_pose,
+    parse_loops,
+    parse_pose,
+    parse_realtime,
+    parse_waypoint_number,
+)
 from navseq.navigators.registry import (
     NavigatorDraft,
     add_navigator_choice,
@@ -34,12 +41,13 @@ if TYPE_CHECKING:
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
+    from navseq.mission.part import MissionPart
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
-    from navseq.sinks.progress import JsonProgress
+    from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
 
@@ -90,6 +98,40 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N|forever",
         help="run the waypoint list N times, or until interrupted (default: the mission's loops:)",
     )
+    parser.add_argument(
+        "--from",
+        dest="from_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="start at waypoint N (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--to",
+        dest="to_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="end at waypoint N, inclusive (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--only",
+        metavar="NAME_OR_NUMBER,...",
+        help="run only these waypoints, in the mission's order (names or 1-based numbers)",
+    )
+    parser.add_argument(
+        "--realtime",
+        type=parse_realtime,
+        nargs="?",
+        const=1.0,
+        metavar="FACTOR",
+        help="pace the simulator at FACTOR times real time (1 when no FACTOR is given), to "
+        "watch it or drive RViz; without it the simulator runs as fast as it can",
+    )
+    parser.add_argument(
+        "--no-picture",
+        action="store_true",
+        default=None,  # None: not given (a resume takes the journal's)
+        help="do not draw mission.png",
+    )
     add_robot_option(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
@@ -115,6 +157,7 @@ class RunSetup:
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
     run_options: dict[str, Any] = field(default_factory=dict)  # journaled for a resume
+    part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
 
@@ -140,13 +183,9 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
-    return {
-        "source": str(map_path),
-        "resolution": grid.resolution,
-        "width": grid.width,
-        "height": grid.height,
-        "origin": [grid.origin.x, grid.origin.y, grid.origin.yaw],
-    }
+    from navseq.sinks.report import map_summary
+
+    return map_summary(grid, map_path)
 
 
 def prepare(args: argparse.Namespace) -> RunSetup:
@@ -154,24 +193,34 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     from navseq.commands.common import choose_robot, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
+    from navseq.mission.part import PartSpec
     from navseq.sinks.journal import mission_digest
 
     resume = history = None
     notes: list[str] = []
+    start_given = args.start is not None  # on this command line, not from a journal
     if args.resume is not None:
         mission_path, resume, history = _read_resume(args.resume, args.mission)
         notes = continue_as_journaled(args, history)
     elif args.mission is None:
-        raise NavseqError("give a MISSION file (or --resume JOURNAL)", source="navseq run")
+        raise NavseqError(
+            "no mission given: name the mission file to run (navseq run MISSION), "
+            "or the journal of a run to continue (--resume JOURNAL)"
+        )
     else:
         mission_path = args.mission
         require_file(mission_path, "MISSION")
     if args.map is not None:
         require_file(args.map, "--map")
     apply_run_defaults(args)
+    _refuse_sim_options(args, start_given)
     mission = load_mission(mission_path)
     if "loops" in vars(args):  # given on the command line (None = forever)
         mission = dataclasses.replace(mission, loops=args.loops)
+    spec = PartSpec(args.from_waypoint, args.to_waypoint, args.only)
+    part = None if spec.whole else spec.select(mission)
+    if part is not None:
+        mission = part.apply(mission)
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
@@ -190,6 +239,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         start_source=start_source,
         robot=choose_robot(args.robot, mission),
         preflight=not args.no_preflight,
+        numbers=part.numbers if part is not None else None,
     )
     made = kind.create(args, draft)
     setup = RunSetup(
@@ -208,6 +258,7 @@ def prepare(args: argparse.Namespace) -> RunSetup:
         history=history,
         notes=[*notes, *made.notes],
         listeners=made.listeners,
+        part=part,
     )
     setup.run_options = run_options(args, setup)
     return setup
@@ -218,7 +269,32 @@ def prepare(args: argparse.Namespace) -> RunSetup:
 #: The chosen navigator kind's options are journaled too (NavigatorKind.journaled).
 RUN_OPTION_DEFAULTS: dict[str, Any] = {
     "navigator": "sim",
+    "no_picture": False,
 }
+#: The options that choose the part of the mission run: a resume must run the same part
+#: (the journal's waypoint positions are positions in it).
+PART_OPTIONS = ("from_waypoint", "to_waypoint", "only")
+#: How the journal's option names are typed on the command line, where they differ.
+OPTION_FLAGS = {"from_waypoint": "--from", "to_waypoint": "--to", "no_picture": "--no-picture"}
+
+
+def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
+    """Options that only the embedded simulator can honour, refused for a real robot."""
+    from navseq.errors import NavseqError
+
+    if args.navigator == "ros1" and start_given:
+        raise NavseqError(
+            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
+            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
+            "which publishes /initialpose)",
+            source="--start",
+        )
+    if args.navigator != "sim" and args.realtime is not None:
+        raise NavseqError(
+            f"paces the embedded simulator; --navigator {args.navigator} keeps its own "
+            "time. Leave --realtime out",
+            source="--realtime",
+        )
 
 
 def apply_run_defaults(args: argparse.Namespace) -> None:
@@ -258,10 +334,23 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
             return "loops" in vars(args)
         return getattr(args, name, None) is not None
 
+    _refuse_another_part(args, recorded, history)
     for name, value in recorded.items():
-        if name not in (*RUN_OPTION_DEFAULTS, *journaled_options(), "loops", "map", "start"):
+        if name not in (
+            *RUN_OPTION_DEFAULTS,
+            *journaled_options(),
+            *PART_OPTIONS,
+            "loops",
+            "map",
+            "start",
+        ):
             continue
         try:
+            if name in PART_OPTIONS:
+                setattr(args, name, value)  # checked by _refuse_another_part
+                continue
+            if name == "no_picture":
+                value = bool(value)
             if name == "loops":
                 value = None if value in (None, "forever") else parse_loops(str(value))
             elif name == "map":
@@ -276,11 +365,36 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
         if not given(name):
             setattr(args, name, value)
         elif getattr(args, name) != value:
+            flag = OPTION_FLAGS.get(name, f"--{name}")
             notes.append(
-                f"resuming with --{name} {_option_text(getattr(args, name))} instead of the "
+                f"resuming with {flag} {_option_text(getattr(args, name))} instead of the "
                 f"journal's {_option_text(value)}"
             )
     return notes
+
+
+def _refuse_another_part(
+    args: argparse.Namespace, recorded: dict[str, Any], history: JournalState
+) -> None:
+    """A resume runs the part of the mission the journal's run ran, or nothing."""
+    from navseq.errors import NavseqError
+    from navseq.mission.part import part_from_options
+
+    journaled = part_from_options(recorded, f"{history.path}:1")
+    asked = {name: getattr(args, name, None) for name in PART_OPTIONS}
+    if all(value is None for value in asked.values()):
+        return
+    if asked != {
+        "from_waypoint": journaled.first,
+        "to_waypoint": journaled.last,
+        "only": journaled.only,
+    }:
+        ran = journaled.describe() or "the whole mission"
+        raise NavseqError(
+            f"a resume continues the part of the mission its run started with ({ran}); "
+            "leave out --from, --to and --only, or start a new run without --resume",
+            source="--resume",
+        )
 
 
 def _option_text(value: Any) -> str:
@@ -299,6 +413,10 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
     return {
         "navigator": args.navigator,
         **{name: getattr(args, name) for name in navigator_kind(args.navigator).journaled()},
+        "no_picture": bool(args.no_picture),
+        "from_waypoint": args.from_waypoint,
+        "to_waypoint": args.to_waypoint,
+        "only": args.only,
         "loops": setup.mission.loops,
         "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
         "start": None
@@ -318,6 +436,9 @@ class RunOutcome:
     recorder: RunRecorder
     json_lines: JsonProgress | None
     error: NavseqError | None = None  # what stopped the run, if an output failed
+    # The navigator's clock and the wall clock over the run, for the real-time factor.
+    navigator_seconds: float = 0.0
+    wall_seconds: float = 0.0
 
 
 def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, bool]:
@@ -370,13 +491,17 @@ def _run_with_sinks(
     setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
 ) -> RunOutcome:
     """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    import time
+
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
-    from navseq.sinks.progress import JsonProgress, make_progress
+    from navseq.sinks.json_events import JsonProgress
+    from navseq.sinks.progress import make_progress
 
     navigator = setup.make_navigator()
     error: NavseqError | None = None
+    navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
         if setup.resume is not None:
             journal = JournalWriter.resume(journal_path, setup.resume)
@@ -387,7 +512,12 @@ def _run_with_sinks(
                 journal_path, source, setup.digest, run_options=setup.run_options
             )
         recorder = new_recorder(setup)
-        progress = make_progress(setup.mission, json_lines=args.json, robot=setup.robot)
+        progress = make_progress(
+            setup.mission,
+            json_lines=args.json,
+            robot=setup.robot,
+            numbers=setup.part.numbers if setup.part is not None else None,
+        )
         with progress, journal:
             try:
                 result = run_mission(
@@ -409,7 +539,26 @@ def _run_with_sinks(
         signals.defer()  # the goal is reached or cancelled: the report comes first now
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
-    return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines, error)
+    return RunOutcome(
+        result,
+        exit_code,
+        interrupted,
+        navigator,
+        recorder,
+        json_lines,
+        error,
+        navigator_seconds=navigator.now() - navigator_start,
+        wall_seconds=time.monotonic() - wall_start,
+    )
+
+
+def real_time_text(simulated: float, wall: float) -> str:
+    """``simulated 62.4 s in 0.9 s: 69x real time``: how fast the simulator ran."""
+    if wall <= 0.0:
+        return f"simulated {simulated:.1f} s"
+    factor = simulated / wall
+    shown = f"{factor:.0f}" if factor >= 10 else f"{factor:.2g}"
+    return f"simulated {simulated:.1f} s in {wall:.1f} s: {shown}x real time"
 
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
@@ -473,26 +622,35 @@ def _execute_locked(
         folder,
         files,
         lambda paths, code: _report(setup, outcome, paths, code),
-        lambda: _picture_png(setup, outcome),
+        None if args.no_picture else lambda: _picture_png(setup, outcome),
         signals,
         outcome.exit_code,
     )
+    notes = []
+    if setup.navigator_info.get("kind") == "sim":
+        notes.append(real_time_text(outcome.navigator_seconds, outcome.wall_seconds))
     if outcome.json_lines is not None:
         try:
-            outcome.json_lines.emit(
-                "RunFinished",
-                {
-                    "success": outcome.result.success,
-                    "reason": outcome.result.reason,
-                    "exit_code": exit_code,
-                    "interrupted": outcome.interrupted,
-                    **files.paths,
-                },
+            outcome.json_lines.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=exit_code,
+                interrupted=outcome.interrupted,
+                files=files.paths,
             )
         except BrokenPipeError:
             silence_stdout()
+        for note in notes:  # stdout is for programs here
+            print(f"navseq run: {note}", file=sys.stderr)
     else:
-        print_summary(setup.mission, outcome.result, files)
+        print_summary(
+            setup.mission,
+            outcome.result,
+            files,
+            numbers=setup.part.numbers if setup.part is not None else None,
+            part=setup.part.describe() if setup.part is not None else None,
+            notes=notes,
+        )
     report_failures(files)
     if outcome.error is not None:
         raise outcome.error
@@ -501,22 +659,22 @@ def _execute_locked(
 
         raise NavseqError(
             f"the report could not be written ({files.failed['report']}); the journal "
-            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it",
-            source="navseq run",
+            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it"
         )
     if exit_code == 2:
         from navseq.errors import NavseqError
 
-        raise NavseqError(files.failed["picture"], source="navseq run")
+        raise NavseqError(f"the picture could not be written: {files.failed['picture']}")
     return exit_code
 
 
 def _report(
     setup: RunSetup, outcome: RunOutcome, files: dict[str, str], exit_code: int
 ) -> dict[str, Any]:
+    from navseq.mission.part import number_visits
     from navseq.sinks.report import build_report
 
-    return build_report(
+    report = build_report(
         setup.mission,
         outcome.result,
         exit_code=exit_code,
@@ -530,6 +688,8 @@ def _report(
         start_source=setup.start_source,
         files=files,
     )
+    number_visits(report, setup.part)
+    return report
 
 
 def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:

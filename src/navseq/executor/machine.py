@@ -485,7 +485,12 @@ class MissionExecutor:
             self._emit(LoopStarted(t=now, loop=loop))
         waypoint = self._mission.waypoints[index]
         result = WaypointResult(
-            index=index, loop=loop, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw
+            index=index,
+            loop=loop,
+            name=waypoint.name,
+            x=waypoint.x,
+            y=waypoint.y,
+            yaw_rad=waypoint.yaw_rad,
         )
         self._visits[(loop, index)] = result
         self._visit = _Visit(loop, index, waypoint, self._mission.policy_for(index), result)
@@ -551,7 +556,7 @@ class MissionExecutor:
                 goal_id=goal.goal_id,
                 x=waypoint.x,
                 y=waypoint.y,
-                yaw=waypoint.yaw,
+                yaw=waypoint.yaw_rad,
             )
         )
         return commands
@@ -592,7 +597,8 @@ class MissionExecutor:
                 self._finish_mission(now, "completed")
             else:
                 missed = sum(v.outcome is not WaypointOutcome.REACHED for v in self._all_visits())
-                self._finish_mission(now, f"completed: {missed} waypoint visit(s) not reached")
+                visits = "waypoint visit" if missed == 1 else "waypoint visits"
+                self._finish_mission(now, f"completed: {missed} {visits} not reached")
             return []
         loop, index = following
         if loop != visit.loop:
@@ -651,7 +657,7 @@ class MissionExecutor:
                         name=waypoint.name,
                         x=waypoint.x,
                         y=waypoint.y,
-                        yaw=waypoint.yaw,
+                        yaw_rad=waypoint.yaw_rad,
                     )
                 visits.append(visit)
         return visits
@@ -969,7 +975,7 @@ def _check_resume_point(mission: Mission, resume: ResumePoint) -> None:
 def _result_for(mission: Mission, done: WaypointResult) -> WaypointResult:
     """An earlier run's visit, with the waypoint's details taken from the mission."""
     waypoint = mission.waypoints[done.index]
-    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw)
+    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
 
 
 __all__ = [

@@ -1,7 +1,14 @@
-"""The outcome of a mission run, per waypoint visit, as the report and exit code see it."""
+"""The outcome of a mission run, per waypoint visit, as the report and exit code see it.
+
+The fields keep the names the journal has always used (``duration``,
+``distance_driven``); the ``*_s`` / ``*_m`` / ``yaw_deg`` properties say the unit in
+the name, as the report and the ``--json`` events do, and are what the public API
+documents.
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -28,6 +35,16 @@ class AttemptResult:
     duration: float = 0.0  # s from the goal sent to its end
     distance_driven: float = 0.0  # m
 
+    @property
+    def duration_s(self) -> float:
+        """Seconds (navigator clock) from the goal sent to its end."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during this attempt."""
+        return self.distance_driven
+
 
 @dataclass
 class WaypointResult:
@@ -38,7 +55,7 @@ class WaypointResult:
     name: str | None
     x: float
     y: float
-    yaw: float  # radians
+    yaw_rad: float
     outcome: WaypointOutcome = WaypointOutcome.NOT_RUN
     attempts: int = 0
     duration: float = 0.0  # s from first goal sent to reached/given up
@@ -46,6 +63,21 @@ class WaypointResult:
     reason: str = ""
     passed_through: bool = False
     attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
+
+    @property
+    def yaw_deg(self) -> float:
+        """The waypoint's heading in degrees."""
+        return math.degrees(self.yaw_rad)
+
+    @property
+    def duration_s(self) -> float:
+        """Seconds (navigator clock) from the first goal sent to reached / given up."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during this visit, all attempts together."""
+        return self.distance_driven
 
     @property
     def last_failure(self) -> AttemptResult | None:
@@ -62,6 +94,16 @@ class MissionResult:
     distance_driven: float = 0.0
     loops_completed: int = 0
     start_pose: Pose2D | None = None  # the robot's first known pose of the run
+
+    @property
+    def duration_s(self) -> float:
+        """Seconds of mission time (navigator clock; simulated time on the simulator)."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during the whole run."""
+        return self.distance_driven
 
     @property
     def exit_code(self) -> int:

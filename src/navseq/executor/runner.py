@@ -16,11 +16,13 @@ driving.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable
+from collections import deque
+from collections.abc import Generator, Iterable, Iterator
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
 from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
+from navseq.executor.events import MissionEvent
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
@@ -138,18 +140,71 @@ def run_mission(
         else:
             guard.defer()  # the caller's outputs come next
     if not server_up:
-        raise NavseqError(
-            f"no navigation server answered within {server_wait:g} s; is the navigation "
-            "stack (move_base or the simulator) running, and is the action name right?",
-            source="navigator",
-        )
+        raise _no_server(server_wait)
     return executor.result
+
+
+def iter_mission(
+    mission: Mission,
+    navigator: Navigator,
+    *,
+    tick: float = 0.1,
+    server_wait: float = 10.0,
+    control: MissionControl | None = None,
+    robot: RobotProfile | None = None,
+) -> Generator[MissionEvent, None, MissionResult]:
+    """:func:`run_mission` as a generator of mission events, for a caller's own loop.
+
+    Yields every event as it happens and returns the result (``StopIteration.value``).
+    It installs no signal handlers (a library's loop may not run in the main thread);
+    whatever ends it early -- an exception, Ctrl-C, or the caller leaving the loop
+    (``close()``) -- cancels the active goal first, as :func:`run_mission` does.
+    Raises :class:`~navseq.errors.NavseqError` when the server is not there.
+    """
+    executor = MissionExecutor(mission, robot=robot)
+    pending: deque[MissionEvent] = deque()
+    executor.add_listener(pending.append)
+    if not navigator.wait_for_server(server_wait):
+        raise _no_server(server_wait)
+    try:
+        for _ in _steps(executor, navigator, tick, control):
+            while pending:
+                yield pending.popleft()
+    except GeneratorExit:
+        _abort(executor, navigator, "interrupted: the caller stopped the run")
+        raise
+    except KeyboardInterrupt:
+        _abort(executor, navigator, "interrupted: SIGINT")
+        raise
+    except BaseException as error:
+        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+        raise
+    while pending:
+        yield pending.popleft()
+    return executor.result
+
+
+def _no_server(server_wait: float) -> NavseqError:
+    return NavseqError(
+        f"no navigation server answered within {server_wait:g} s; is the navigation "
+        "stack (move_base or the simulator) running, and is the action name right?",
+        source="navigator",
+    )
 
 
 def _drive(
     executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
 ) -> None:
     """The loop: navigator events, operator requests and the clock in; commands out."""
+    for _ in _steps(executor, navigator, tick, control):
+        pass
+
+
+def _steps(
+    executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
+) -> Iterator[None]:
+    """The loop, one step (one look at the mission, then ``tick`` of navigator time) per
+    item, so that :func:`iter_mission` can hand over the events between steps."""
     _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
         events = navigator.poll()
@@ -166,6 +221,7 @@ def _drive(
                 _apply(navigator, _operate(executor, request, navigator.now()))
         pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
         _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
+        yield
         if not executor.finished:
             navigator.spin(tick)
 

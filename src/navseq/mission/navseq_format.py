@@ -245,7 +245,7 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         x=x,
         y=y,
         z=z or 0.0,
-        yaw=yaw,
+        yaw_rad=yaw,
         name=name,
         overrides=MappingProxyType(overrides),
         where=node.where,
@@ -273,7 +273,7 @@ def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoi
         return None
     x, y, *rest = (v for v in values if v is not None)
     yaw = rest[0] if rest else 0.0
-    return Waypoint(x=x, y=y, yaw=yaw, where=node.where)
+    return Waypoint(x=x, y=y, yaw_rad=yaw, where=node.where)
 
 
 def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
@@ -70,6 +70,9 @@ class NavigatorDraft:
     start_source: str | None
     robot: RobotProfile
     preflight: bool = True  # False with --no-preflight
+    # The waypoints' numbers in the file when the run is a part of it (--from/--to/--only),
+    # so that pre-flight names them as the user numbers them.
+    numbers: Sequence[int] | None = None
 
     def check_against(self, costmap: Costmap) -> None:
         """Pre-flight on this costmap: every problem of the mission, raised together."""
@@ -78,7 +81,9 @@ class NavigatorDraft:
         from navseq.commands.common import preflight_errors
         from navseq.errors import MissionErrors
 
-        problems = preflight_errors(self.mission, costmap, self.start, robot=self.robot)
+        problems = preflight_errors(
+            self.mission, costmap, self.start, self.numbers, robot=self.robot
+        )
         if problems:
             raise MissionErrors(problems)
 

@@ -1,7 +1,9 @@
 """The ``sim`` navigator: navseq's embedded simulator behind the Navigator interface.
 
 It drives a :class:`navseq.sim.world.SimWorld` in simulated time, as fast as the CPU
-allows: :meth:`SimNavigator.spin` steps the world, and ``now()`` is the world's clock.
+allows, or paced against the wall clock at a chosen factor (``realtime``: 1 to watch
+it or to drive RViz in real time): :meth:`SimNavigator.spin` steps the world, and
+``now()`` is the world's clock.
 Events follow what an actionlib client of move_base would see:
 
 - ``GoalAccepted`` as soon as a goal is sent;
@@ -17,6 +19,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 from navseq.geometry import Pose2D
@@ -44,12 +48,32 @@ class SimNavigator:
     ``trajectory`` records ``(t, x, y)`` of the robot at the start and whenever it
     has moved 5 mm (or a 0.05 s step passed), for reports and pictures; it is a
     :class:`~navseq.track.Track`, so it stays bounded on a patrol that runs for days.
+
+    ``realtime`` (a factor > 0, or None for as fast as possible) paces simulated time
+    against ``wall_clock``: after each step the navigator sleeps until the wall clock has
+    caught up with simulated time / ``realtime`` since the first step. Pacing is against
+    that first step, not per step, so rounding does not add up over a long run, and a
+    slow step is caught up rather than lost.
     """
 
-    def __init__(self, world: SimWorld, *, feedback_period: float = 0.2) -> None:
+    def __init__(
+        self,
+        world: SimWorld,
+        *,
+        feedback_period: float = 0.2,
+        realtime: float | None = None,
+        wall_clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> None:
         if not feedback_period > 0:
             raise ValueError(f"feedback_period must be positive, got {feedback_period}")
+        if realtime is not None and not (math.isfinite(realtime) and realtime > 0):
+            raise ValueError(f"realtime must be a factor above 0, got {realtime}")
         self.world = world
+        self.realtime = realtime
+        self._wall_clock = wall_clock
+        self._sleep = sleep
+        self._pace_origin: tuple[float, float] | None = None  # (simulated, wall) time
         self.feedback_period = feedback_period
         pose = world.robot.pose
         self.trajectory = Track(min_step=0.005, min_interval=0.05)
@@ -131,11 +155,25 @@ class SimNavigator:
                 trajectory.append((world.time, robot.pose.x, robot.pose.y))
             if self._active is not None:
                 self._report(self._active)
+            if self.realtime is not None:
+                self._pace()
 
     def close(self) -> None:
         self.cancel_goal()
 
     # -- internals ---------------------------------------------------------------------
+
+    def _pace(self) -> None:
+        """Sleep until the wall clock is where simulated time says it should be."""
+        assert self.realtime is not None
+        now = self._wall_clock()
+        if self._pace_origin is None:
+            self._pace_origin = (self.world.time, now)
+            return
+        sim_origin, wall_origin = self._pace_origin
+        due = wall_origin + (self.world.time - sim_origin) / self.realtime
+        if due > now:
+            self._sleep(due - now)
 
     def _report(self, goal: Goal) -> None:
         """Turn what the server did during the last step into events."""
@@ -167,8 +205,7 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
     """
     from navseq.commands.common import format_pose
     from navseq.errors import NavseqError
-    from navseq.sim.costmap import Costmap
-    from navseq.sim.profile import SimSettings
+    from navseq.simrun import prepare_sim_world
 
     if draft.map_path is None:
         raise NavseqError(
@@ -176,28 +213,28 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
             source=draft.mission.source,
         )
     grid = load_map(draft.map_path)
-    settings = SimSettings.of(draft.robot)
+    # The same preparation as the Python API's simulate(): default start, pre-flight on
+    # the one costmap the simulated server also uses, the world.
+    ready = prepare_sim_world(
+        draft.mission,
+        grid,
+        draft.start,
+        draft.robot,
+        preflight=draft.preflight,
+        numbers=draft.numbers,
+    )
     notes = []
-    if draft.start is None:
-        draft.start = default_start(grid, settings.footprint)
+    if ready.start_defaulted:
+        draft.start = ready.start
         draft.start_source = "simulator default"
         notes.append(
             f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(draft.start)}, the roomy point nearest the map origin"
+            f"{format_pose(ready.start)}, the roomy point nearest the map origin"
         )
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    draft.check_against(costmap)
-    world = SimWorld(
-        grid,
-        draft.start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
+    world = ready.world
+    realtime = getattr(args, "realtime", None)
     return NavigatorSetup(
-        make_navigator=lambda: SimNavigator(world),
+        make_navigator=lambda: SimNavigator(world, realtime=realtime),
         info={"kind": "sim", "robot": draft.robot.name},
         grid=grid,
         notes=notes,
