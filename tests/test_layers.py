@@ -125,11 +125,11 @@ SRC = REPO / "src" / "navseq"
 # Client libraries and the message packages only they give meaning to. geometry_msgs and
 # friends exist in ROS 1 and ROS 2 alike, so they count for both.
 ROS1_ONLY = {"rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "genpy", "roslib"}
-ROS1_ONLY |= {"rosgraph", "rosgraph_msgs", "roslaunch", "rosbag", "tf", "tf2_ros"}
+ROS1_ONLY |= {"rosgraph", "roslaunch", "rosbag", "tf", "tf2_ros"}
 ROS2_ONLY = {"rclpy", "nav2_msgs", "action_msgs", "rosidl_runtime_py", "lifecycle_msgs"}
 ROS2_ONLY |= {"builtin_interfaces", "launch", "launch_ros"}
 SHARED_MSGS = {"geometry_msgs", "nav_msgs", "std_msgs", "std_srvs", "visualization_msgs"}
-SHARED_MSGS |= {"tf2_msgs"}
+SHARED_MSGS |= {"tf2_msgs", "rosgraph_msgs"}
 
 
 def imported_roots(path: Path) -> set[str]:
