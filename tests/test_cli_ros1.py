@@ -41,8 +41,6 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
             "ros1",
             "--map",
             MAP,
-            "--start",
-            "-2,-0.5,0",
             "--out",
             out,
         ],
