@@ -282,11 +282,11 @@ def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
     """Options that only the embedded simulator can honour, refused for a real robot."""
     from navseq.errors import NavseqError
 
-    if args.navigator == "ros1" and start_given:
+    if not navigator_kind(args.navigator).places_robot and start_given:
         raise NavseqError(
-            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
-            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
-            "which publishes /initialpose)",
+            f"sets the simulated robot's start pose; with --navigator {args.navigator} the "
+            "robot is where it is. Leave --start out (set a robot's pose with RViz's 2D Pose "
+            "Estimate, which publishes /initialpose)",
             source="--start",
         )
     if args.navigator != "sim" and args.realtime is not None:
