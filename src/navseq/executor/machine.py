@@ -163,6 +163,9 @@ class _Visit:
     reached_at: float | None = None
     attempt_sent_at: float = 0.0  # when the current attempt's goal was first sent
     attempt_start_distance: float = 0.0  # the visit's distance driven at that moment
+    # The stack's count of recovery behaviours for the current attempt's goal, when the
+    # stack gives one (Nav2's number_of_recoveries); None: not known.
+    attempt_recoveries: int | None = None
 
 
 class MissionExecutor:
@@ -501,6 +504,7 @@ class MissionExecutor:
         visit.result.attempts += 1
         visit.attempt_sent_at = now
         visit.attempt_start_distance = visit.result.distance_driven
+        visit.attempt_recoveries = None
         return self._send_goal(now)
 
     def _passes_through(self, visit: _Visit) -> bool:
@@ -524,6 +528,7 @@ class MissionExecutor:
             text=text,
             duration=max(0.0, now - visit.attempt_sent_at),
             distance_driven=visit.result.distance_driven - visit.attempt_start_distance,
+            recoveries=visit.attempt_recoveries,
         )
         visit.result.attempt_results.append(record)
         return record
@@ -699,6 +704,7 @@ class MissionExecutor:
                 duration=record.duration,
                 distance_driven=record.distance_driven,
                 loop=visit.loop,
+                recoveries=record.recoveries,
             )
         )
         if will_retry:
@@ -809,6 +815,8 @@ class MissionExecutor:
         attempt = self._attempt
         assert attempt is not None
         attempt.feedback_seen = True
+        if event.recoveries is not None:
+            self._current.attempt_recoveries = event.recoveries
         if not self._tick_pose_seen:
             self._accumulate_distance(event.pose)
         self._see_pose(event.pose)
@@ -817,7 +825,7 @@ class MissionExecutor:
             remaining = event.distance_remaining
             if remaining is None:
                 remaining = self._remaining(attempt, event.pose)
-            self._emit_progress(now, event.pose, remaining)
+            self._emit_progress(now, event.pose, remaining, event.recoveries, event.navigation_time)
         return commands
 
     @staticmethod
@@ -930,7 +938,14 @@ class MissionExecutor:
             return True
         return False
 
-    def _emit_progress(self, now: float, pose: Pose2D, remaining: float | None) -> None:
+    def _emit_progress(
+        self,
+        now: float,
+        pose: Pose2D,
+        remaining: float | None,
+        recoveries: int | None = None,
+        navigation_time: float | None = None,
+    ) -> None:
         visit = self._current
         self._emit(
             WaypointProgress(
@@ -941,6 +956,8 @@ class MissionExecutor:
                 yaw=pose.yaw,
                 distance_remaining=remaining,
                 distance_driven=visit.result.distance_driven,
+                recoveries=recoveries,
+                navigation_time=navigation_time,
             )
         )
 

@@ -1,12 +1,12 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 3; the unit is in every field's name where there is one:
+Schema (``schema_version`` 4; the unit is in every field's name where there is one:
 ``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
 mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
 ``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
-      "schema_version": 3,
+      "schema_version": 4,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
@@ -24,7 +24,7 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
                  "duration_s", "distance_m", "loops_completed"},
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
                   "attempts": [{"number", "reached", "status", "reason", "text",
-                                "duration_s", "distance_m"}],
+                                "duration_s", "distance_m", "recoveries"}],
                   "duration_s", "distance_m", "reason", "passed_through"}],
       "files": {"journal", "picture", ...}
     }
@@ -39,7 +39,9 @@ Each attempt is one goal sent: ``status`` is the navigation stack's terminal sta
 (SUCCEEDED, ABORTED, ...; null when navseq ended the attempt: timeout, stalled,
 interrupt), ``reason`` navseq's verdict (empty for the attempt that reached the
 waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but the
-robot was not there), ``text`` the stack's own result text. Version 1 had
+robot was not there), ``text`` the stack's own result text, ``recoveries`` the
+recovery behaviours the stack ran for the goal (Nav2's count; null from stacks that
+do not count them; version 4 added it). Version 1 had
 ``attempts`` as a count: it is the length of the list now. Version 2 had the map's
 ``resolution``, ``width``, ``height`` and an ``origin`` list with its yaw in radians.
 """
@@ -64,7 +66,7 @@ from navseq.mission.model import Mission
 if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
 
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 #: ``start_source`` when the report's start is the robot's own first pose.
 START_FROM_ROBOT = "robot"
 
@@ -101,6 +103,7 @@ def _attempt_dict(attempt: AttemptResult) -> dict[str, Any]:
         "text": attempt.text,
         "duration_s": _rounded(attempt.duration, 2),
         "distance_m": _rounded(attempt.distance_driven),
+        "recoveries": attempt.recoveries,
     }
 
 
