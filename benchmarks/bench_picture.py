@@ -127,7 +127,7 @@ def main() -> None:
     args = parser.parse_args()
 
     before = module_at(args.before) if args.before else None
-    table = Table(title="mission picture: draw time (best of %d)" % args.repeat)
+    table = Table(title=f"mission picture: draw time (best of {args.repeat})")
     for header in ("waypoints", "trajectory rows", "plans", "now s", "PNG kB"):
         table.add_column(header, justify="right")
     if before is not None:

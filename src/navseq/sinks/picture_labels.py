@@ -39,6 +39,8 @@ class PlacedLabel:
     x: float
     y: float
     box: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax in pixels
+    anchor: tuple[float, float]  # the marker it names (pixels)
+    far: bool = False  # not right beside its marker: worth a leader line
 
 
 @dataclass
@@ -77,14 +79,18 @@ class LabelPlacer:
         if len(self.placed) >= self.limit:
             return False
         width, height = self.measure(text)
-        for dx, dy in _SPOTS:
-            cx = x + dx * (clearance + width / 2.0)
-            cy = y + dy * (clearance + height / 2.0)
-            box = (cx - width / 2.0, cy - height / 2.0, cx + width / 2.0, cy + height / 2.0)
-            if self.free(box):
-                self.placed.append(PlacedLabel(item, text, cx, cy, box))
-                self._boxes = np.concatenate([self._boxes, np.array([box])])
-                return True
+        # Right beside the marker first; a little further out if a neighbour is in the way.
+        for ring, distance in enumerate(
+            (clearance, clearance + 0.6 * height, clearance + 1.5 * height)
+        ):
+            for dx, dy in _SPOTS:
+                cx = x + dx * (distance + width / 2.0)
+                cy = y + dy * (distance + height / 2.0)
+                box = (cx - width / 2.0, cy - height / 2.0, cx + width / 2.0, cy + height / 2.0)
+                if self.free(box):
+                    self.placed.append(PlacedLabel(item, text, cx, cy, box, (x, y), ring > 0))
+                    self._boxes = np.concatenate([self._boxes, np.array([box])])
+                    return True
         return False
 
 

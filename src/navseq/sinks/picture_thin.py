@@ -101,7 +101,7 @@ def _kept_pairs(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Indices (i, j) of consecutive kept points: each a point entering a new cell."""
     moved = np.ones(len(cells), dtype=bool)
-    moved[1:] = (cells[1:] != cells[:-1]).any(axis=1) | (run_id[1:] != run_id[:-1])
+    moved[1:] = (cells[1:] != cells[:-1]).any(axis=1) | ~finite[:-1]
     # The last point of each run is kept too, so that a line ends where the robot stopped.
     last_of_run = np.append(run_id[1:] != run_id[:-1], True)
     kept = np.flatnonzero(finite & (moved | last_of_run))
