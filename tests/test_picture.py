@@ -131,7 +131,11 @@ def assert_readable(fig) -> list:
     for i, a in enumerate(boxes):
         for b in boxes[i + 1 :]:
             assert not overlap(a.shrunk(0.98, 0.98), b.shrunk(0.98, 0.98)), "labels overlap"
-    others = [fig.axes[1].get_legend().get_window_extent(renderer)]
+    legend = fig.axes[1].get_legend().get_window_extent(renderer)
+    whole = fig.bbox
+    assert whole.x0 <= legend.x0 and legend.x1 <= whole.x1, "legend cut by the figure's edge"
+    assert whole.y0 <= legend.y0 and legend.y1 <= whole.y1, "legend cut by the figure's edge"
+    others = [legend]
     others += [a.get_window_extent(renderer) for a in fig.axes[2:]]  # the colour bar
     for other in others:
         assert not overlap(frame, other), "legend or colour bar over the map"

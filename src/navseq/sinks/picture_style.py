@@ -31,9 +31,9 @@ STATUS_COLOURS = {
 }
 STATUS_LABELS = {
     Status.REACHED: "reached",
-    Status.SKIPPED: "skipped (gave up, went on)",
-    Status.FAILED: "failed (mission stopped)",
-    Status.INTERRUPTED: "interrupted (Ctrl-C, signal)",
+    Status.SKIPPED: "skipped (went on)",
+    Status.FAILED: "failed (stopped)",
+    Status.INTERRUPTED: "interrupted",
     Status.NOT_RUN: "not run",
 }
 STATUSES = tuple(Status)
@@ -46,8 +46,8 @@ MAP_BORDER_COLOUR = "#6b7785"
 # Layout, inches: the map axes, then the legend and colour bar in a side panel.
 AXES_WIDTH = 7.0
 AXES_HEIGHT_RANGE = (4.2, 9.0)
-LEFT, GAP, SIDE, RIGHT = 0.75, 0.3, 2.1, 0.1
-BOTTOM, TOP = 0.55, 0.75
+LEFT, GAP, SIDE, RIGHT = 0.75, 0.3, 2.2, 0.1
+BOTTOM, TOP = 0.55, 0.6
 # Waypoint markers, points.
 DISC = 15.0  # a numbered disc
 DISC_MIN = 11.0
@@ -56,11 +56,11 @@ NUMBERED_MAX = 300  # more discs than this are never numbered one by one
 DOT_LABELS = 50  # labels shown when the mission is too crowded to label everything
 LABEL_FONT = 7.0
 LABEL_PAD = 0.15  # fraction of the font size, around a label's text
-PLAN_SEGMENTS = 6_000
-DOTS_DRAWN = 10_000  # beyond this, dots covering one another are drawn once
+PLAN_SEGMENTS = 3_000
+DOTS_DRAWN = 6_000  # beyond this, dots covering one another are drawn once
 ALARMING = (Status.FAILED, Status.INTERRUPTED)
 COINCIDENT = 0.02  # m: closer than this, two waypoints are one spot
-TRAJECTORY_SEGMENTS = 12_000
+TRAJECTORY_SEGMENTS = 6_000
 
 
 @dataclass(frozen=True)
