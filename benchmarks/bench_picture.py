@@ -6,10 +6,11 @@ be drawn in bounded time whatever the mission. Each size is a seeded mission on 
 (``--points-per-leg`` positions per leg, up to a million rows), the last 1000 legs'
 plans, 70 % of the waypoints run (every 37th skipped, then one failed, the rest not
 run). With ``--before REF`` the same inputs are drawn by the picture module of git
-``REF`` too (sizes up to ``--before-max``), side by side.
+``REF`` too (sizes up to ``--before-max``), side by side: 46a4aae is the last commit
+before the picture learnt to thin.
 
     .venv/bin/python benchmarks/bench_picture.py
-    .venv/bin/python benchmarks/bench_picture.py --before main --out /tmp/pictures
+    .venv/bin/python benchmarks/bench_picture.py --before 46a4aae --out /tmp/pictures
 """
 
 from __future__ import annotations
