@@ -447,6 +447,20 @@ def test_off_map_waypoints_are_drawn_on_the_border_pointing_at_them(tmp_path):
     assert corners[:, 0].max() == pytest.approx(4.0) and corners[:, 0].min() == pytest.approx(-1.0)
 
 
+def test_without_a_map_a_far_outlier_is_marked_on_the_border_not_zoomed_out_to(tmp_path):
+    mission = Mission(
+        (*(Waypoint(float(i % 4), float(i // 4), 0.0) for i in range(12)), Waypoint(1e6, 2.0, 0.0)),
+        source="outlier.yaml",
+    )
+    fig = mission_figure(mission, visits_result(mission, [REACHED] * 13))
+    save(fig, "outlier-no-map", tmp_path)
+    xmin, xmax = fig.axes[0].get_xlim()
+    assert xmin < 0.0 and 3.0 < xmax < 100.0
+    texts = [t.get_text() for t in assert_readable(fig)]
+    assert "13 at (1000000.0, 2.0)" in texts
+    assert sorted(disc_numbers(fig), key=int) == [str(i) for i in range(1, 13)]
+
+
 # --------------------------------------------------------------------------- thinning
 
 

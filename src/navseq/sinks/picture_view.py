@@ -136,10 +136,12 @@ def _reach(waypoints: np.ndarray, grid: OccupancyGrid | None) -> Box:
         return box.grown(max(2.0, 0.25 * max(box.width, box.height)))
     if len(waypoints) == 0:
         return Box(-math.inf, -math.inf, math.inf, math.inf)
-    low = np.percentile(waypoints, 2, axis=0)
-    high = np.percentile(waypoints, 98, axis=0)
-    bulk = Box(*low, *high)
-    return bulk.grown(max(5.0, 2.0 * max(bulk.width, bulk.height)))
+    # The middle half of the waypoints, widened three times its size (at least 2 m):
+    # a spread-out mission is all inside, a lone point 1 km away is not.
+    low = np.percentile(waypoints, 25, axis=0)
+    high = np.percentile(waypoints, 75, axis=0)
+    middle = Box(*low, *high)
+    return middle.grown(3.0 * max(middle.width, middle.height, 2.0))
 
 
 def area_of_interest(
