@@ -461,6 +461,19 @@ def test_without_a_map_a_far_outlier_is_marked_on_the_border_not_zoomed_out_to(t
     assert sorted(disc_numbers(fig), key=int) == [str(i) for i in range(1, 13)]
 
 
+def test_thousands_of_far_waypoints_are_a_bounded_row_of_triangles():
+    from matplotlib.collections import PatchCollection
+
+    near = tuple(Waypoint(float(i % 60), float(i // 60), 0.0) for i in range(3600))
+    # 10 km north of it, spread along it: clipped, they line the whole top border.
+    far = tuple(Waypoint(0.06 * i, 1e4, 0.0) for i in range(1000))
+    mission = Mission(near + far, source="far.yaml")
+    fig = mission_figure(mission, visits_result(mission, [REACHED] * len(mission)))
+    (triangles,) = [c for c in fig.axes[0].collections if isinstance(c, PatchCollection)]
+    assert 1 <= len(triangles.get_paths()) <= 200
+    assert_readable(fig)
+
+
 # --------------------------------------------------------------------------- thinning
 
 

@@ -31,6 +31,7 @@ from navseq.sinks.picture_style import (
     LABEL_FONT,
     LABEL_PAD,
     NUMBERED_MAX,
+    OFF_VIEW_DRAWN,
     STATUS_COLOURS,
     STATUSES,
     Status,
@@ -191,6 +192,11 @@ def draw_markers(
         )
     # Off the view: a triangle on the border, pointing at the waypoint.
     outside = np.flatnonzero(~inside)
+    if len(outside) > OFF_VIEW_DRAWN:
+        # Thousands beyond the view: one triangle per disc-sized stretch of the border.
+        cells = np.floor(markers.pixels[outside] / (DISC / 72.0 * layout.dpi)).astype(np.int64)
+        _, first = np.unique(cells, axis=0, return_index=True)
+        outside = outside[np.sort(first)]
     if len(outside):
         metres = DISC / 72.0 * layout.dpi / layout.scale  # a disc's diameter
         triangles = []

@@ -58,6 +58,7 @@ LABEL_FONT = 7.0
 LABEL_PAD = 0.15  # fraction of the font size, around a label's text
 PLAN_SEGMENTS = 3_000
 DOTS_DRAWN = 6_000  # beyond this, dots covering one another are drawn once
+OFF_VIEW_DRAWN = 200  # beyond this, triangles on one stretch of the border are drawn once
 ALARMING = (Status.FAILED, Status.INTERRUPTED)
 COINCIDENT = 0.02  # m: closer than this, two waypoints are one spot
 TRAJECTORY_SEGMENTS = 6_000
