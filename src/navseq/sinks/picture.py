@@ -21,6 +21,12 @@ signal waits for it):
   both thinned to what the pixels can show;
 - the start pose, a legend and a colour bar beside the map, and a title with the
   mission name and its result.
+
+This module reads the run (:func:`waypoint_outcomes` is the only place that reads a
+result's visits) and puts the picture together; the helpers draw: ``picture_view``
+(view, layout, map, paths), ``picture_marks`` (markers and labels), ``picture_legend``
+(side panel), with ``picture_style`` (colours, sizes, budgets), ``picture_thin`` and
+``picture_labels`` (the numpy and placement work).
 """
 
 from __future__ import annotations
@@ -88,11 +94,12 @@ __all__ = [
 Path2D = Sequence[tuple[float, float]]
 
 
-# How bad a visit's outcome is (enum members and their values: a result read back
-# from JSON may hold either).
+# How bad a visit's outcome is. WaypointOutcome is a str enum, so these keys also
+# match the plain strings ("reached") of a result read back from JSON.
 _SEVERITY: dict[Any, int] = {
-    **{WaypointOutcome.REACHED: 1, WaypointOutcome.SKIPPED: 2, WaypointOutcome.FAILED: 3},
-    **{"reached": 1, "skipped": 2, "failed": 3},
+    WaypointOutcome.REACHED: 1,
+    WaypointOutcome.SKIPPED: 2,
+    WaypointOutcome.FAILED: 3,
 }
 
 

@@ -134,7 +134,7 @@ class Groups:
 def coincident_groups(points: np.ndarray, tolerance: float) -> Groups:
     """Group points (N, 2) closer than about ``tolerance`` (snapped to a grid of that size).
 
-    Linear (one sort): points in the same grid cell share a marker. Two points just
+    One sort, no pairwise distances: points in the same grid cell share a marker. Two points just
     either side of a cell border stay apart, which only means two markers that touch.
     """
     points = np.asarray(points, dtype=float).reshape(-1, 2)
