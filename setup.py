@@ -41,6 +41,8 @@ if _run_by_catkin():
     )
 else:
     setup(
+        # pyproject.toml lists license as dynamic (see the comment there).
+        license="Apache-2.0",
         packages=PACKAGES,
         package_dir=PACKAGE_DIR,
         ext_modules=[

@@ -120,7 +120,9 @@ def random_mission(
     for number in range(count):
         x, y = pick(known_free if rng.random() < 0.25 else open_floor)
         yaw = math.radians(45.0 * int(rng.integers(8)))
-        points.append(Waypoint(x, y, yaw, name=f"p{number + 1}", where=f"{name}:{number + 1}"))
+        points.append(
+            Waypoint(x, y, yaw_rad=yaw, name=f"p{number + 1}", where=f"{name}:{number + 1}")
+        )
     return Mission(waypoints=tuple(points), start=start, source=name)
 
 
@@ -164,7 +166,7 @@ def run_one(
     leg_start: Pose2D | None = mission.start  # None: where the robot gave up, unknown
     failed = False
     for visit in result.visits:
-        goal = Pose2D(visit.x, visit.y, visit.yaw)
+        goal = Pose2D(visit.x, visit.y, visit.yaw_rad)
         if visit.outcome is WaypointOutcome.REACHED:
             stats.reached += 1
             if leg_start is not None:

@@ -12,7 +12,7 @@ subprocess (this same script in a ``--role``), and all of them are stopped at th
    moment goal n+1 arrived (and was accepted). That is everything a sequencer adds
    between two goals: receiving the result, deciding, sending the next goal. Clients:
 
-   - navseq: :class:`~navseq.navigators.ros1.Ros1Navigator` +
+   - navseq: :class:`~navseq.ros1.navigator.Ros1Navigator` +
      :func:`~navseq.executor.runner.run_mission`, with the executor tick the CLI and the
      node use (0.1 s) and with a 10x shorter one; with its default ``settle`` (0.05 s of
      wall time after a result before the next goal, which keeps clear of move_base's
@@ -135,10 +135,10 @@ def bench_goals(count: int) -> list[tuple[float, float, float]]:
 def role_navseq_client(goals: int, tick: float, settle: float) -> None:
     """navseq's sequencer (Ros1Navigator + run_mission) sending ``goals`` goals in a row."""
     from navseq.executor.runner import run_mission
-    from navseq.navigators.ros1 import Ros1Navigator
+    from navseq.ros1.navigator import Ros1Navigator
 
     mission = Mission(
-        waypoints=tuple(Waypoint(x, y, yaw) for x, y, yaw in bench_goals(goals)),
+        waypoints=tuple(Waypoint(x, y, yaw_rad=yaw) for x, y, yaw in bench_goals(goals)),
         defaults=Policy(goal_timeout=10.0, on_failure=FailureAction.STOP),
         source="<bench_ros1>",
     )

@@ -1,4 +1,8 @@
-"""Shared pytest fixtures. ROS tests (marker ``ros``) are skipped where ROS 1 is missing."""
+"""Shared pytest fixtures. ROS tests are skipped where their ROS is missing.
+
+Marker ``ros``: needs ROS 1 (Debian's packages). Marker ``ros2``: needs ROS 2 (see
+``ros2_support``).
+"""
 
 from __future__ import annotations
 
@@ -7,18 +11,26 @@ from pathlib import Path
 
 import pytest
 
+from ros2_support import ros2_available
 from ros_support import RosMaster, rospy_available, running_master
 
 ROS_AVAILABLE, ROS_MISSING_REASON = rospy_available()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    if ROS_AVAILABLE:
-        return
-    skip = pytest.mark.skip(reason=f"ROS 1 not available: {ROS_MISSING_REASON}")
-    for item in items:
-        if "ros" in item.keywords:
-            item.add_marker(skip)
+    if not ROS_AVAILABLE:
+        skip = pytest.mark.skip(reason=f"ROS 1 not available: {ROS_MISSING_REASON}")
+        for item in items:
+            if "ros" in item.keywords:
+                item.add_marker(skip)
+    if any("ros2" in item.keywords for item in items):
+        # Probing starts a process: only when a ros2 test was collected.
+        available, reason = ros2_available()
+        if not available:
+            skip = pytest.mark.skip(reason=f"ROS 2 not available: {reason}")
+            for item in items:
+                if "ros2" in item.keywords:
+                    item.add_marker(skip)
 
 
 @pytest.fixture

@@ -11,13 +11,12 @@ from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Policy, Waypoint
 from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import (
-    GoalDone,
     GoalFeedback,
     GoalPlan,
-    GoalStatus,
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.scripted import scripted_done
 
 E = TypeVar("E")
 
@@ -30,7 +29,7 @@ def line_mission(
     **policy: Any,
 ) -> Mission:
     """``count`` waypoints 1 m apart along +x (1,0), (2,0), ..., all facing +x."""
-    waypoints = tuple(Waypoint(float(i + 1), 0.0, 0.0, name=f"p{i + 1}") for i in range(count))
+    waypoints = tuple(Waypoint(float(i + 1), 0.0, name=f"p{i + 1}") for i in range(count))
     return Mission(
         waypoints=waypoints,
         defaults=Policy(**policy),
@@ -73,7 +72,7 @@ class Harness:
 
     def done(
         self,
-        status: GoalStatus,
+        status: str,
         t: float,
         goal_id: int | None = None,
         *,
@@ -81,10 +80,12 @@ class Harness:
         text: str = "",
     ) -> list[Command]:
         gid = self.goal_id if goal_id is None else goal_id
-        return self._keep(self.executor.on_event(GoalDone(gid, status, text), t, pose))
+        # Statuses by actionlib's names, ended the way the scripted double ends them.
+        done = scripted_done(gid, status, text)
+        return self._keep(self.executor.on_event(done, t, pose))
 
     def succeed(self, t: float, pose: Pose2D | None = None) -> list[Command]:
-        return self.done(GoalStatus.SUCCEEDED, t, pose=pose)
+        return self.done("SUCCEEDED", t, pose=pose)
 
     def plan(self, t: float, path: list[tuple[float, float]]) -> list[Command]:
         return self._keep(self.executor.on_event(GoalPlan(self.goal_id, tuple(path)), t))

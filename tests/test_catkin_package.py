@@ -63,8 +63,8 @@ def test_every_node_script_is_an_executable_relay_to_a_main_and_is_installed():
         text = script.read_text()
         assert text.startswith("#!/usr/bin/env python3\n"), script
         assert os.access(script, os.X_OK), f"{script} is not executable"
-        module = re.search(r"^from (navseq\.ros\.\w+) import main$", text, re.M)
-        assert module, f"{script} should only import and call navseq.ros.<module>.main"
+        module = re.search(r"^from (navseq\.ros1\.\w+) import main$", text, re.M)
+        assert module, f"{script} should only import and call navseq.ros1.<module>.main"
         assert f"nodes/{script.name}" in install_block.group(1), f"{script} not installed"
 
 
@@ -157,7 +157,7 @@ def test_catkin_make_builds_a_workspace_where_rosrun_and_roslaunch_find_the_node
         assert os.access(installed, os.X_OK), installed
         assert installed.read_text().startswith("#!/usr/bin/env python3\n")
     python_dir = install / "lib" / "python3" / "dist-packages" / "navseq"
-    assert (python_dir / "ros" / "sim_nav_node.py").is_file()
+    assert (python_dir / "ros1" / "sim_nav_node.py").is_file()
     assert (python_dir / "sim" / "navserver.py").is_file()
     share = install / "share" / "navseq"
     for relative in ("package.xml", "launch/sim.launch", "maps/turtlebot3_world.yaml"):

@@ -279,7 +279,7 @@ def test_json_output_is_one_object_per_line(tmp_path):
     assert kinds[0] == "MissionStarted" and kinds[-2] == "MissionFinished"
     assert kinds.count("WaypointFinished") == 4
     assert records[-1]["event"] == "RunFinished" and records[-1]["exit_code"] == 0
-    assert Path(records[-1]["report"]).exists()
+    assert Path(records[-1]["files"]["report"]).exists()
 
 
 def test_run_never_overwrites_earlier_output(tmp_path):

@@ -41,8 +41,6 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
             "ros1",
             "--map",
             MAP,
-            "--start",
-            "-2,-0.5,0",
             "--out",
             out,
         ],
@@ -59,9 +57,12 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
         "frame": "map",
         "ns": "",
     }
-    # The sim's move_base sets no footprint or local planner: navseq says it assumes the burger.
-    assert navigator["robot"] == "turtlebot3_burger"
-    assert "assuming turtlebot3_burger" in navigator["robot_source"]
+    # The sim's move_base declares the robot it simulates (the burger by default) under
+    # move_base's parameter names, and navseq reads it from there.
+    assert navigator["robot"] == "navstack:/move_base"
+    assert navigator["robot_source"].startswith(
+        "robot from /move_base parameters: footprint 4 points, circumscribed 0.15 m"
+    ), navigator["robot_source"]
     assert [v["outcome"] for v in report["visits"]] == ["reached", "reached"]
     assert report["visits"][1]["distance_m"] > 0.5
     assert (out / "mission.png").exists()

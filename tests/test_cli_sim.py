@@ -40,7 +40,7 @@ def test_example_mission_runs_to_the_end_and_writes_report_and_picture(tmp_path)
     assert report["success"] is True and report["exit_code"] == 0
     assert report["navigator"]["kind"] == "sim"
     assert report["map"]["source"].endswith("turtlebot3_world.yaml")
-    assert report["map"]["resolution"] == pytest.approx(0.05)
+    assert report["map"]["resolution_m"] == pytest.approx(0.05)
     assert report["start"] is not None
     visits = report["visits"]
     assert len(visits) >= 6 and all(v["outcome"] == "reached" for v in visits)

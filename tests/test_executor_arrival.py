@@ -23,7 +23,6 @@ from navseq.executor.machine import ARRIVAL_SLACK_M, ARRIVAL_SLACK_RAD
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance
-from navseq.navigators.base import GoalStatus
 from navseq.navigators.scripted import FalseSuccess, ScriptedNavigator
 
 GOAL = Pose2D(1.0, 0.0, 0.0)  # line_mission's first waypoint
@@ -33,7 +32,7 @@ def test_succeeded_far_from_the_goal_is_a_failed_attempt_and_the_retry_resends()
     h = Harness(line_mission(2, retries=1))
     h.start(0.0)
     first = h.goal_id
-    h.done(GoalStatus.SUCCEEDED, 0.05, pose=Pose2D(-1.38, 0.0, 0.0), text="Goal reached.")
+    h.done("SUCCEEDED", 0.05, pose=Pose2D(-1.38, 0.0, 0.0), text="Goal reached.")
     [failure] = h.of_type(AttemptFailed)
     assert failure.reason == "succeeded far from goal (2.38 m)"
     assert failure.status == "SUCCEEDED" and failure.text == "Goal reached."
@@ -92,7 +91,9 @@ def test_with_no_pose_at_all_the_success_is_believed() -> None:
 
 
 def _one_waypoint(**overrides: float) -> Mission:
-    return Mission(waypoints=(Waypoint(1.0, 0.0, 0.0, overrides=overrides),), defaults=Policy())
+    return Mission(
+        waypoints=(Waypoint(1.0, 0.0, yaw_rad=0.0, overrides=overrides),), defaults=Policy()
+    )
 
 
 def test_the_robot_profiles_tolerance_applies_where_the_waypoint_sets_none() -> None:

@@ -20,18 +20,19 @@ from navseq.executor.result import AttemptResult
 from navseq.executor.runner import run_mission
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction
-from navseq.navigators.base import GoalStatus
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Stall, Succeed
 from navseq.sinks.journal import JournalWriter, read_journal, resume_point
-from navseq.sinks.progress import JsonProgress, LogProgress, summary_table
+from navseq.sinks.json_events import JsonProgress
+from navseq.sinks.progress import LogProgress
 from navseq.sinks.report import build_report
+from navseq.sinks.summary import summary_table
 
 NO_PLAN = "Failed to find a valid plan. Even after executing recovery behaviors."
 
 
 def run_with_a_failing_first_attempt(listeners: list = ()):  # type: ignore[no-untyped-def,type-arg]
     navigator = ScriptedNavigator(
-        [Finish(GoalStatus.ABORTED, after=2.0, text=NO_PLAN), Succeed(), Stall(), Stall()],
+        [Finish("ABORTED", after=2.0, text=NO_PLAN), Succeed(), Stall(), Stall()],
         speed=0.25,
         step=0.05,
     )
@@ -79,7 +80,7 @@ def test_summary_table_says_why_a_visit_was_not_reached() -> None:
     mission = line_mission(2, on_failure=FailureAction.SKIP)
     h = Harness(mission)
     h.start(0.0)
-    h.done(GoalStatus.ABORTED, 3.0, text=NO_PLAN)
+    h.done("ABORTED", 3.0, text=NO_PLAN)
     h.succeed(6.0)
     console = Console(file=io.StringIO(), width=250)
     console.print(summary_table(mission, h.executor.result))
@@ -100,7 +101,7 @@ def test_progress_lines_and_json_carry_the_stacks_text() -> None:
         if record["event"] == "AttemptFailed"
     ]
     assert failed[0]["text"] == NO_PLAN and failed[0]["status"] == "ABORTED"
-    assert failed[0]["duration"] == pytest.approx(2.0, abs=0.11)
+    assert failed[0]["duration_s"] == pytest.approx(2.0, abs=0.11)
 
 
 # ---------------------------------------------------------------- journal

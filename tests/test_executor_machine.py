@@ -24,14 +24,14 @@ from navseq.executor.events import (
 from navseq.executor.result import WaypointResult
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction
-from navseq.navigators.base import GoalStatus
+from navseq.navigators.base import GoalDone
 
 REACHED = WaypointOutcome.REACHED
 FAILED_STATUSES = [
-    GoalStatus.ABORTED,
-    GoalStatus.REJECTED,
-    GoalStatus.PREEMPTED,
-    GoalStatus.RECALLED,
+    "ABORTED",
+    "REJECTED",
+    "PREEMPTED",
+    "RECALLED",
 ]
 
 
@@ -62,7 +62,7 @@ def test_succeeded_goes_through_every_waypoint_in_order() -> None:
 
 
 @pytest.mark.parametrize("status", FAILED_STATUSES)
-def test_failed_status_with_stop_policy_ends_the_mission(status: GoalStatus) -> None:
+def test_failed_status_with_stop_policy_ends_the_mission(status: str) -> None:
     h = Harness(line_mission(3, on_failure=FailureAction.STOP))
     h.start(0.0)
     h.succeed(5.0)
@@ -73,9 +73,9 @@ def test_failed_status_with_stop_policy_ends_the_mission(status: GoalStatus) -> 
             t=7.0,
             index=1,
             attempt=1,
-            reason=status.value,
+            reason=status,
             will_retry=False,
-            status=status.value,
+            status=status,
             duration=2.0,
         )
     ]
@@ -83,13 +83,38 @@ def test_failed_status_with_stop_policy_ends_the_mission(status: GoalStatus) -> 
     assert outcomes(h) == [REACHED, WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN]
     result = h.executor.result
     assert not result.success and result.exit_code == 1
-    assert result.reason == f"stopped: waypoint 2 'p2' failed ({status.value})"
-    assert result.visits[1].reason == status.value
+    assert result.reason == f"stopped: waypoint 2 'p2' failed ({status})"
+    assert result.visits[1].reason == status
     assert len(h.goals()) == 2
 
 
+def test_outcomes_are_the_stacks_and_its_status_names_reach_the_record() -> None:
+    """A stack with other status names (Nav2's) needs no executor change: the outcome
+    decides what happens, the stack's own name is what the result records."""
+    h = Harness(line_mission(2, on_failure=FailureAction.SKIP))
+    h.start(0.0)
+    h._keep(h.executor.on_event(GoalDone.failed(h.goal_id, "CANCELED", "by a client"), 2.0))
+    h._keep(h.executor.on_event(GoalDone.succeeded(h.goal_id, status="STATUS_SUCCEEDED"), 4.0))
+    first, second = h.executor.result.visits
+    assert first.outcome is WaypointOutcome.SKIPPED and first.reason == "CANCELED"
+    attempt = first.attempt_results[0]
+    assert (attempt.status, attempt.reason, attempt.text) == (
+        "CANCELED",
+        "CANCELED",
+        "by a client",
+    )
+    assert second.outcome is REACHED
+    assert second.attempt_results[0].status == "STATUS_SUCCEEDED"
+    # LOST, whatever the stack calls it, waits for the server instead of failing.
+    h = Harness(line_mission(1))
+    h.start(0.0)
+    h.executor.on_event(GoalDone.lost(h.goal_id, status="UNKNOWN"), 1.0)
+    assert h.executor.state is ExecutorState.WAITING_SERVER
+    assert h.of_type(ServerStatusChanged)[0].reason == "goal UNKNOWN"
+
+
 @pytest.mark.parametrize("status", FAILED_STATUSES)
-def test_failed_status_with_skip_policy_goes_on(status: GoalStatus) -> None:
+def test_failed_status_with_skip_policy_goes_on(status: str) -> None:
     h = Harness(line_mission(3, on_failure=FailureAction.SKIP))
     h.start(0.0)
     h.done(status, 2.0)
@@ -106,10 +131,10 @@ def test_results_for_stale_goal_ids_are_ignored() -> None:
     h = Harness(line_mission(2, retries=1))
     h.start(0.0)
     old = h.goal_id
-    h.done(GoalStatus.ABORTED, 1.0)
+    h.done("ABORTED", 1.0)
     h.tick(2.0)
     assert h.goal_id != old
-    h.done(GoalStatus.SUCCEEDED, 3.0, goal_id=old)  # late news about the first attempt
+    h.done("SUCCEEDED", 3.0, goal_id=old)  # late news about the first attempt
     h.feedback(3.0, Pose2D(1.0, 0.0, 0.0), 0.0, goal_id=old)
     assert h.of_type(WaypointFinished) == []
     assert h.executor.state is ExecutorState.ACTIVE
@@ -126,7 +151,7 @@ def test_lost_server_back_in_time_resends_without_using_a_retry(how: str) -> Non
     h.start(0.0)
     first = h.goal_id
     if how == "lost_status":
-        h.done(GoalStatus.LOST, 5.0)
+        h.done("LOST", 5.0)
     else:
         h.server_lost(5.0)
     assert h.executor.state is ExecutorState.WAITING_SERVER
@@ -163,7 +188,7 @@ def test_server_not_back_in_time_stops_the_mission() -> None:
 def test_server_timeout_none_waits_forever() -> None:
     h = Harness(line_mission(1, server_timeout=None))
     h.start(0.0)
-    h.done(GoalStatus.LOST, 1.0)
+    h.done("LOST", 1.0)
     h.tick(1e6)
     assert h.executor.state is ExecutorState.WAITING_SERVER
     h.server_back(1e6 + 1)
@@ -174,7 +199,7 @@ def test_server_timeout_none_waits_forever() -> None:
 def test_server_lost_during_back_off_waits_before_the_retry() -> None:
     h = Harness(line_mission(1, retries=1, server_timeout=10.0))
     h.start(0.0)
-    h.done(GoalStatus.ABORTED, 1.0)
+    h.done("ABORTED", 1.0)
     h.server_lost(1.5)
     h.tick(2.0)  # back-off over, but no server
     assert h.executor.state is ExecutorState.WAITING_SERVER and len(h.goals()) == 1
@@ -263,13 +288,13 @@ def test_retries_back_off_one_second_and_clear_costmaps_when_asked(clear: bool) 
     h.start(0.0)
     for attempt in (1, 2):
         t = 10.0 * attempt
-        assert h.done(GoalStatus.ABORTED, t) == []
+        assert h.done("ABORTED", t) == []
         assert h.executor.state is ExecutorState.WAITING_RETRY
         assert h.tick(t + 0.99) == []
         commands = h.tick(t + 1.0)
         expected = ([ClearCostmaps()] if clear else []) + [SendGoal(h.goals()[-1].goal)]
         assert commands == expected
-    h.done(GoalStatus.ABORTED, 30.0)  # third attempt: retries used up
+    h.done("ABORTED", 30.0)  # third attempt: retries used up
     assert [f.will_retry for f in h.of_type(AttemptFailed)] == [True, True, False]
     assert len(h.goals()) == 3 and len(h.clears()) == (2 if clear else 0)
     assert [s.attempt for s in h.of_type(WaypointStarted)] == [1, 2, 3]
@@ -281,7 +306,7 @@ def test_on_failure_retry_retries_without_limit() -> None:
     h = Harness(line_mission(1, retries=0, on_failure=FailureAction.RETRY))
     h.start(0.0)
     for attempt in range(25):
-        h.done(GoalStatus.ABORTED, 2.0 * attempt)
+        h.done("ABORTED", 2.0 * attempt)
         h.tick(2.0 * attempt + 1.0)
     assert len(h.goals()) == 26
     h.succeed(100.0)
@@ -419,7 +444,7 @@ def test_operator_skip_goes_on_without_cancel_but_cancels_the_last_goal() -> Non
 
 def test_resume_starts_at_the_resume_point_and_keeps_earlier_visits() -> None:
     done = tuple(
-        WaypointResult(index=i, loop=0, name=None, x=0, y=0, yaw=0, outcome=REACHED, attempts=1)
+        WaypointResult(index=i, loop=0, name=None, x=0, y=0, yaw_rad=0, outcome=REACHED, attempts=1)
         for i in range(2)
     )
     h = Harness(line_mission(3), resume=ResumePoint(loop=0, index=2, done=done))

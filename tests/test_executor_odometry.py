@@ -89,7 +89,7 @@ def test_the_simulator_and_the_scripted_navigator_give_odometry_from_their_start
     odom = scripted.odometry_pose()
     assert odom is not None
     assert (odom.x, odom.y, odom.yaw) == pytest.approx((0.0, 0.0, 0.0), abs=1e-12)
-    corner = Mission((Waypoint(-0.55, -1.75, 0.0),))  # 1.45 m ahead, 1.25 m right of start
+    corner = Mission((Waypoint(-0.55, -1.75, yaw_rad=0.0),))  # 1.45 m ahead, 1.25 m right of start
     assert run_mission(corner, sim).success
     odom = sim.odometry_pose()
     assert odom is not None and (odom.x, odom.y) == pytest.approx((1.45, -1.25), abs=0.06)

@@ -67,7 +67,7 @@ def test_driving_along_a_straight_plan_leaves_the_rest_of_it(
 def far_goal(stall_timeout: float = 3.0) -> Mission:
     """One waypoint 2 m north of the start, as the crow flies."""
     return Mission(
-        waypoints=(Waypoint(0.0, 2.0, math.pi / 2, name="beyond the wall"),),
+        waypoints=(Waypoint(0.0, 2.0, yaw_rad=math.pi / 2, name="beyond the wall"),),
         defaults=Policy(stall_timeout=stall_timeout, on_failure=FailureAction.SKIP),
     )
 
@@ -179,7 +179,7 @@ def test_a_long_detour_on_the_simulator_is_driven_to_the_end_not_stalled() -> No
     grid = wall_with_a_gap_at_the_far_end()
     navigator = SimNavigator(SimWorld(grid, Pose2D(1.0, 1.0, 0.0)))
     mission = Mission(
-        waypoints=(Waypoint(1.0, 3.0, math.pi, name="behind the wall"),),
+        waypoints=(Waypoint(1.0, 3.0, yaw_rad=math.pi, name="behind the wall"),),
         # Far shorter than the detour takes at 0.22 m/s, longer than any pause on it.
         defaults=Policy(stall_timeout=20.0, on_failure=FailureAction.SKIP),
     )

@@ -118,7 +118,7 @@ def mission_checks(mission: Mission | None) -> None:
     assert len(mission.waypoints) >= 1
     for waypoint in mission.waypoints:
         assert all(abs(v) <= MAX_COORDINATE for v in (waypoint.x, waypoint.y, waypoint.z))
-        assert -math.pi < waypoint.yaw <= math.pi
+        assert -math.pi < waypoint.yaw_rad <= math.pi
         assert waypoint.name is None or text_problem(waypoint.name) is None
     assert text_problem(mission.frame) is None
     if mission.start is not None:

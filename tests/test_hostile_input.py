@@ -36,7 +36,8 @@ from navseq.mission import load_mission
 from navseq.mission.model import Mission, Waypoint
 from navseq.sim.occupancy import load_map
 from navseq.sinks.journal import read_journal
-from navseq.sinks.progress import LogProgress, summary_table
+from navseq.sinks.progress import LogProgress
+from navseq.sinks.summary import summary_table
 from navseq.text import printable, text_problem
 
 # Long enough to never cut a healthy run short on a loaded machine; short enough that
@@ -390,7 +391,7 @@ def test_a_yaw_of_many_turns_is_driven_as_the_direction_it_means(tmp_path):
         f"map: {TURTLEBOT3_MAP}\nstart: {{x: -2, y: -0.5}}\n"
         "waypoints:\n  - {x: -1.9, y: -0.5, yaw: 3590}\n",
     )
-    assert load_mission(path).waypoints[0].yaw_degrees == pytest.approx(-10.0)
+    assert load_mission(path).waypoints[0].yaw_deg == pytest.approx(-10.0)
     result = navseq("run", path, "--out", tmp_path / "out", cwd=tmp_path, timeout=60)
     assert result.returncode == 0, result.stderr
 
@@ -467,7 +468,7 @@ def test_summary_table_escapes_names_and_reasons():
         name="\x1b[2Jdock",
         x=1.0,
         y=0.0,
-        yaw=0.0,
+        yaw_rad=0.0,
         outcome=WaypointOutcome.FAILED,
         attempts=1,
         duration=1.0,

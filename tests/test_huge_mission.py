@@ -47,11 +47,7 @@ def write_room_mission(folder: Path, count: int) -> Path:
     return mission
 
 
-@pytest.mark.skip(
-    reason="mission.png of 100 000 waypoints took 25 min and 4.1 GB after the signal "
-    "until sinks/picture.py thins what it draws (issue 9 item 13, another branch); "
-    "unskip once that lands"
-)
+@pytest.mark.slow
 def test_a_sigtermed_100k_waypoint_run_exits_143_with_a_report(tmp_path: Path) -> None:
     mission = write_room_mission(tmp_path, WAYPOINTS)
     out = tmp_path / "out"

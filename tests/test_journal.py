@@ -26,7 +26,6 @@ from navseq.executor.events import (
 )
 from navseq.executor.resume import ResumePoint
 from navseq.mission.model import FailureAction
-from navseq.navigators.base import GoalStatus
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Succeed
 from navseq.sinks.journal import (
     JournalWriter,
@@ -152,7 +151,7 @@ def test_skipped_visits_are_not_rerun_but_a_failed_stop_is(
     tmp_path: Path, mission_file: Path
 ) -> None:
     path = tmp_path / "run.journal"
-    nav = ScriptedNavigator([Finish(GoalStatus.ABORTED), Finish(GoalStatus.ABORTED)])
+    nav = ScriptedNavigator([Finish("ABORTED"), Finish("ABORTED")])
     with JournalWriter(path, str(mission_file), mission_digest(mission_file)) as journal:
         result = run_mission(line_mission(3, on_failure=FailureAction.SKIP), nav, [journal])
     assert [v.outcome for v in result.visits][:2] == [WaypointOutcome.SKIPPED] * 2
@@ -160,7 +159,7 @@ def test_skipped_visits_are_not_rerun_but_a_failed_stop_is(
         resume_point(read_journal(path))
 
     stopped = tmp_path / "stopped.journal"
-    nav = ScriptedNavigator([Succeed(), Finish(GoalStatus.ABORTED)])
+    nav = ScriptedNavigator([Succeed(), Finish("ABORTED")])
     with JournalWriter(stopped, str(mission_file), mission_digest(mission_file)) as journal:
         result = run_mission(line_mission(3), nav, [journal])
     assert result.reason.startswith("stopped")
@@ -276,7 +275,7 @@ def test_arbitrary_bytes_raise_only_navseq_errors(tmp_path: Path, content: bytes
 def valid_journal(tmp_path_factory: pytest.TempPathFactory) -> bytes:
     folder = tmp_path_factory.mktemp("valid")
     path = folder / "run.journal"
-    nav = ScriptedNavigator([Finish(GoalStatus.ABORTED, after=0.5)])
+    nav = ScriptedNavigator([Finish("ABORTED", after=0.5)])
     with JournalWriter(path, "mission.yaml", "0" * 64) as journal:
         run_mission(line_mission(3, loops=2, retries=1), nav, [journal])
     return path.read_bytes()

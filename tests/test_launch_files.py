@@ -89,6 +89,31 @@ def test_demo_launch_starts_the_robot_where_the_example_mission_starts():
     assert launched == pytest.approx([start.x, start.y, start.yaw], abs=1e-3)
 
 
+@pytest.mark.parametrize(
+    ("launch_file", "namespaces"),
+    [
+        ("sim.launch", [""]),
+        ("demo.launch", [""]),
+        ("sim_robot.launch", [""]),
+        ("multi_robot.launch", ["/robot1", "/robot2"]),
+    ],
+)
+def test_the_robot_argument_reaches_both_sim_nodes_of_every_robot(launch_file, namespaces):
+    def robots(*args: str) -> dict[str, str]:
+        dumped = yaml.safe_load(roslaunch_query("--dump-params", "navseq", launch_file, *args))
+        return {
+            f"{ns}/{node}": dumped[f"{ns}/{node}/robot"]
+            for ns in namespaces
+            for node in ("sim_robot", "move_base")
+        }
+
+    map_arg = "map:=maps/turtlebot3_world.yaml"  # sim_robot.launch has no default map
+    default = robots(map_arg)
+    assert set(default.values()) == {"turtlebot3_burger"}, default
+    waffle = robots(map_arg, "robot:=turtlebot3_waffle")
+    assert set(waffle.values()) == {"turtlebot3_waffle"}, waffle
+
+
 def test_rviz_config_shows_map_plan_robot_and_waypoints():
     config = yaml.safe_load(RVIZ.read_text())
     displays = config["Visualization Manager"]["Displays"]

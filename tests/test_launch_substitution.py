@@ -33,7 +33,7 @@ def package(folder: Path, name: str) -> Path:
 
 
 def poses(mission: Mission) -> list[tuple[float, float, float]]:
-    return [(w.x, w.y, round(math.degrees(w.yaw), 6)) for w in mission.waypoints]
+    return [(w.x, w.y, round(math.degrees(w.yaw_rad), 6)) for w in mission.waypoints]
 
 
 def only_error(path: Path) -> NavseqError:

@@ -1,7 +1,9 @@
-"""navseq's core works where there is no ROS at all: only the ROS adapters import rospy."""
+"""navseq's core works where there is no ROS at all: only ``navseq.ros1`` imports rospy (and
+ROS 1 messages), only ``navseq.ros2`` would import rclpy; neither is imported by the core."""
 
 from __future__ import annotations
 
+import ast
 import json
 import subprocess
 import sys
@@ -17,7 +19,9 @@ NO_ROS_PRELUDE = textwrap.dedent(
     import importlib.abc, sys
 
     ROS = ("rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "geometry_msgs",
-           "nav_msgs", "std_srvs", "tf2_ros", "visualization_msgs", "genpy", "roslib")
+           "nav_msgs", "std_srvs", "tf2_ros", "visualization_msgs", "genpy", "roslib",
+           "rclpy", "nav2_msgs", "action_msgs", "rosgraph", "rosgraph_msgs", "std_msgs",
+           "lifecycle_msgs", "builtin_interfaces", "tf2_msgs")
 
     class NoRos(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path=None, target=None):
@@ -34,9 +38,16 @@ CORE_MODULES = [
     "navseq.commands.run",
     "navseq.commands.validate",
     "navseq.commands.convert",
+    "navseq.commands.sim",
+    "navseq.ros2",
+    "navseq.ros2.standin",
+    "navseq.ros2.sim_config",
     "navseq.mission",
     "navseq.executor.machine",
     "navseq.executor.runner",
+    "navseq.executor.control",
+    "navseq.geometry",
+    "navseq.navigators.registry",
     "navseq.navigators.sim",
     "navseq.navigators.scripted",
     "navseq.preflight",
@@ -108,3 +119,45 @@ def test_asking_for_ros_without_ros_is_one_clear_error(tmp_path: Path):
     assert done.returncode == 2
     assert "Traceback" not in done.stderr
     assert "ros" in done.stderr.lower()
+
+
+SRC = REPO / "src" / "navseq"
+# Client libraries and the message packages only they give meaning to. geometry_msgs and
+# friends exist in ROS 1 and ROS 2 alike, so they count for both.
+ROS1_ONLY = {"rospy", "actionlib", "actionlib_msgs", "move_base_msgs", "genpy", "roslib"}
+ROS1_ONLY |= {"rosgraph", "roslaunch", "rosbag", "tf", "tf2_ros"}
+ROS2_ONLY = {"rclpy", "nav2_msgs", "action_msgs", "rosidl_runtime_py", "lifecycle_msgs"}
+ROS2_ONLY |= {"builtin_interfaces", "launch", "launch_ros"}
+SHARED_MSGS = {"geometry_msgs", "nav_msgs", "std_msgs", "std_srvs", "visualization_msgs"}
+SHARED_MSGS |= {"tf2_msgs", "rosgraph_msgs"}
+
+
+def imported_roots(path: Path) -> set[str]:
+    """Top-level package names a module imports, anywhere in it (also inside functions)."""
+    roots = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            roots |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            roots.add(node.module.split(".")[0])
+    return roots
+
+
+def test_only_navseq_ros1_imports_rospy_and_only_navseq_ros2_rclpy():
+    offenders = []
+    for path in sorted(SRC.rglob("*.py")):
+        package = path.relative_to(SRC).parts[0]
+        roots = imported_roots(path)
+        allowed = {"ros1": ROS1_ONLY | SHARED_MSGS, "ros2": ROS2_ONLY | SHARED_MSGS}.get(
+            package, set()
+        )
+        wrong = (roots & (ROS1_ONLY | ROS2_ONLY | SHARED_MSGS)) - allowed
+        if wrong:
+            offenders.append(f"{path.relative_to(SRC)}: {sorted(wrong)}")
+    assert offenders == []
+    assert "rospy" in imported_roots(SRC / "ros1" / "navigator.py")  # the check sees imports
+
+
+def test_the_old_ros_package_is_gone():
+    """``navseq.ros`` became ``navseq.ros1``; nothing external needed an alias."""
+    assert not (SRC / "ros").exists()

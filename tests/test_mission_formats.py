@@ -24,7 +24,7 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def poses(mission: Mission) -> list[tuple[float, float, float]]:
-    return [(w.x, w.y, round(math.degrees(w.yaw), 6)) for w in mission.waypoints]
+    return [(w.x, w.y, round(math.degrees(w.yaw_rad), 6)) for w in mission.waypoints]
 
 
 # --- the tutorial's formats ----------------------------------------------------------
@@ -37,7 +37,7 @@ def test_tutorial_launch_file_gives_its_three_waypoints_with_yaws_in_radians():
         (1.0, -4.0, 0.0),
         (1.0, -1.0, 0.0),
     ]
-    assert [w.yaw for w in mission.waypoints] == pytest.approx(
+    assert [w.yaw_rad for w in mission.waypoints] == pytest.approx(
         [math.pi / 2, 0.0, math.pi], abs=1e-12
     )
     # The tutorial stops at every point and knows no timeouts: so do navseq's defaults.
@@ -149,7 +149,7 @@ def test_rosparam_file_at_top_level(tmp_path):
     path = write(tmp_path, "params.yml", "p_seq: [1, 2, 3]\nyea_seq: [90]\n")
     (waypoint,) = load_mission(path).waypoints
     assert (waypoint.x, waypoint.y, waypoint.z) == (1.0, 2.0, 3.0)
-    assert waypoint.yaw == pytest.approx(math.pi / 2)
+    assert waypoint.yaw_rad == pytest.approx(math.pi / 2)
 
 
 # --- CSV -----------------------------------------------------------------------------
@@ -221,7 +221,7 @@ waypoints:
 """,
     )
     mission = load_mission(path)
-    yaws = [w.yaw for w in mission.waypoints]
+    yaws = [w.yaw_rad for w in mission.waypoints]
     assert yaws == pytest.approx([math.pi / 2, -1.5, math.pi, 0.0, -math.pi / 4, 0.0])
     assert mission.waypoints[1].z == 0.5
     assert (mission.waypoints[5].x, mission.waypoints[5].y) == (1000.0, -0.25)

@@ -246,7 +246,7 @@ def missions(draw, yaws=typed_yaw):
             x=draw(finite),
             y=draw(finite),
             z=draw(st.just(0.0) | finite),
-            yaw=draw(yaws),
+            yaw_rad=draw(yaws),
             name=name,
             overrides=draw(policy_values),
         )
@@ -282,7 +282,7 @@ def test_computed_yaws_round_to_a_millionth_of_a_degree_and_then_stay(scratch, m
     text = dump_mission_yaml(mission)
     again = reload(scratch, text)
     for before, after in zip(mission.waypoints, again.waypoints, strict=True):
-        assert after.yaw == pytest.approx(before.yaw, abs=math.radians(1e-6))
+        assert after.yaw_rad == pytest.approx(before.yaw_rad, abs=math.radians(1e-6))
     assert dump_mission_yaml(again) == text
 
 

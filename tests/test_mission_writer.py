@@ -24,7 +24,7 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
 def small_mission(**changes) -> Mission:
-    fields = {"waypoints": (Waypoint(1.0, 2.0, math.radians(90), name="dock"),)}
+    fields = {"waypoints": (Waypoint(1.0, 2.0, yaw_deg=90, name="dock"),)}
     fields.update(changes)
     return Mission(**fields)
 
@@ -44,11 +44,11 @@ def test_dump_is_plain_yaml_with_degrees_and_policy_overrides():
             Waypoint(
                 1.0,
                 2.0,
-                math.radians(90),
+                yaw_deg=90,
                 name="dock",
                 overrides={"dwell": 5.0, "on_failure": FailureAction.SKIP},
             ),
-            Waypoint(3.0, 4.0, quaternion_to_yaw(0, 0, math.sqrt(0.5), math.sqrt(0.5))),
+            Waypoint(3.0, 4.0, yaw_rad=quaternion_to_yaw(0, 0, math.sqrt(0.5), math.sqrt(0.5))),
         ),
         defaults=Policy(goal_timeout=60.0),
         loops=None,
@@ -75,8 +75,8 @@ def test_every_example_converts_to_navseq_yaml_that_loads_the_same(tmp_path, nam
     assert [(w.x, w.y, w.z, w.name) for w in converted.waypoints] == [
         (w.x, w.y, w.z, w.name) for w in original.waypoints
     ]
-    assert [w.yaw for w in converted.waypoints] == pytest.approx(
-        [w.yaw for w in original.waypoints], abs=1e-7
+    assert [w.yaw_rad for w in converted.waypoints] == pytest.approx(
+        [w.yaw_rad for w in original.waypoints], abs=1e-7
     )
     assert (converted.defaults, converted.loops, converted.map, converted.start) == (
         original.defaults,

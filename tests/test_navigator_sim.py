@@ -15,8 +15,8 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
+    GoalOutcome,
     GoalPlan,
-    GoalStatus,
     Navigator,
 )
 from navseq.navigators.sim import SimNavigator
@@ -57,7 +57,7 @@ def test_goal_to_success_event_sequence(nav: SimNavigator) -> None:
     assert isinstance(events[0], GoalPlan) and events[0].goal_id == 7
     assert events[0].path[0] == (START.x, START.y)
     assert events[0].path[-1] == (goal.pose.x, goal.pose.y)
-    assert events[-1] == GoalDone(7, GoalStatus.SUCCEEDED, "goal reached")
+    assert events[-1] == GoalDone.succeeded(7, "goal reached")
     feedback = [e for e in events if isinstance(e, GoalFeedback)]
     assert all(f.goal_id == 7 for f in feedback)
     # One feedback per 0.2 s of simulated time, distance remaining shrinking.
@@ -77,7 +77,8 @@ def test_goal_in_an_obstacle_is_accepted_then_aborted(nav: SimNavigator) -> None
     events = nav.poll()
     assert events[0] == GoalAccepted(1)
     assert isinstance(events[1], GoalDone)
-    assert events[1].status is GoalStatus.ABORTED
+    assert events[1].outcome is GoalOutcome.FAILED
+    assert events[1].status == "ABORTED"
     assert "obstacle" in events[1].text
     assert len(events) == 2
     assert nav.robot_pose() == START
@@ -89,19 +90,19 @@ def test_new_goal_preempts_the_active_one(nav: SimNavigator) -> None:
     nav.poll()
     nav.send_goal(Goal(2, Pose2D(-2.0, 0.5)))
     assert nav.poll() == [
-        GoalDone(1, GoalStatus.PREEMPTED, "replaced by a new goal"),
+        GoalDone.failed(1, "PREEMPTED", "replaced by a new goal"),
         GoalAccepted(2),
     ]
     events = spin_until_done(nav)
     assert all(getattr(e, "goal_id", 2) == 2 for e in events)
-    assert events[-1].status is GoalStatus.SUCCEEDED  # type: ignore[attr-defined]
+    assert events[-1].outcome is GoalOutcome.SUCCEEDED  # type: ignore[attr-defined]
 
 
 def test_cancel_preempts_and_the_robot_stops(nav: SimNavigator) -> None:
     nav.send_goal(Goal(1, Pose2D(1.6, -0.5)))
     nav.spin(3.0)
     nav.cancel_goal()
-    assert nav.poll()[-1] == GoalDone(1, GoalStatus.PREEMPTED, "canceled")
+    assert nav.poll()[-1] == GoalDone.failed(1, "PREEMPTED", "canceled")
     nav.cancel_goal()  # twice: nothing more
     nav.spin(1.0)  # let it brake
     assert nav.poll() == []
@@ -115,7 +116,7 @@ def test_close_cancels_the_active_goal(nav: SimNavigator) -> None:
     nav.send_goal(Goal(3, Pose2D(1.6, -0.5)))
     nav.spin(1.0)
     nav.close()
-    assert nav.poll()[-1] == GoalDone(3, GoalStatus.PREEMPTED, "canceled")
+    assert nav.poll()[-1] == GoalDone.failed(3, "PREEMPTED", "canceled")
     assert nav.world.server.state.value == "CANCELED"
 
 

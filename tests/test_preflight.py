@@ -38,7 +38,9 @@ def pocket_map() -> Costmap:
 
 def mission_of(points, *, names=None, loops: int | None = 1, start=None) -> Mission:
     waypoints = tuple(
-        Waypoint(x, y, 0.0, name=(names[i] if names else None), where=f"mission.yaml:{10 + i}")
+        Waypoint(
+            x, y, yaw_rad=0.0, name=(names[i] if names else None), where=f"mission.yaml:{10 + i}"
+        )
         for i, (x, y) in enumerate(points)
     )
     return Mission(waypoints=waypoints, loops=loops, start=start, source="mission.yaml")
@@ -127,9 +129,9 @@ def test_pocket_unreachable_from_previous_waypoint(pocket_map: Costmap) -> None:
     inside, outside = (2.0, 2.0), (0.5, 0.5)
     mission = mission_of([outside, inside, (3.5, 3.5)], names=["door", "pocket", "corner"])
     problems = check_mission(mission, pocket_map)
-    assert [p.subject for p in problems] == ["waypoint 2 'pocket'", "waypoint 3 'corner'"]
+    # The pocket is blamed once; the corner, reachable from the door, is not.
+    assert [p.subject for p in problems] == ["waypoint 2 'pocket'"]
     assert "cannot be reached from waypoint 1 'door' at (0.50, 0.50)" in str(problems[0])
-    assert "cannot be reached from waypoint 2 'pocket' at (2.00, 2.00)" in str(problems[1])
     # The planner agrees: there is no path in.
     assert plan_path(pocket_map, outside, inside) is None
 
@@ -151,15 +153,47 @@ def test_looping_mission_must_get_back_to_its_first_waypoint(pocket_map: Costmap
     assert check_mission(mission_of(points, loops=None), pocket_map) == []
 
 
-def test_loop_back_to_the_first_waypoint_is_checked(pocket_map: Costmap) -> None:
-    # Waypoint 2 is unreachable from 1, and the loop back from 2 to 1 is too.
+def test_a_looping_mission_blames_an_unreachable_waypoint_once(pocket_map: Costmap) -> None:
+    # Waypoint 2 is unreachable from 1; the loop back from it to 1 is the same fault.
     points = [(0.5, 0.5), (2.0, 2.0)]
     once = check_mission(mission_of(points, loops=1), pocket_map)
     looped = check_mission(mission_of(points, loops=2), pocket_map)
     assert [p.subject for p in once] == ["waypoint 2"]
-    assert [p.subject for p in looped] == ["waypoint 2", "waypoint 1"]
-    assert "to start the next loop" in str(looped[1])
-    assert "from waypoint 2 at (2.00, 2.00)" in str(looped[1])
+    assert messages(looped) == messages(once)
+
+
+def test_without_a_start_the_odd_one_out_is_blamed(pocket_map: Costmap) -> None:
+    # The first waypoint is the isolated one: the three others are not blamed for it.
+    mission = mission_of([(2.0, 2.0), (0.5, 0.5), (3.5, 0.5), (3.5, 3.5)], loops=None)
+    (problem,) = check_mission(mission, pocket_map)
+    assert problem.subject == "waypoint 1"
+    assert "cut off from the mission's other waypoints" in str(problem)
+
+
+def test_thirteen_isolated_points_are_thirteen_problems() -> None:
+    """The issue's map: 13 walled-in pockets; a mission that visits each between
+    points of the open floor gets one problem per pocket, and each leg after a pocket
+    is checked from the last point the robot can reach."""
+    size = 200  # 10 m at 0.05 m
+    data = np.zeros((size, size), np.int8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = 100
+    pockets = []
+    for n in range(13):
+        row, col = 20 + (n // 5) * 60, 20 + (n % 5) * 35
+        data[row : row + 21, col] = data[row : row + 21, col + 20] = 100
+        data[row, col : col + 21] = data[row + 20, col : col + 21] = 100
+        pockets.append(((col + 10.5) * 0.05, (row + 10.5) * 0.05))
+    costmap = Costmap.from_grid(OccupancyGrid(data, 0.05, Pose2D(0.0, 0.0, 0.0), "pockets.yaml"))
+    points = []
+    for n, pocket in enumerate(pockets):
+        points += [(0.6 + 0.1 * n, 9.4), pocket]
+    problems = check_mission(mission_of(points), costmap, start=Pose2D(0.5, 9.5, 0.0))
+    assert len(problems) == 13
+    assert [p.subject for p in problems] == [f"waypoint {2 * n + 2}" for n in range(13)]
+    # Each pocket is compared with the open-floor point before it, never with a pocket.
+    for n, problem in enumerate(problems):
+        floor = f"waypoint {2 * n + 1} at ({0.6 + 0.1 * n:.2f}, 9.40)"
+        assert f"cannot be reached from {floor}" in str(problem), str(problem)
 
 
 def test_reachability_skips_over_a_bad_waypoint(pocket_map: Costmap) -> None:

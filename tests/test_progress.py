@@ -1,9 +1,8 @@
-"""Terminal progress: live panel, plain log lines, JSON lines and the summary table."""
+"""Terminal progress: live panel, plain log lines and JSON lines (the table: test_summary)."""
 
 from __future__ import annotations
 
 import io
-import json
 import math
 
 from rich.console import Console
@@ -21,22 +20,20 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import MissionResult, WaypointResult
 from navseq.mission.model import Mission, Waypoint
+from navseq.sinks.json_events import JsonProgress
 from navseq.sinks.progress import (
-    JsonProgress,
     LiveProgress,
     LogProgress,
     RunView,
     make_progress,
-    summary_table,
 )
 
 MISSION = Mission(
     waypoints=(
-        Waypoint(1.0, 0.0, 0.0, name="dock"),
-        Waypoint(2.0, 0.0, math.pi / 2),
-        Waypoint(2.0, 2.0, math.pi, name="desk"),
+        Waypoint(1.0, 0.0, yaw_rad=0.0, name="dock"),
+        Waypoint(2.0, 0.0, yaw_rad=math.pi / 2),
+        Waypoint(2.0, 2.0, yaw_rad=math.pi, name="desk"),
     ),
     loops=2,
     source="office.yaml",
@@ -100,7 +97,7 @@ def test_log_lines_say_what_happened_to_each_waypoint():
     assert "waypoint 2/3: skipped (timeout) after 12.0 s, 0.40 m, 2 attempts" in text
     assert "waypoint 3/3 'desk': dwelling 5 s" in text
     assert "navigation server lost: no heartbeat" in text
-    assert "mission finished: interrupted: SIGINT (not every waypoint reached)" in lines[-1]
+    assert "mission finished: interrupted: SIGINT; not every waypoint reached" in lines[-1]
     # Elapsed mission time prefixes every line.
     assert lines[-1].startswith("[    35.0 s]")
 
@@ -115,21 +112,6 @@ def test_log_progress_lines_are_throttled_to_the_period():
     assert progress_lines == [
         "[    12.0 s] waypoint 1/3 'dock': 0.10 m to go (~0 s at 0.22 m/s), 0.90 m driven"
     ]
-
-
-def test_json_lines_are_one_parseable_object_per_event():
-    out = io.StringIO()
-    sink = JsonProgress(out)
-    events = run_events()
-    for event in events:
-        sink(event)
-    sink.emit("RunFinished", {"exit_code": 130, "bad": math.inf})
-    records = [json.loads(line) for line in out.getvalue().splitlines()]
-    assert [r["event"] for r in records[:-1]] == [type(e).__name__ for e in events]
-    finished = records[events.index(events[7])]
-    assert finished["outcome"] == "reached" and finished["index"] == 0
-    assert records[3]["path"] == [[0.0, 0.0], [1.0, 0.0]]
-    assert records[-1] == {"event": "RunFinished", "exit_code": 130, "bad": None}
 
 
 def test_make_progress_is_plain_when_not_a_terminal_and_json_when_asked():
@@ -152,39 +134,6 @@ def test_live_panel_shows_waypoint_status_distance_loop_and_attempt():
     assert "elapsed     3.0 s" in text
     # The latest notable event is shown under the current state.
     assert "[    0.0 s] waypoint 1/3 'dock': going to (1.00, 0.00, 0°), attempt 1" in text
-
-
-def test_summary_table_lists_every_visit_with_totals():
-    result = MissionResult(
-        success=False,
-        reason="stopped: waypoint 2 failed",
-        visits=[
-            WaypointResult(0, 0, "dock", 1.0, 0.0, 0.0, WaypointOutcome.REACHED, 1, 13.0, 1.0),
-            WaypointResult(
-                1, 0, None, 2.0, 0.0, 1.57, WaypointOutcome.FAILED, 3, 40.0, 0.4, reason="ABORTED"
-            ),
-            WaypointResult(2, 0, "desk", 2.0, 2.0, 3.14, WaypointOutcome.NOT_RUN),
-        ],
-        duration=53.0,
-        distance_driven=1.4,
-    )
-    console = Console(file=io.StringIO(), width=120, record=True)
-    console.print(summary_table(MISSION, result))
-    text = console.export_text()
-    assert "stopped: waypoint 2 failed" in text
-    for expected in (
-        "dock",
-        "reached",
-        "failed",
-        "ABORTED",
-        "not run",
-        "53.0",
-        "1.40",
-        "time [s]",
-        "distance [m]",
-    ):
-        assert expected in text
-    assert "loop" not in text  # a single loop needs no loop column
 
 
 def test_log_lines_give_the_time_still_to_go_at_the_robots_top_speed() -> None:

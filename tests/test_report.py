@@ -12,7 +12,10 @@ from navseq.mission.model import Mission, Waypoint
 from navseq.sinks.report import SCHEMA_VERSION, build_report, write_report
 
 MISSION = Mission(
-    waypoints=(Waypoint(1.0, 0.0, 0.0, name="dock"), Waypoint(2.0, 0.0, math.pi / 2)),
+    waypoints=(
+        Waypoint(1.0, 0.0, yaw_rad=0.0, name="dock"),
+        Waypoint(2.0, 0.0, yaw_rad=math.pi / 2),
+    ),
     loops=None,
     source="/data/missions/office.yaml",
 )
@@ -26,7 +29,7 @@ def result(*outcomes: WaypointOutcome, success: bool = False) -> MissionResult:
             name=MISSION.waypoints[i % 2].name,
             x=MISSION.waypoints[i % 2].x,
             y=0.0,
-            yaw=MISSION.waypoints[i % 2].yaw,
+            yaw_rad=MISSION.waypoints[i % 2].yaw_rad,
             outcome=o,
             attempts=1 if o != WaypointOutcome.NOT_RUN else 0,
             duration=10.0 * (i + 1),

@@ -37,7 +37,7 @@ def _drive(argv: list[str]) -> int:
     from navseq.errors import NavseqError
     from navseq.geometry import Pose2D
     from navseq.navigators.base import Goal, GoalDone, ServerBack
-    from navseq.navigators.ros1 import Ros1Navigator
+    from navseq.ros1.navigator import Ros1Navigator
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--goals", required=True, help="x,y,yaw_deg;x,y,yaw_deg;...")
@@ -81,8 +81,8 @@ def _drive(argv: list[str]) -> int:
             for event in events:
                 record = {"type": type(event).__name__, **vars(event)}
                 record.pop("pose", None)
-                if "status" in record:
-                    record["status"] = event.status.value
+                if "outcome" in record:
+                    record["outcome"] = event.outcome.value
                 _emit(record)
                 if isinstance(event, GoalDone) and event.goal_id == goal.goal_id:
                     done = True
@@ -141,7 +141,7 @@ def _spin_on_sim_time(argv: list[str]) -> int:
     """Wait for the simulation clock, spin once with no goal, report both clocks."""
     import time
 
-    from navseq.navigators.ros1 import Ros1Navigator
+    from navseq.ros1.navigator import Ros1Navigator
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--seconds", type=float, required=True)

@@ -35,7 +35,7 @@ def start_server(master: RosMaster, log: Path, script: str = "", then: str = "su
 def start_node(master: RosMaster, **params: Any) -> RosProcess:
     for key, value in {"p_seq": P_SEQ, "yea_seq": YEA_SEQ, **params}.items():
         master.set_param(f"/navseq/{key}", value)
-    return master.start_python("-m", "navseq.ros.navseq_node", label="navseq_node")
+    return master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
 
 
 def watch_status(master: RosMaster) -> RosProcess:

@@ -64,7 +64,7 @@ POSE_PUBLISHER = textwrap.dedent(
 def start_recorder(master: RosMaster, out: Path, **params) -> RosProcess:
     for key, value in {"out": str(out), **params}.items():
         master.set_param(f"/navseq_record/{key}", value)
-    recorder = master.start_python("-m", "navseq.ros.record", label="recorder")
+    recorder = master.start_python("-m", "navseq.ros1.record", label="recorder")
     return recorder
 
 
@@ -95,7 +95,7 @@ def test_every_goal_pose_becomes_a_waypoint_and_survives_ctrl_c(
     mission = load_mission(out)
     assert mission.frame == "map"
     assert [(w.x, w.y) for w in mission.waypoints] == [(1, 2), (-0.5, 1.5), (2, 0)]
-    assert [math.degrees(w.yaw) for w in mission.waypoints] == pytest.approx([90, 180, 0])
+    assert [math.degrees(w.yaw_rad) for w in mission.waypoints] == pytest.approx([90, 180, 0])
     assert "3 waypoints saved" in recorder.output()
 
 
@@ -119,7 +119,7 @@ def test_initialpose_topic_with_covariance(ros_master: RosMaster, tmp_path: Path
     wait_for(lambda: waypoint_count(out) == 1, 10, "the waypoint in the file")
     waypoint = load_mission(out).waypoints[0]
     assert (waypoint.x, waypoint.y) == (-2, -0.5)
-    assert math.degrees(waypoint.yaw) == pytest.approx(45)
+    assert math.degrees(waypoint.yaw_rad) == pytest.approx(45)
 
 
 def test_existing_file_is_never_replaced_unless_asked(ros_master: RosMaster, tmp_path: Path):
@@ -150,7 +150,7 @@ def test_record_service_takes_the_robot_pose_from_tf(ros_master: RosMaster, tmp_
     assert response["success"], response
     waypoint = load_mission(out).waypoints[0]
     assert (waypoint.x, waypoint.y) == pytest.approx((0.75, -1.25))
-    assert math.degrees(waypoint.yaw) == pytest.approx(30)
+    assert math.degrees(waypoint.yaw_rad) == pytest.approx(30)
 
 
 def test_tf_poses_are_recorded_to_the_millimetre_and_the_tenth_of_a_degree(
@@ -167,4 +167,4 @@ def test_tf_poses_are_recorded_to_the_millimetre_and_the_tenth_of_a_degree(
     assert "-1.8739" not in text and "33.333" not in text
     waypoint = load_mission(out).waypoints[0]
     assert (waypoint.x, waypoint.y) == (-1.874, 0.5)
-    assert math.degrees(waypoint.yaw) == pytest.approx(33.3, abs=1e-9)
+    assert math.degrees(waypoint.yaw_rad) == pytest.approx(33.3, abs=1e-9)

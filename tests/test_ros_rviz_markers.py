@@ -133,7 +133,7 @@ def test_navseq_run_publishes_waypoint_markers_and_status(ros_master: RosMaster,
 ODOMETRY = textwrap.dedent(
     """
     import json, time
-    from navseq.navigators.ros1 import Ros1Navigator
+    from navseq.ros1.navigator import Ros1Navigator
     navigator = Ros1Navigator()
     navigator.require_server(30)
     elsewhere = Ros1Navigator(odom_frame="no_such_frame")

@@ -52,7 +52,7 @@ def example_mission_goals() -> tuple[tuple[float, float, float], list[tuple[floa
     mission = load_mission(EXAMPLE_MISSION)
     start = mission.start
     assert start is not None, "the example mission names its start pose"
-    return (start.x, start.y, start.yaw), [(w.x, w.y, w.yaw) for w in mission.waypoints]
+    return (start.x, start.y, start.yaw), [(w.x, w.y, w.yaw_rad) for w in mission.waypoints]
 
 
 # -- move_base clients ------------------------------------------------------------------------

@@ -73,8 +73,8 @@ def test_teleport_into_the_wall_is_refused():
 
 
 def ros_conversions():
-    """:mod:`navseq.ros.conversions`, or a skip where rospy cannot be imported."""
-    return pytest.importorskip("navseq.ros.conversions", reason="rospy not importable")
+    """:mod:`navseq.ros1.conversions`, or a skip where rospy cannot be imported."""
+    return pytest.importorskip("navseq.ros1.conversions", reason="rospy not importable")
 
 
 @pytest.mark.ros

@@ -50,8 +50,8 @@ def test_example_mission_reaches_every_waypoint_without_collision() -> None:
 
 def test_pass_through_keeps_the_robot_moving() -> None:
     waypoints = (
-        Waypoint(-0.55, -1.75, 0.0, name="corner"),
-        Waypoint(1.75, -0.55, math.pi / 2, name="end"),
+        Waypoint(-0.55, -1.75, yaw_rad=0.0, name="corner"),
+        Waypoint(1.75, -0.55, yaw_rad=math.pi / 2, name="end"),
     )
     passing = Mission(waypoints, defaults=Policy(pass_through=0.3))
     stopping = Mission(waypoints, defaults=Policy(pass_through=None))
@@ -69,8 +69,8 @@ def test_pass_through_keeps_the_robot_moving() -> None:
 def test_goal_timeout_cancels_and_skips_to_the_next_waypoint() -> None:
     mission = Mission(
         (
-            Waypoint(1.75, 1.0, 0.0, name="far", overrides={"goal_timeout": 5.0}),
-            Waypoint(-1.75, 0.55, 0.0, name="near"),
+            Waypoint(1.75, 1.0, yaw_rad=0.0, name="far", overrides={"goal_timeout": 5.0}),
+            Waypoint(-1.75, 0.55, yaw_rad=0.0, name="near"),
         ),
         defaults=Policy(on_failure=FailureAction.SKIP),
     )
@@ -86,8 +86,8 @@ def test_goal_timeout_cancels_and_skips_to_the_next_waypoint() -> None:
 def test_unreachable_waypoint_is_retried_then_skipped() -> None:
     mission = Mission(
         (
-            Waypoint(1.1, 1.1, 0.0, name="in-a-pillar"),
-            Waypoint(-0.55, -1.75, 0.0, name="south"),
+            Waypoint(1.1, 1.1, yaw_rad=0.0, name="in-a-pillar"),
+            Waypoint(-0.55, -1.75, yaw_rad=0.0, name="south"),
         ),
         defaults=Policy(retries=2, clear_costmaps_on_retry=True, on_failure=FailureAction.SKIP),
     )
@@ -103,8 +103,8 @@ def test_unreachable_waypoint_is_retried_then_skipped() -> None:
 def test_stop_policy_ends_the_mission_at_the_first_failure() -> None:
     mission = Mission(
         (
-            Waypoint(0.0, 0.0, 0.0, name="centre-pillar"),
-            Waypoint(-0.55, -1.75, 0.0, name="south"),
+            Waypoint(0.0, 0.0, yaw_rad=0.0, name="centre-pillar"),
+            Waypoint(-0.55, -1.75, yaw_rad=0.0, name="south"),
         ),
         defaults=Policy(on_failure=FailureAction.STOP),
     )

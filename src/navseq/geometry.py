@@ -1,4 +1,9 @@
-"""Planar poses and the yaw <-> quaternion conversions every source needs."""
+"""Planar poses and the yaw <-> quaternion conversions every source needs.
+
+Also the readers of ROS pose-like messages (:func:`yaw_of`, :func:`pose2d_from_pose`,
+:func:`pose2d_from_transform`): they only read fields, which ROS 1 and ROS 2 messages
+name alike, so they import no ROS and serve both (``navseq.ros1``, later ``navseq.ros2``).
+"""
 
 from __future__ import annotations
 
@@ -6,6 +11,7 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -34,6 +40,22 @@ def yaw_to_quaternion(yaw: float) -> tuple[float, float, float, float]:
 def quaternion_to_yaw(x: float, y: float, z: float, w: float) -> float:
     """Yaw (radians, in [-pi, pi]) of a quaternion; roll and pitch are ignored."""
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def yaw_of(orientation: Any) -> float:
+    """Yaw (radians) of a geometry_msgs/Quaternion-like object; roll and pitch ignored."""
+    return quaternion_to_yaw(orientation.x, orientation.y, orientation.z, orientation.w)
+
+
+def pose2d_from_pose(pose: Any) -> Pose2D:
+    """A planar pose from a ``geometry_msgs/Pose``-like object (z, roll, pitch ignored)."""
+    return Pose2D(float(pose.position.x), float(pose.position.y), yaw_of(pose.orientation))
+
+
+def pose2d_from_transform(transform: Any) -> Pose2D:
+    """Where a planar ``TransformStamped``-like object puts its child in its parent frame."""
+    t = transform.transform
+    return Pose2D(float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
 
 
 def yaw_degrees_to_quaternion(degrees: float) -> tuple[float, float, float, float]:

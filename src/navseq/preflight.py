@@ -7,9 +7,11 @@
 - a waypoint where the robot cannot turn: closer to an obstacle, unknown space or the
   map edge than the footprint's circumscribed radius (the robot stops and turns to the
   goal's heading at every waypoint, and at the start it turns toward the first one);
-- a waypoint that no path connects to the one before it (or to the start pose, for
-  the first waypoint; or to the last waypoint, for the first one of the next round
-  when the mission loops);
+- a waypoint that no path connects to the last place before it the robot can get to
+  (the start pose, or an earlier waypoint), each such waypoint once: the leg after an
+  unreachable waypoint is checked from the last reachable one, so an isolated point
+  does not get its innocent successor blamed too. Without a start pose, the region
+  most waypoints are in is taken for the robot's;
 - a start pose off the map, where the footprint overlaps something (the exact test the
   simulated body uses), or where the robot cannot turn.
 
@@ -74,50 +76,57 @@ def check_mission(
         else:
             start_region = free.region_at(start.x, start.y)
 
-    # The reference for reachability: the last place the robot is known to get to.
-    previous_label, previous_region = ("the start pose", start_region)
-    regions: list[int | None] = []
-    for index, waypoint in zip(numbers, mission.waypoints, strict=True):
+    # Reachability is judged against one region of the map: the start pose's, or, when
+    # the start is not known, the one most waypoints are in. A waypoint outside it is
+    # reported once, and the leg after it is checked from the last waypoint the robot
+    # can get to, so a waypoint after an isolated one is not blamed as well. Every
+    # waypoint reached is in that one region, so the way back to the first waypoint
+    # for the next loop needs no check of its own.
+    placed = [
+        _placement_problem(free, waypoint.x, waypoint.y, "", None) is None
+        for waypoint in mission.waypoints
+    ]
+    regions = [
+        free.region_at(waypoint.x, waypoint.y) if ok else None
+        for waypoint, ok in zip(mission.waypoints, placed, strict=True)
+    ]
+    reference = start_region if start_region is not None else _most_common(regions)
+    previous_label = "the start pose" if start_region is not None else None
+    for index, waypoint, region in zip(numbers, mission.waypoints, regions, strict=True):
         source = waypoint.where or mission.source
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
-        problem = _placement_problem(
-            free, waypoint.x, waypoint.y, "the robot cannot turn there", previous_region
-        )
-        if problem:
+        if region is None:
+            problem = _placement_problem(
+                free, waypoint.x, waypoint.y, "the robot cannot turn there", reference
+            )
             problems.append(NavseqError(f"{position} {problem}", source=source, subject=subject))
-            regions.append(None)
             continue
-        region = free.region_at(waypoint.x, waypoint.y)
-        regions.append(region)
-        if previous_region is not None and region != previous_region:
+        if reference is not None and region != reference:
+            where_from = (
+                f"cannot be reached from {previous_label}"
+                if previous_label is not None
+                else "is cut off from the mission's other waypoints"
+            )
             problems.append(
                 NavseqError(
-                    f"{position} cannot be reached from {previous_label}: "
-                    "no free path connects them on the map",
+                    f"{position} {where_from}: no free path connects them on the map",
                     source=source,
                     subject=subject,
                 )
             )
+            continue
         previous_label = f"{subject} {position}"
-        previous_region = region
-
-    loops_again = mission.loops is None or mission.loops > 1
-    if loops_again and len(mission.waypoints) > 1:
-        first, last = regions[0], regions[-1]
-        if first is not None and last is not None and first != last:
-            waypoint, last_waypoint = mission.waypoints[0], mission.waypoints[-1]
-            problems.append(
-                NavseqError(
-                    f"{_format_position(waypoint.x, waypoint.y)} cannot be reached from "
-                    f"{last_waypoint.label(numbers[-1])} "
-                    f"{_format_position(last_waypoint.x, last_waypoint.y)} "
-                    "to start the next loop: no free path connects them on the map",
-                    source=waypoint.where or mission.source,
-                    subject=waypoint.label(numbers[0]),
-                )
-            )
     return problems
+
+
+def _most_common(regions: Sequence[int | None]) -> int | None:
+    """The region most waypoints are in (the earliest one's on a tie), None if none."""
+    counts: dict[int, int] = {}
+    for region in regions:
+        if region is not None:
+            counts[region] = counts.get(region, 0) + 1
+    return max(counts, key=lambda region: counts[region]) if counts else None
 
 
 def _start_problem(free: _FreeRegions, start: Pose2D) -> str | None:

@@ -8,7 +8,7 @@ A subcommand module provides two functions:
 Modules are imported when the parser is built, so they must import only light
 things at module level (argparse, pathlib) and import the heavy machinery (the
 simulator, matplotlib, rospy) inside ``run``. Adding a subcommand is one module
-plus one line in :data:`SUBCOMMANDS` (``navseq record`` lives in ``navseq.ros.record``).
+plus one line in :data:`SUBCOMMANDS` (``navseq record`` lives in ``navseq.ros1.record``).
 """
 
 from __future__ import annotations
@@ -54,10 +54,15 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "write any supported mission format as navseq YAML",
         "navseq.commands.convert",
     ),
+    Subcommand(
+        "sim",
+        "run the simulated robot with a Nav2 stand-in as ROS 2 nodes (--ros2)",
+        "navseq.commands.sim",
+    ),
     # Lives with the ROS code; it imports rospy only when recording starts.
     Subcommand(
         "record",
         "record waypoints from RViz goals (or a pose topic) into a mission file (ROS 1)",
-        "navseq.ros.record",
+        "navseq.ros1.record",
     ),
 )

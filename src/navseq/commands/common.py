@@ -65,6 +65,34 @@ def parse_loops(text: str) -> int | None:
     return loops
 
 
+def parse_waypoint_number(text: str) -> int:
+    """A whole number: a 1-based waypoint number, as the summary table prints it.
+
+    Whether the waypoint exists is checked against the mission, whose size says the
+    valid range (:class:`navseq.mission.part.PartSpec`).
+    """
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a waypoint number (1 for the first), got {text!r}"
+        ) from None
+
+
+def parse_realtime(text: str) -> float:
+    """A real-time factor > 0 (``--realtime 2``: twice as fast as real time)."""
+    try:
+        factor = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a speed factor such as 1 or 0.5, got {text!r} (its FACTOR is optional: "
+            "put MISSION before --realtime, or give one, e.g. --realtime 1)"
+        ) from None
+    if not (math.isfinite(factor) and factor > 0):
+        raise argparse.ArgumentTypeError(f"the factor must be a number above 0, got {text!r}")
+    return factor
+
+
 def format_pose(pose: Pose2D) -> str:
     return f"({pose.x:.2f}, {pose.y:.2f}, {math.degrees(pose.yaw):.0f}°)"
 
@@ -111,15 +139,18 @@ def add_robot_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def choose_robot(option: str | None, mission: Mission | None) -> RobotProfile:
+def choose_robot(option: str | RobotProfile | None, mission: Mission | None) -> RobotProfile:
     """The robot to plan and check for: ``--robot`` > the mission's ``robot:`` > default.
 
-    ``--robot`` is read here, not by argparse, so that a bad name or file is one
-    NavseqError (exit 2) like every other input problem.
+    ``--robot`` (a built-in name or a file) is read here, not by argparse, so that a bad
+    name or file is one NavseqError (exit 2) like every other input problem. The Python
+    API may pass a :class:`RobotProfile` itself.
     """
-    from navseq.mission.robot import DEFAULT_PROFILE
+    from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
     from navseq.mission.robot_format import robot_from_option
 
+    if isinstance(option, RobotProfile):
+        return option
     if option is not None:
         return robot_from_option(option)
     if mission is not None and mission.robot is not None:

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
     from navseq.mission.model import Mission
+    from navseq.mission.part import MissionPart
     from navseq.sinks.journal import JournalState
 
 JOURNAL_NAME = "journal.jsonl"
@@ -42,8 +43,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
     from navseq.runlock import RunLock
+    from navseq.text import printable
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
+    if args.run.is_dir() and not journal.exists():
+        from navseq.errors import NavseqError
+
+        raise NavseqError(
+            f"{printable(str(args.run))} is not a run's output folder (it has no "
+            f"{JOURNAL_NAME}); give the folder navseq run wrote (navseq-out/...) or its "
+            f"{JOURNAL_NAME}",
+            source="RUN",
+        )
     require_file(journal, "RUN")
     with RunLock(journal.parent):  # not while a live run writes them
         rebuilt = rebuild_outputs(journal)
@@ -68,23 +79,27 @@ def rebuild_outputs(journal: Path) -> Rebuilt:
     """Write the missing or broken report / picture of the run in ``journal``."""
     from navseq.commands.run_outputs import output_error
     from navseq.files import write_atomically
+    from navseq.mission.part import number_visits
     from navseq.sinks.journal import read_journal
 
     state = read_journal(journal)
-    mission = journaled_mission(state)
+    whole = journaled_mission(state)
+    part = journaled_part(state, whole)
+    mission = part.apply(whole) if part is not None else whole
     result = result_from_journal(state, mission)
     folder = journal.parent
     report_path, picture_path = folder / "report.json", folder / "mission.png"
     written: dict[str, str] = {}
     if not _complete_report(report_path):
         report = _report(state, mission, result, report_path, picture_path, journal)
+        number_visits(report, part)
         text = json.dumps(report, indent=2, ensure_ascii=False) + "\n"
         try:
             write_atomically(report_path, text)
         except OSError as error:
             raise output_error(report_path, error) from None
         written["report"] = str(report_path)
-    if not _complete_picture(picture_path):
+    if not state.run_options.get("no_picture") and not _complete_picture(picture_path):
         png = _picture(state, mission, result)
         try:
             write_atomically(picture_path, png)
@@ -118,7 +133,9 @@ def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
         if known.outcome is WaypointOutcome.NOT_RUN:
             continue  # never finished: listed (or counted) as not run
         waypoint = mission.waypoints[index]
-        log.add(replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw))
+        log.add(
+            replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
+        )
         done_per_loop[loop] = done_per_loop.get(loop, 0) + 1
     success = log.finished > 0 and log.all_reached()
     return log.result(
@@ -162,6 +179,14 @@ def journaled_mission(state: JournalState) -> Mission:
     return mission
 
 
+def journaled_part(state: JournalState, mission: Mission) -> MissionPart | None:
+    """The part of the (whole) mission the journal's run ran; None for all of it."""
+    from navseq.mission.part import part_from_options
+
+    spec = part_from_options(state.run_options, f"{state.path}:1")
+    return None if spec.whole else spec.select(mission)
+
+
 def _report(
     state: JournalState,
     mission: Mission,
@@ -187,7 +212,7 @@ def _report(
         files={
             "journal": str(journal),
             "report": str(report_path),
-            "picture": str(picture_path),
+            **({} if options.get("no_picture") else {"picture": str(picture_path)}),
         },
     )
     report["rebuilt_from_journal"] = True

@@ -18,7 +18,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from navseq.commands.common import add_robot_option, format_pose, parse_loops, parse_pose
+from navseq.commands.common import (
+    add_robot_option,
+    format_pose,
+    parse_loops,
+    parse_pose,
+    parse_realtime,
+    parse_waypoint_number,
+)
+from navseq.navigators.registry import (
+    NavigatorDraft,
+    add_navigator_choice,
+    add_navigator_options,
+    journaled_options,
+    navigator_kind,
+)
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -27,17 +41,14 @@ if TYPE_CHECKING:
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
+    from navseq.mission.part import MissionPart
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
-    from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.journal import JournalState
-    from navseq.sinks.progress import JsonProgress
+    from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
-
-NAVIGATORS = ("sim", "ros1")
-TEST_NAVIGATORS = ("scripted",)  # a deterministic stand-in, for tests of the plumbing
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -49,13 +60,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="mission file (navseq YAML, launch, rosparam YAML, CSV); "
         "optional with --resume (taken from the journal)",
     )
-    parser.add_argument(
-        "--navigator",
-        choices=NAVIGATORS + TEST_NAVIGATORS,
-        default=None,  # None: sim, or the journal's when resuming
-        metavar="{sim,ros1}",
-        help="sim: the embedded simulator (default); ros1: move_base over actionlib",
-    )
+    add_navigator_choice(parser, default=None)  # None: sim, or the journal's when resuming
     parser.add_argument(
         "--map", type=Path, metavar="MAP", help="map_server YAML (default: the mission's map:)"
     )
@@ -93,26 +98,43 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="N|forever",
         help="run the waypoint list N times, or until interrupted (default: the mission's loops:)",
     )
+    parser.add_argument(
+        "--from",
+        dest="from_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="start at waypoint N (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--to",
+        dest="to_waypoint",
+        type=parse_waypoint_number,
+        metavar="N",
+        help="end at waypoint N, inclusive (1-based, as numbered in the summary table)",
+    )
+    parser.add_argument(
+        "--only",
+        metavar="NAME_OR_NUMBER,...",
+        help="run only these waypoints, in the mission's order (names or 1-based numbers)",
+    )
+    parser.add_argument(
+        "--realtime",
+        type=parse_realtime,
+        nargs="?",
+        const=1.0,
+        metavar="FACTOR",
+        help="pace the simulator at FACTOR times real time (1 when no FACTOR is given), to "
+        "watch it or drive RViz; without it the simulator runs as fast as it can",
+    )
+    parser.add_argument(
+        "--no-picture",
+        action="store_true",
+        default=None,  # None: not given (a resume takes the journal's)
+        help="do not draw mission.png",
+    )
     add_robot_option(parser)
-    ros1 = parser.add_argument_group("ros1 navigator")
-    ros1.add_argument(
-        "--action", default=None, help="MoveBaseAction server name (default: move_base)"
-    )
-    ros1.add_argument("--frame", help="goal frame (default: the mission's frame:, usually map)")
-    ros1.add_argument("--ns", default=None, help="robot namespace, e.g. robot1 (default: none)")
-    ros1.add_argument(
-        "--settle",
-        type=float,
-        default=None,  # 0.05, or the journal's when resuming
-        metavar="S",
-        help="wall seconds between a goal's result and the next goal, against move_base's "
-        "SUCCEEDED race (navigation #949); 0: off (default 0.05)",
-    )
-    # Options of the scripted test navigator, hidden from --help.
-    parser.add_argument("--scripted-speed", type=float, default=0.5, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-realtime", type=float, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-log", type=Path, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--scripted-script", default="", help=argparse.SUPPRESS)
+    # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
+    add_navigator_options(parser)
 
 
 @dataclass
@@ -135,6 +157,7 @@ class RunSetup:
     history: JournalState | None = None  # what that journal held before resuming
     notes: list[str] = field(default_factory=list)
     run_options: dict[str, Any] = field(default_factory=dict)  # journaled for a resume
+    part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
 
@@ -160,40 +183,9 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
 
 
 def _map_info(grid: OccupancyGrid, map_path: Path) -> dict[str, Any]:
-    return {
-        "source": str(map_path),
-        "resolution": grid.resolution,
-        "width": grid.width,
-        "height": grid.height,
-        "origin": [grid.origin.x, grid.origin.y, grid.origin.yaw],
-    }
+    from navseq.sinks.report import map_summary
 
-
-def _check_against_map(
-    mission: Mission, costmap: Costmap, start: Pose2D | None, robot: RobotProfile
-) -> None:
-    """Pre-flight: every problem of the mission on this map, raised together."""
-    from navseq.commands.common import preflight_errors
-    from navseq.errors import MissionErrors
-
-    problems = preflight_errors(mission, costmap, start, robot=robot)
-    if problems:
-        raise MissionErrors(problems)
-
-
-def _optional_map(args: argparse.Namespace, setup: dict[str, Any]) -> OccupancyGrid | None:
-    """The map, if one is known, with the mission checked against it."""
-    from navseq.commands.common import costmap_for_robot
-    from navseq.sim.occupancy import load_map
-
-    if setup["map_path"] is None:
-        return None
-    grid = load_map(setup["map_path"])
-    if not args.no_preflight:
-        robot = setup["robot"]
-        costmap = costmap_for_robot(grid, robot)
-        _check_against_map(setup["mission"], costmap, setup["start"], robot)
-    return grid
+    return map_summary(grid, map_path)
 
 
 def prepare(args: argparse.Namespace) -> RunSetup:
@@ -201,24 +193,34 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     from navseq.commands.common import choose_robot, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
+    from navseq.mission.part import PartSpec
     from navseq.sinks.journal import mission_digest
 
     resume = history = None
     notes: list[str] = []
+    start_given = args.start is not None  # on this command line, not from a journal
     if args.resume is not None:
         mission_path, resume, history = _read_resume(args.resume, args.mission)
         notes = continue_as_journaled(args, history)
     elif args.mission is None:
-        raise NavseqError("give a MISSION file (or --resume JOURNAL)", source="navseq run")
+        raise NavseqError(
+            "no mission given: name the mission file to run (navseq run MISSION), "
+            "or the journal of a run to continue (--resume JOURNAL)"
+        )
     else:
         mission_path = args.mission
         require_file(mission_path, "MISSION")
     if args.map is not None:
         require_file(args.map, "--map")
     apply_run_defaults(args)
+    _refuse_sim_options(args, start_given)
     mission = load_mission(mission_path)
     if "loops" in vars(args):  # given on the command line (None = forever)
         mission = dataclasses.replace(mission, loops=args.loops)
+    spec = PartSpec(args.from_waypoint, args.to_waypoint, args.only)
+    part = None if spec.whole else spec.select(mission)
+    if part is not None:
+        mission = part.apply(mission)
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
@@ -229,43 +231,84 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     start_source = (
         "--start" if args.start is not None else "mission start:" if start is not None else None
     )
-    setup_kwargs: dict[str, Any] = {
-        "mission": mission,
-        "mission_path": mission_path,
-        "digest": mission_digest(mission_path),
-        "resume": resume,
-        "journal": args.resume,
-        "history": history,
-        "map_path": map_path,
-        "start": start,
-        "robot": choose_robot(args.robot, mission),
-        "start_source": start_source,
-    }
-    if args.navigator == "sim":
-        setup = _prepare_sim(args, setup_kwargs)
-    elif args.navigator == "ros1":
-        setup = _prepare_ros1(args, setup_kwargs)
-    else:
-        setup = _prepare_scripted(args, setup_kwargs)
-    setup.notes[:0] = notes
+    kind = navigator_kind(args.navigator)
+    draft = NavigatorDraft(
+        mission=mission,
+        map_path=map_path,
+        start=start,
+        start_source=start_source,
+        robot=choose_robot(args.robot, mission),
+        preflight=not args.no_preflight,
+        numbers=part.numbers if part is not None else None,
+    )
+    made = kind.create(args, draft)
+    setup = RunSetup(
+        mission=mission,
+        mission_path=mission_path,
+        digest=mission_digest(mission_path),
+        make_navigator=made.make_navigator,
+        navigator_info=made.info,
+        robot=draft.robot,
+        start=draft.start,
+        start_source=draft.start_source,
+        grid=made.grid,
+        map_path=map_path,
+        resume=resume,
+        journal=args.resume,
+        history=history,
+        notes=[*notes, *made.notes],
+        listeners=made.listeners,
+        part=part,
+    )
     setup.run_options = run_options(args, setup)
     return setup
 
 
 #: Options a run records in its journal, with their defaults; a resume continues with
 #: the recorded value of each one the command line does not give again.
+#: The chosen navigator kind's options are journaled too (NavigatorKind.journaled).
 RUN_OPTION_DEFAULTS: dict[str, Any] = {
     "navigator": "sim",
-    "action": "move_base",
-    "ns": "",
-    "frame": None,
-    "settle": 0.05,
+    "no_picture": False,
 }
+#: The options that choose the part of the mission run: a resume must run the same part
+#: (the journal's waypoint positions are positions in it).
+PART_OPTIONS = ("from_waypoint", "to_waypoint", "only")
+#: How the journal's option names are typed on the command line, where they differ.
+OPTION_FLAGS = {"from_waypoint": "--from", "to_waypoint": "--to", "no_picture": "--no-picture"}
+
+
+def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
+    """Options that only the embedded simulator can honour, refused for a real robot."""
+    from navseq.errors import NavseqError
+
+    if args.navigator == "ros1" and start_given:
+        raise NavseqError(
+            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
+            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
+            "which publishes /initialpose)",
+            source="--start",
+        )
+    if args.navigator != "sim" and args.realtime is not None:
+        raise NavseqError(
+            f"paces the embedded simulator; --navigator {args.navigator} keeps its own "
+            "time. Leave --realtime out",
+            source="--realtime",
+        )
 
 
 def apply_run_defaults(args: argparse.Namespace) -> None:
-    """Fill the options left out (None) with their defaults."""
+    """Fill the options left out (None) with their defaults, the navigator's included."""
+    from navseq.errors import NavseqError
+
     for name, default in RUN_OPTION_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, default)
+    try:
+        kind = navigator_kind(args.navigator)
+    except KeyError:  # a journal naming a navigator this navseq does not have
+        raise NavseqError(f"unknown navigator {args.navigator!r}", source="--navigator") from None
+    for name, default in kind.option_defaults().items():
         if getattr(args, name, None) is None:
             setattr(args, name, default)
 
@@ -291,10 +334,23 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
             return "loops" in vars(args)
         return getattr(args, name, None) is not None
 
+    _refuse_another_part(args, recorded, history)
     for name, value in recorded.items():
-        if name not in (*RUN_OPTION_DEFAULTS, "loops", "map", "start"):
+        if name not in (
+            *RUN_OPTION_DEFAULTS,
+            *journaled_options(),
+            *PART_OPTIONS,
+            "loops",
+            "map",
+            "start",
+        ):
             continue
         try:
+            if name in PART_OPTIONS:
+                setattr(args, name, value)  # checked by _refuse_another_part
+                continue
+            if name == "no_picture":
+                value = bool(value)
             if name == "loops":
                 value = None if value in (None, "forever") else parse_loops(str(value))
             elif name == "map":
@@ -309,11 +365,36 @@ def continue_as_journaled(args: argparse.Namespace, history: JournalState) -> li
         if not given(name):
             setattr(args, name, value)
         elif getattr(args, name) != value:
+            flag = OPTION_FLAGS.get(name, f"--{name}")
             notes.append(
-                f"resuming with --{name} {_option_text(getattr(args, name))} instead of the "
+                f"resuming with {flag} {_option_text(getattr(args, name))} instead of the "
                 f"journal's {_option_text(value)}"
             )
     return notes
+
+
+def _refuse_another_part(
+    args: argparse.Namespace, recorded: dict[str, Any], history: JournalState
+) -> None:
+    """A resume runs the part of the mission the journal's run ran, or nothing."""
+    from navseq.errors import NavseqError
+    from navseq.mission.part import part_from_options
+
+    journaled = part_from_options(recorded, f"{history.path}:1")
+    asked = {name: getattr(args, name, None) for name in PART_OPTIONS}
+    if all(value is None for value in asked.values()):
+        return
+    if asked != {
+        "from_waypoint": journaled.first,
+        "to_waypoint": journaled.last,
+        "only": journaled.only,
+    }:
+        ran = journaled.describe() or "the whole mission"
+        raise NavseqError(
+            f"a resume continues the part of the mission its run started with ({ran}); "
+            "leave out --from, --to and --only, or start a new run without --resume",
+            source="--resume",
+        )
 
 
 def _option_text(value: Any) -> str:
@@ -331,159 +412,17 @@ def run_options(args: argparse.Namespace, setup: RunSetup) -> dict[str, Any]:
     start = setup.start
     return {
         "navigator": args.navigator,
-        "action": args.action,
-        "ns": args.ns,
-        "frame": args.frame,
-        "settle": args.settle,
+        **{name: getattr(args, name) for name in navigator_kind(args.navigator).journaled()},
+        "no_picture": bool(args.no_picture),
+        "from_waypoint": args.from_waypoint,
+        "to_waypoint": args.to_waypoint,
+        "only": args.only,
         "loops": setup.mission.loops,
         "map": str(Path(setup.map_path).resolve()) if setup.map_path is not None else None,
         "start": None
         if start is None
         else [round(start.x, 6), round(start.y, 6), round(math.degrees(start.yaw), 6)],
     }
-
-
-def _prepare_sim(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.errors import NavseqError
-    from navseq.navigators.sim import SimNavigator
-    from navseq.sim.costmap import Costmap
-    from navseq.sim.occupancy import load_map
-    from navseq.sim.profile import SimSettings
-    from navseq.sim.world import SimWorld, default_start
-
-    mission: Mission = setup["mission"]
-    map_path: Path | None = setup["map_path"]
-    start: Pose2D | None = setup["start"]
-    if map_path is None:
-        raise NavseqError(
-            "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
-            source=mission.source,
-        )
-    grid = load_map(map_path)
-    robot: RobotProfile = setup["robot"]
-    settings = SimSettings.of(robot)
-    notes = []
-    if start is None:
-        start = default_start(grid, settings.footprint)
-        setup["start"] = start
-        setup["start_source"] = "simulator default"
-        notes.append(
-            f"no start pose given (--start or start:): the robot starts at "
-            f"{format_pose(start)}, the roomy point nearest the map origin"
-        )
-    # One costmap for pre-flight and the simulated navigation server alike.
-    costmap = Costmap.from_grid(grid, settings.costmap_params)
-    # Pre-flight first: it lists every problem, where building the world would stop at
-    # the first (a start pose inside an obstacle).
-    if not args.no_preflight:
-        _check_against_map(mission, costmap, start, robot)
-    world = SimWorld(
-        grid,
-        start,
-        costmap=costmap,
-        nav_params=settings.nav_params,
-        footprint=settings.footprint,
-    )
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=lambda: SimNavigator(world),
-        navigator_info={"kind": "sim", "robot": robot.name},
-        notes=notes,
-    )
-
-
-def _prepare_ros1(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.errors import NavseqError
-
-    mission: Mission = setup["mission"]
-    frame = args.frame or mission.frame
-    try:
-        from navseq.ros.run_setup import connect_for_run
-    except ImportError as error:
-        raise NavseqError(
-            f"the ros1 navigator needs ROS 1's Python packages (rospy, actionlib, "
-            f"move_base_msgs): {error}. Install them (see DEVELOPERS.md) and run navseq "
-            "from the project's venv",
-            source="--navigator ros1",
-        ) from None
-    # Before anything is written: the server must answer and its clock run; the robot
-    # comes from move_base's parameters unless the user named one.
-    connection = connect_for_run(
-        mission,
-        action=args.action,
-        frame=frame,
-        namespace=args.ns,
-        settle=args.settle,
-        read_robot=getattr(args, "robot", None) is None and mission.robot is None,
-    )
-    info: dict[str, Any] = {"kind": "ros1", "action": args.action, "frame": frame, "ns": args.ns}
-    notes = []
-    if connection.robot is not None and connection.robot_note is not None:
-        # The stack's own robot: what pre-flight checks against, as move_base plans with it.
-        setup["robot"] = connection.robot
-        info["robot_source"] = connection.robot_note
-        notes.append(connection.robot_note)
-    info["robot"] = setup["robot"].name
-    try:
-        grid = _optional_map(args, setup)
-    except BaseException:
-        connection.navigator.close()
-        raise
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=lambda: connection.navigator,
-        navigator_info=info,
-        notes=notes,
-        listeners=[connection.topics],
-    )
-
-
-def _scripted_behaviours(script: str) -> list[Any]:
-    """Test-only: ``succeed,aborted@2,stall@1,hang,falsesuccess`` -> ScriptedNavigator
-    behaviours."""
-    from navseq.navigators.base import GoalStatus
-    from navseq.navigators.scripted import FalseSuccess, Finish, Hang, Stall, Succeed
-
-    behaviours: list[Any] = []
-    for token in filter(None, (part.strip() for part in script.split(","))):
-        name, _, after = token.partition("@")
-        seconds = float(after) if after else 0.0
-        if name == "succeed":
-            behaviours.append(Succeed())
-        elif name == "hang":
-            behaviours.append(Hang())
-        elif name == "stall":
-            behaviours.append(Stall(after=seconds))
-        elif name == "falsesuccess":
-            behaviours.append(FalseSuccess(after=seconds))
-        else:
-            behaviours.append(Finish(GoalStatus(name.upper()), after=seconds))
-    return behaviours
-
-
-def _prepare_scripted(args: argparse.Namespace, setup: dict[str, Any]) -> RunSetup:
-    from navseq.navigators.scripted import ScriptedNavigator
-
-    start: Pose2D | None = setup["start"]
-    grid = _optional_map(args, setup)
-
-    def make_navigator() -> Navigator:
-        return ScriptedNavigator(
-            _scripted_behaviours(args.scripted_script),
-            start=start,
-            speed=args.scripted_speed,
-            realtime=args.scripted_realtime,
-            log_path=args.scripted_log,
-        )
-
-    return RunSetup(
-        **setup,
-        grid=grid,
-        make_navigator=make_navigator,
-        navigator_info={"kind": "scripted", "speed": args.scripted_speed},
-    )
 
 
 @dataclass
@@ -497,6 +436,9 @@ class RunOutcome:
     recorder: RunRecorder
     json_lines: JsonProgress | None
     error: NavseqError | None = None  # what stopped the run, if an output failed
+    # The navigator's clock and the wall clock over the run, for the real-time factor.
+    navigator_seconds: float = 0.0
+    wall_seconds: float = 0.0
 
 
 def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, bool]:
@@ -549,13 +491,17 @@ def _run_with_sinks(
     setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
 ) -> RunOutcome:
     """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    import time
+
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
     from navseq.sinks.journal import JournalWriter
-    from navseq.sinks.progress import JsonProgress, make_progress
+    from navseq.sinks.json_events import JsonProgress
+    from navseq.sinks.progress import make_progress
 
     navigator = setup.make_navigator()
     error: NavseqError | None = None
+    navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
         if setup.resume is not None:
             journal = JournalWriter.resume(journal_path, setup.resume)
@@ -566,7 +512,12 @@ def _run_with_sinks(
                 journal_path, source, setup.digest, run_options=setup.run_options
             )
         recorder = new_recorder(setup)
-        progress = make_progress(setup.mission, json_lines=args.json, robot=setup.robot)
+        progress = make_progress(
+            setup.mission,
+            json_lines=args.json,
+            robot=setup.robot,
+            numbers=setup.part.numbers if setup.part is not None else None,
+        )
         with progress, journal:
             try:
                 result = run_mission(
@@ -588,7 +539,26 @@ def _run_with_sinks(
         signals.defer()  # the goal is reached or cancelled: the report comes first now
         navigator.close()
     json_lines = progress if isinstance(progress, JsonProgress) else None
-    return RunOutcome(result, exit_code, interrupted, navigator, recorder, json_lines, error)
+    return RunOutcome(
+        result,
+        exit_code,
+        interrupted,
+        navigator,
+        recorder,
+        json_lines,
+        error,
+        navigator_seconds=navigator.now() - navigator_start,
+        wall_seconds=time.monotonic() - wall_start,
+    )
+
+
+def real_time_text(simulated: float, wall: float) -> str:
+    """``simulated 62.4 s in 0.9 s: 69x real time``: how fast the simulator ran."""
+    if wall <= 0.0:
+        return f"simulated {simulated:.1f} s"
+    factor = simulated / wall
+    shown = f"{factor:.0f}" if factor >= 10 else f"{factor:.2g}"
+    return f"simulated {simulated:.1f} s in {wall:.1f} s: {shown}x real time"
 
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
@@ -652,26 +622,35 @@ def _execute_locked(
         folder,
         files,
         lambda paths, code: _report(setup, outcome, paths, code),
-        lambda: _picture_png(setup, outcome),
+        None if args.no_picture else lambda: _picture_png(setup, outcome),
         signals,
         outcome.exit_code,
     )
+    notes = []
+    if setup.navigator_info.get("kind") == "sim":
+        notes.append(real_time_text(outcome.navigator_seconds, outcome.wall_seconds))
     if outcome.json_lines is not None:
         try:
-            outcome.json_lines.emit(
-                "RunFinished",
-                {
-                    "success": outcome.result.success,
-                    "reason": outcome.result.reason,
-                    "exit_code": exit_code,
-                    "interrupted": outcome.interrupted,
-                    **files.paths,
-                },
+            outcome.json_lines.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=exit_code,
+                interrupted=outcome.interrupted,
+                files=files.paths,
             )
         except BrokenPipeError:
             silence_stdout()
+        for note in notes:  # stdout is for programs here
+            print(f"navseq run: {note}", file=sys.stderr)
     else:
-        print_summary(setup.mission, outcome.result, files)
+        print_summary(
+            setup.mission,
+            outcome.result,
+            files,
+            numbers=setup.part.numbers if setup.part is not None else None,
+            part=setup.part.describe() if setup.part is not None else None,
+            notes=notes,
+        )
     report_failures(files)
     if outcome.error is not None:
         raise outcome.error
@@ -680,22 +659,22 @@ def _execute_locked(
 
         raise NavseqError(
             f"the report could not be written ({files.failed['report']}); the journal "
-            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it",
-            source="navseq run",
+            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it"
         )
     if exit_code == 2:
         from navseq.errors import NavseqError
 
-        raise NavseqError(files.failed["picture"], source="navseq run")
+        raise NavseqError(f"the picture could not be written: {files.failed['picture']}")
     return exit_code
 
 
 def _report(
     setup: RunSetup, outcome: RunOutcome, files: dict[str, str], exit_code: int
 ) -> dict[str, Any]:
+    from navseq.mission.part import number_visits
     from navseq.sinks.report import build_report
 
-    return build_report(
+    report = build_report(
         setup.mission,
         outcome.result,
         exit_code=exit_code,
@@ -709,6 +688,8 @@ def _report(
         start_source=setup.start_source,
         files=files,
     )
+    number_visits(report, setup.part)
+    return report
 
 
 def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:

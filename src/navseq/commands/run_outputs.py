@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import errno
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -88,7 +88,7 @@ def write_outputs(
     folder: Path,
     files: RunFiles,
     build_report: Callable[[dict[str, str], int], dict[str, Any]],
-    render_picture: Callable[[], bytes],
+    render_picture: Callable[[], bytes] | None,
     signals: SignalGuard | None,
     exit_code: int,
 ) -> int:
@@ -96,7 +96,8 @@ def write_outputs(
 
     ``build_report(paths, exit_code)`` makes the report given every file's path (the
     picture's name is chosen first so that the report can name it); ``render_picture()``
-    the PNG. A picture given up by the operator is only noted. A picture that cannot be
+    the PNG, or None for no picture (``--no-picture``: the report names none). A picture
+    given up by the operator is only noted. A picture that cannot be
     written (disk full) makes the run's status 2, and the report is written again to say
     so, if it can be.
     """
@@ -104,8 +105,9 @@ def write_outputs(
 
     from navseq.signals import StepAbandoned
 
-    picture_path = free_name(folder, "mission.png")
-    files.paths["picture"] = str(picture_path)
+    if render_picture is not None:
+        picture_path = free_name(folder, "mission.png")
+        files.paths["picture"] = str(picture_path)
 
     def report_text(path: Path) -> str:
         files.paths["report"] = str(path)
@@ -121,6 +123,8 @@ def write_outputs(
     except NavseqError as error:
         report_path = None
         files.failed["report"] = str(error)
+    if render_picture is None:
+        return exit_code
     try:
         if signals is not None:
             with signals.abortable():
@@ -143,15 +147,28 @@ def write_outputs(
     return exit_code
 
 
-def print_summary(mission: Mission, result: MissionResult, files: RunFiles) -> None:
-    """The final table and the files, on stdout; a reader gone away is not an error."""
+def print_summary(
+    mission: Mission,
+    result: MissionResult,
+    files: RunFiles,
+    *,
+    numbers: Sequence[int] | None = None,
+    part: str | None = None,
+    notes: Sequence[str] = (),
+) -> None:
+    """The final table, ``notes`` and the files, on stdout; a reader gone away is not an error.
+
+    ``numbers`` and ``part``: see :func:`~navseq.sinks.summary.summary_table`.
+    """
     from rich.console import Console
 
-    from navseq.sinks.progress import summary_table
+    from navseq.sinks.summary import print_table, summary_table
 
     try:
         console = Console()
-        console.print(summary_table(mission, result))
+        print_table(summary_table(mission, result, numbers=numbers, part=part), console)
+        for note in notes:
+            console.print(note, highlight=False)
         for role, path in files.paths.items():
             if role not in files.failed:
                 console.print(f"{role:>8}: {path}", highlight=False)

@@ -18,7 +18,9 @@ from navseq.commands.common import add_robot_option, parse_pose
 from navseq.errors import NavseqError
 
 if TYPE_CHECKING:
+    from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -39,33 +41,41 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.commands.common import require_file
+    from navseq.commands.common import choose_robot, require_file
     from navseq.errors import MissionErrors
-    from navseq.mission import inspect_mission_file
     from navseq.mission.robot_format import robot_from_option
 
+    # Every problem of every input, in one list: a bad --map or --robot does not hide
+    # the mission's problems, nor the other way round.
+    option_errors: list[NavseqError] = []
     if args.map is not None:
-        require_file(args.map, "--map")
+        try:
+            require_file(args.map, "--map")
+        except NavseqError as error:
+            option_errors.append(error)
     if args.robot is not None:
-        robot_from_option(args.robot)  # a bad --robot is reported before the mission
-    mission, problems = inspect_mission_file(args.mission)
-    errors = list(problems.errors)
-    if mission is None and problems.salvage is not None:
-        # Check the waypoints that did read against the map as well, so that one run
-        # of validate lists everything to fix.
-        errors += _map_problems(args, problems.salvage.mission, problems.salvage.numbers)
-    elif mission is not None:
-        errors += _map_problems(args, mission)
+        try:
+            robot_from_option(args.robot)
+        except NavseqError as error:
+            option_errors.append(error)
+    if option_errors:
+        # The map cannot be checked without them; the file's own problems still can.
+        from navseq.mission import inspect_mission_file
+
+        mission, problems = inspect_mission_file(args.mission)
+        errors = [*problems.errors, *option_errors]
+    else:
+        mission, errors = mission_file_problems(
+            args.mission, map_path=args.map, start=args.start, robot=args.robot
+        )
     if errors:
         raise MissionErrors(errors)
     assert mission is not None
     count = len(mission.waypoints)
     loops = "forever" if mission.loops is None else str(mission.loops)
-    map_path = _map_path(args, mission)
+    map_path = args.map if args.map is not None else mission.map
     checked = f"checked against map {map_path}" if map_path is not None else "no map to check"
     if map_path is not None:
-        from navseq.commands.common import choose_robot
-
         checked += f" for robot {choose_robot(args.robot, mission).name}"
     print(
         f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
@@ -75,23 +85,60 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _map_path(args: argparse.Namespace, mission: Mission) -> Path | None:
-    return args.map if args.map is not None else mission.map
+def mission_file_problems(
+    path: Path,
+    *,
+    map_path: Path | None = None,
+    start: Pose2D | None = None,
+    robot: str | RobotProfile | None = None,
+) -> tuple[Mission | None, list[NavseqError]]:
+    """The mission in ``path`` (None if it cannot be read) and every problem found.
+
+    The file's own problems and, when a map is known (``map_path``, else the mission's
+    ``map:``), the pre-flight problems of every waypoint that did read, in one list.
+    ``robot`` is a profile, or a built-in name or file as ``--robot`` takes (default:
+    the mission's ``robot:``). ``navseq validate`` and :func:`navseq.validate_file` both
+    call this.
+    """
+    from navseq.mission import inspect_mission_file
+
+    mission, problems = inspect_mission_file(path)
+    errors = list(problems.errors)
+    if mission is None and problems.salvage is not None:
+        # Check the waypoints that did read against the map as well, so that one run
+        # of validate lists everything to fix.
+        salvage = problems.salvage
+        errors += _map_problems(salvage.mission, map_path, start, robot, salvage.numbers)
+    elif mission is not None:
+        errors += _map_problems(mission, map_path, start, robot)
+    elif map_path is not None:  # no waypoints to check, but the map can still be read
+        errors += _map_problems(None, map_path, start, robot)
+    return mission, errors
 
 
 def _map_problems(
-    args: argparse.Namespace, mission: Mission, numbers: Sequence[int] | None = None
+    mission: Mission | None,
+    map_path: Path | None,
+    start: Pose2D | None,
+    robot_option: str | RobotProfile | None,
+    numbers: Sequence[int] | None = None,
 ) -> list[NavseqError]:
-    """The pre-flight problems of ``mission`` on the map given or named, if any."""
+    """The pre-flight problems of ``mission`` on the map given or named, if any.
+
+    Without a mission (a file that did not read at all) only the map itself is checked.
+    """
     from navseq.commands.common import choose_robot, costmap_for_map, preflight_errors
 
-    map_path = _map_path(args, mission)
+    if map_path is None and mission is not None:
+        map_path = mission.map
     if map_path is None:
         return []
-    robot = choose_robot(args.robot, mission)
+    robot = choose_robot(robot_option, mission)
     try:
         costmap = costmap_for_map(map_path, robot)
     except NavseqError as error:  # an unreadable map is one more problem to list
         return [error]
-    start = args.start if args.start is not None else mission.start
+    if mission is None:
+        return []
+    start = start if start is not None else mission.start
     return preflight_errors(mission, costmap, start, numbers, robot)

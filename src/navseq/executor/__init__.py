@@ -5,7 +5,8 @@
 - :func:`run_mission` (``runner``): the loop that drives it against a navigator and
   cancels the goal on SIGINT/SIGTERM/exceptions.
 - :class:`ResumePoint` (``resume``): where a resumed run continues (from a journal).
-- :class:`MissionControl` (``control``): operator requests (skip) from other threads.
+- :class:`MissionControl` (``control``): operator requests (skip, pause, resume,
+  cancel) from other threads, carried out as executor inputs.
 """
 
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal

@@ -67,11 +67,12 @@ class WaypointPlan:
 class AttemptFailed:
     """One attempt at a waypoint failed; ``will_retry`` says whether another follows.
 
-    ``reason`` is navseq's verdict: a GoalStatus value (``"ABORTED"``), ``"timeout"``,
-    ``"stalled"``, or ``"succeeded far from goal (2.38 m)"`` / ``"succeeded 35° off the
-    goal yaw"`` when the stack said SUCCEEDED but the robot is not there. ``status`` is
-    the terminal status the navigation stack gave (None when navseq gave up on the goal
-    itself), ``text`` the stack's own words (move_base's result text, may be empty).
+    ``reason`` is navseq's verdict: the stack's failure status (``"ABORTED"``,
+    Nav2's ``"CANCELED"`` ...), ``"timeout"``, ``"stalled"``, or ``"succeeded far from
+    goal (2.38 m)"`` / ``"succeeded 35° off the goal yaw"`` when the stack said
+    SUCCEEDED but the robot is not there. ``status`` is the terminal status the
+    navigation stack gave (None when navseq gave up on the goal itself), ``text``
+    the stack's own words (move_base's result text, may be empty).
     ``duration`` (s) and ``distance_driven`` (m) are the attempt's own. Fields after
     ``will_retry`` default so that journals written before them still read.
     """
@@ -116,6 +117,29 @@ class ServerStatusChanged:
 
 
 @dataclass(frozen=True)
+class MissionPaused:
+    """The operator paused the mission: the active goal is cancelled, the clock held.
+
+    ``state`` is what the run was doing (``active``, ``dwelling`` ...), ``index`` the
+    waypoint it was at.
+    """
+
+    t: float
+    index: int
+    reason: str = ""
+    state: str = ""
+
+
+@dataclass(frozen=True)
+class MissionResumed:
+    """The pause ended; every deadline of the run moved on by ``paused_for`` seconds."""
+
+    t: float
+    index: int
+    paused_for: float
+
+
+@dataclass(frozen=True)
 class MissionFinished:
     t: float
     success: bool  # every waypoint reached
@@ -132,5 +156,7 @@ MissionEvent = (
     | WaypointDwelling
     | WaypointFinished
     | ServerStatusChanged
+    | MissionPaused
+    | MissionResumed
     | MissionFinished
 )

@@ -11,7 +11,17 @@ navigator's clock):
 * :meth:`~MissionExecutor.on_tick` regularly (every 0.1 s is plenty), with the
   latest robot pose (and odometry pose, when known), so that timeouts, dwell and
   back-off can expire and distance driven adds up;
+* :meth:`~MissionExecutor.skip`, :meth:`~MissionExecutor.pause`,
+  :meth:`~MissionExecutor.resume` and :meth:`~MissionExecutor.cancel`: operator
+  requests (one path for the ROS nodes and the CLI, see
+  :class:`~navseq.executor.control.MissionControl`);
 * :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash).
+
+Pausing cancels the active goal (the robot stops) and holds the run in
+:attr:`ExecutorState.PAUSED`, where no deadline runs: on resume the goal timeout, the
+stall timeout, a dwell, a retry back-off and the server wait all move on by the time
+spent paused, and an interrupted goal is sent again (a fresh goal id, the same
+attempt). Durations in the result stay what they were on the clock, pauses included.
 
 Each input returns the commands (:mod:`navseq.executor.commands`) the caller must
 apply to the navigator, in order. What happened is told to listeners as mission
@@ -55,6 +65,8 @@ from navseq.executor.events import (
     LoopStarted,
     MissionEvent,
     MissionFinished,
+    MissionPaused,
+    MissionResumed,
     MissionStarted,
     ServerStatusChanged,
     WaypointDwelling,
@@ -73,8 +85,8 @@ from navseq.navigators.base import (
     Goal,
     GoalDone,
     GoalFeedback,
+    GoalOutcome,
     GoalPlan,
-    GoalStatus,
     NavEvent,
     ServerBack,
     ServerLost,
@@ -112,6 +124,7 @@ class ExecutorState(enum.Enum):
     DWELLING = "dwelling"  # goal reached; waiting the waypoint's dwell time
     WAITING_RETRY = "waiting_retry"  # attempt failed; back-off before the next attempt
     WAITING_SERVER = "waiting_server"  # server gone; the goal is resent when it is back
+    PAUSED = "paused"  # the operator paused: no goal out, no deadline running
     FINISHED = "finished"  # the mission ended (see result.reason)
 
 
@@ -199,6 +212,11 @@ class MissionExecutor:
         self._start_pose: Pose2D | None = None  # the first robot pose of the run
         self._tick_pose_seen = False
         self._started_at: float | None = None
+        # While PAUSED: the state to go back to, when the pause began, and the attempt
+        # whose goal the pause cancelled (to send again on resume).
+        self._paused_from: ExecutorState | None = None
+        self._paused_at = 0.0
+        self._paused_attempt: _Attempt | None = None
         self._now = 0.0
         self._loops_completed = 0
         self._success = False
@@ -217,6 +235,10 @@ class MissionExecutor:
     @property
     def finished(self) -> bool:
         return self._state is ExecutorState.FINISHED
+
+    @property
+    def paused(self) -> bool:
+        return self._state is ExecutorState.PAUSED
 
     @property
     def now(self) -> float:
@@ -357,11 +379,14 @@ class MissionExecutor:
 
         An operator's decision, whatever the waypoint's ``on_failure`` says. A visit
         already reached and dwelling just ends its dwell (outcome REACHED). When no
-        visit follows, the goal is cancelled and the mission ends.
+        visit follows, the goal is cancelled and the mission ends. A paused mission is
+        resumed by a skip: the next waypoint's goal goes out.
         """
         self._now = max(self._now, now)
         if self._state in (ExecutorState.IDLE, ExecutorState.FINISHED):
             return []
+        if self._state is ExecutorState.PAUSED:
+            self._end_pause(now)
         if self._state is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
         else:
@@ -371,8 +396,65 @@ class MissionExecutor:
             return [CancelGoal(), *commands]  # no next goal replaces the active one
         return commands
 
+    def pause(self, now: float, reason: str = "paused by operator") -> list[Command]:
+        """Stop the robot and hold the run until :meth:`resume` (no deadline runs).
+
+        Cancels the active goal, if one is out. Pausing a paused, finished or not yet
+        started run does nothing.
+        """
+        self._now = max(self._now, now)
+        if self._state in (ExecutorState.IDLE, ExecutorState.FINISHED, ExecutorState.PAUSED):
+            return []
+        commands: list[Command] = []
+        if self._state is ExecutorState.ACTIVE:
+            commands.append(CancelGoal())
+        self._paused_from = self._state
+        self._paused_at = now
+        self._paused_attempt = self._attempt
+        self._attempt = None  # the cancelled goal's last words are not the mission's
+        self._state = ExecutorState.PAUSED
+        self._emit(
+            MissionPaused(
+                t=now, index=self._current.index, reason=reason, state=self._paused_from.value
+            )
+        )
+        return commands
+
+    def resume(self, now: float) -> list[Command]:
+        """End a pause: deadlines move on by the time paused; a cancelled goal is resent.
+
+        Does nothing when the run is not paused.
+        """
+        self._now = max(self._now, now)
+        if self._state is not ExecutorState.PAUSED:
+            return []
+        attempt = self._paused_attempt
+        resumed = self._end_pause(now)
+        if resumed is ExecutorState.ACTIVE:
+            # Same attempt, fresh goal id: late events of the cancelled goal are ignored.
+            commands = self._send_goal(now)
+            if self._attempt is not None and attempt is not None:
+                shift = now - self._paused_at
+                self._attempt.sent_at = attempt.sent_at + shift
+                self._attempt.last_progress_at = attempt.last_progress_at + shift
+            return commands
+        if resumed is ExecutorState.WAITING_SERVER and self._server_up:
+            return self._send_goal(now)  # the server came back while paused
+        return self._check_clock(now)
+
+    def cancel(self, now: float, reason: str = "cancelled by operator") -> list[Command]:
+        """The operator ends the mission: the goal is cancelled, the visit FAILED.
+
+        The mission's reason is ``reason`` (sinks tell it from an interruption by
+        its ``cancelled`` start).
+        """
+        return self._end_now(now, reason)
+
     def interrupt(self, now: float, reason: str) -> list[Command]:
         """End the run at once (``reason`` like ``"interrupted: SIGINT"``); cancels the goal."""
+        return self._end_now(now, reason)
+
+    def _end_now(self, now: float, reason: str) -> list[Command]:
         self._now = max(self._now, now)
         if self.finished:
             return []
@@ -383,6 +465,21 @@ class MissionExecutor:
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, reason)
         return [CancelGoal()]
+
+    def _end_pause(self, now: float) -> ExecutorState:
+        """Leave PAUSED for the state it interrupted, with its deadlines moved on."""
+        resumed = self._paused_from
+        assert resumed is not None
+        shift = max(0.0, now - self._paused_at)
+        self._deadline += shift  # dwell or back-off
+        if not self._server_up and self._server_lost_at <= self._paused_at:
+            self._server_lost_at += shift
+        self._state = resumed
+        self._attempt = None
+        self._paused_from = None
+        self._paused_attempt = None
+        self._emit(MissionResumed(t=now, index=self._current.index, paused_for=shift))
+        return resumed
 
     # ------------------------------------------------------------------ visits
 
@@ -396,7 +493,12 @@ class MissionExecutor:
             self._emit(LoopStarted(t=now, loop=loop))
         waypoint = self._mission.waypoints[index]
         result = WaypointResult(
-            index=index, loop=loop, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw
+            index=index,
+            loop=loop,
+            name=waypoint.name,
+            x=waypoint.x,
+            y=waypoint.y,
+            yaw_rad=waypoint.yaw_rad,
         )
         self._visit = _Visit(loop, index, waypoint, self._mission.policy_for(index), result)
         return self._start_attempt(now)
@@ -461,7 +563,7 @@ class MissionExecutor:
                 goal_id=goal.goal_id,
                 x=waypoint.x,
                 y=waypoint.y,
-                yaw=waypoint.yaw,
+                yaw=waypoint.yaw_rad,
             )
         )
         return commands
@@ -501,7 +603,8 @@ class MissionExecutor:
                 self._finish_mission(now, "completed")
             else:
                 missed = self._log.not_reached(self._active_result())
-                self._finish_mission(now, f"completed: {missed} waypoint visit(s) not reached")
+                visits = "waypoint visit" if missed == 1 else "waypoint visits"
+                self._finish_mission(now, f"completed: {missed} {visits} not reached")
             return []
         loop, index = following
         if loop != visit.loop:
@@ -555,7 +658,7 @@ class MissionExecutor:
         reason: str,
         *,
         cancel: bool,
-        status: GoalStatus | None = None,
+        status: str | None = None,
         text: str = "",
     ) -> list[Command]:
         visit = self._current
@@ -568,7 +671,7 @@ class MissionExecutor:
         record = self._close_attempt(
             now,
             reached=False,
-            status=status.value if status is not None else None,
+            status=status,
             reason=reason,
             text=text,
         )
@@ -600,25 +703,22 @@ class MissionExecutor:
         return commands
 
     def _on_goal_done(self, now: float, event: GoalDone) -> list[Command]:
-        if event.status is GoalStatus.SUCCEEDED:
+        # The stack's own name for how the goal ended goes into the record as is.
+        if event.outcome is GoalOutcome.SUCCEEDED:
+            status = event.status or "SUCCEEDED"
             miss = self._arrival_miss()
             if miss is None:
-                return self._reached(
-                    now, passed_through=False, status=event.status.value, text=event.text
-                )
-            return self._attempt_failed(
-                now, miss, cancel=False, status=event.status, text=event.text
-            )
-        if event.status is GoalStatus.LOST:
+                return self._reached(now, passed_through=False, status=status, text=event.text)
+            return self._attempt_failed(now, miss, cancel=False, status=status, text=event.text)
+        if event.outcome is GoalOutcome.LOST:
             # Not the waypoint's fault: the stack lost track of the goal. Treat it as
             # a vanished server and resend once it reports back.
-            self._mark_server_lost(now, event.text or "goal LOST")
+            self._mark_server_lost(now, event.text or f"goal {event.status or 'LOST'}")
             self._state = ExecutorState.WAITING_SERVER
             self._attempt = None
             return self._check_clock(now)
-        return self._attempt_failed(
-            now, event.status.value, cancel=False, status=event.status, text=event.text
-        )
+        status = event.status or "FAILED"
+        return self._attempt_failed(now, status, cancel=False, status=status, text=event.text)
 
     def _arrival_miss(self) -> str | None:
         """Why a SUCCEEDED is not believed (the robot is not there), or None.
@@ -863,7 +963,7 @@ def _check_resume_point(mission: Mission, resume: ResumePoint) -> None:
 def _result_for(mission: Mission, done: WaypointResult) -> WaypointResult:
     """An earlier run's visit, with the waypoint's details taken from the mission."""
     waypoint = mission.waypoints[done.index]
-    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw=waypoint.yaw)
+    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
 
 
 __all__ = [

@@ -1,7 +1,14 @@
-"""The outcome of a mission run, per waypoint visit, as the report and exit code see it."""
+"""The outcome of a mission run, per waypoint visit, as the report and exit code see it.
+
+The fields keep the names the journal has always used (``duration``,
+``distance_driven``); the ``*_s`` / ``*_m`` / ``yaw_deg`` properties say the unit in
+the name, as the report and the ``--json`` events do, and are what the public API
+documents.
+"""
 
 from __future__ import annotations
 
+import math
 from collections import Counter, deque
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
@@ -15,10 +22,11 @@ from navseq.geometry import Pose2D
 class AttemptResult:
     """One goal sent for a visit, and how it ended.
 
-    ``status`` is the terminal status the navigation stack reported (a GoalStatus
-    value), or None when navseq ended the attempt itself (timeout, stalled, skip,
-    interrupt). ``reason`` is empty for the attempt that reached the waypoint, else
-    why it failed; ``text`` is the stack's own result text.
+    ``status`` is the terminal status the navigation stack reported, in its own
+    words (``SUCCEEDED``, ``ABORTED``, ``CANCELED`` ...), or None when navseq ended
+    the attempt itself (timeout, stalled, skip, interrupt). ``reason`` is empty for
+    the attempt that reached the waypoint, else why it failed; ``text`` is the
+    stack's own result text.
     """
 
     number: int  # 1-based
@@ -28,6 +36,16 @@ class AttemptResult:
     text: str = ""
     duration: float = 0.0  # s from the goal sent to its end
     distance_driven: float = 0.0  # m
+
+    @property
+    def duration_s(self) -> float:
+        """Seconds (navigator clock) from the goal sent to its end."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during this attempt."""
+        return self.distance_driven
 
 
 @dataclass
@@ -39,7 +57,7 @@ class WaypointResult:
     name: str | None
     x: float
     y: float
-    yaw: float  # radians
+    yaw_rad: float
     outcome: WaypointOutcome = WaypointOutcome.NOT_RUN
     attempts: int = 0
     duration: float = 0.0  # s from first goal sent to reached/given up
@@ -47,6 +65,21 @@ class WaypointResult:
     reason: str = ""
     passed_through: bool = False
     attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
+
+    @property
+    def yaw_deg(self) -> float:
+        """The waypoint's heading in degrees."""
+        return math.degrees(self.yaw_rad)
+
+    @property
+    def duration_s(self) -> float:
+        """Seconds (navigator clock) from the first goal sent to reached / given up."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during this visit, all attempts together."""
+        return self.distance_driven
 
     @property
     def last_failure(self) -> AttemptResult | None:
@@ -98,6 +131,16 @@ class MissionResult:
         }
 
     @property
+    def duration_s(self) -> float:
+        """Seconds of mission time (navigator clock; simulated time on the simulator)."""
+        return self.duration
+
+    @property
+    def distance_m(self) -> float:
+        """Metres driven during the whole run."""
+        return self.distance_driven
+
+    @property
     def exit_code(self) -> int:
         """0 only if every waypoint was reached, 1 otherwise."""
         return 0 if self.success else 1
@@ -127,7 +170,7 @@ class WaypointTotals:
     name: str | None
     x: float
     y: float
-    yaw: float  # radians
+    yaw_rad: float
     visits: int = 0
     reached: int = 0
     skipped: int = 0
@@ -174,7 +217,7 @@ class VisitLog:
     ):
         self._waypoints = waypoints
         self._loops = loops
-        self._totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw) for i, w in enumerate(waypoints)]
+        self._totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(waypoints)]
         self._recent: deque[WaypointResult] = deque(maxlen=max(1, keep_last))
         self._not_reached: list[WaypointResult] = []
         self._keep_not_reached = keep_not_reached
@@ -277,4 +320,4 @@ class VisitLog:
 
     def _not_run(self, loop: int, index: int) -> WaypointResult:
         waypoint = self._waypoints[index]
-        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw)
+        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw_rad)

@@ -16,11 +16,13 @@ driving.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable
+from collections import deque
+from collections.abc import Generator, Iterable, Iterator
 
 from navseq.errors import NavseqError
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
-from navseq.executor.control import MissionControl
+from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
+from navseq.executor.events import MissionEvent
 from navseq.executor.machine import MissionExecutor, MissionListener
 from navseq.executor.result import MissionResult
 from navseq.executor.resume import ResumePoint
@@ -80,7 +82,8 @@ def run_mission(
     ``resume`` continues an earlier run (see :mod:`navseq.sinks.journal`). ``tick`` is
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
-    ``control`` lets other threads file operator requests (skip the current waypoint).
+    ``control`` lets other threads file operator requests (skip, pause, resume,
+    cancel) and tells the run when its process is being shut down (``stop_reason``).
     ``signals`` is the run's :class:`~navseq.signals.SignalGuard`: armed for the run
     (SIGINT, SIGTERM and SIGHUP end it, also where SIGINT was ignored), deferring from
     the moment the run is stopped or ends, so that the caller can finish its outputs
@@ -90,7 +93,9 @@ def run_mission(
     ``robot:``, else the TurtleBot3 burger).
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
-    :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP, :class:`MissionAborted` when
+    :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP,
+    :class:`~navseq.executor.control.StopRequested` when ``control``'s ``stop_reason``
+    gives a reason (the result then says ``interrupted (<reason>)``), :class:`MissionAborted` when
     a NavseqError (a sink that cannot write) stops the run, and re-raises any other
     exception;
     in the last two cases only after cancelling the active goal and telling the
@@ -114,6 +119,10 @@ def run_mission(
         name = signalled.signal_name
         result = _abort(executor, navigator, f"interrupted: {name}")
         raise MissionInterrupted(name, result) from None
+    except StopRequested as stop:
+        guard.defer()
+        _abort(executor, navigator, f"interrupted ({stop})")
+        raise
     except NavseqError as error:
         # A sink could not do its job (the journal on a full disk): stop, then say why.
         guard.defer()
@@ -124,34 +133,123 @@ def run_mission(
         _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
         raise
     finally:
+        if control is not None:
+            control.close("the mission has ended")
         if signals is None:
             guard.restore()
         else:
             guard.defer()  # the caller's outputs come next
     if not server_up:
-        raise NavseqError(
-            f"no navigation server answered within {server_wait:g} s; is the navigation "
-            "stack (move_base or the simulator) running, and is the action name right?",
-            source="navigator",
-        )
+        raise _no_server(server_wait)
     return executor.result
+
+
+def iter_mission(
+    mission: Mission,
+    navigator: Navigator,
+    *,
+    tick: float = 0.1,
+    server_wait: float = 10.0,
+    control: MissionControl | None = None,
+    robot: RobotProfile | None = None,
+) -> Generator[MissionEvent, None, MissionResult]:
+    """:func:`run_mission` as a generator of mission events, for a caller's own loop.
+
+    Yields every event as it happens and returns the result (``StopIteration.value``).
+    It installs no signal handlers (a library's loop may not run in the main thread);
+    whatever ends it early -- an exception, Ctrl-C, or the caller leaving the loop
+    (``close()``) -- cancels the active goal first, as :func:`run_mission` does.
+    Raises :class:`~navseq.errors.NavseqError` when the server is not there.
+    """
+    executor = MissionExecutor(mission, robot=robot)
+    pending: deque[MissionEvent] = deque()
+    executor.add_listener(pending.append)
+    if not navigator.wait_for_server(server_wait):
+        raise _no_server(server_wait)
+    try:
+        for _ in _steps(executor, navigator, tick, control):
+            while pending:
+                yield pending.popleft()
+    except GeneratorExit:
+        _abort(executor, navigator, "interrupted: the caller stopped the run")
+        raise
+    except KeyboardInterrupt:
+        _abort(executor, navigator, "interrupted: SIGINT")
+        raise
+    except BaseException as error:
+        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+        raise
+    while pending:
+        yield pending.popleft()
+    return executor.result
+
+
+def _no_server(server_wait: float) -> NavseqError:
+    return NavseqError(
+        f"no navigation server answered within {server_wait:g} s; is the navigation "
+        "stack (move_base or the simulator) running, and is the action name right?",
+        source="navigator",
+    )
 
 
 def _drive(
     executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
 ) -> None:
     """The loop: navigator events, operator requests and the clock in; commands out."""
+    for _ in _steps(executor, navigator, tick, control):
+        pass
+
+
+def _steps(
+    executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
+) -> Iterator[None]:
+    """The loop, one step (one look at the mission, then ``tick`` of navigator time) per
+    item, so that :func:`iter_mission` can hand over the events between steps."""
     _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
-        for event in navigator.poll():
+        events = navigator.poll()
+        if control is not None and control.stop_reason is not None:
+            # Asked after taking the events: a shutdown is announced before the goal is
+            # cancelled under us, so that cancel's result is never a failed waypoint.
+            stop = control.stop_reason()
+            if stop is not None:
+                raise StopRequested(stop)
+        for event in events:
             _apply(navigator, executor.on_event(event, navigator.now(), navigator.robot_pose()))
         if control is not None:
-            for reason in control.take_skips():
-                _apply(navigator, executor.skip(navigator.now(), reason))
+            for request in control.take_requests():
+                _apply(navigator, _operate(executor, request, navigator.now()))
         pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
         _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
+        yield
         if not executor.finished:
             navigator.spin(tick)
+
+
+def _operate(executor: MissionExecutor, request: OperatorRequest, now: float) -> list[Command]:
+    """Carry out one operator request as an executor input, and answer it."""
+    if executor.finished:
+        request.answer(False, f"nothing to {request.kind}: the mission has ended")
+        return []
+    if request.kind == "skip":
+        commands = executor.skip(now, request.reason or "skipped by operator")
+        request.answer(True, "skipped; going on with the next waypoint")
+    elif request.kind == "pause":
+        if executor.paused:
+            request.answer(False, "already paused")
+            return []
+        commands = executor.pause(now, request.reason or "paused by operator")
+        request.answer(True, "paused; the active goal was cancelled")
+    elif request.kind == "resume":
+        if not executor.paused:
+            request.answer(False, "not paused")
+            return []
+        commands = executor.resume(now)
+        request.answer(True, "resumed")
+    else:  # cancel
+        commands = executor.cancel(now, request.reason or "cancelled by operator")
+        request.answer(True, "mission cancelled; the active goal was cancelled")
+    return commands
 
 
 def _odometry_pose(navigator: Navigator) -> Pose2D | None:

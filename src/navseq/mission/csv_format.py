@@ -106,7 +106,7 @@ def _waypoint(cells: list[str], index: int, where: str, problems: Problems) -> W
     yaw = fields.attempt(problems, lambda: quaternion_yaw_checked(quaternion, where, subject))
     if yaw is None or math.isnan(yaw):
         return None
-    return Waypoint(x=x, y=y, z=z, yaw=yaw, where=where)
+    return Waypoint(x=x, y=y, z=z, yaw_rad=yaw, where=where)
 
 
 def _number(cell: str, where: str, label: str, column: str) -> float:

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, NoReturn
 
 from navseq.geometry import Pose2D
 from navseq.mission.robot import RobotProfile
@@ -52,26 +52,82 @@ class Policy:
 POLICY_FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(Policy))
 
 
-@dataclass(frozen=True)
-class Waypoint:
-    """One goal of a mission. ``yaw`` is radians here (files say degrees)."""
+_NO_OVERRIDES: Mapping[str, Any] = MappingProxyType({})
 
-    x: float
-    y: float
-    yaw: float = 0.0
-    z: float = 0.0
+
+@dataclass(frozen=True, init=False)
+class Waypoint:
+    """One goal of a mission: a position in metres and a heading, with a unit you name.
+
+    The heading is given as ``yaw_deg=`` (degrees, as mission files and the tutorial
+    write it) or ``yaw_rad=`` (radians, as ROS messages carry it), never as a bare
+    number: ``Waypoint(1.0, 2.0, yaw_deg=90)`` faces +y. It is stored as
+    :attr:`yaw_rad`; :attr:`yaw_deg` reads it back in degrees. Everything after ``x``
+    and ``y`` is keyword-only, so a third positional number cannot be taken for the
+    wrong unit, and ``Waypoint(x, y, yaw=90)`` is a :class:`TypeError` saying so.
+
+    ``overrides`` are per-waypoint :class:`Policy` values (``{"goal_timeout": 30.0}``);
+    ``where`` (``"file.yaml:12"``) is where the user wrote it, for messages, and is
+    not part of equality.
+    """
+
+    x: float  # m
+    y: float  # m
+    yaw_rad: float = 0.0
+    z: float = 0.0  # m
     name: str | None = None
-    overrides: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
-    # "file.yaml:12" — where the user wrote it, for messages; not part of equality
+    overrides: Mapping[str, Any] = field(default_factory=lambda: _NO_OVERRIDES)
     where: str | None = field(default=None, compare=False)
+
+    def __init__(
+        self,
+        x: float,
+        y: float,
+        *ambiguous: NoReturn,
+        yaw_deg: float | None = None,
+        yaw_rad: float | None = None,
+        z: float = 0.0,
+        name: str | None = None,
+        overrides: Mapping[str, Any] | None = None,
+        where: str | None = None,
+        **unknown: NoReturn,
+    ) -> None:
+        # ``NoReturn`` above: a type checker flags Waypoint(1, 2, 90) and yaw=90 too.
+        if ambiguous:
+            raise TypeError(
+                f"Waypoint(x, y, {ambiguous[0]!r}): a yaw given by position has no unit; "
+                "write yaw_deg= (degrees) or yaw_rad= (radians)"
+            )
+        if "yaw" in unknown:
+            raise TypeError(
+                "Waypoint(yaw=...) is ambiguous: write yaw_deg= (degrees, as in mission "
+                "files) or yaw_rad= (radians)"
+            )
+        if unknown:
+            raise TypeError(f"Waypoint() got unexpected keyword argument(s): {', '.join(unknown)}")
+        if yaw_deg is not None and yaw_rad is not None:
+            raise TypeError("Waypoint(): give the yaw once, as yaw_deg= or yaw_rad=, not both")
+        yaw = math.radians(yaw_deg) if yaw_deg is not None else (yaw_rad or 0.0)
+        for name_, value in (
+            ("x", x),
+            ("y", y),
+            ("yaw_rad", yaw),
+            ("z", z),
+            ("name", name),
+            ("overrides", _NO_OVERRIDES if not overrides else MappingProxyType(dict(overrides))),
+            ("where", where),
+        ):
+            object.__setattr__(self, name_, value)
+
+    @property
+    def yaw_deg(self) -> float:
+        """The heading in degrees."""
+        return math.degrees(self.yaw_rad)
 
     @property
     def pose(self) -> Pose2D:
-        return Pose2D(self.x, self.y, self.yaw)
-
-    @property
-    def yaw_degrees(self) -> float:
-        return math.degrees(self.yaw)
+        """Position and heading as a :class:`~navseq.geometry.Pose2D` (yaw in radians)."""
+        return Pose2D(self.x, self.y, self.yaw_rad)
 
     def label(self, index: int) -> str:
         """Human name used in messages: ``waypoint 3 'dock'`` (1-based, like the files)."""

@@ -239,7 +239,7 @@ def _plain_waypoint(node: Located) -> Waypoint | None:
             x=fields.coordinate(x, ""),
             y=fields.coordinate(y, ""),
             z=(fields.coordinate(z_node, "") or 0.0) if z_node is not None else 0.0,
-            yaw=fields.yaw_degrees(yaw_node, "") if yaw_node is not None else 0.0,
+            yaw_rad=fields.yaw_degrees(yaw_node, "") if yaw_node is not None else 0.0,
             name=name,
             overrides=_NO_OVERRIDES,
             where=node.where,
@@ -284,7 +284,7 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         x=x,
         y=y,
         z=z or 0.0,
-        yaw=yaw,
+        yaw_rad=yaw,
         name=name,
         overrides=MappingProxyType(overrides),
         where=node.where,
@@ -312,7 +312,7 @@ def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoi
         return None
     x, y, *rest = (v for v in values if v is not None)
     yaw = rest[0] if rest else 0.0
-    return Waypoint(x=x, y=y, yaw=yaw, where=node.where)
+    return Waypoint(x=x, y=y, yaw_rad=yaw, where=node.where)
 
 
 def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:

@@ -134,8 +134,13 @@ def builtin_profile(name: str, where: str | None, subject: str, source: str | No
     """The built-in profile called ``name``, or an error naming the closest known one."""
     profile = BUILTIN_PROFILES.get(name.strip())
     if profile is None:
+        # A likely typo is named; the list of robots is given once, after it. A long
+        # "name" (a file that is not a robot file) is shown cut short.
+        typo = closest_hint(name, BUILTIN_PROFILES)
+        typo = typo if "did you mean" in typo else ""
+        shown = name if len(name) <= 60 else f"{name[:57]}..."
         raise NavseqError(
-            f"unknown robot {name!r}{closest_hint(name, BUILTIN_PROFILES)}; built-in robots: "
+            f"unknown robot {shown!r}{typo}; built-in robots: "
             f"{', '.join(BUILTIN_PROFILES)} (or give a mapping with base: and overrides)",
             source=where,
             subject=subject,

@@ -69,7 +69,7 @@ def waypoints_from_sequences(
     if len(problems) > before or not positions or yaws is None:
         return ()
     return tuple(
-        Waypoint(x=x.value, y=y.value, z=z.value, yaw=yaw.value, where=x.where)
+        Waypoint(x=x.value, y=y.value, z=z.value, yaw_rad=yaw.value, where=x.where)
         for (x, y, z), yaw in zip(_triples(positions), yaws, strict=True)
     )
 

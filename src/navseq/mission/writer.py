@@ -157,7 +157,7 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
     entry["y"] = waypoint.y
     if waypoint.z != 0.0:
         entry["z"] = waypoint.z
-    entry.update(_yaw_entry(waypoint.yaw))
+    entry.update(_yaw_entry(waypoint.yaw_rad))
     entry.update(
         _policy_values(
             Policy().with_overrides(waypoint.overrides),

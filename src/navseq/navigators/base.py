@@ -1,5 +1,8 @@
 """The small interface every navigator (sim, ros1, later nav2) implements.
 
+Nothing here names one stack's statuses: a goal ends :class:`GoalOutcome` SUCCEEDED,
+FAILED or LOST, with the stack's own status name as detail.
+
 A navigator pursues one goal at a time on behalf of the executor. It never decides
 what to do next: it only reports what happened, as events the executor polls.
 Time is the navigator's own (simulated for ``sim``, ROS time for ``ros1``), read
@@ -15,19 +18,17 @@ from typing import Protocol, runtime_checkable
 from navseq.geometry import Pose2D
 
 
-class GoalStatus(str, enum.Enum):
-    """Terminal outcome of a goal, named after actionlib_msgs/GoalStatus.
+class GoalOutcome(str, enum.Enum):
+    """How a goal ended, in terms every navigation stack shares.
 
-    ``LOST`` covers an action server that vanished with the goal active (and
-    actionlib's own LOST status).
+    Each navigator maps its stack's own terminal statuses onto these three and passes
+    the stack's name for the status along (:attr:`GoalDone.status`), so the executor
+    needs no stack's vocabulary while reports still say ``ABORTED`` or ``CANCELED``.
     """
 
-    SUCCEEDED = "SUCCEEDED"
-    ABORTED = "ABORTED"
-    REJECTED = "REJECTED"
-    PREEMPTED = "PREEMPTED"
-    RECALLED = "RECALLED"
-    LOST = "LOST"
+    SUCCEEDED = "succeeded"  # the stack says the robot is there (the executor checks)
+    FAILED = "failed"  # the stack gave up on the goal, refused it, or it was cancelled
+    LOST = "lost"  # the stack lost track of the goal (server gone or restarted)
 
 
 @dataclass(frozen=True)
@@ -64,9 +65,29 @@ class GoalPlan:
 
 @dataclass(frozen=True)
 class GoalDone:
+    """The goal ended: ``outcome`` for the executor, ``status`` and ``text`` for people.
+
+    ``status`` is the stack's own name of its terminal status (actionlib's ``ABORTED``,
+    ``PREEMPTED``, Nav2's ``CANCELED`` ...), kept verbatim in the journal and report;
+    ``text`` the stack's own words about it (may be empty).
+    """
+
     goal_id: int
-    status: GoalStatus
+    outcome: GoalOutcome
+    status: str = ""
     text: str = ""
+
+    @classmethod
+    def succeeded(cls, goal_id: int, text: str = "", status: str = "SUCCEEDED") -> GoalDone:
+        return cls(goal_id, GoalOutcome.SUCCEEDED, status, text)
+
+    @classmethod
+    def failed(cls, goal_id: int, status: str, text: str = "") -> GoalDone:
+        return cls(goal_id, GoalOutcome.FAILED, status, text)
+
+    @classmethod
+    def lost(cls, goal_id: int, text: str = "", status: str = "LOST") -> GoalDone:
+        return cls(goal_id, GoalOutcome.LOST, status, text)
 
 
 @dataclass(frozen=True)

@@ -5,10 +5,12 @@ interface with its own simulated clock. The robot drives in a straight line to t
 goal at a fixed speed, then turns in place to the goal yaw, and sends feedback every
 step. What each goal does is scripted, in the order goals are sent::
 
-    nav = ScriptedNavigator([Succeed(), Finish(GoalStatus.ABORTED, after=2.0), Stall()])
+    nav = ScriptedNavigator([Succeed(), Finish("ABORTED", after=2.0), Stall()])
 
 The first goal succeeds on arrival, the second is aborted after 2 s, the third stops
-moving and never finishes; goals beyond the script succeed. :class:`FalseSuccess`
+moving and never finishes; goals beyond the script succeed. Statuses are actionlib's
+names (the double plays move_base): ``SUCCEEDED`` ends a goal succeeded, ``LOST`` lost,
+any other name failed with that name as the stack's status. :class:`FalseSuccess`
 plays move_base's plan race (ros-planning/navigation #949): SUCCEEDED at once, with
 the robot still where it was. A goal resent after a
 server loss is a new goal and takes the next behaviour.
@@ -21,6 +23,7 @@ so that simulated time runs at that multiple of wall time (for signal tests).
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import time
@@ -35,11 +38,12 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
-    GoalStatus,
+    GoalOutcome,
     NavEvent,
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
 
 
 @dataclass(frozen=True)
@@ -51,10 +55,11 @@ class Succeed:
 class Finish:
     """Report ``status`` ``after`` seconds after the goal was sent; drive meanwhile.
 
+    ``status`` is a stack's status name (``"ABORTED"``, ``"CANCELED"`` ...).
     ``REJECTED`` and ``RECALLED`` goals are never accepted, like in actionlib.
     """
 
-    status: GoalStatus
+    status: str
     after: float = 0.0
     text: str = ""
 
@@ -98,7 +103,20 @@ class FalseSuccess:
 
 Behaviour = Succeed | Finish | LoseServer | Hang | Stall | FalseSuccess
 
-_UNACCEPTED = (GoalStatus.REJECTED, GoalStatus.RECALLED)
+_UNACCEPTED = ("REJECTED", "RECALLED")
+#: Status names a ``--scripted-script`` may end a goal with: actionlib's, and Nav2's
+#: CANCELED.
+SCRIPT_STATUSES = ("SUCCEEDED", "ABORTED", "REJECTED", "PREEMPTED", "RECALLED", "LOST", "CANCELED")
+
+
+def scripted_done(goal_id: int, status: str, text: str = "") -> GoalDone:
+    """How the double ends a goal with an actionlib status name."""
+    outcome = {"SUCCEEDED": GoalOutcome.SUCCEEDED, "LOST": GoalOutcome.LOST}.get(
+        status, GoalOutcome.FAILED
+    )
+    return GoalDone(goal_id, outcome, status, text)
+
+
 _ARRIVED_YAW = 1e-3
 
 
@@ -164,7 +182,7 @@ class ScriptedNavigator:
         if self._server_down_until is not None:
             return  # nobody listening: the goal goes nowhere
         if self._active is not None:
-            self._events.append(GoalDone(self._active.goal.goal_id, GoalStatus.PREEMPTED))
+            self._events.append(GoalDone.failed(self._active.goal.goal_id, "PREEMPTED"))
         index = len(self.sent_goals) - 1
         behaviour = self.script[index] if index < len(self.script) else Succeed()
         self._active = _ActiveGoal(goal, behaviour, self._t)
@@ -176,7 +194,7 @@ class ScriptedNavigator:
         self.cancels.append((self._t, active_id))
         self._record("cancel_goal", goal_id=active_id)
         if self._active is not None and self._server_down_until is None:
-            self._events.append(GoalDone(self._active.goal.goal_id, GoalStatus.PREEMPTED))
+            self._events.append(GoalDone.failed(self._active.goal.goal_id, "PREEMPTED"))
         self._active = None
 
     def clear_costmaps(self) -> None:
@@ -228,17 +246,17 @@ class ScriptedNavigator:
             self._server_down_until = self._t + down_for
             self._active = None
             if behaviour.as_goal_status:
-                self._events.append(GoalDone(goal_id, GoalStatus.LOST))
+                self._events.append(GoalDone.lost(goal_id))
             else:
                 self._events.append(ServerLost("scripted server loss"))
             return
         if isinstance(behaviour, Finish) and elapsed >= behaviour.after:
-            self._events.append(GoalDone(goal_id, behaviour.status, behaviour.text))
+            self._events.append(scripted_done(goal_id, behaviour.status, behaviour.text))
             self._active = None
             return
         if isinstance(behaviour, FalseSuccess):
             if elapsed >= behaviour.after:
-                self._events.append(GoalDone(goal_id, GoalStatus.SUCCEEDED, behaviour.text))
+                self._events.append(GoalDone.succeeded(goal_id, behaviour.text))
                 self._active = None
             return  # the robot never moves
         stalled = isinstance(behaviour, Stall) and elapsed >= behaviour.after
@@ -246,7 +264,7 @@ class ScriptedNavigator:
         remaining = self._pose.distance_to(active.goal.pose) if self.report_distance else None
         self._events.append(GoalFeedback(goal_id, self._pose, remaining))
         if arrived and isinstance(behaviour, Succeed):
-            self._events.append(GoalDone(goal_id, GoalStatus.SUCCEEDED))
+            self._events.append(GoalDone.succeeded(goal_id))
             self._active = None
 
     def _move_towards(self, target: Pose2D, dt: float) -> bool:
@@ -277,6 +295,52 @@ class ScriptedNavigator:
             self._log.flush()
 
 
+def behaviours_of(script: str) -> list[Behaviour]:
+    """``succeed,aborted@2,stall@1,hang,falsesuccess`` as behaviours (``--scripted-script``).
+
+    A status name ends the goal with that status (``aborted@2``: ABORTED after 2 s);
+    anything else is a ValueError (test-only input: an internal error, not a user's).
+    """
+    behaviours: list[Behaviour] = []
+    for token in filter(None, (part.strip() for part in script.split(","))):
+        name, _, after = token.partition("@")
+        seconds = float(after) if after else 0.0
+        if name == "succeed":
+            behaviours.append(Succeed())
+        elif name == "hang":
+            behaviours.append(Hang())
+        elif name == "stall":
+            behaviours.append(Stall(after=seconds))
+        elif name == "falsesuccess":
+            behaviours.append(FalseSuccess(after=seconds))
+        elif name.upper() in SCRIPT_STATUSES:
+            behaviours.append(Finish(name.upper(), after=seconds))
+        else:
+            raise ValueError(f"{name!r} is no scripted behaviour or status")
+    return behaviours
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """``navseq run --navigator scripted`` (hidden): the double, for the CLI's tests."""
+    grid = draft.optional_map()
+    start = draft.start
+
+    def make_navigator() -> ScriptedNavigator:
+        return ScriptedNavigator(
+            behaviours_of(args.scripted_script),
+            start=start,
+            speed=args.scripted_speed,
+            realtime=args.scripted_realtime,
+            log_path=args.scripted_log,
+        )
+
+    return NavigatorSetup(
+        make_navigator=make_navigator,
+        info={"kind": "scripted", "speed": args.scripted_speed},
+        grid=grid,
+    )
+
+
 __all__ = [
     "Behaviour",
     "FalseSuccess",
@@ -286,4 +350,7 @@ __all__ = [
     "ScriptedNavigator",
     "Stall",
     "Succeed",
+    "behaviours_of",
+    "create",
+    "scripted_done",
 ]

@@ -1,20 +1,26 @@
 """The ``sim`` navigator: navseq's embedded simulator behind the Navigator interface.
 
 It drives a :class:`navseq.sim.world.SimWorld` in simulated time, as fast as the CPU
-allows: :meth:`SimNavigator.spin` steps the world, and ``now()`` is the world's clock.
+allows, or paced against the wall clock at a chosen factor (``realtime``: 1 to watch
+it or to drive RViz in real time): :meth:`SimNavigator.spin` steps the world, and
+``now()`` is the world's clock.
 Events follow what an actionlib client of move_base would see:
 
 - ``GoalAccepted`` as soon as a goal is sent;
 - ``GoalPlan`` each time the navigation server adopts a new plan for it;
 - ``GoalFeedback`` (pose, distance remaining along the plan) every ``feedback_period``
   seconds of simulated time while the goal is active;
-- ``GoalDone`` with SUCCEEDED or ABORTED (the server's verdict and its reason), or
-  PREEMPTED for a goal that was cancelled or replaced by a newer one.
+- ``GoalDone`` succeeded (status SUCCEEDED) or failed (ABORTED), the server's verdict
+  and its reason, or failed (PREEMPTED) for a goal that was cancelled or replaced by
+  a newer one.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 from navseq.geometry import Pose2D
@@ -24,15 +30,16 @@ from navseq.navigators.base import (
     GoalDone,
     GoalFeedback,
     GoalPlan,
-    GoalStatus,
     NavEvent,
 )
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
 from navseq.sim.navserver import NavParams, NavState
 from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
 from navseq.track import Track
 
-_TERMINAL = {NavState.SUCCEEDED: GoalStatus.SUCCEEDED, NavState.ABORTED: GoalStatus.ABORTED}
+# The simulated server plays move_base, so its results carry actionlib's status names.
+_SUCCEEDED, _ABORTED, _PREEMPTED = "SUCCEEDED", "ABORTED", "PREEMPTED"
 
 
 class SimNavigator:
@@ -41,12 +48,32 @@ class SimNavigator:
     ``trajectory`` records ``(t, x, y)`` of the robot at the start and whenever it
     has moved 5 mm (or a 0.05 s step passed), for reports and pictures; it is a
     :class:`~navseq.track.Track`, so it stays bounded on a patrol that runs for days.
+
+    ``realtime`` (a factor > 0, or None for as fast as possible) paces simulated time
+    against ``wall_clock``: after each step the navigator sleeps until the wall clock has
+    caught up with simulated time / ``realtime`` since the first step. Pacing is against
+    that first step, not per step, so rounding does not add up over a long run, and a
+    slow step is caught up rather than lost.
     """
 
-    def __init__(self, world: SimWorld, *, feedback_period: float = 0.2) -> None:
+    def __init__(
+        self,
+        world: SimWorld,
+        *,
+        feedback_period: float = 0.2,
+        realtime: float | None = None,
+        wall_clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> None:
         if not feedback_period > 0:
             raise ValueError(f"feedback_period must be positive, got {feedback_period}")
+        if realtime is not None and not (math.isfinite(realtime) and realtime > 0):
+            raise ValueError(f"realtime must be a factor above 0, got {realtime}")
         self.world = world
+        self.realtime = realtime
+        self._wall_clock = wall_clock
+        self._sleep = sleep
+        self._pace_origin: tuple[float, float] | None = None  # (simulated, wall) time
         self.feedback_period = feedback_period
         pose = world.robot.pose
         self.trajectory = Track(min_step=0.005, min_interval=0.05)
@@ -87,7 +114,7 @@ class SimNavigator:
     def send_goal(self, goal: Goal) -> None:
         if self._active is not None:
             self._events.append(
-                GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "replaced by a new goal")
+                GoalDone.failed(self._active.goal_id, _PREEMPTED, "replaced by a new goal")
             )
         self._active = goal
         self.world.server.set_goal(goal.pose)
@@ -98,7 +125,7 @@ class SimNavigator:
         if self._active is None:
             return
         self.world.server.cancel()
-        self._events.append(GoalDone(self._active.goal_id, GoalStatus.PREEMPTED, "canceled"))
+        self._events.append(GoalDone.failed(self._active.goal_id, _PREEMPTED, "canceled"))
         self._active = None
 
     def clear_costmaps(self) -> None:
@@ -128,11 +155,25 @@ class SimNavigator:
                 trajectory.append((world.time, robot.pose.x, robot.pose.y))
             if self._active is not None:
                 self._report(self._active)
+            if self.realtime is not None:
+                self._pace()
 
     def close(self) -> None:
         self.cancel_goal()
 
     # -- internals ---------------------------------------------------------------------
+
+    def _pace(self) -> None:
+        """Sleep until the wall clock is where simulated time says it should be."""
+        assert self.realtime is not None
+        now = self._wall_clock()
+        if self._pace_origin is None:
+            self._pace_origin = (self.world.time, now)
+            return
+        sim_origin, wall_origin = self._pace_origin
+        due = wall_origin + (self.world.time - sim_origin) / self.realtime
+        if due > now:
+            self._sleep(due - now)
 
     def _report(self, goal: Goal) -> None:
         """Turn what the server did during the last step into events."""
@@ -142,12 +183,59 @@ class SimNavigator:
             self._plan_version = server.plan_version
             path = tuple((float(x), float(y)) for x, y in server.plan.points)
             self._events.append(GoalPlan(goal.goal_id, path))
-        status = _TERMINAL.get(server.state)
-        if status is not None:
-            self._events.append(GoalDone(goal.goal_id, status, server.status_text))
+        if server.state in (NavState.SUCCEEDED, NavState.ABORTED):
+            if server.state is NavState.SUCCEEDED:
+                done = GoalDone.succeeded(goal.goal_id, server.status_text, _SUCCEEDED)
+            else:
+                done = GoalDone.failed(goal.goal_id, _ABORTED, server.status_text)
+            self._events.append(done)
             self._active = None
         elif world.time >= self._next_feedback - 1e-9:
             self._next_feedback += self.feedback_period
             self._events.append(
                 GoalFeedback(goal.goal_id, world.robot.pose, server.distance_remaining)
             )
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """``navseq run --navigator sim``: the simulated world on the mission's map.
+
+    With no start pose given, the robot starts at the roomy point nearest the map
+    origin (said in a note). One costmap serves pre-flight and the simulated server.
+    """
+    from navseq.commands.common import format_pose
+    from navseq.errors import NavseqError
+    from navseq.simrun import prepare_sim_world
+
+    if draft.map_path is None:
+        raise NavseqError(
+            "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
+            source=draft.mission.source,
+        )
+    grid = load_map(draft.map_path)
+    # The same preparation as the Python API's simulate(): default start, pre-flight on
+    # the one costmap the simulated server also uses, the world.
+    ready = prepare_sim_world(
+        draft.mission,
+        grid,
+        draft.start,
+        draft.robot,
+        preflight=draft.preflight,
+        numbers=draft.numbers,
+    )
+    notes = []
+    if ready.start_defaulted:
+        draft.start = ready.start
+        draft.start_source = "simulator default"
+        notes.append(
+            f"no start pose given (--start or start:): the robot starts at "
+            f"{format_pose(ready.start)}, the roomy point nearest the map origin"
+        )
+    world = ready.world
+    realtime = getattr(args, "realtime", None)
+    return NavigatorSetup(
+        make_navigator=lambda: SimNavigator(world, realtime=realtime),
+        info={"kind": "sim", "robot": draft.robot.name},
+        grid=grid,
+        notes=notes,
+    )

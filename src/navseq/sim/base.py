@@ -1,6 +1,6 @@
 """A simulated robot base: commanded velocity in, pose in the map and odom frames out.
 
-This is the body that navseq's sim robot ROS node (:mod:`navseq.ros.sim_robot_node`)
+This is the body that navseq's sim robot ROS node (:mod:`navseq.ros1.sim_robot_node`)
 wraps. It has no sensors and no physics beyond differential-drive kinematics
 (:class:`navseq.sim.robot.DiffDriveRobot`), and it behaves like a real base driver in the
 two ways a navigation stack notices: it stops when velocity commands stop coming, and

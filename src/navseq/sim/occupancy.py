@@ -363,6 +363,14 @@ def _number(value: Any) -> float | None:
 def _read_yaml(path: Path) -> Located:
     """The map YAML as a located mapping, read with the mission files' care."""
     source = str(path)
+    if _is_image(path):
+        sibling = path.with_suffix(".yaml")
+        hint = f" ({printable(str(sibling))}?)" if sibling.is_file() else ""
+        raise NavseqError(
+            "is a map image, not a map description: give the map's YAML file, the one that "
+            f"names this image and its resolution and origin{hint}",
+            source=source,
+        )
     try:
         text = read_mission_text(path, max_bytes=MAX_MAP_YAML_BYTES, what="map YAML file")
     except NavseqError as error:
@@ -381,6 +389,22 @@ def _read_yaml(path: Path) -> Located:
             source=source if doc is None else doc.where,
         )
     return doc
+
+
+def _is_image(path: Path) -> bool:
+    """Whether ``path`` is a PGM/PPM/PBM or PNG file (a map's image given for its YAML).
+
+    Only a regular file is opened: a FIFO would block here.
+    """
+    try:
+        if not path.is_file():
+            return False
+        with path.open("rb") as stream:
+            head = stream.read(8)
+    except OSError:
+        return False
+    netpbm = head[:1] == b"P" and head[1:2] in (b"1", b"2", b"3", b"4", b"5", b"6")
+    return head.startswith(b"\x89PNG") or (netpbm and head[2:3].isspace())
 
 
 def max_map_pixels() -> int:

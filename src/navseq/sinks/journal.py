@@ -83,6 +83,8 @@ _EVENT_TYPES: dict[str, type] = {
         ev.AttemptFailed,
         ev.WaypointDwelling,
         ev.WaypointFinished,
+        ev.MissionPaused,
+        ev.MissionResumed,
         ev.ServerStatusChanged,
         ev.MissionFinished,
     )
@@ -506,7 +508,7 @@ def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> W
         name=None,
         x=0.0,
         y=0.0,
-        yaw=0.0,
+        yaw_rad=0.0,
         outcome=event.outcome,
         attempts=event.attempts,
         duration=event.duration,

@@ -5,21 +5,21 @@ Three listeners share one model of the run, :class:`RunView`:
 - :class:`LiveProgress`: a rich live panel for terminals (current waypoint n/N and
   name, status, distance remaining, mission-clock elapsed time, loop, attempt);
 - :class:`LogProgress`: one plain line per thing that happened, for logs and pipes;
-- :class:`JsonProgress`: one JSON object per event, for programs (``--json``).
+- :class:`~navseq.sinks.json_events.JsonProgress`: one JSON object per event, for
+  programs (``--json``; its own module).
 
-:func:`make_progress` picks one; :func:`summary_table` is the per-visit table printed
-at the end. Elapsed time is the navigator's clock (simulated time on the simulator).
+:func:`make_progress` picks one; the table printed at the end is
+:mod:`navseq.sinks.summary`'s. Elapsed time is the navigator's clock (simulated time
+on the simulator).
 """
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 from collections import deque
-from collections.abc import Mapping
-from dataclasses import asdict
-from typing import IO, Any
+from collections.abc import Sequence
+from typing import IO
 
 from rich.console import Console, Group, RenderableType
 from rich.live import Live
@@ -34,6 +34,8 @@ from navseq.executor.events import (
     LoopStarted,
     MissionEvent,
     MissionFinished,
+    MissionPaused,
+    MissionResumed,
     MissionStarted,
     ServerStatusChanged,
     WaypointDwelling,
@@ -42,9 +44,9 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import MissionResult, WaypointResult
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.sinks.json_events import JsonProgress
 from navseq.text import printable
 
 OUTCOME_STYLE = {
@@ -84,8 +86,10 @@ def eta_text(remaining: float, robot: RobotProfile) -> str:
 class RunView:
     """The state of a run as a watcher sees it, folded from mission events."""
 
-    def __init__(self, mission: Mission):
+    def __init__(self, mission: Mission, numbers: Sequence[int] | None = None):
         self.mission = mission
+        # The waypoints' positions in the file when the mission is a part of it.
+        self.numbers = numbers
         self.count = len(mission.waypoints)
         self.loops = mission.loops
         self.t = 0.0
@@ -106,7 +110,10 @@ class RunView:
 
     def waypoint_label(self, index: int) -> str:
         name = self.mission.waypoints[index].name if index < self.count else None
-        return f"waypoint {index + 1}/{self.count}" + (f" '{printable(name)}'" if name else "")
+        named = f" '{printable(name)}'" if name else ""
+        if self.numbers is not None and index < len(self.numbers):  # a part: file numbers
+            return f"waypoint {self.numbers[index] + 1}{named} ({index + 1}/{self.count})"
+        return f"waypoint {index + 1}/{self.count}{named}"
 
     def loop_label(self) -> str:
         total = "∞" if self.loops is None else str(self.loops)
@@ -151,6 +158,10 @@ class RunView:
                 + (f": {printable(event.reason)}" if event.reason else "")
                 + ", waiting"
             )
+        elif isinstance(event, MissionPaused):
+            self.status = f"paused ({printable(event.reason)})" if event.reason else "paused"
+        elif isinstance(event, MissionResumed):
+            self.status = "resumed"
         elif isinstance(event, MissionFinished):
             self.finished = event
             self.status = printable(event.reason)
@@ -172,8 +183,9 @@ class LiveProgress:
         *,
         recent_lines: int = 4,
         robot: RobotProfile = DEFAULT_PROFILE,
+        numbers: Sequence[int] | None = None,
     ):
-        self.view = RunView(mission)
+        self.view = RunView(mission, numbers)
         self.robot = robot
         self.console = console
         self.recent: deque[str] = deque(maxlen=recent_lines)
@@ -303,10 +315,28 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
         )
     if isinstance(event, ServerStatusChanged):
         return view.status
+    if isinstance(event, MissionPaused):
+        why = f" ({printable(event.reason)})" if event.reason else ""
+        return f"{view.waypoint_label(event.index)}: paused{why}, the robot stopped"
+    if isinstance(event, MissionResumed):
+        return f"{view.waypoint_label(event.index)}: resumed after {event.paused_for:.1f} s"
     if isinstance(event, MissionFinished):
-        verdict = "success" if event.success else "not every waypoint reached"
-        return f"mission finished: {event.reason} ({verdict})"
+        return f"mission finished: {final_status(event.reason, event.success)}"
     return None  # WaypointProgress, WaypointPlan
+
+
+def final_status(reason: str, success: bool) -> str:
+    """How the mission ended, in one sentence that says each thing once.
+
+    ``completed, every waypoint reached``; ``completed: 8 waypoint visits not reached``
+    (the reason says it already); ``interrupted: SIGINT; not every waypoint reached``.
+    """
+    reason = printable(reason)
+    if success:
+        return f"{reason}, every waypoint reached"
+    if "not reached" in reason:
+        return reason
+    return f"{reason}; not every waypoint reached"
 
 
 class LogProgress:
@@ -323,8 +353,9 @@ class LogProgress:
         *,
         progress_period: float = 10.0,
         robot: RobotProfile = DEFAULT_PROFILE,
+        numbers: Sequence[int] | None = None,
     ):
-        self.view = RunView(mission)
+        self.view = RunView(mission, numbers)
         self.robot = robot
         self.stream = stream
         self.progress_period = progress_period
@@ -365,48 +396,6 @@ class LogProgress:
             self._log(text)
 
 
-def _json_safe(value: Any) -> Any:
-    """Replace non-finite floats (not valid JSON) by None, recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    return value
-
-
-def event_to_json(event: MissionEvent) -> str:
-    """One event as a single-line JSON object: ``{"event": "<ClassName>", ...fields}``."""
-    return json.dumps(
-        {"event": type(event).__name__, **_json_safe(asdict(event))},
-        ensure_ascii=False,
-        separators=(",", ":"),
-    )
-
-
-class JsonProgress:
-    """One JSON object per event on ``stream`` (``navseq run --json``)."""
-
-    def __init__(self, stream: IO[str]):
-        self.stream = stream
-
-    def __enter__(self) -> JsonProgress:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stream.flush()
-
-    def __call__(self, event: MissionEvent) -> None:
-        self.stream.write(event_to_json(event) + "\n")
-        self.stream.flush()
-
-    def emit(self, kind: str, fields: Mapping[str, Any]) -> None:
-        """A record that is not a mission event (e.g. the final ``RunFinished``)."""
-        self.stream.write(json.dumps({"event": kind, **_json_safe(dict(fields))}) + "\n")
-        self.stream.flush()
-
-
 ProgressSink = LiveProgress | LogProgress | JsonProgress
 
 
@@ -416,72 +405,17 @@ def make_progress(
     json_lines: bool,
     stream: IO[str] | None = None,
     robot: RobotProfile = DEFAULT_PROFILE,
+    numbers: Sequence[int] | None = None,
 ) -> ProgressSink:
     """JSON lines if asked, a live panel on a terminal, plain log lines otherwise.
 
     ``robot``'s top speed gives the time still to go (at least) shown with the distance.
+    ``numbers``: the waypoints' positions in the file when ``mission`` is a part of it.
     """
     stream = stream if stream is not None else sys.stdout
     if json_lines:
         return JsonProgress(stream)
     console = Console(file=stream)
     if console.is_terminal:
-        return LiveProgress(mission, console, robot=robot)
-    return LogProgress(mission, stream, robot=robot)
-
-
-def _visit_reason(visit: WaypointResult) -> str:
-    """Why a visit was not reached: its last failure's reason and the stack's text."""
-    if WaypointOutcome(visit.outcome) is WaypointOutcome.REACHED:
-        return visit.reason
-    failure = visit.last_failure
-    if failure is None:
-        return visit.reason
-    return _why(visit.reason or failure.reason, failure.text)
-
-
-def summary_table(mission: Mission, result: MissionResult) -> Table:
-    """Per-visit outcome, attempts, time and distance, with totals in the footer.
-
-    For a visit not reached, the reason column says why: the last failure's reason
-    and the navigation stack's own text (move_base's "Failed to find a valid plan").
-    """
-    several_loops = any(visit.loop > 0 for visit in result.visits)
-    title = printable(f"mission {mission.source}: {result.reason}")
-    table = Table(title=Text(title), show_footer=True)
-    table.add_column("#", justify="right", footer="total")
-    if several_loops:
-        table.add_column("loop", justify="right")
-    table.add_column("name")
-    table.add_column("outcome", no_wrap=True)
-    table.add_column(
-        "attempts", justify="right", footer=str(sum(visit.attempts for visit in result.visits))
-    )
-    # Brackets are rich markup: escape the unit.
-    table.add_column(escape("time [s]"), justify="right", footer=f"{result.duration:.1f}")
-    table.add_column(
-        escape("distance [m]"), justify="right", footer=f"{result.distance_driven:.2f}"
-    )
-    reasons = [_visit_reason(visit) for visit in result.visits]
-    any_reason = any(reasons)
-    if any_reason:
-        table.add_column("reason")
-    for visit, reason in zip(result.visits, reasons, strict=True):
-        outcome = WaypointOutcome(visit.outcome)
-        label = "passed through" if visit.passed_through else outcome.value.replace("_", " ")
-        cells = [str(visit.index + 1)]
-        if several_loops:
-            cells.append(str(visit.loop + 1))
-        cells += [
-            visit.name or "",
-            f"{OUTCOME_MARK[outcome]} {label}",
-            str(visit.attempts),
-            f"{visit.duration:.1f}",
-            f"{visit.distance_driven:.2f}",
-        ]
-        if any_reason:
-            cells.append(reason)
-        # Text cells: a name or reason with [brackets] is not markup; a control
-        # character in one is shown escaped, never sent to the terminal.
-        table.add_row(*(Text(printable(cell)) for cell in cells), style=OUTCOME_STYLE[outcome])
-    return table
+        return LiveProgress(mission, console, robot=robot, numbers=numbers)
+    return LogProgress(mission, stream, robot=robot, numbers=numbers)

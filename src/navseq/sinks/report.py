@@ -1,6 +1,9 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 3; times in seconds, distances in metres, angles in degrees)::
+Schema (``schema_version`` 4; the unit is in every field's name where there is one:
+``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
+mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
+``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
       "schema_version": 3,
@@ -8,7 +11,8 @@ Schema (``schema_version`` 3; times in seconds, distances in metres, angles in d
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
       "navigator": {"kind": "sim" | "ros1" | ..., ...options},
-      "map": {"source", "resolution", "width", "height", "origin"} | null,
+      "map": {"source", "resolution_m", "width_cells", "height_cells",
+              "origin": {"x", "y", "yaw_deg"}} | null,
       "start": {"x", "y", "yaw_deg"} | null,      # where the robot was when the run began
       "start_source": "robot" | "mission start:" | "--start" | ... | null,
       "planned_start": {"x", "y", "yaw_deg"} | null,  # --start or the mission's start:
@@ -39,7 +43,8 @@ Each attempt is one goal sent: ``status`` is the navigation stack's terminal sta
 interrupt), ``reason`` navseq's verdict (empty for the attempt that reached the
 waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but the
 robot was not there), ``text`` the stack's own result text. Version 1 had
-``attempts`` as a count: it is the length of the list now.
+``attempts`` as a count: it is the length of the list now. Version 2 had the map's
+``resolution``, ``width``, ``height`` and an ``origin`` list with its yaw in radians.
 
 A patrol that loops for days, or a mission of 100 000 waypoints, makes more visits
 than a report can list: ``visits`` lists a small finite mission's every visit, else
@@ -47,8 +52,8 @@ the last 1000 visits and up to 1000 earlier visits that were not reached (see
 :class:`~navseq.executor.result.VisitLog`); ``visits_listed`` says how many are
 listed, how many omitted and what was kept. ``totals`` and ``waypoints`` (one entry
 per mission waypoint, its visits over every loop: counts, summed time and distance)
-count every visit. Version 2 had neither ``waypoints`` nor ``visits_listed`` and
-listed every visit; readers of reports (``navseq report``) accept both.
+count every visit. Versions 2 and 3 had neither ``waypoints`` nor
+``visits_listed`` and listed every visit; readers of reports (``navseq report``) accept both.
 """
 
 from __future__ import annotations
@@ -58,7 +63,7 @@ import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from navseq import __version__
 from navseq.executor.events import WaypointOutcome
@@ -74,7 +79,10 @@ from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 
-SCHEMA_VERSION = 3
+if TYPE_CHECKING:
+    from navseq.sim.occupancy import OccupancyGrid
+
+SCHEMA_VERSION = 4
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -93,6 +101,17 @@ def _pose_dict(pose: Pose2D) -> dict[str, float | None]:
         "x": _rounded(pose.x),
         "y": _rounded(pose.y),
         "yaw_deg": _rounded(math.degrees(pose.yaw), 1),
+    }
+
+
+def map_summary(grid: OccupancyGrid, source: Path | str) -> dict[str, Any]:
+    """The report's ``map``: where the map came from, its cell size, extent and origin."""
+    return {
+        "source": str(source),
+        "resolution_m": grid.resolution,  # metres per cell (map_server's resolution)
+        "width_cells": grid.width,
+        "height_cells": grid.height,
+        "origin": _pose_dict(grid.origin),
     }
 
 
@@ -116,7 +135,7 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "name": visit.name,
         "x": _rounded(visit.x),
         "y": _rounded(visit.y),
-        "yaw_deg": _rounded(math.degrees(visit.yaw), 1),
+        "yaw_deg": _rounded(math.degrees(visit.yaw_rad), 1),
         "outcome": WaypointOutcome(visit.outcome).value,
         "attempts": [_attempt_dict(attempt) for attempt in visit.attempt_results],
         "duration_s": _rounded(visit.duration, 2),
@@ -146,7 +165,7 @@ def _waypoint_totals(mission: Mission, result: MissionResult) -> list[WaypointTo
     """The result's per-waypoint totals; counted from ``visits`` for a result without."""
     if result.waypoints:
         return result.waypoints
-    totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw) for i, w in enumerate(mission.waypoints)]
+    totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(mission.waypoints)]
     for visit in result.visits:
         if 0 <= visit.index < len(totals):
             totals[visit.index].add(visit)

@@ -34,6 +34,13 @@ after the previous goal's result ends SUCCEEDED at once, with the robot wherever
 being computed for the previous goal to the new one; a client that sends its next goal
 a few milliseconds after a result triggers it.
 
+The robot's outline, inflation, speed limits and goal tolerances come from ``~robot``
+(a built-in robot name, default ``turtlebot3_burger``, or a robot YAML file; see
+:mod:`navseq.ros1.robot_param`), through the same settings the in-process simulator
+uses; ``~inflation_radius``, ``~cost_scaling_factor``, ``~xy_goal_tolerance`` and
+``~yaw_goal_tolerance``, when set, still override the profile's values. Give the robot
+node the same ``~robot``: this node plans and stops for the outline it is told of.
+
 It knows the robot only through ROS: its pose from TF (``~global_frame`` ->
 ``~base_frame``) and its velocity from ``odom``, so it drives navseq's sim robot node,
 or a real base, alike. The map comes from ``~map`` (a map_server YAML) or, when that is
@@ -42,7 +49,8 @@ empty, from the first message on the ``map`` topic.
 In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
 ``[robot2/base_footprint]``); their poses come from TF every control step and the
 server plans around them, stops short of them, and waits for one that blocks the only
-way (see :mod:`navseq.sim.navserver` and :mod:`navseq.ros.fleet`).
+way (see :mod:`navseq.sim.navserver` and :mod:`navseq.ros1.fleet`); they are taken to
+be the same model as this robot.
 
 Control runs at ``~controller_frequency`` Hz of ROS time, so under ``use_sim_time`` the
 whole stack follows the simulated clock and its speed factor.
@@ -57,6 +65,7 @@ import random
 import sys
 import time
 from collections.abc import Callable
+from typing import Any
 
 import actionlib
 import numpy as np
@@ -77,19 +86,22 @@ from std_srvs.srv import Empty, EmptyRequest, EmptyResponse
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, compose
-from navseq.ros.conversions import (
+from navseq.ros1.conversions import (
     grid_from_msg,
     grid_to_msg,
     pose2d_from_pose,
     pose2d_from_transform,
     pose_from_pose2d,
 )
-from navseq.ros.fleet import OtherRobots, other_robots_param
-from navseq.ros.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.fleet import OtherRobots, other_robots_param
+from navseq.ros1.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.robot_param import describe_settings, sim_settings_param
 from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap, CostmapParams
+from navseq.sim.footprint import Footprint
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid, load_map
 from navseq.sim.planner import Plan
+from navseq.sim.profile import SimSettings
 
 ACTION = "move_base"
 PLAN_TOPIC = f"{ACTION}/NavfnROS/plan"
@@ -97,6 +109,10 @@ COSTMAP_TOPIC = f"{ACTION}/global_costmap/costmap"
 FOOTPRINT_TOPIC = f"{ACTION}/local_costmap/footprint"
 FOOTPRINT_PERIOD = 0.2  # s of ROS time between two footprint messages (RViz needs no more)
 COSTMAP_PERIOD = 1.0  # s of ROS time at least between two costmap messages (they are big)
+# The local planner name under which the robot's limits and tolerances are shown, as
+# move_base shows its local planner's parameters (this stand-in's controller is a
+# regulated pure pursuit).
+LOCAL_PLANNER = "RegulatedPurePursuit"
 
 
 def costmap_to_occupancy_values(cost: np.ndarray) -> np.ndarray:
@@ -151,18 +167,27 @@ class NavNodeConfig:
     pose_timeout: float
     transform_tolerance: float
     publish_costmap: bool
+    settings: SimSettings  # the robot (``~robot``), before the per-parameter overrides
     costmap: CostmapParams
     nav: NavParams
     other_robots: tuple[str, ...]
     race_window: float = 0.0
     race_probability: float = 1.0
 
+    @property
+    def footprint(self) -> Footprint:
+        return self.settings.footprint
+
     @classmethod
     def from_params(cls) -> NavNodeConfig:
-        costmap_defaults = CostmapParams()
-        nav_defaults = NavParams()
+        settings = sim_settings_param()
+        # The profile gives the defaults; the node's own parameters (move_base's names)
+        # win where set, as they did before there was a profile.
+        costmap_defaults = settings.costmap_params
+        nav_defaults = settings.nav_params
         base_frame = str_param("base_frame", "base_footprint")
         config = cls(
+            settings=settings,
             map_yaml=str_param("map", ""),
             global_frame=str_param("global_frame", "map"),
             base_frame=base_frame,
@@ -199,6 +224,30 @@ class NavNodeConfig:
         return config
 
 
+def navstack_params(config: NavNodeConfig) -> dict[str, Any]:
+    """The robot this node drives, under the parameter names a real move_base uses.
+
+    A client that reads the robot from move_base's parameters
+    (:mod:`navseq.ros1.navstack_params`, ``navseq run --navigator ros1``) then checks and
+    judges the mission with the simulated robot, not with a guess. Keys are relative to
+    the node's namespace; none of them is a parameter this node reads, so a restart with
+    another ``~robot`` is not overridden by what an earlier run wrote.
+    """
+    limits = config.nav.limits
+    return {
+        "global_costmap/footprint": [[float(x), float(y)] for x, y in config.footprint.polygon],
+        "global_costmap/inflation_layer/inflation_radius": config.costmap.inflation_radius,
+        "global_costmap/inflation_layer/cost_scaling_factor": config.costmap.cost_scaling_factor,
+        "base_local_planner": f"navseq/{LOCAL_PLANNER}",
+        f"{LOCAL_PLANNER}/xy_goal_tolerance": config.nav.xy_tolerance,
+        f"{LOCAL_PLANNER}/yaw_goal_tolerance": config.nav.yaw_tolerance,
+        f"{LOCAL_PLANNER}/max_vel_x": limits.max_v,
+        f"{LOCAL_PLANNER}/max_vel_theta": limits.max_w,
+        f"{LOCAL_PLANNER}/acc_lim_x": limits.acc_v,
+        f"{LOCAL_PLANNER}/acc_lim_theta": limits.acc_w,
+    }
+
+
 def wait_for_map(topic: str) -> OccupancyGrid:
     """The first map on ``topic``; logs while waiting, gives up only at shutdown."""
     while not rospy.is_shutdown():
@@ -223,7 +272,7 @@ class SimNavNode:
     def __init__(self, config: NavNodeConfig, grid: OccupancyGrid) -> None:
         self.config = config
         self.costmap = Costmap.from_grid(grid, config.costmap)
-        self.server = NavigationServer(self.costmap, config.nav)
+        self.server = NavigationServer(self.costmap, config.nav, config.footprint)
         self._goal: Pose2D | None = None
         self._published_plan_version = -1
         self._velocity = (0.0, 0.0)
@@ -241,6 +290,7 @@ class SimNavNode:
                 config.global_frame,
                 config.other_robots,
                 tolerance=config.transform_tolerance,
+                footprint=config.footprint,
             )
             if config.other_robots
             else None
@@ -533,6 +583,9 @@ def main(argv: list[str] | None = None) -> int:
     rospy.init_node("move_base", argv=argv if argv is not None else sys.argv)
     try:
         config = NavNodeConfig.from_params()
+        # Before the action server exists: a client that found the server finds these.
+        for name, value in navstack_params(config).items():
+            rospy.set_param(f"~{name}", value)
         grid = load_map(config.map_yaml) if config.map_yaml else wait_for_map("map")
         node = SimNavNode(config, grid)
     except NavseqError as error:
@@ -540,10 +593,16 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     rospy.on_shutdown(node.shutdown)
     rospy.loginfo(
-        "sim move_base ready: action %s on %s, robot frame %s",
+        "sim move_base ready: action %s on %s, robot frame %s, %s, inflation %g m x %g, "
+        "tolerance %g m / %g rad",
         rospy.resolve_name(ACTION),
         config.map_yaml or "map from topic",
         config.base_frame,
+        describe_settings(config.settings),
+        config.costmap.inflation_radius,
+        config.costmap.cost_scaling_factor,
+        config.nav.xy_tolerance,
+        config.nav.yaw_tolerance,
     )
     node.spin()
     return 0

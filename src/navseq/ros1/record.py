@@ -81,7 +81,7 @@ class WaypointRecorder:
                     subject=f"waypoint {len(self._waypoints) + 1}",
                 )
             self._frame = frame
-            self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw=pose.yaw, z=z))
+            self._waypoints.append(Waypoint(x=pose.x, y=pose.y, yaw_rad=pose.yaw, z=z))
             mission = Mission(waypoints=tuple(self._waypoints), frame=frame, source=str(self.out))
             # The first write may replace a user's file only when asked; later ones
             # replace the file we wrote ourselves.
@@ -117,8 +117,8 @@ def record_main(
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
     from std_srvs.srv import Trigger, TriggerResponse
 
-    from navseq.navigators.ros1 import ensure_node
-    from navseq.ros.conversions import pose2d_from_pose, pose2d_from_transform
+    from navseq.ros1.conversions import pose2d_from_pose, pose2d_from_transform
+    from navseq.ros1.navigator import ensure_node
 
     try:
         ensure_node(NODE_NAME)
@@ -213,8 +213,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="also offer the ~record service that records the robot's current TF pose",
     )
-    parser.add_argument("--base-frame", default="base_footprint")
-    parser.add_argument("--frame", default="map", help="frame of TF-recorded poses")
+    parser.add_argument(
+        "--base-frame",
+        default="base_footprint",
+        help="the robot's TF frame whose pose --from-tf records (default base_footprint)",
+    )
+    parser.add_argument("--frame", default="map", help="frame of TF-recorded poses (default map)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -235,8 +239,8 @@ def main() -> None:
     """ROS node: ``~out`` (required), ``~topic``, ``~overwrite``, ``~from_tf``, ``~base_frame``."""
     import rospy
 
-    from navseq.navigators.ros1 import ensure_node
-    from navseq.ros.params import bool_param
+    from navseq.ros1.navigator import ensure_node
+    from navseq.ros1.params import bool_param
 
     try:
         ensure_node(NODE_NAME, anonymous=False)

@@ -48,7 +48,7 @@ import rospy
 from std_srvs.srv import Trigger, TriggerResponse
 
 from navseq.errors import NavseqError
-from navseq.executor.control import MissionControl
+from navseq.executor.control import MissionControl, StopRequested
 from navseq.executor.events import (
     MissionEvent,
     WaypointFinished,
@@ -57,10 +57,9 @@ from navseq.executor.events import (
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
-from navseq.navigators.ros1 import CANCEL_FLUSH, Ros1Navigator, ensure_node
-from navseq.ros.mission_topics import MissionTopics
-from navseq.ros.operator import NodeShutdown, OperatorCancel, OperatorNavigator
-from navseq.ros.params import bool_param
+from navseq.ros1.mission_topics import MissionTopics
+from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
+from navseq.ros1.params import bool_param
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -138,12 +137,14 @@ def read_params() -> tuple[Mission, dict[str, Any]]:
     return mission, settings
 
 
-def _trigger_service(name: str, operator: OperatorNavigator, topics: MissionTopics) -> None:
+def _trigger_service(name: str, control: MissionControl, topics: MissionTopics) -> None:
+    """``~pause``, ``~resume``, ``~cancel``: executor inputs, answered by the run's thread."""
+
     def handle(_request: Any) -> TriggerResponse:
         if topics.over is not None:
-            # Nobody polls the operator any more: a request would only time out.
+            # Nobody takes requests any more: a request would only be refused.
             return TriggerResponse(success=False, message=f"nothing to {name}: {topics.over}")
-        ok, message = operator.request(name)
+        ok, message = control.request(name, f"{name} requested by the operator (~{name})")
         return TriggerResponse(success=ok, message=message)
 
     rospy.Service(f"~{name}", Trigger, handle)
@@ -186,11 +187,10 @@ def run_node() -> int:
     except (NavseqError, TypeError, ValueError) as error:
         rospy.logerr("navseq: bad node parameter (param ~): %s", error)
         return 2
-    operator = OperatorNavigator(navigator, stop_reason=ShutdownWatch())
     topics = MissionTopics(mission)
-    control = MissionControl()
+    control = MissionControl(stop_reason=ShutdownWatch())
     for name in ("pause", "resume", "cancel"):
-        _trigger_service(name, operator, topics)
+        _trigger_service(name, control, topics)
     _skip_service(topics, control)
     try:
         rospy.loginfo(
@@ -202,7 +202,7 @@ def run_node() -> int:
         navigator.require_server(float(settings["server_wait"]))
         result = run_mission(
             mission,
-            operator,
+            navigator,
             [topics, log_waypoint_outcome],
             tick=float(settings["tick"]),
             control=control,
@@ -218,7 +218,7 @@ def run_node() -> int:
         # Ctrl-C while still waiting for the action server: no goal is out yet.
         rospy.logwarn("navseq: interrupted (SIGINT) while waiting for the action server")
         return SIGNAL_EXIT_CODES["SIGINT"]
-    except NodeShutdown as shutdown:
+    except StopRequested as shutdown:
         # rosnode kill / master shutdown: the navigator's shutdown hook cancelled the goal.
         _log_interrupted(str(shutdown))
         return 1
@@ -226,11 +226,11 @@ def run_node() -> int:
         # A shutdown seen first by rospy.sleep (simulated time), not by the poll.
         _log_interrupted("ROS shutdown")
         return 1
-    except OperatorCancel as cancelled:
-        rospy.logwarn("navseq: %s", cancelled)
-        code, topics.over = 1, "the mission was cancelled"
     else:
-        if result.success:
+        if result.reason.startswith("cancelled"):
+            rospy.logwarn("navseq: mission cancelled by the operator (~cancel)")
+            topics.over = "the mission was cancelled"
+        elif result.success:
             rospy.loginfo("navseq: mission succeeded (%s)", result.reason)
             topics.over = "the mission has ended (succeeded)"
         else:

@@ -4,7 +4,8 @@ Each sim node of a robot can be given the base frames of the other robots (priva
 param ``~other_robots``, e.g. ``[robot2/base_footprint]``). Their poses are looked up in
 the global frame every step; a robot whose pose is not (yet) in TF, or too old, is left
 out — with a throttled warning — rather than guessed. Every other robot is taken to
-have the TurtleBot3 burger footprint, the simulator's only robot.
+have the footprint the caller gives (the sim nodes give their own robot's, from
+``~robot``: a fleet of one model); the burger's when none is given.
 """
 
 from __future__ import annotations
@@ -13,8 +14,8 @@ import rospy
 import tf2_ros
 
 from navseq.geometry import Pose2D
-from navseq.ros.conversions import pose2d_from_transform
-from navseq.ros.params import param_error, str_list_param
+from navseq.ros1.conversions import pose2d_from_transform
+from navseq.ros1.params import param_error, str_list_param
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
 
 WARN_PERIOD = 10.0  # s between two warnings about other robots without a pose

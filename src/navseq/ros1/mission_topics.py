@@ -21,13 +21,14 @@ from visualization_msgs.msg import MarkerArray
 from navseq.executor.events import (
     MissionEvent,
     MissionFinished,
+    MissionPaused,
     WaypointFinished,
     WaypointOutcome,
     WaypointProgress,
     WaypointStarted,
 )
 from navseq.mission.model import Mission
-from navseq.ros.markers import MarkerStatus, waypoint_markers
+from navseq.ros1.markers import MarkerStatus, waypoint_markers
 
 PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 RUN_TOPICS_NS = "navseq"  # where `navseq run` publishes, like the node named navseq
@@ -108,10 +109,15 @@ def run_topics_namespace(robot_ns: str) -> str:
 
 
 def _state(event: MissionEvent) -> str:
-    """The ``state`` field of a status message: running, succeeded, failed or interrupted."""
+    """The ``state`` field of a status message: running, paused, succeeded, failed,
+    cancelled or interrupted."""
+    if isinstance(event, MissionPaused):
+        return "paused"
     if not isinstance(event, MissionFinished):
         return "running"
     if event.success:
         return "succeeded"
     # The runner's reason for a run ended from outside ("interrupted: SIGINT" ...).
+    if event.reason.startswith("cancelled"):
+        return "cancelled"  # by the operator (~cancel)
     return "interrupted" if event.reason.startswith("interrupted") else "failed"

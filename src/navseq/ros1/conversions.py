@@ -1,13 +1,11 @@
 """Conversions between navseq's plain types and ROS 1 messages.
 
 Shared by every navseq ROS node (the sequencer, the recorder, the simulator nodes).
-Message classes are imported here, so only code under ``navseq.ros`` (and the ``ros1``
-navigator) may import this module.
+Message classes are imported here, so only code under ``navseq.ros1`` may import this
+module.
 """
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 import rospy
@@ -17,23 +15,30 @@ from move_base_msgs.msg import MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 
 from navseq.errors import NavseqError
-from navseq.geometry import Pose2D, quaternion_to_yaw, yaw_to_quaternion
-from navseq.navigators.base import GoalStatus
+from navseq.geometry import (  # the message-free readers, re-exported for the nodes
+    Pose2D,
+    pose2d_from_pose,
+    pose2d_from_transform,
+    yaw_of,
+    yaw_to_quaternion,
+)
+from navseq.navigators.base import GoalOutcome
 from navseq.sim.occupancy import OccupancyGrid
 
-# actionlib_msgs/GoalStatus values that end a goal, and what the executor calls them.
-TERMINAL_STATUSES: dict[int, GoalStatus] = {
-    GoalStatusMsg.SUCCEEDED: GoalStatus.SUCCEEDED,
-    GoalStatusMsg.ABORTED: GoalStatus.ABORTED,
-    GoalStatusMsg.REJECTED: GoalStatus.REJECTED,
-    GoalStatusMsg.PREEMPTED: GoalStatus.PREEMPTED,
-    GoalStatusMsg.RECALLED: GoalStatus.RECALLED,
-    GoalStatusMsg.LOST: GoalStatus.LOST,
+# actionlib_msgs/GoalStatus values that end a goal: the executor's outcome and the name
+# the report gives the status.
+TERMINAL_STATUSES: dict[int, tuple[GoalOutcome, str]] = {
+    GoalStatusMsg.SUCCEEDED: (GoalOutcome.SUCCEEDED, "SUCCEEDED"),
+    GoalStatusMsg.ABORTED: (GoalOutcome.FAILED, "ABORTED"),
+    GoalStatusMsg.REJECTED: (GoalOutcome.FAILED, "REJECTED"),
+    GoalStatusMsg.PREEMPTED: (GoalOutcome.FAILED, "PREEMPTED"),
+    GoalStatusMsg.RECALLED: (GoalOutcome.FAILED, "RECALLED"),
+    GoalStatusMsg.LOST: (GoalOutcome.LOST, "LOST"),
 }
 
 
-def terminal_status(code: int) -> GoalStatus | None:
-    """The executor's name for a terminal actionlib status, None while the goal is alive.
+def terminal_status(code: int) -> tuple[GoalOutcome, str] | None:
+    """The outcome and name of a terminal actionlib status, None while the goal is alive.
 
     PENDING, ACTIVE, PREEMPTING and RECALLING are not terminal: a result still follows.
     """
@@ -43,16 +48,6 @@ def terminal_status(code: int) -> GoalStatus | None:
 def quaternion_msg(yaw: float) -> Quaternion:
     x, y, z, w = yaw_to_quaternion(yaw)
     return Quaternion(x=x, y=y, z=z, w=w)
-
-
-def yaw_of(orientation: Any) -> float:
-    """Yaw (radians) of a geometry_msgs/Quaternion-like object; roll and pitch ignored."""
-    return quaternion_to_yaw(orientation.x, orientation.y, orientation.z, orientation.w)
-
-
-def pose2d_from_pose(pose: Pose) -> Pose2D:
-    """A planar pose from a ``geometry_msgs/Pose`` (z, roll and pitch are ignored)."""
-    return Pose2D(float(pose.position.x), float(pose.position.y), yaw_of(pose.orientation))
 
 
 def pose_from_pose2d(pose: Pose2D, z: float = 0.0) -> Pose:
@@ -76,12 +71,6 @@ def pose_stamped(pose: Pose2D, frame: str, stamp: rospy.Time, z: float = 0.0) ->
 def move_base_goal(pose: Pose2D, frame: str, stamp: rospy.Time, z: float = 0.0) -> MoveBaseGoal:
     """The MoveBaseGoal the tutorial builds: target pose in ``frame``, yaw as a quaternion."""
     return MoveBaseGoal(target_pose=pose_stamped(pose, frame, stamp, z))
-
-
-def pose2d_from_transform(transform: TransformStamped) -> Pose2D:
-    """Where a planar ``TransformStamped`` puts its child frame in its parent frame."""
-    t = transform.transform
-    return Pose2D(float(t.translation.x), float(t.translation.y), yaw_of(t.rotation))
 
 
 def transform_stamped(pose: Pose2D, parent: str, child: str, stamp: rospy.Time) -> TransformStamped:
@@ -125,3 +114,19 @@ def grid_from_msg(msg: OccupancyGridMsg, source: str) -> OccupancyGrid:
         origin=pose2d_from_pose(msg.info.origin),
         source=source,
     )
+
+
+__all__ = [
+    "TERMINAL_STATUSES",
+    "grid_from_msg",
+    "grid_to_msg",
+    "move_base_goal",
+    "pose2d_from_pose",
+    "pose2d_from_transform",
+    "pose_from_pose2d",
+    "pose_stamped",
+    "quaternion_msg",
+    "terminal_status",
+    "transform_stamped",
+    "yaw_of",
+]

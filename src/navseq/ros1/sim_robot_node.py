@@ -1,18 +1,25 @@
-"""The simulated robot as a ROS 1 node: a TurtleBot3-like base that obeys ``cmd_vel``.
+"""The simulated robot as a ROS 1 node: a differential-drive base that obeys ``cmd_vel``.
 
 This is the body half of navseq's embedded simulator (the navigation half is
-:mod:`navseq.ros.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
+:mod:`navseq.ros1.sim_nav_node`). Like Nav2's loopback simulator it has no sensors and no
 physics beyond differential-drive kinematics: the ROS-free body,
 :class:`navseq.sim.base.SimulatedBase`, integrates velocity commands and refuses any step
 that would put its footprint on an occupied or unknown cell of the map (it stops as if
 it had hit a bumper); this module speaks ROS around it.
 
+The robot is the one ``~robot`` names: a built-in profile (``turtlebot3_burger``, the
+default, ``turtlebot3_waffle``, ``turtlebot3_waffle_pi``) or a robot YAML file, as
+``navseq run --robot`` takes (see :mod:`navseq.ros1.robot_param`). Its outline is what
+collides and what ``footprint`` shows; its speed and acceleration limits bound what
+``cmd_vel`` can make it do.
+
 Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
 ``/robot1/cmd_vel`` ...):
 
 - subscribes ``cmd_vel`` (``geometry_msgs/Twist``): forward speed ``linear.x`` and turn
-  rate ``angular.z``; the robot stops when no command arrives for ``~cmd_vel_timeout``
-  seconds, like a real base driver;
+  rate ``angular.z``, reached within the robot's speed and acceleration limits; the
+  robot stops when no command arrives for ``~cmd_vel_timeout`` seconds, like a real
+  base driver;
 - subscribes ``initialpose`` (``geometry_msgs/PoseWithCovarianceStamped``, RViz's
   "2D Pose Estimate"): teleports the robot there (refused inside an obstacle);
 - publishes ``odom`` (``nav_msgs/Odometry``) and the TF chain
@@ -21,7 +28,8 @@ Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
   than the wall clock (1.0 = real time, for RViz; tests use 5-10). With several robots
   exactly one node drives the clock; the others get ``~publish_clock: false`` and step
   with the ROS time it publishes;
-- publishes ``footprint`` (``geometry_msgs/PolygonStamped``, base frame) at 5 Hz for RViz;
+- publishes ``footprint`` (``geometry_msgs/PolygonStamped``, base frame): the robot's
+  outline, at 5 Hz for RViz;
 - publishes ``map`` (``nav_msgs/OccupancyGrid``, latched) loaded from ``~map`` (a
   map_server YAML) when ``~publish_map`` is true. Without ``~map`` the node takes the
   map for its collision checks from the ``map`` topic instead (e.g. a real map_server).
@@ -29,7 +37,8 @@ Interface (names relative to the node's namespace, so ``ns:=robot1`` gives
 In a fleet, ``~other_robots`` lists the other robots' base frames (e.g.
 ``[robot2/base_footprint]``): their poses come from TF in ``~global_frame`` every
 step, and the body refuses to overlap them as it refuses to overlap walls (see
-:mod:`navseq.ros.fleet`).
+:mod:`navseq.ros1.fleet`). The other robots are taken to be the same model as this one
+(one ``robot`` for the whole fleet in ``multi_robot.launch``).
 
 Odometry behaves like a real robot's: the ``odom`` frame starts at the start pose and
 odometry is continuous; a teleport moves the robot in the map and shifts the
@@ -52,17 +61,19 @@ from rosgraph_msgs.msg import Clock
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
-from navseq.ros.conversions import (
+from navseq.ros1.conversions import (
     grid_from_msg,
     grid_to_msg,
     pose2d_from_pose,
     pose_from_pose2d,
     transform_stamped,
 )
-from navseq.ros.fleet import OtherRobots, other_robots_param
-from navseq.ros.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.fleet import OtherRobots, other_robots_param
+from navseq.ros1.params import bool_param, float_param, param_error, str_param
+from navseq.ros1.robot_param import describe_settings, sim_settings_param
 from navseq.sim.base import SimulatedBase
 from navseq.sim.occupancy import load_map
+from navseq.sim.profile import SimSettings
 
 FOOTPRINT_RATE = 5.0  # Hz of sim time: enough for RViz, cheap at high speed factors
 OTHER_POSE_TOLERANCE = 1.0  # s of ROS time: an older pose of another robot is not used
@@ -84,11 +95,13 @@ class RobotNodeConfig:
     publish_clock: bool
     use_sim_time: bool
     other_robots: tuple[str, ...]
+    settings: SimSettings  # the robot (``~robot``): outline and limits
 
     @classmethod
     def from_params(cls) -> RobotNodeConfig:
         base_frame = str_param("base_frame", "base_footprint")
         config = cls(
+            settings=sim_settings_param(),
             map_yaml=str_param("map", ""),
             start=Pose2D(float_param("x", 0.0), float_param("y", 0.0), float_param("yaw", 0.0)),
             speed=float_param("speed", 1.0),
@@ -115,7 +128,14 @@ class SimRobotNode:
         self.config = config
         self._lock = threading.Lock()
         grid = load_map(config.map_yaml) if config.map_yaml else None
-        self.base = SimulatedBase(config.start, grid, cmd_vel_timeout=config.cmd_vel_timeout)
+        settings = config.settings
+        self.base = SimulatedBase(
+            config.start,
+            grid,
+            footprint=settings.footprint,
+            limits=settings.nav_params.limits,
+            cmd_vel_timeout=config.cmd_vel_timeout,
+        )
         if self.base.collides(config.start):
             raise NavseqError(
                 f"start pose ({config.start.x:.2f}, {config.start.y:.2f}) puts the robot on an "
@@ -159,6 +179,7 @@ class SimRobotNode:
                 config.global_frame,
                 config.other_robots,
                 tolerance=OTHER_POSE_TOLERANCE,
+                footprint=settings.footprint,
             )
 
     # -- callbacks (rospy threads) -------------------------------------------------------
@@ -310,11 +331,12 @@ def main(argv: list[str] | None = None) -> int:
         rospy.logfatal("%s", error)
         return 2
     rospy.loginfo(
-        "sim robot at (%.2f, %.2f, %.2f rad), %s, speed x%.1f%s",
+        "sim robot at (%.2f, %.2f, %.2f rad), %s, %s, speed x%.1f%s",
         node.base.pose.x,
         node.base.pose.y,
         node.base.pose.yaw,
         f"map {node.config.map_yaml}" if node.config.map_yaml else "map from topic",
+        describe_settings(node.config.settings),
         node.speed,
         f", other robots {', '.join(node.config.other_robots)}" if node.config.other_robots else "",
     )

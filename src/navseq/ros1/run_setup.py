@@ -10,13 +10,15 @@ markers and status topics are set up as the navseq node's are (:class:`MissionTo
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
-from navseq.navigators.ros1 import DEFAULT_SETTLE, Ros1Navigator
-from navseq.ros.mission_topics import MissionTopics, run_topics_namespace
-from navseq.ros.navstack_params import read_navstack_profile
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.ros1.mission_topics import MissionTopics, run_topics_namespace
+from navseq.ros1.navigator import DEFAULT_SETTLE, Ros1Navigator
+from navseq.ros1.navstack_params import read_navstack_profile
 
 SERVER_WAIT = 30.0  # s of wall time for the action server, as the navseq node waits
 
@@ -58,3 +60,42 @@ def connect_for_run(
         navigator.close()
         raise
     return Ros1Connection(navigator, topics, robot, note)
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """``navseq run --navigator ros1``: the connection, then pre-flight on a known map.
+
+    Before anything is written the server must answer and its clock run; the robot
+    comes from move_base's parameters unless the user named one (``--robot`` or the
+    mission's ``robot:``), and pre-flight then checks against the stack's own robot.
+    """
+    mission = draft.mission
+    frame = args.frame or mission.frame
+    connection = connect_for_run(
+        mission,
+        action=args.action,
+        frame=frame,
+        namespace=args.ns,
+        settle=args.settle,
+        read_robot=getattr(args, "robot", None) is None and mission.robot is None,
+    )
+    info: dict[str, object] = {"kind": "ros1", "action": args.action, "frame": frame}
+    info["ns"] = args.ns
+    notes = []
+    if connection.robot is not None and connection.robot_note is not None:
+        draft.robot = connection.robot
+        info["robot_source"] = connection.robot_note
+        notes.append(connection.robot_note)
+    info["robot"] = draft.robot.name
+    try:
+        grid = draft.optional_map()
+    except BaseException:
+        connection.navigator.close()
+        raise
+    return NavigatorSetup(
+        make_navigator=lambda: connection.navigator,
+        info=info,
+        grid=grid,
+        notes=notes,
+        listeners=[connection.topics],
+    )

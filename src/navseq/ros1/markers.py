@@ -16,7 +16,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from navseq.mission.model import Mission
-from navseq.ros.conversions import pose_from_pose2d
+from navseq.ros1.conversions import pose_from_pose2d
 
 ARROW_NS = "navseq_waypoints"
 LABEL_NS = "navseq_labels"

@@ -74,14 +74,14 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
+    GoalOutcome,
     GoalPlan,
-    GoalStatus,
     NavEvent,
     ServerBack,
     ServerLost,
 )
-from navseq.ros.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
-from navseq.ros.conversions import terminal_status as terminal_status_of
+from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
+from navseq.ros1.conversions import terminal_status as terminal_status_of
 
 DEFAULT_NODE_NAME = "navseq"
 MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up
@@ -511,12 +511,15 @@ class Ros1Navigator:
                 self._accepted = True
                 self._queue(GoalAccepted(goal_id))
             elif state == CommState.DONE:
-                status = terminal_status_of(handle.get_goal_status()) or GoalStatus.LOST
-                if status is GoalStatus.LOST:
+                outcome, status = terminal_status_of(handle.get_goal_status()) or (
+                    GoalOutcome.LOST,
+                    "LOST",
+                )
+                if outcome is GoalOutcome.LOST:
                     # The server forgot the goal (e.g. restarted quickly): let poll()
                     # announce ServerBack once it is ready, so the executor resends.
                     self._server_up = False
-                self._queue(GoalDone(goal_id, status, handle.get_goal_status_text()))
+                self._queue(GoalDone(goal_id, outcome, status, handle.get_goal_status_text()))
                 self._last_result = (
                     time.monotonic(),
                     handle.comm_state_machine.action_goal.goal_id.id,

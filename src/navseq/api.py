@@ -1,0 +1,277 @@
+"""navseq's Python API: load, build and check a mission, run it, read the result.
+
+Everything here is exported by :mod:`navseq` itself (``import navseq``) and calls the
+same core functions as the ``navseq`` command line, so a mission behaves the same
+whichever face runs it. See ``docs/api.md`` for examples.
+
+Units are in the names: ``yaw_deg`` / ``yaw_rad``, ``_s`` seconds, ``_m`` metres;
+``x`` and ``y`` are metres in the mission's frame. Input problems raise
+:class:`~navseq.errors.NavseqError` (several at once: :class:`~navseq.errors.MissionErrors`,
+whose ``errors`` lists them); the ``check_*`` / ``validate_*`` functions return them
+as a list of :class:`Problem` instead.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Generator, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from navseq.errors import MissionErrors, NavseqError
+from navseq.executor.events import MissionEvent
+from navseq.executor.result import MissionResult
+from navseq.geometry import Pose2D
+from navseq.mission.model import Mission
+from navseq.mission.robot import RobotProfile
+
+if TYPE_CHECKING:
+    from navseq.navigators.base import Navigator
+    from navseq.navigators.sim import SimNavigator
+
+#: A path given as text or as a :class:`~pathlib.Path`.
+PathLike = str | os.PathLike[str]
+#: A robot: a profile, a built-in name (``"turtlebot3_waffle"``) or a robot YAML file.
+RobotLike = RobotProfile | str
+#: Called with every mission event as it happens.
+EventCallback = Callable[[MissionEvent], object]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with a mission, as ``navseq validate`` lists it.
+
+    ``where`` is the place (``"mission.yaml:12"``, ``"param ~p_seq"``), ``subject``
+    what it concerns (``"waypoint 3 'dock'"``), ``message`` what is wrong and how to
+    fix it; ``str(problem)`` is the one line the CLI prints.
+    """
+
+    message: str
+    where: str | None = None
+    subject: str | None = None
+
+    @classmethod
+    def from_error(cls, error: NavseqError) -> Problem:
+        return cls(error.message, error.source, error.subject)
+
+    def __str__(self) -> str:
+        return str(NavseqError(self.message, source=self.where, subject=self.subject))
+
+
+def _problems(errors: list[NavseqError]) -> list[Problem]:
+    found: list[Problem] = []
+    for error in errors:
+        if isinstance(error, MissionErrors):
+            found += _problems(error.errors)
+        else:
+            found.append(Problem.from_error(error))
+    return found
+
+
+def load_mission(path: PathLike) -> Mission:
+    """Read a mission file: navseq YAML, rosparam YAML, a roslaunch file, or CSV.
+
+    Raises :class:`~navseq.errors.NavseqError` naming the file, line and field of
+    every problem (:class:`~navseq.errors.MissionErrors` when there are several).
+    """
+    from navseq.commands.common import require_file
+    from navseq.mission.loader import load_mission as load
+
+    path = Path(path)
+    require_file(path, "mission")
+    return load(path)
+
+
+def validate_file(
+    path: PathLike,
+    *,
+    map: PathLike | None = None,
+    start: Pose2D | None = None,
+    robot: RobotLike | None = None,
+) -> list[Problem]:
+    """Every problem of a mission file, as ``navseq validate`` finds them; [] if none.
+
+    The file's own problems and, when a map is known (``map``, else the mission's
+    ``map:``), each waypoint checked against it for ``robot`` (default: the mission's
+    ``robot:``, else the TurtleBot3 burger). ``start`` (default: the mission's
+    ``start:``) is checked too.
+    """
+    from navseq.commands.common import require_file
+    from navseq.commands.validate import mission_file_problems
+
+    try:
+        require_file(Path(path), "mission")
+    except NavseqError as error:
+        return [Problem.from_error(error)]
+    _, errors = mission_file_problems(
+        Path(path),
+        map_path=Path(map) if map is not None else None,
+        start=start,
+        robot=robot,
+    )
+    return _problems(errors)
+
+
+def check_mission(
+    mission: Mission,
+    *,
+    map: PathLike | None = None,
+    start: Pose2D | None = None,
+    robot: RobotLike | None = None,
+) -> list[Problem]:
+    """Pre-flight: every waypoint of ``mission`` checked against a map; [] if all is well.
+
+    ``map`` defaults to the mission's ``map:``; with neither there is nothing to check.
+    A waypoint outside the map, in an obstacle, where the robot's footprint does not
+    fit, or that cannot be reached from the one before is a problem. ``robot`` and
+    ``start`` default to the mission's.
+    """
+    from navseq.commands.common import choose_robot, costmap_for_map, preflight_errors
+
+    map_path = Path(map) if map is not None else mission.map
+    if map_path is None:
+        return []
+    profile = choose_robot(robot, mission)
+    try:
+        costmap = costmap_for_map(map_path, profile)
+    except NavseqError as error:
+        return _problems([error])
+    start = start if start is not None else mission.start
+    return _problems(preflight_errors(mission, costmap, start, robot=profile))
+
+
+def sim_navigator(
+    mission: Mission,
+    *,
+    map: PathLike | None = None,
+    start: Pose2D | None = None,
+    robot: RobotLike | None = None,
+    preflight: bool = True,
+) -> SimNavigator:
+    """A navigator on the embedded simulator, ready for ``mission``.
+
+    ``map`` (default: the mission's ``map:``) is required. ``start`` (default: the
+    mission's ``start:``, else the roomy point nearest the map origin) is where the
+    simulated robot begins. With ``preflight`` (as ``navseq run`` does) the mission is
+    checked against the map first and every problem is raised together as
+    :class:`~navseq.errors.MissionErrors` before anything moves.
+    """
+    from navseq.commands.common import choose_robot
+    from navseq.navigators.sim import SimNavigator
+    from navseq.sim.occupancy import load_map
+    from navseq.simrun import prepare_sim_world
+
+    map_path = Path(map) if map is not None else mission.map
+    if map_path is None:
+        raise NavseqError(
+            "the simulator needs a map: pass map= or give the mission a map:",
+            source=mission.source,
+        )
+    profile = choose_robot(robot, mission)
+    start = start if start is not None else mission.start
+    ready = prepare_sim_world(mission, load_map(map_path), start, profile, preflight=preflight)
+    return SimNavigator(ready.world)
+
+
+def run_mission(
+    mission: Mission,
+    navigator: Navigator,
+    *,
+    on_event: EventCallback | None = None,
+    robot: RobotLike | None = None,
+    server_wait_s: float = 10.0,
+) -> MissionResult:
+    """Drive ``mission`` through ``navigator`` to the end and return its result.
+
+    The loop ``navseq run`` runs: ``on_event`` gets every event as it happens. While
+    it runs (in the main thread), SIGINT and SIGTERM stop the robot first and then
+    raise :class:`~navseq.executor.runner.MissionInterrupted`, whose ``result`` says
+    what was done; any other exception also cancels the active goal before it
+    propagates. ``robot`` gives the arrival check's goal tolerance (default: the
+    mission's ``robot:``). The navigator is not closed: call its ``close()``.
+    """
+    from navseq.commands.common import choose_robot
+    from navseq.executor.runner import run_mission as run
+
+    def listener(event: MissionEvent) -> None:
+        if on_event is not None:
+            on_event(event)
+
+    listeners = [listener] if on_event is not None else []
+    return run(
+        mission,
+        navigator,
+        listeners,
+        robot=choose_robot(robot, mission),
+        server_wait=server_wait_s,
+    )
+
+
+def simulate(
+    mission: Mission,
+    *,
+    map: PathLike | None = None,
+    start: Pose2D | None = None,
+    robot: RobotLike | None = None,
+    on_event: EventCallback | None = None,
+    preflight: bool = True,
+) -> MissionResult:
+    """Run ``mission`` on the embedded simulator and return the result.
+
+    :func:`sim_navigator` then :func:`run_mission`: the same simulator, pre-flight
+    check and executor as ``navseq run``, in simulated time (as fast as the CPU goes).
+    Writes no files.
+    """
+    navigator = sim_navigator(mission, map=map, start=start, robot=robot, preflight=preflight)
+    try:
+        return run_mission(mission, navigator, on_event=on_event, robot=robot)
+    finally:
+        navigator.close()
+
+
+class MissionRun:
+    """A mission run as an iterator of its events, for a loop of your own.
+
+    ::
+
+        run = MissionRun(mission, navigator)
+        for event in run:
+            ...            # leaving the loop early (break) cancels the active goal
+        print(run.result.success)
+
+    Nothing moves until the iteration starts. No signal handlers are installed; an
+    exception (Ctrl-C included) or a ``break`` cancels the goal the robot is driving
+    to. :attr:`result` is the result once the loop has run to its end; it stays None
+    when the loop was left early.
+    """
+
+    def __init__(
+        self,
+        mission: Mission,
+        navigator: Navigator,
+        *,
+        robot: RobotLike | None = None,
+        server_wait_s: float = 10.0,
+    ) -> None:
+        from navseq.commands.common import choose_robot
+
+        self.mission = mission
+        self.navigator = navigator
+        self.robot = choose_robot(robot, mission)
+        self.server_wait_s = server_wait_s
+        self.result: MissionResult | None = None
+        self._events: Generator[MissionEvent, None, MissionResult] | None = None
+
+    def __iter__(self) -> Iterator[MissionEvent]:
+        from navseq.executor.runner import iter_mission
+
+        if self._events is not None:
+            raise RuntimeError("a MissionRun runs once; make a new one to run again")
+        self._events = iter_mission(
+            self.mission, self.navigator, robot=self.robot, server_wait=self.server_wait_s
+        )
+        try:
+            self.result = yield from self._events
+        finally:
+            self._events.close()  # on break: cancels the goal (no-op once finished)

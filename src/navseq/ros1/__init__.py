@@ -1,0 +1,19 @@
+"""ROS 1 (rospy) code: the only package that imports rospy and ROS 1 messages.
+
+- :mod:`navseq.ros1.navigator`: the ``ros1`` navigator (move_base over actionlib);
+
+- :mod:`navseq.ros1.navseq_node`: the sequencer node (tutorial params, markers, services);
+- :mod:`navseq.ros1.record`: waypoint recorder (``navseq record`` and ``record_node``);
+- :mod:`navseq.ros1.markers`: RViz markers of a mission;
+- :mod:`navseq.ros1.mission_topics`: a mission listener publishing markers and a JSON status;
+- :mod:`navseq.ros1.navstack_params`: the robot profile from a running move_base's params;
+- :mod:`navseq.ros1.run_setup`: ``navseq run --navigator ros1``'s connection to the stack
+  (the ``create`` of the kind in :mod:`navseq.navigators.registry`);
+- :mod:`navseq.ros1.conversions`: navseq types <-> ROS 1 messages, shared by all nodes
+  (the message-free readers live in :mod:`navseq.geometry`, for ROS 2 too);
+- :mod:`navseq.ros1.params`: typed private parameters with errors naming the parameter;
+- :mod:`navseq.ros1.fleet`: the other robots of a simulated fleet, their poses from TF;
+- ``sim_robot_node`` / ``sim_nav_node``: the embedded simulator served as ROS nodes.
+
+Importing this package imports nothing from ROS; each module does so itself.
+"""

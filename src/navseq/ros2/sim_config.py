@@ -1,0 +1,123 @@
+"""The ROS 2 simulator's settings: command-line options and their checks, without ROS.
+
+Shared by ``python -m navseq.ros2.sim_node`` and ``navseq sim --ros2`` so that both take
+the same options with the same meaning; importing this module imports no ROS 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from navseq.commands.common import parse_pose, require_file
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+
+# ROS 2 name rules for one namespace token: letters, digits, underscores, not a digit first.
+_NAMESPACE_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+MAX_SPEED = 100.0  # beyond this the simulation cannot keep up on any machine anyway
+
+
+def default_map() -> Path | None:
+    """The TurtleBot3 world of a source checkout (``maps/`` next to ``src/``), if there."""
+    candidate = Path(__file__).resolve().parents[3] / "maps" / "turtlebot3_world.yaml"
+    return candidate if candidate.is_file() else None
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--map",
+        type=Path,
+        metavar="MAP",
+        help="map_server YAML (default: the TurtleBot3 world of a source checkout)",
+    )
+    parser.add_argument(
+        "--start",
+        type=parse_pose,
+        metavar="X,Y,YAW",
+        help="start pose, metres, metres, degrees (default: the roomy point nearest the "
+        "map origin)",
+    )
+    parser.add_argument(
+        "--ns",
+        default="",
+        metavar="NS",
+        help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose, frames "
+        "robot1/odom, robot1/base_footprint)",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="simulated seconds per wall second; 1 = wall-clock time, otherwise /clock is "
+        "published and clients should use use_sim_time (default 1)",
+    )
+    parser.add_argument(
+        "--robot",
+        metavar="NAME|FILE",
+        help="robot profile: a built-in name (turtlebot3_burger, turtlebot3_waffle, "
+        "turtlebot3_waffle_pi) or a YAML file like a mission's robot: section "
+        "(default turtlebot3_burger)",
+    )
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Everything the ROS 2 simulator node needs to start."""
+
+    map_yaml: Path
+    start: Pose2D | None
+    namespace: str  # "" or "robot1" (no slashes at the ends)
+    speed: float
+    robot: RobotProfile
+    rate: float = 20.0  # simulation steps per simulated second
+
+    @property
+    def frame_prefix(self) -> str:
+        """``robot1/`` in a namespace, as the ROS 1 sim nodes name their frames."""
+        return f"{self.namespace}/" if self.namespace else ""
+
+    @property
+    def sim_time(self) -> bool:
+        """Whether the node publishes /clock (at any speed but wall-clock speed)."""
+        return self.speed != 1.0
+
+
+def namespace_of(text: str) -> str:
+    """``/robot1/`` -> ``robot1``; a clear error for a name ROS 2 would refuse."""
+    stripped = text.strip().strip("/")
+    if not stripped:
+        return ""
+    if not all(_NAMESPACE_TOKEN.fullmatch(token) for token in stripped.split("/")):
+        raise NavseqError(
+            f"{text!r} is not a ROS 2 namespace (letters, digits and underscores, "
+            "separated by '/', not starting with a digit)",
+            source="--ns",
+        )
+    return stripped
+
+
+def config_from_args(args: argparse.Namespace) -> SimConfig:
+    """The checked settings; every bad value is a NavseqError naming its option."""
+    from navseq.mission.robot_format import robot_from_option
+
+    map_yaml = args.map if args.map is not None else default_map()
+    if map_yaml is None:
+        raise NavseqError("no map: give --map MAP.yaml (a map_server YAML)", source="--map")
+    require_file(map_yaml, "--map")
+    speed = float(args.speed)
+    if not (math.isfinite(speed) and 0.0 < speed <= MAX_SPEED):
+        raise NavseqError(f"must be > 0 and <= {MAX_SPEED:g}, got {args.speed}", source="--speed")
+    robot = robot_from_option(args.robot) if args.robot is not None else DEFAULT_PROFILE
+    return SimConfig(
+        map_yaml=map_yaml,
+        start=args.start,
+        namespace=namespace_of(args.ns),
+        speed=speed,
+        robot=robot,
+    )

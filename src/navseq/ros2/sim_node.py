@@ -1,0 +1,627 @@
+"""navseq's simulator as one ROS 2 node that serves Nav2's interfaces.
+
+So that Nav2 users can try navseq — and any Nav2 client — without Gazebo or Nav2, one
+process holds a simulated robot (:class:`navseq.sim.world.SimWorld`: the same body and
+:class:`~navseq.sim.navserver.NavigationServer` as the ROS 1 sim nodes and the in-process
+simulator) and speaks Nav2's ROS 2 interface around it. The rules of Nav2's navigators
+(preemption, pass-through, missed waypoints) live in :mod:`navseq.ros2.standin`; this
+module only translates.
+
+Interface (names relative to the namespace ``--ns``, frames prefixed with it):
+
+- actions ``navigate_to_pose``, ``navigate_through_poses`` (``nav2_msgs/action/...``)
+  with Nav2's feedback (current pose, navigation time, time remaining, recoveries,
+  distance remaining, poses remaining) and results SUCCEEDED / ABORTED (with Nav2's
+  planner or controller ``error_code`` and ``error_msg``) / CANCELED; a new goal
+  preempts the running one, which ends ABORTED, as in Nav2;
+- ``follow_waypoints`` (result ``missed_waypoints``; parameter ``stop_on_failure``,
+  default true as in Nav2) and ``compute_path_to_pose``;
+- topics ``odom`` (``nav_msgs/Odometry``), ``/tf`` (``map -> odom -> base_footprint``),
+  ``/tf_static`` (``base_footprint -> base_link``), ``map`` (transient local, as
+  map_server), ``plan`` (``nav_msgs/Path``), ``cmd_vel`` (the velocity the controller
+  drives with; honoured as teleop while no goal runs), ``initialpose`` (teleports),
+  ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal), ``amcl_pose``
+  (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1;
+- services ``global_costmap/clear_entirely_global_costmap``,
+  ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``)
+  and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
+  ``amcl``, ...), answering *active*.
+
+Goal poses may be given in the map, odom or base frame (the node knows those
+transforms); other frames are refused (this stand-in has no TF listener).
+
+Run it with ``python -m navseq.ros2.sim_node --map MAP`` or ``navseq sim --ros2``;
+SIGINT / SIGTERM end every goal (ABORTED), stop the robot and exit 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import signal
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from types import FrameType
+from typing import Any
+
+import rclpy
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformStamped, Twist
+from lifecycle_msgs.msg import State
+from lifecycle_msgs.srv import GetState
+from nav2_msgs.action import (
+    ComputePathToPose,
+    FollowWaypoints,
+    NavigateThroughPoses,
+    NavigateToPose,
+)
+from nav2_msgs.msg import MissedWaypoint
+from nav2_msgs.srv import ClearEntireCostmap
+from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
+from nav_msgs.msg import Odometry, Path
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D, compose
+from navseq.ros2.messages import (
+    duration_msg,
+    grid_msg,
+    path_msg,
+    pose2d_of,
+    pose_msg,
+    pose_stamped,
+    time_msg,
+    transform_stamped,
+)
+from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
+from navseq.ros2.standin import (
+    Ending,
+    ErrorCode,
+    Nav2StandIn,
+    Navigator,
+    NavTask,
+    Outcome,
+    WaypointRun,
+)
+from navseq.sim.occupancy import load_map
+from navseq.sim.profile import SimSettings
+from navseq.sim.world import SimWorld, default_start
+
+NODE_NAME = "navseq_sim"
+MAP_FRAME = "map"
+FEEDBACK_PERIOD = 0.1  # s of wall time between two feedback messages of a goal
+AMCL_POSE_PERIOD = 0.5  # s of simulated time between two amcl_pose messages
+TELEOP_QUIET = 0.5  # s of wall time after our own cmd_vel before outside commands count
+# The Nav2 servers whose lifecycle state Nav2 clients (nav2_simple_commander, ...) ask.
+LIFECYCLE_NODES = (
+    "bt_navigator",
+    "amcl",
+    "map_server",
+    "planner_server",
+    "controller_server",
+    "behavior_server",
+    "waypoint_follower",
+)
+TRANSIENT_LOCAL = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+
+
+class SimNode:
+    """The ROS 2 face of a :class:`Nav2StandIn`; see the module docstring.
+
+    Concurrency: the executor's threads run the callbacks (one per running goal waits in
+    its execute callback) and one thread of our own steps the simulation; everything
+    that touches the stand-in holds ``self._lock``.
+    """
+
+    def __init__(self, node: Node, config: SimConfig) -> None:
+        self.node = node
+        self.config = config
+        grid = load_map(config.map_yaml)
+        settings = SimSettings.of(config.robot)
+        start = (
+            config.start if config.start is not None else default_start(grid, settings.footprint)
+        )
+        world = SimWorld(
+            grid,
+            start,
+            dt=1.0 / config.rate,
+            costmap_params=settings.costmap_params,
+            nav_params=settings.nav_params,
+            footprint=settings.footprint,
+        )
+        self.standin = Nav2StandIn(world)
+        self._lock = threading.Lock()
+        self._stopping = threading.Event()
+        self._thread: threading.Thread | None = None
+        prefix = config.frame_prefix
+        self.odom_frame = f"{prefix}odom"
+        self.base_frame = f"{prefix}base_footprint"
+        self.base_link = f"{prefix}base_link"
+        self._plan_version = -1
+        self._was_active = False
+        self._last_own_cmd = -float("inf")
+        self._localized = False
+        self._last_amcl = -float("inf")
+        self._topic_goal: NavTask | None = None
+        self.log = node.get_logger()
+        node.declare_parameter("stop_on_failure", True)
+
+        group = ReentrantCallbackGroup()
+        self._odom_pub = node.create_publisher(Odometry, "odom", 10)
+        self._tf_pub = node.create_publisher(TFMessage, "/tf", 100)
+        self._tf_static_pub = node.create_publisher(TFMessage, "/tf_static", TRANSIENT_LOCAL)
+        self._map_pub = node.create_publisher(OccupancyGridMsg, "map", TRANSIENT_LOCAL)
+        self._plan_pub = node.create_publisher(Path, "plan", 1)
+        self._cmd_pub = node.create_publisher(Twist, "cmd_vel", 10)
+        self._amcl_pub = node.create_publisher(
+            PoseWithCovarianceStamped, "amcl_pose", TRANSIENT_LOCAL
+        )
+        self._clock_pub = node.create_publisher(Clock, "/clock", 10) if config.sim_time else None
+        node.create_subscription(
+            PoseWithCovarianceStamped,
+            "initialpose",
+            self._on_initial_pose,
+            10,
+            callback_group=group,
+        )
+        node.create_subscription(
+            PoseStamped, "goal_pose", self._on_goal_pose, 10, callback_group=group
+        )
+        node.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10, callback_group=group)
+        for service in (
+            "global_costmap/clear_entirely_global_costmap",
+            "local_costmap/clear_entirely_local_costmap",
+        ):
+            node.create_service(
+                ClearEntireCostmap, service, self._on_clear_costmap, callback_group=group
+            )
+        for lifecycle_node in LIFECYCLE_NODES:
+            node.create_service(
+                GetState, f"{lifecycle_node}/get_state", self._on_get_state, callback_group=group
+            )
+        self._servers = [
+            self._nav_server(NavigateToPose, Navigator.TO_POSE, group),
+            self._nav_server(NavigateThroughPoses, Navigator.THROUGH_POSES, group),
+            ActionServer(
+                node,
+                FollowWaypoints,
+                "follow_waypoints",
+                execute_callback=self._execute_waypoints,
+                cancel_callback=_accept_cancel,
+                callback_group=group,
+            ),
+            ActionServer(
+                node,
+                ComputePathToPose,
+                "compute_path_to_pose",
+                execute_callback=self._execute_compute_path,
+                callback_group=group,
+            ),
+        ]
+        stamp = self._stamp()
+        self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
+        # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.
+        base_link = TransformStamped()
+        base_link.header.frame_id = self.base_frame
+        base_link.header.stamp = stamp
+        base_link.child_frame_id = self.base_link
+        base_link.transform.translation.z = 0.010
+        base_link.transform.rotation.w = 1.0
+        self._tf_static_pub.publish(TFMessage(transforms=[base_link]))
+        self._publish_state()
+
+    # -- life cycle ------------------------------------------------------------------
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._simulate, name="navseq-sim", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """End every goal (ABORTED) and leave the robot standing."""
+        self._stopping.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+        with self._lock:
+            self.standin.abort_all("the simulator is shutting down")
+        with contextlib.suppress(Exception):
+            self._cmd_pub.publish(Twist())
+
+    # -- simulation thread -----------------------------------------------------------
+
+    def _simulate(self) -> None:
+        """Step every ``dt / speed`` wall seconds; a busy CPU slows simulated time down
+        instead of catching up in a burst."""
+        period = self.standin.world.dt / self.config.speed
+        next_tick = time.monotonic()
+        while not self._stopping.is_set():
+            with self._lock:
+                self.standin.step()
+            self._publish_state()
+            next_tick += period
+            delay = next_tick - time.monotonic()
+            if delay > 0:
+                self._stopping.wait(delay)
+            elif delay < -0.25:
+                next_tick = time.monotonic()
+
+    def _stamp(self) -> Any:
+        if self.config.sim_time:
+            return time_msg(self.standin.time)
+        return self.node.get_clock().now().to_msg()
+
+    def _publish_state(self) -> None:
+        with self._lock:
+            standin = self.standin
+            world = standin.world
+            sim_time = standin.time
+            body = world.body
+            map_to_odom, odom_pose, pose = body.map_to_odom, body.odom_pose, body.pose
+            v, w = body.robot.v, body.robot.w
+            server = world.server
+            active = standin.active is not None
+            new_plan = server.plan_version != self._plan_version
+            plan, goal = server.plan, server.goal
+            self._plan_version = server.plan_version
+            topic_goal = self._topic_goal
+            topic_ending = topic_goal.ending if topic_goal is not None else None
+            if topic_ending is not None:
+                self._topic_goal = None
+        stamp = self._stamp()
+        if self._clock_pub is not None:
+            self._clock_pub.publish(Clock(clock=stamp))
+        self._tf_pub.publish(
+            TFMessage(
+                transforms=[
+                    transform_stamped(map_to_odom, MAP_FRAME, self.odom_frame, stamp),
+                    transform_stamped(odom_pose, self.odom_frame, self.base_frame, stamp),
+                ]
+            )
+        )
+        odom = Odometry()
+        odom.header.stamp = stamp
+        odom.header.frame_id = self.odom_frame
+        odom.child_frame_id = self.base_frame
+        odom.pose.pose = pose_msg(odom_pose)
+        odom.twist.twist.linear.x = float(v)
+        odom.twist.twist.angular.z = float(w)
+        self._odom_pub.publish(odom)
+        if new_plan and plan is not None:
+            self._plan_pub.publish(path_msg(plan, goal, MAP_FRAME, stamp))
+        if active or self._was_active:
+            twist = Twist()
+            if active:
+                twist.linear.x, twist.angular.z = float(v), float(w)
+            self._cmd_pub.publish(twist)
+            self._last_own_cmd = time.monotonic()
+        self._was_active = active
+        if self._localized and sim_time - self._last_amcl >= AMCL_POSE_PERIOD:
+            self._publish_amcl_pose(pose, stamp, sim_time)
+        if topic_ending is not None:
+            self.log.info(
+                f"goal_pose goal ended {topic_ending.outcome.value} {topic_ending.error_msg}"
+            )
+
+    def _publish_amcl_pose(self, pose: Pose2D, stamp: Any, sim_time: float) -> None:
+        message = PoseWithCovarianceStamped()
+        message.header.frame_id = MAP_FRAME
+        message.header.stamp = stamp
+        message.pose.pose = pose_msg(pose)
+        # amcl's covariance after converging: a few centimetres, a few degrees.
+        covariance = [0.0] * 36
+        covariance[0] = covariance[7] = 0.0025
+        covariance[35] = 0.0025
+        message.pose.covariance = covariance
+        self._amcl_pub.publish(message)
+        self._last_amcl = sim_time
+
+    # -- goal poses ------------------------------------------------------------------
+
+    def _in_map(self, pose: PoseStamped) -> Pose2D | str:
+        """A goal pose in the map frame, or why it cannot be used (call with the lock)."""
+        planar = pose2d_of(pose.pose)
+        if isinstance(planar, str):
+            return planar
+        frame = pose.header.frame_id.lstrip("/")
+        body = self.standin.world.body
+        if frame in ("", MAP_FRAME):
+            return planar
+        if frame == self.odom_frame:
+            return compose(body.map_to_odom, planar)
+        if frame in (self.base_frame, self.base_link):
+            return compose(body.pose, planar)
+        return (
+            f"frame {frame!r} is not {MAP_FRAME!r}, {self.odom_frame!r} or "
+            f"{self.base_frame!r} (the simulator knows no other transform)"
+        )
+
+    def _poses_in_map(self, poses: Sequence[PoseStamped]) -> list[Pose2D] | str:
+        found: list[Pose2D] = []
+        for index, pose in enumerate(poses):
+            planar = self._in_map(pose)
+            if isinstance(planar, str):
+                return f"pose {index}: {planar}" if len(poses) > 1 else planar
+            found.append(planar)
+        return found
+
+    # -- navigate_to_pose / navigate_through_poses -------------------------------------
+
+    def _nav_server(self, action: Any, navigator: Navigator, group: Any) -> ActionServer:
+        return ActionServer(
+            self.node,
+            action,
+            navigator.value,
+            execute_callback=lambda handle: self._execute_navigation(handle, action, navigator),
+            goal_callback=lambda _request: GoalResponse.ACCEPT,
+            cancel_callback=_accept_cancel,
+            callback_group=group,
+        )
+
+    def _execute_navigation(self, handle: Any, action: Any, navigator: Navigator) -> Any:
+        request = handle.request
+        raw = [request.pose] if navigator is Navigator.TO_POSE else list(request.poses)
+        with self._lock:
+            poses = self._poses_in_map(raw)
+            if isinstance(poses, str):
+                task = None
+                ending = Ending(Outcome.ABORTED, ErrorCode.PLANNER_UNKNOWN, poses)
+            else:
+                task = self.standin.navigate(navigator, poses)
+        if task is not None:
+            self.log.info(
+                f"{navigator.value}: goal to ({task.poses[-1].x:.2f}, {task.poses[-1].y:.2f})"
+                + (f" through {len(task.poses) - 1} poses" if len(task.poses) > 1 else "")
+            )
+            ending = self._follow_task(handle, task, action, navigator)
+        result = action.Result()
+        result.error_code = int(ending.error_code)
+        result.error_msg = ending.error_msg
+        _finish(handle, ending)
+        if ending.outcome is not Outcome.SUCCEEDED:
+            self.log.info(f"{navigator.value}: {ending.outcome.value} {ending.error_msg}")
+        return result
+
+    def _follow_task(self, handle: Any, task: NavTask, action: Any, navigator: Navigator) -> Ending:
+        """Feedback until ``task`` ends; a cancel request cancels it."""
+        while not task.done.wait(FEEDBACK_PERIOD):
+            if handle.is_cancel_requested:
+                with self._lock:
+                    self.standin.cancel(task)
+                break
+            with self._lock:
+                numbers = self.standin.feedback(task)
+            feedback = action.Feedback()
+            feedback.current_pose = pose_stamped(numbers.pose, MAP_FRAME, self._stamp())
+            feedback.navigation_time = duration_msg(numbers.navigation_time)
+            feedback.estimated_time_remaining = duration_msg(numbers.estimated_time_remaining)
+            feedback.number_of_recoveries = int(numbers.number_of_recoveries)
+            feedback.distance_remaining = float(numbers.distance_remaining)
+            if navigator is Navigator.THROUGH_POSES:
+                feedback.number_of_poses_remaining = int(numbers.poses_remaining)
+            handle.publish_feedback(feedback)
+        assert task.ending is not None
+        return task.ending
+
+    # -- follow_waypoints --------------------------------------------------------------
+
+    def _execute_waypoints(self, handle: Any) -> Any:
+        request = handle.request
+        stop_on_failure = bool(self.node.get_parameter("stop_on_failure").value)
+        with self._lock:
+            poses = self._poses_in_map(list(request.poses))
+            if isinstance(poses, str):
+                run: WaypointRun | None = None
+                ending = Ending(Outcome.ABORTED, 601, poses)  # TASK_EXECUTOR_FAILED
+            else:
+                run = self.standin.follow(
+                    poses,
+                    loops=int(request.number_of_loops),
+                    start_index=int(request.goal_index),
+                    stop_on_failure=stop_on_failure,
+                )
+        result = FollowWaypoints.Result()
+        if run is not None:
+            self.log.info(f"follow_waypoints: {len(run.poses)} waypoints")
+            while not run.done.wait(FEEDBACK_PERIOD):
+                if handle.is_cancel_requested:
+                    with self._lock:
+                        self.standin.cancel_waypoints(run)
+                    break
+                handle.publish_feedback(FollowWaypoints.Feedback(current_waypoint=run.current))
+            assert run.ending is not None
+            ending = run.ending
+            stamp = self._stamp()
+            result.missed_waypoints = [
+                MissedWaypoint(
+                    index=missed.index,
+                    goal=pose_stamped(missed.pose, MAP_FRAME, stamp),
+                    error_code=int(missed.error_code),
+                )
+                for missed in run.missed
+            ]
+        result.error_code = int(ending.error_code)
+        result.error_msg = ending.error_msg
+        _finish(handle, ending)
+        return result
+
+    # -- compute_path_to_pose ----------------------------------------------------------
+
+    def _execute_compute_path(self, handle: Any) -> Any:
+        request = handle.request
+        result = ComputePathToPose.Result()
+        started = time.monotonic()
+        with self._lock:
+            goal = self._in_map(request.goal)
+            start = (
+                self._in_map(request.start) if request.use_start else self.standin.world.robot.pose
+            )
+            plan = None
+            if isinstance(goal, str) or isinstance(start, str):
+                result.error_code = ComputePathToPose.Result.UNKNOWN
+                result.error_msg = goal if isinstance(goal, str) else str(start)
+            else:
+                plan = self.standin.world.server.make_plan(start, goal)
+                if plan is None:
+                    result.error_code, result.error_msg = self.standin.no_plan_reason(start, goal)
+        result.planning_time = duration_msg(time.monotonic() - started)
+        if plan is None:
+            handle.abort()
+            return result
+        assert not isinstance(goal, str)
+        result.path = path_msg(plan, goal, MAP_FRAME, self._stamp())
+        handle.succeed()
+        return result
+
+    # -- topics and services -------------------------------------------------------------
+
+    def _on_initial_pose(self, message: PoseWithCovarianceStamped) -> None:
+        frame = message.header.frame_id.lstrip("/")
+        if frame not in ("", MAP_FRAME):
+            self.log.warning(f"initialpose ignored: frame {frame!r} is not {MAP_FRAME!r}")
+            return
+        pose = pose2d_of(message.pose.pose)
+        if isinstance(pose, str):
+            self.log.warning(f"initialpose ignored: {pose}")
+            return
+        with self._lock:
+            refused = self.standin.teleport(pose)
+            sim_time = self.standin.time
+        if refused is not None:
+            self.log.warning(f"initialpose refused: {refused}")
+            return
+        self.log.info(f"teleported to ({pose.x:.2f}, {pose.y:.2f}, {pose.yaw:.2f} rad)")
+        self._localized = True
+        self._publish_amcl_pose(pose, self._stamp(), sim_time)
+
+    def _on_goal_pose(self, message: PoseStamped) -> None:
+        """RViz's "Goal Pose": a navigate_to_pose goal, as bt_navigator makes of it."""
+        with self._lock:
+            pose = self._in_map(message)
+            if isinstance(pose, str):
+                self.log.warning(f"goal_pose ignored: {pose}")
+                return
+            self._topic_goal = self.standin.navigate(Navigator.TO_POSE, [pose])
+        self.log.info(f"goal_pose: navigating to ({pose.x:.2f}, {pose.y:.2f})")
+
+    def _on_cmd_vel(self, message: Twist) -> None:
+        """Teleop while no goal runs; our own commands (echoed back to us) are skipped."""
+        if time.monotonic() - self._last_own_cmd < TELEOP_QUIET:
+            return
+        with self._lock:
+            self.standin.command(float(message.linear.x), float(message.angular.z))
+
+    def _on_clear_costmap(self, _request: Any, response: Any) -> Any:
+        with self._lock:
+            self.standin.world.server.clear_costmaps()
+        return response
+
+    def _on_get_state(self, _request: Any, response: Any) -> Any:
+        response.current_state = State(id=State.PRIMARY_STATE_ACTIVE, label="active")
+        return response
+
+
+def _accept_cancel(_handle: Any) -> CancelResponse:
+    return CancelResponse.ACCEPT
+
+
+def _finish(handle: Any, ending: Ending) -> None:
+    """Set the goal's terminal status from ``ending`` (CANCELED only if it was asked)."""
+    if ending.outcome is Outcome.SUCCEEDED:
+        handle.succeed()
+    elif ending.outcome is Outcome.CANCELED and handle.is_cancel_requested:
+        handle.canceled()
+    else:
+        handle.abort()
+
+
+def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
+    """Serve until SIGINT / SIGTERM; 0 then, 2 when the simulator cannot start."""
+    rclpy.init(
+        args=list(ros_args) if ros_args else None, signal_handler_options=SignalHandlerOptions.NO
+    )
+    stop = threading.Event()
+    previous: dict[int, Any] = {}
+
+    def request_stop(signum: int, _frame: FrameType | None) -> None:
+        stop.set()
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        previous[signum] = signal.signal(signum, request_stop)
+    sim: SimNode | None = None
+    node: Node | None = None
+    spinner: threading.Thread | None = None
+    executor = MultiThreadedExecutor(num_threads=8)
+    try:
+        overrides = [Parameter("use_sim_time", value=True)] if config.sim_time else []
+        node = Node(NODE_NAME, namespace=config.namespace or None, parameter_overrides=overrides)
+        try:
+            sim = SimNode(node, config)
+        except NavseqError as error:
+            print(f"navseq sim: {error}", file=sys.stderr)
+            return 2
+        executor.add_node(node)
+        spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2")
+        spinner.start()
+        sim.start()
+        pose = sim.standin.world.robot.pose
+        namespace = f"/{config.namespace}" if config.namespace else ""
+        print(
+            f"navseq sim: ready: {namespace}/navigate_to_pose on {config.map_yaml}, robot at "
+            f"({pose.x:.2f}, {pose.y:.2f}), speed x{config.speed:g}"
+            + (" (/clock published: use_sim_time:=true)" if config.sim_time else ""),
+            flush=True,
+        )
+        while not stop.wait(0.2):
+            pass
+        return 0
+    finally:
+        if sim is not None:
+            sim.stop()
+        executor.shutdown(timeout_sec=5.0)
+        if spinner is not None:
+            spinner.join(timeout=5.0)
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _spin(executor: MultiThreadedExecutor) -> None:
+    with contextlib.suppress(ExternalShutdownException):
+        executor.spin()
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m navseq.ros2.sim_node [--map MAP] ... [--ros-args ...]``."""
+    from rclpy.utilities import remove_ros_args
+
+    from navseq.cli import _attach_negative_values  # --start -2,0,0 as argparse wants it
+
+    everything = list(sys.argv if argv is None else ["navseq_sim", *argv])
+    parser = argparse.ArgumentParser(
+        prog="python -m navseq.ros2.sim_node",
+        description="navseq's simulator serving Nav2's interfaces (ROS 2)",
+    )
+    add_arguments(parser)
+    args = parser.parse_args(_attach_negative_values(remove_ros_args(everything)[1:]))
+    try:
+        config = config_from_args(args)
+    except NavseqError as error:
+        print(f"navseq sim: {error}", file=sys.stderr)
+        return 2
+    return run(config, everything)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

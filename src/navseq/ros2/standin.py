@@ -1,0 +1,424 @@
+"""What Nav2's navigators do, over navseq's simulator core, without any ROS import.
+
+The ROS 2 simulator node (:mod:`navseq.ros2.sim_node`) serves Nav2's action interfaces;
+this module holds the rules behind them, so that they can be read and tested without
+rclpy. One :class:`Nav2StandIn` owns a :class:`navseq.sim.world.SimWorld` (the robot
+body and the same :class:`navseq.sim.navserver.NavigationServer` the ROS 1 ``move_base``
+stand-in uses) and plays three Nav2 servers on it:
+
+- ``bt_navigator``'s two navigators, ``navigate_to_pose`` and ``navigate_through_poses``
+  (:meth:`Nav2StandIn.navigate`). A new goal of the same navigator preempts the running
+  one, which ends ABORTED with an empty result — what Nav2's ``SimpleActionServer``
+  does in ``accept_pending_goal``. A goal for the *other* navigator while one runs is
+  refused at once (ABORTED), as Nav2's navigator muxer does ("Requested navigation from
+  ... while another navigator is processing"). Through poses, every pose but the last
+  is passed without stopping: once the robot is within ``pass_radius`` (Nav2's
+  ``RemovePassedGoals`` radius, 0.5 m) the next pose becomes the target;
+- ``waypoint_follower``'s ``follow_waypoints`` (:meth:`Nav2StandIn.follow`): one
+  ``navigate_to_pose`` task per pose, so that anyone else's ``navigate_to_pose`` goal
+  preempts the follower's current one exactly as it would in Nav2. A waypoint whose
+  task fails (aborted, preempted or canceled) is a missed waypoint; with
+  ``stop_on_failure`` (Nav2's default) the whole goal then ends ABORTED, otherwise the
+  follower goes on and SUCCEEDS at the end with the missed ones listed.
+
+Times are simulated seconds (:attr:`Nav2StandIn.time`); the node steps this object from
+one thread and calls everything else under the same lock.
+"""
+
+from __future__ import annotations
+
+import enum
+import itertools
+import math
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from navseq.errors import NavseqError
+from navseq.geometry import Pose2D
+from navseq.sim.navserver import CONTROL_FAILED, NavState
+from navseq.sim.world import SimWorld
+
+PASS_RADIUS = 0.5  # m: Nav2's RemovePassedGoals default radius
+
+
+class Navigator(enum.Enum):
+    """bt_navigator's two navigators (the action each one serves)."""
+
+    TO_POSE = "navigate_to_pose"
+    THROUGH_POSES = "navigate_through_poses"
+
+
+class Outcome(enum.Enum):
+    """How a goal ends, as the action's terminal status."""
+
+    SUCCEEDED = "SUCCEEDED"
+    ABORTED = "ABORTED"
+    CANCELED = "CANCELED"
+
+
+class ErrorCode(enum.IntEnum):
+    """The Nav2 error codes a failed goal carries (nav2_msgs, Jazzy).
+
+    Nav2's navigators pass on the code of the server that failed: the planner's
+    ``ComputePathToPose`` codes (2xx) when there is no plan, the controller's
+    ``FollowPath`` codes (1xx) when the robot cannot follow it.
+    """
+
+    NONE = 0
+    CONTROLLER_UNKNOWN = 100
+    FAILED_TO_MAKE_PROGRESS = 105
+    NO_VALID_CONTROL = 106
+    PLANNER_UNKNOWN = 200
+    START_OUTSIDE_MAP = 203
+    GOAL_OUTSIDE_MAP = 204
+    START_OCCUPIED = 205
+    GOAL_OCCUPIED = 206
+    NO_VALID_PATH = 208
+
+
+@dataclass(frozen=True)
+class Ending:
+    outcome: Outcome
+    error_code: int = ErrorCode.NONE
+    error_msg: str = ""
+
+
+@dataclass
+class NavTask:
+    """One ``navigate_to_pose`` / ``navigate_through_poses`` goal and how far it got."""
+
+    navigator: Navigator
+    poses: tuple[Pose2D, ...]
+    started: float  # simulated seconds
+    index: int = 0  # the pose being driven to
+    recoveries_before: int = 0  # recovery behaviours run for poses already passed
+    ending: Ending | None = None
+    done: threading.Event = field(default_factory=threading.Event, repr=False)
+
+    @property
+    def target(self) -> Pose2D:
+        return self.poses[self.index]
+
+    def end(self, ending: Ending) -> None:
+        if self.ending is None:
+            self.ending = ending
+            self.done.set()
+
+
+@dataclass(frozen=True)
+class MissedWaypoint:
+    index: int
+    pose: Pose2D
+    error_code: int
+
+
+@dataclass
+class WaypointRun:
+    """One ``follow_waypoints`` goal: the poses, where it is, what it missed."""
+
+    poses: tuple[Pose2D, ...]
+    loops: int  # extra rounds after the first (Nav2's number_of_loops)
+    stop_on_failure: bool
+    current: int = 0
+    loop: int = 0
+    task: NavTask | None = None
+    missed: list[MissedWaypoint] = field(default_factory=list)
+    ending: Ending | None = None
+    done: threading.Event = field(default_factory=threading.Event, repr=False)
+
+    def end(self, ending: Ending) -> None:
+        if self.ending is None:
+            self.ending = ending
+            self.done.set()
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """The numbers Nav2's navigators put in their feedback."""
+
+    pose: Pose2D
+    navigation_time: float
+    estimated_time_remaining: float
+    number_of_recoveries: int
+    distance_remaining: float
+    poses_remaining: int
+
+
+class Nav2StandIn:
+    """bt_navigator and waypoint_follower on one simulated robot; see the module doc."""
+
+    def __init__(self, world: SimWorld, *, pass_radius: float = PASS_RADIUS) -> None:
+        self.world = world
+        self.pass_radius = pass_radius
+        self.time = 0.0
+        self.active: NavTask | None = None
+        self.waypoints: WaypointRun | None = None
+        # A robot driven from outside (teleop on cmd_vel) follows its commands for longer
+        # than the world's two steps; while a goal runs a command comes every step.
+        world.body.cmd_vel_timeout = max(world.body.cmd_vel_timeout, 0.5)
+
+    # -- goals -----------------------------------------------------------------------
+
+    def navigate(self, navigator: Navigator, poses: Sequence[Pose2D]) -> NavTask:
+        """Start a goal of ``navigator``; the task may have ended already (refused)."""
+        task = NavTask(navigator, tuple(poses), self.time)
+        if not task.poses:
+            task.end(Ending(Outcome.ABORTED, ErrorCode.PLANNER_UNKNOWN, "no poses in the goal"))
+            return task
+        active = self.active
+        if active is not None and active.navigator is not navigator:
+            task.end(
+                Ending(
+                    Outcome.ABORTED,
+                    ErrorCode.NONE,
+                    f"requested navigation from {navigator.value} while another "
+                    f"navigator ({active.navigator.value}) is processing, rejecting request",
+                )
+            )
+            return task
+        if active is not None:
+            active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by a new goal"))
+        self.active = task
+        self.world.server.set_goal(task.target)
+        return task
+
+    def cancel(self, task: NavTask) -> None:
+        """The client cancels ``task``: the robot stops (the body brakes from the next step)."""
+        if task is self.active:
+            self._stop()
+        task.end(Ending(Outcome.CANCELED))
+
+    def follow(
+        self,
+        poses: Sequence[Pose2D],
+        *,
+        loops: int = 0,
+        start_index: int = 0,
+        stop_on_failure: bool = True,
+    ) -> WaypointRun:
+        """Start a ``follow_waypoints`` goal; a running one is preempted (ABORTED)."""
+        run = WaypointRun(tuple(poses), loops, stop_on_failure, current=start_index)
+        previous = self.waypoints
+        if previous is not None:
+            self._drop_waypoint_task(previous)
+            previous.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by a new goal"))
+        if not run.poses or not 0 <= start_index < len(run.poses):
+            run.end(
+                Ending(
+                    Outcome.ABORTED,
+                    601,  # FollowWaypoints TASK_EXECUTOR_FAILED: Nav2 has no better code
+                    f"goal_index {start_index} is not a pose of the {len(run.poses)} given",
+                )
+            )
+            return run
+        self.waypoints = run
+        self._next_waypoint_task(run)
+        return run
+
+    def cancel_waypoints(self, run: WaypointRun) -> None:
+        if run is self.waypoints:
+            self._drop_waypoint_task(run)
+            self.waypoints = None
+        run.end(Ending(Outcome.CANCELED))
+
+    def abort_all(self, why: str) -> None:
+        """End every goal (the node is shutting down) and stop the robot."""
+        if self.waypoints is not None:
+            self.waypoints.end(Ending(Outcome.ABORTED, ErrorCode.NONE, why))
+            self.waypoints = None
+        if self.active is not None:
+            self.active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, why))
+        self._stop()
+
+    # -- simulation ------------------------------------------------------------------
+
+    def step(self) -> None:
+        """Advance the world one step and settle whatever goal that ends."""
+        world = self.world
+        task = self.active
+        if task is not None and task.ending is None:
+            self._pass_through(task)
+        if world.server.state is NavState.ACTIVE:
+            world.step()
+        else:
+            world.body.step(world.dt)  # idle: a teleop command, or braking to rest
+        self.time += world.dt
+        if task is not None and task.ending is None:
+            self._settle(task)
+        if task is not None and task.ending is not None and task is self.active:
+            self.active = None
+            self._stop()
+        run = self.waypoints
+        if run is not None:
+            self._advance_waypoints(run)
+
+    def command(self, v: float, w: float) -> bool:
+        """A velocity command from outside (teleop); ignored (False) while a goal runs."""
+        if self.world.server.state is NavState.ACTIVE:
+            return False
+        self.world.body.command(v, w)
+        return True
+
+    def teleport(self, pose: Pose2D) -> str | None:
+        """Put the robot at ``pose``; why not, if it cannot be."""
+        try:
+            self.world.teleport(pose)
+        except NavseqError as error:
+            return str(error)
+        return None
+
+    def feedback(self, task: NavTask) -> Feedback:
+        """What Nav2 reports for ``task`` now.
+
+        The distance is along the current plan to the current pose, plus the straight
+        lines between the poses still ahead; the time remaining is that distance at the
+        robot's present speed, zero when it stands or is within 0.1 m (Nav2's rule).
+        """
+        world = self.world
+        robot = world.robot
+        server = world.server
+        if server.distance_remaining is not None and task is self.active:
+            to_target = server.distance_remaining
+        else:
+            to_target = robot.pose.distance_to(task.target)
+        ahead = sum(a.distance_to(b) for a, b in itertools.pairwise(task.poses[task.index :]))
+        remaining = to_target + ahead
+        speed = abs(robot.v)
+        eta = remaining / speed if speed > 0.01 and remaining > 0.1 else 0.0
+        recoveries = task.recoveries_before + (server.recoveries_run if task is self.active else 0)
+        return Feedback(
+            pose=robot.pose,
+            navigation_time=self.time - task.started,
+            estimated_time_remaining=eta,
+            number_of_recoveries=recoveries,
+            distance_remaining=remaining,
+            poses_remaining=len(task.poses) - task.index,
+        )
+
+    # -- internals -------------------------------------------------------------------
+
+    def _stop(self) -> None:
+        self.world.server.cancel()
+        self.world.body.command(0.0, 0.0)
+
+    def _pass_through(self, task: NavTask) -> None:
+        """Through poses: the next pose becomes the target once this one is near."""
+        while (
+            task.index + 1 < len(task.poses)
+            and self.world.robot.pose.distance_to(task.target) <= self.pass_radius
+        ):
+            task.recoveries_before += self.world.server.recoveries_run
+            task.index += 1
+            self.world.server.set_goal(task.target)  # replans; the robot keeps rolling
+
+    def _settle(self, task: NavTask) -> None:
+        server = self.world.server
+        if server.state is NavState.SUCCEEDED:
+            if task.index + 1 < len(task.poses):  # reached a pose to pass: go on
+                task.recoveries_before += server.recoveries_run
+                task.index += 1
+                server.set_goal(task.target)
+            else:
+                task.end(Ending(Outcome.SUCCEEDED))
+        elif server.state is NavState.ABORTED:
+            task.end(Ending(Outcome.ABORTED, self._error_code(task), server.status_text))
+        elif server.state is NavState.CANCELED:
+            task.end(Ending(Outcome.CANCELED))
+
+    def _error_code(self, task: NavTask) -> int:
+        """The Nav2 code for the server's failure (see :class:`ErrorCode`)."""
+        text = self.world.server.status_text
+        code, _ = self.no_plan_reason(self.world.robot.pose, task.target)
+        if code in (ErrorCode.GOAL_OUTSIDE_MAP, ErrorCode.GOAL_OCCUPIED):
+            return code
+        if "another robot" in text:
+            return ErrorCode.FAILED_TO_MAKE_PROGRESS
+        if text.startswith(CONTROL_FAILED):
+            return ErrorCode.NO_VALID_CONTROL
+        return code
+
+    def no_plan_reason(self, start: Pose2D, goal: Pose2D) -> tuple[int, str]:
+        """Nav2's planner code and a text for why no plan leads from ``start`` to ``goal``."""
+        costmap = self.world.server.costmap
+        grid = costmap.grid
+        if not grid.contains(goal.x, goal.y):
+            return (
+                ErrorCode.GOAL_OUTSIDE_MAP,
+                f"goal ({goal.x:.2f}, {goal.y:.2f}) is outside the map",
+            )
+        if not costmap.is_free(goal.x, goal.y):
+            return ErrorCode.GOAL_OCCUPIED, (
+                f"goal ({goal.x:.2f}, {goal.y:.2f}) is in an obstacle or too close to one"
+            )
+        if not grid.contains(start.x, start.y):
+            return (
+                ErrorCode.START_OUTSIDE_MAP,
+                f"start ({start.x:.2f}, {start.y:.2f}) is outside the map",
+            )
+        return ErrorCode.NO_VALID_PATH, f"no valid path to ({goal.x:.2f}, {goal.y:.2f})"
+
+    def _next_waypoint_task(self, run: WaypointRun) -> None:
+        run.task = self.navigate(Navigator.TO_POSE, [run.poses[run.current]])
+
+    def _drop_waypoint_task(self, run: WaypointRun) -> None:
+        task = run.task
+        if task is not None and task.ending is None:
+            if task is self.active:
+                self.active = None
+                self._stop()
+            task.end(Ending(Outcome.CANCELED))
+
+    def _advance_waypoints(self, run: WaypointRun) -> None:
+        """Waypoint follower: on to the next pose when the current task has ended."""
+        task = run.task
+        if task is None or task.ending is None or run.ending is not None:
+            return
+        if task.ending.outcome is not Outcome.SUCCEEDED:
+            run.missed.append(
+                MissedWaypoint(run.current, run.poses[run.current], task.ending.error_code)
+            )
+            if run.stop_on_failure:
+                run.end(
+                    Ending(
+                        Outcome.ABORTED,
+                        task.ending.error_code,
+                        f"failed to process waypoint {run.current}: "
+                        f"{task.ending.error_msg or task.ending.outcome.value}",
+                    )
+                )
+                self.waypoints = None
+                return
+        following = run.current + 1
+        if following >= len(run.poses):
+            if run.loop >= run.loops:
+                run.end(Ending(Outcome.SUCCEEDED))
+                self.waypoints = None
+                return
+            run.loop += 1
+            following = 0
+        run.current = following
+        self._next_waypoint_task(run)
+
+
+def plan_poses(points: npt.ArrayLike, goal: Pose2D | None) -> list[Pose2D]:
+    """The poses of a published plan (``points``: N x 2): each faces the next point, the
+    last one has the goal's yaw (or keeps the last heading without a goal)."""
+    xy = np.asarray(points, dtype=float).reshape(-1, 2)
+    poses: list[Pose2D] = []
+    count = len(xy)
+    for index in range(count):
+        x, y = float(xy[index, 0]), float(xy[index, 1])
+        if index + 1 < count:
+            yaw = math.atan2(float(xy[index + 1, 1]) - y, float(xy[index + 1, 0]) - x)
+        elif goal is not None:
+            yaw = goal.yaw
+        elif index > 0:
+            yaw = math.atan2(y - float(xy[index - 1, 1]), x - float(xy[index - 1, 0]))
+        else:
+            yaw = 0.0
+        poses.append(Pose2D(x, y, yaw))
+    return poses

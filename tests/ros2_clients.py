@@ -1,0 +1,263 @@
+"""Real rclpy clients for the ROS 2 tests, run as subprocesses (never in pytest's process).
+
+``python tests/ros2_clients.py VERB [options]`` does one thing a Nav2 user's client does
+and prints one JSON object on its last stdout line: what it saw. Verbs:
+
+- ``navigate X,Y,YAW``: a ``navigate_to_pose`` goal (``--delay`` before sending,
+  ``--cancel-after`` seconds then a cancel and a watch of ``odom`` until the robot stands);
+- ``through X,Y,YAW X,Y,YAW ...``: a ``navigate_through_poses`` goal;
+- ``waypoints X,Y,YAW ...``: a ``follow_waypoints`` goal;
+- ``path X,Y,YAW``: ``compute_path_to_pose`` from the robot;
+- ``map``: subscribes to ``map`` late, transient local, like RViz or a costmap;
+- ``ready``: the lifecycle ``get_state`` of bt_navigator and amcl, then an
+  ``initialpose`` and the ``amcl_pose`` that follows, then a clear-costmap call — what
+  nav2_simple_commander's ``waitUntilNav2Active`` and ``clearAllCostmaps`` do.
+
+``--ns NS`` puts every name in a namespace. Yaw is in degrees.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from typing import Any
+
+import rclpy
+from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from lifecycle_msgs.srv import GetState
+from nav2_msgs.action import (
+    ComputePathToPose,
+    FollowWaypoints,
+    NavigateThroughPoses,
+    NavigateToPose,
+)
+from nav2_msgs.srv import ClearEntireCostmap
+from nav_msgs.msg import OccupancyGrid, Odometry
+from rclpy.action import ActionClient
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+STATUS = {
+    GoalStatus.STATUS_SUCCEEDED: "SUCCEEDED",
+    GoalStatus.STATUS_ABORTED: "ABORTED",
+    GoalStatus.STATUS_CANCELED: "CANCELED",
+}
+LATCHED = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+
+
+def pose_stamped(text: str, frame: str = "map") -> PoseStamped:
+    x, y, yaw = (float(part) for part in text.split(","))
+    pose = PoseStamped()
+    pose.header.frame_id = frame
+    pose.pose.position.x = x
+    pose.pose.position.y = y
+    pose.pose.orientation.z = math.sin(math.radians(yaw) / 2)
+    pose.pose.orientation.w = math.cos(math.radians(yaw) / 2)
+    return pose
+
+
+def name(ns: str, relative: str) -> str:
+    return f"/{ns}/{relative}" if ns else relative
+
+
+def wait(node: Node, future: Any, timeout: float) -> Any:
+    rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
+    if not future.done():
+        raise SystemExit(f"timed out after {timeout} s")
+    return future.result()
+
+
+def run_goal(node: Node, args: argparse.Namespace, action: Any, name_: str, goal: Any) -> dict:
+    """Send ``goal``, gather feedback, cancel if asked; the result and what was seen."""
+    client = ActionClient(node, action, name(args.ns, name_))
+    if not client.wait_for_server(timeout_sec=args.timeout):
+        raise SystemExit(f"no {name_} server")
+    if args.delay:
+        end = time.monotonic() + args.delay
+        while time.monotonic() < end:
+            rclpy.spin_once(node, timeout_sec=0.05)
+    feedback: list[dict] = []
+
+    def on_feedback(message: Any) -> None:
+        fb = message.feedback
+        entry = {"t": time.monotonic()}
+        for field in (
+            "distance_remaining",
+            "number_of_recoveries",
+            "number_of_poses_remaining",
+            "current_waypoint",
+        ):
+            if hasattr(fb, field):
+                entry[field] = getattr(fb, field)
+        if hasattr(fb, "navigation_time"):
+            entry["navigation_time"] = fb.navigation_time.sec + fb.navigation_time.nanosec * 1e-9
+            eta = fb.estimated_time_remaining
+            entry["eta"] = eta.sec + eta.nanosec * 1e-9
+            entry["x"] = fb.current_pose.pose.position.x
+            entry["frame"] = fb.current_pose.header.frame_id
+        feedback.append(entry)
+
+    handle = wait(node, client.send_goal_async(goal, feedback_callback=on_feedback), args.timeout)
+    out: dict[str, Any] = {"accepted": bool(handle.accepted)}
+    if not handle.accepted:
+        return out
+    result_future = handle.get_result_async()
+    if args.cancel_after is not None:
+        end = time.monotonic() + args.cancel_after
+        while time.monotonic() < end and not result_future.done():
+            rclpy.spin_once(node, timeout_sec=0.05)
+        speeds: list[tuple[float, float]] = []
+        node.create_subscription(
+            Odometry,
+            name(args.ns, "odom"),
+            lambda m: speeds.append((time.monotonic(), abs(m.twist.twist.linear.x))),
+            50,
+        )
+        moving = feedback[-1]["x"] if feedback else None
+        response = wait(node, handle.cancel_goal_async(), args.timeout)
+        canceled_at = time.monotonic()
+        out["cancel_accepted"] = len(response.goals_canceling) == 1
+        out["x_before_cancel"] = moving
+        wait(node, result_future, args.timeout)
+        end = time.monotonic() + 2.0
+        while time.monotonic() < end:
+            rclpy.spin_once(node, timeout_sec=0.05)
+        stopped = [t for t, v in speeds if t >= canceled_at and v == 0.0]
+        out["stopped_after"] = stopped[0] - canceled_at if stopped else None
+        out["speeds_after_cancel"] = [v for t, v in speeds if t >= canceled_at][:60]
+        out["moving_at_end"] = bool(speeds) and speeds[-1][1] != 0.0
+    result = wait(node, result_future, args.timeout)
+    out["status"] = STATUS.get(result.status, str(result.status))
+    out["error_code"] = int(result.result.error_code)
+    out["error_msg"] = result.result.error_msg
+    if hasattr(result.result, "missed_waypoints"):
+        out["missed"] = [
+            {"index": int(m.index), "error_code": int(m.error_code)}
+            for m in result.result.missed_waypoints
+        ]
+    out["feedback"] = feedback
+    return out
+
+
+def navigate(node: Node, args: argparse.Namespace) -> dict:
+    goal = NavigateToPose.Goal(pose=pose_stamped(args.poses[0], args.frame))
+    return run_goal(node, args, NavigateToPose, "navigate_to_pose", goal)
+
+
+def through(node: Node, args: argparse.Namespace) -> dict:
+    goal = NavigateThroughPoses.Goal(poses=[pose_stamped(p, args.frame) for p in args.poses])
+    return run_goal(node, args, NavigateThroughPoses, "navigate_through_poses", goal)
+
+
+def waypoints(node: Node, args: argparse.Namespace) -> dict:
+    goal = FollowWaypoints.Goal(poses=[pose_stamped(p, args.frame) for p in args.poses])
+    return run_goal(node, args, FollowWaypoints, "follow_waypoints", goal)
+
+
+def path(node: Node, args: argparse.Namespace) -> dict:
+    client = ActionClient(node, ComputePathToPose, name(args.ns, "compute_path_to_pose"))
+    if not client.wait_for_server(timeout_sec=args.timeout):
+        raise SystemExit("no compute_path_to_pose server")
+    goal = ComputePathToPose.Goal(goal=pose_stamped(args.poses[0], args.frame), use_start=False)
+    handle = wait(node, client.send_goal_async(goal), args.timeout)
+    result = wait(node, handle.get_result_async(), args.timeout)
+    poses = result.result.path.poses
+    return {
+        "status": STATUS.get(result.status, str(result.status)),
+        "error_code": int(result.result.error_code),
+        "points": len(poses),
+        "frame": result.result.path.header.frame_id,
+        "last": [poses[-1].pose.position.x, poses[-1].pose.position.y] if poses else None,
+    }
+
+
+def late_map(node: Node, args: argparse.Namespace) -> dict:
+    got: list[OccupancyGrid] = []
+    node.create_subscription(OccupancyGrid, name(args.ns, "map"), got.append, LATCHED)
+    end = time.monotonic() + args.timeout
+    while not got and time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    if not got:
+        return {"map": None}
+    grid = got[0]
+    return {
+        "map": [grid.info.width, grid.info.height, round(grid.info.resolution, 4)],
+        "frame": grid.header.frame_id,
+        "cells": {str(v): sum(1 for value in grid.data if value == v) for v in (-1, 0, 100)},
+    }
+
+
+def ready(node: Node, args: argparse.Namespace) -> dict:
+    out: dict[str, Any] = {}
+    for server in ("bt_navigator", "amcl"):
+        client = node.create_client(GetState, name(args.ns, f"{server}/get_state"))
+        if not client.wait_for_service(timeout_sec=args.timeout):
+            raise SystemExit(f"no {server}/get_state")
+        state = wait(node, client.call_async(GetState.Request()), args.timeout)
+        out[server] = state.current_state.label
+    amcl: list[PoseWithCovarianceStamped] = []
+    node.create_subscription(
+        PoseWithCovarianceStamped, name(args.ns, "amcl_pose"), amcl.append, LATCHED
+    )
+    publisher = node.create_publisher(PoseWithCovarianceStamped, name(args.ns, "initialpose"), 10)
+    initial = PoseWithCovarianceStamped()
+    target = pose_stamped(args.poses[0] if args.poses else "-1.5,-0.5,90")
+    initial.header = target.header
+    initial.pose.pose = target.pose
+    end = time.monotonic() + args.timeout
+    while not amcl and time.monotonic() < end:
+        publisher.publish(initial)  # until someone listens: what the commander does too
+        for _ in range(5):
+            rclpy.spin_once(node, timeout_sec=0.05)
+    out["amcl_pose"] = (
+        [amcl[-1].pose.pose.position.x, amcl[-1].pose.pose.position.y] if amcl else None
+    )
+    for costmap in ("global_costmap", "local_costmap"):
+        client = node.create_client(
+            ClearEntireCostmap, name(args.ns, f"{costmap}/clear_entirely_{costmap}")
+        )
+        if not client.wait_for_service(timeout_sec=args.timeout):
+            raise SystemExit(f"no {costmap} clear service")
+        wait(node, client.call_async(ClearEntireCostmap.Request()), args.timeout)
+        out[costmap] = "cleared"
+    return out
+
+
+VERBS = {
+    "navigate": navigate,
+    "through": through,
+    "waypoints": waypoints,
+    "path": path,
+    "map": late_map,
+    "ready": ready,
+}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("verb", choices=sorted(VERBS))
+    parser.add_argument("poses", nargs="*", help="x,y,yaw (degrees)")
+    parser.add_argument("--ns", default="")
+    parser.add_argument("--frame", default="map")
+    parser.add_argument("--delay", type=float, default=0.0)
+    parser.add_argument("--cancel-after", type=float)
+    parser.add_argument("--timeout", type=float, default=60.0)
+    args = parser.parse_args()
+    rclpy.init()
+    node = Node(f"navseq_test_{args.verb}")
+    try:
+        print(json.dumps(VERBS[args.verb](node, args)), flush=True)
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

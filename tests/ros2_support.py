@@ -1,0 +1,77 @@
+"""Real ROS 2 for tests: the environment a ROS 2 process needs, and isolated runs.
+
+ROS 2 is found in ``$NAVSEQ_ROS2_PREFIX``, else ``/opt/ros2min`` (where
+``scripts/install-ros2-min.sh`` unpacks the test machine's minimal Jazzy), else an
+already sourced ROS 2 (``$AMENT_PREFIX_PATH``). Tests never import rclpy in the pytest
+process: ``LD_LIBRARY_PATH`` must be set before a process starts, and rclpy, like rospy,
+keeps global state. Every ROS 2 client and server runs as a subprocess started with
+:func:`ros2_environment`, which gives the run its own ``ROS_DOMAIN_ID`` and keeps DDS
+discovery on the loopback.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import subprocess
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+
+DEFAULT_PREFIX = Path("/opt/ros2min")
+PYTHON_DIR = f"python{sys.version_info.major}.{sys.version_info.minor}"
+
+
+def ros2_prefix() -> Path | None:
+    """The install prefix of a usable ROS 2 (one that has rclpy), or None."""
+    candidates = [os.environ.get("NAVSEQ_ROS2_PREFIX", ""), str(DEFAULT_PREFIX)]
+    candidates += os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)
+    for candidate in candidates:
+        if (
+            candidate
+            and (Path(candidate) / "lib" / PYTHON_DIR / "site-packages" / "rclpy").is_dir()
+        ):
+            return Path(candidate)
+    return None
+
+
+def ros2_environment(
+    prefix: Path, domain_id: int | None = None, base: Mapping[str, str] | None = None
+) -> dict[str, str]:
+    """The environment of a ROS 2 process: the prefix's paths first, a private domain."""
+    env = dict(os.environ if base is None else base)
+
+    def first(variable: str, path: Path) -> None:
+        rest = [part for part in env.get(variable, "").split(os.pathsep) if part]
+        env[variable] = os.pathsep.join([str(path), *rest])
+
+    first("AMENT_PREFIX_PATH", prefix)
+    first("PYTHONPATH", prefix / "lib" / PYTHON_DIR / "site-packages")
+    # Debian 12 has unrelated ROS 2 libraries with another ABI: this tree's lib first.
+    first("LD_LIBRARY_PATH", prefix / "lib")
+    first("PATH", prefix / "bin")
+    env["ROS_DOMAIN_ID"] = str(random.randint(1, 101) if domain_id is None else domain_id)
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env.pop("ROS_LOCALHOST_ONLY", None)  # deprecated in Jazzy: every process would warn
+    env["RMW_IMPLEMENTATION"] = "rmw_cyclonedds_cpp"
+    return env
+
+
+def ros2_available() -> tuple[bool, str]:
+    """Whether rclpy and nav2_msgs import in a ROS 2 process here, and why not."""
+    prefix = ros2_prefix()
+    if prefix is None:
+        return False, (
+            "no ROS 2 found (set NAVSEQ_ROS2_PREFIX, source ROS 2, or run "
+            "scripts/install-ros2-min.sh)"
+        )
+    probe = subprocess.run(
+        [sys.executable, "-c", "import rclpy, nav2_msgs.action"],
+        env=ros2_environment(prefix),
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    if probe.returncode != 0:
+        return False, f"rclpy does not import from {prefix}: {probe.stderr.strip()[-300:]}"
+    return True, ""

@@ -1,0 +1,186 @@
+"""Nav2's navigator rules in navseq.ros2.standin, in process (no ROS 2 needed)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from navseq.geometry import Pose2D
+from navseq.ros2.standin import (
+    ErrorCode,
+    Nav2StandIn,
+    Navigator,
+    NavTask,
+    Outcome,
+    WaypointRun,
+    plan_poses,
+)
+from navseq.sim.occupancy import load_map
+from navseq.sim.world import SimWorld
+
+MAP = Path(__file__).resolve().parents[1] / "maps" / "turtlebot3_world.yaml"
+START = Pose2D(-2.0, -0.5, 0.0)
+IN_A_PILLAR = Pose2D(-1.1, 0.0)
+
+
+@pytest.fixture(scope="module")
+def grid():
+    return load_map(MAP)
+
+
+@pytest.fixture
+def standin(grid) -> Nav2StandIn:
+    return Nav2StandIn(SimWorld(grid, START))
+
+
+def run_until_done(standin: Nav2StandIn, goal: NavTask | WaypointRun, seconds: float = 120.0):
+    for _ in range(round(seconds / standin.world.dt)):
+        if goal.ending is not None:
+            return goal.ending
+        standin.step()
+    raise AssertionError(f"not done after {seconds} simulated seconds")
+
+
+def test_a_reached_goal_succeeds_and_the_robot_stands(standin: Nav2StandIn):
+    task = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.0, -0.5, 0.0)])
+    assert run_until_done(standin, task).outcome is Outcome.SUCCEEDED
+    assert task.done.is_set()
+    assert standin.world.robot.pose.distance_to(Pose2D(-1.0, -0.5)) < 0.1
+    for _ in range(10):
+        standin.step()
+    assert standin.world.robot.v == 0.0 and standin.active is None
+
+
+def test_a_new_goal_preempts_the_running_one_which_ends_aborted(standin: Nav2StandIn):
+    first = standin.navigate(Navigator.TO_POSE, [Pose2D(2.0, 0.5)])
+    for _ in range(20):
+        standin.step()
+    second = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.5, -0.5)])
+    assert first.ending is not None
+    assert (first.ending.outcome, first.ending.error_code) == (Outcome.ABORTED, ErrorCode.NONE)
+    assert run_until_done(standin, second).outcome is Outcome.SUCCEEDED
+
+
+def test_the_other_navigator_is_refused_while_one_runs(standin: Nav2StandIn):
+    running = standin.navigate(Navigator.THROUGH_POSES, [Pose2D(-1.5, -0.5), Pose2D(2.0, 0.5)])
+    refused = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.0, -0.5)])
+    assert refused.ending is not None and refused.ending.outcome is Outcome.ABORTED
+    assert "another navigator" in refused.ending.error_msg
+    assert running.ending is None and standin.active is running
+
+
+def test_a_goal_in_a_pillar_aborts_with_goal_occupied(standin: Nav2StandIn):
+    task = standin.navigate(Navigator.TO_POSE, [IN_A_PILLAR])
+    ending = run_until_done(standin, task)
+    assert (ending.outcome, ending.error_code) == (Outcome.ABORTED, ErrorCode.GOAL_OCCUPIED)
+
+
+def test_cancel_ends_canceled_and_the_robot_brakes_at_once(standin: Nav2StandIn):
+    task = standin.navigate(Navigator.TO_POSE, [Pose2D(2.0, 0.5)])
+    for _ in range(60):
+        standin.step()
+    assert standin.world.robot.v > 0.1
+    standin.cancel(task)
+    assert task.ending is not None and task.ending.outcome is Outcome.CANCELED
+    for _ in range(4):  # 0.2 s: the burger brakes at 2.5 m/s²
+        standin.step()
+    assert standin.world.robot.v == 0.0
+
+
+def test_through_poses_rolls_past_the_first_pose_without_stopping(standin: Nav2StandIn):
+    passing, last = Pose2D(-1.0, -0.5, 0.0), Pose2D(-0.5, -1.7, 0.0)
+    task = standin.navigate(Navigator.THROUGH_POSES, [passing, last])
+    cruise = standin.world.server.params.limits.max_v
+    slowest_near_pass = cruise
+    remaining = []
+    while task.ending is None:
+        standin.step()
+        robot = standin.world.robot
+        if robot.pose.distance_to(passing) < 0.3:
+            slowest_near_pass = min(slowest_near_pass, robot.v)
+        if task.ending is None:
+            remaining.append(standin.feedback(task).poses_remaining)
+        assert standin.time < 120
+    assert task.ending.outcome is Outcome.SUCCEEDED
+    assert slowest_near_pass > cruise / 2
+    assert remaining[0] == 2 and remaining[-1] == 1
+    assert standin.world.robot.pose.distance_to(last) < 0.1
+
+
+def test_feedback_counts_time_and_distance_like_nav2(standin: Nav2StandIn):
+    task = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.0, -0.5, 0.0)])
+    first = standin.feedback(task)
+    assert first.distance_remaining == pytest.approx(1.0, abs=0.05)
+    assert first.estimated_time_remaining == 0.0  # standing still: Nav2 gives no ETA
+    for _ in range(40):
+        standin.step()
+    later = standin.feedback(task)
+    assert later.navigation_time == pytest.approx(2.0)
+    assert later.distance_remaining < first.distance_remaining
+    speed = standin.world.robot.v
+    assert later.estimated_time_remaining == pytest.approx(later.distance_remaining / speed)
+
+
+def test_follow_waypoints_stops_at_a_missed_one_by_default(standin: Nav2StandIn):
+    run = standin.follow([Pose2D(-1.5, -0.5), IN_A_PILLAR, Pose2D(-1.0, -0.5)])
+    ending = run_until_done(standin, run)
+    assert ending.outcome is Outcome.ABORTED
+    assert [(m.index, m.error_code) for m in run.missed] == [(1, ErrorCode.GOAL_OCCUPIED)]
+    assert run.current == 1
+
+
+def test_follow_waypoints_goes_on_without_stop_on_failure(standin: Nav2StandIn):
+    run = standin.follow(
+        [Pose2D(-1.5, -0.5), IN_A_PILLAR, Pose2D(-1.0, -0.5)], stop_on_failure=False
+    )
+    assert run_until_done(standin, run).outcome is Outcome.SUCCEEDED
+    assert [m.index for m in run.missed] == [1]
+    assert standin.world.robot.pose.distance_to(Pose2D(-1.0, -0.5)) < 0.1
+
+
+def test_someone_elses_navigate_goal_makes_the_follower_miss_its_waypoint(standin: Nav2StandIn):
+    run = standin.follow([Pose2D(2.0, 0.5), Pose2D(-1.0, -0.5)])
+    for _ in range(10):
+        standin.step()
+    standin.navigate(Navigator.TO_POSE, [Pose2D(-1.5, -0.5)])
+    standin.step()
+    assert run.ending is not None and run.ending.outcome is Outcome.ABORTED
+    assert [m.index for m in run.missed] == [0]
+
+
+def test_loops_repeat_the_waypoints(standin: Nav2StandIn):
+    run = standin.follow([Pose2D(-1.5, -0.5), Pose2D(-1.0, -0.5)], loops=1)
+    seen = []
+    while run.ending is None:
+        standin.step()
+        if not seen or seen[-1] != run.current:
+            seen.append(run.current)
+    assert run.ending.outcome is Outcome.SUCCEEDED
+    assert seen == [0, 1, 0, 1]
+
+
+def test_a_bad_goal_index_aborts_the_follower(standin: Nav2StandIn):
+    run = standin.follow([Pose2D(-1.5, -0.5)], start_index=3)
+    assert run.ending is not None and run.ending.outcome is Outcome.ABORTED
+
+
+def test_teleport_into_a_pillar_is_refused(standin: Nav2StandIn):
+    assert standin.teleport(IN_A_PILLAR) is not None
+    assert standin.teleport(Pose2D(-1.5, -0.5, 1.0)) is None
+    assert standin.world.robot.pose == Pose2D(-1.5, -0.5, 1.0)
+
+
+def test_teleop_drives_only_while_no_goal_runs(standin: Nav2StandIn):
+    assert standin.command(0.1, 0.0)
+    for _ in range(10):
+        standin.step()
+    assert standin.world.robot.pose.x > START.x + 0.03
+    standin.navigate(Navigator.TO_POSE, [Pose2D(-1.0, -0.5)])
+    standin.step()
+    assert not standin.command(0.0, 1.0)
+
+
+def test_plan_poses_face_the_next_point_and_end_with_the_goal_yaw():
+    poses = plan_poses([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], Pose2D(1.0, 1.0, 3.0))
+    assert [round(p.yaw, 3) for p in poses] == [0.0, 1.571, 3.0]
