@@ -217,7 +217,9 @@ class VisitLog:
     ):
         self._waypoints = waypoints
         self._loops = loops
-        self._totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(waypoints)]
+        self._totals = [
+            WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(waypoints)
+        ]
         self._recent: deque[WaypointResult] = deque(maxlen=max(1, keep_last))
         self._not_reached: list[WaypointResult] = []
         self._keep_not_reached = keep_not_reached

@@ -165,7 +165,9 @@ def _waypoint_totals(mission: Mission, result: MissionResult) -> list[WaypointTo
     """The result's per-waypoint totals; counted from ``visits`` for a result without."""
     if result.waypoints:
         return result.waypoints
-    totals = [WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(mission.waypoints)]
+    totals = [
+        WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(mission.waypoints)
+    ]
     for visit in result.visits:
         if 0 <= visit.index < len(totals):
             totals[visit.index].add(visit)
