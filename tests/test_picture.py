@@ -306,6 +306,25 @@ def test_a_patrol_point_interrupted_after_1806_good_laps_is_reached_with_a_ring(
     assert "5,418/5,419 visits reached" in fig.axes[0].get_title(loc="left")
 
 
+def test_a_patrol_longer_than_the_report_lists_is_drawn_from_its_totals():
+    """The result of a long patrol lists only its last visits; the picture counts all."""
+    from navseq.executor.result import VisitLog
+
+    log = VisitLog(MISSION.waypoints, None)
+    for visit in patrol_interrupted(1806, cut_at=1).visits:
+        log.add(visit)
+    result = log.result(
+        success=False, reason="interrupted: SIGINT", duration=9e4, loops_completed=1806
+    )
+    assert result.omitted_visits > 0  # the premise: not every visit is listed
+    outcomes = waypoint_outcomes(result, 3)
+    assert [outcomes[i] for i in range(3)] == [Status.REACHED] * 3
+    assert list(outcomes.interrupted) == [False, True, False]
+    assert outcomes.reached[1] == 1806
+    fig = mission_figure(MISSION, result, grid=make_grid(), interrupted="SIGINT")
+    assert "5,418/5,419 visits reached" in fig.axes[0].get_title(loc="left")
+
+
 def test_a_waypoint_only_ever_interrupted_is_interrupted_and_a_real_failure_is_failed():
     mission = Mission(WAYPOINTS, source="m.yaml")
     cut = visits_result(mission, [REACHED, (FAILED, "interrupted: SIGTERM"), NOT_RUN])

@@ -134,6 +134,18 @@ def waypoint_outcomes(result: MissionResult, count: int) -> WaypointOutcomes:
             reached[index] += 1
         if severity > worst[index]:
             worst[index] = severity
+    if result.omitted_visits and result.waypoints:
+        # A long patrol lists only some visits in full; the per-waypoint totals count
+        # them all (an interruption is counted as failed there: at most one per run).
+        for totals in result.waypoints:
+            index = totals.index
+            if not 0 <= index < count:
+                continue
+            failures = totals.failed - int(interrupted[index])
+            reached[index] = totals.reached
+            ended[index] = totals.reached + totals.skipped + failures
+            severity = 3 if failures > 0 else 2 if totals.skipped else 1 if totals.reached else 0
+            worst[index] = max(int(worst[index]), severity)
     code = {status: STATUSES.index(status) for status in Status}
     status = np.select(
         [worst == 3, worst == 2, worst == 1, interrupted],
