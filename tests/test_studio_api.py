@@ -255,7 +255,7 @@ def test_a_run_writes_the_usual_output_folder(client: TestClient, workspace: Pat
     state = wait_for_run(client)
     assert state["status"] == "completed", state
     assert state["waypoints"] == ["reached"] * 7
-    folder = Path(state["folder"])
+    folder = workspace / "out" / state["folder"]
     assert folder.parent == workspace / "out/navseq-out"
     names = {path.name for path in folder.iterdir()}
     assert {"journal.jsonl", "report.json", "mission.png", "turtlebot3_world.yaml"} <= names

@@ -306,7 +306,7 @@ class Studio:
         run.start()  # NavseqError (pre-flight problems) -> 422 with them
         with self._lock:
             self.run = run
-        return {"folder": str(run.folder), "status": run.view.status}
+        return {"folder": run.view.folder, "status": run.view.status}
 
     def current_run(self) -> StudioRun:
         if self.run is None:

@@ -17,6 +17,7 @@ import argparse
 import contextlib
 import json
 import math
+import os
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -219,7 +220,8 @@ class StudioRun:
 
         setup.make_navigator = watched_navigator
         self.folder = folder
-        self.view.folder = str(folder)
+        # Shown as navseq run says it: relative to where the studio was started.
+        self.view.folder = os.path.relpath(folder, self.out_base)
         return setup, args
 
     def _run(self, run_command: Any, setup: Any, args: argparse.Namespace) -> None:

@@ -365,6 +365,12 @@ async function check() {
 async function save(path) {
   const body = { mission: S.doc, version: path ? null : S.version };
   if (path) body.path = path;
+  if (!path && S.exists) {
+    // The opened file is replaced only once the user says so (and the server still
+    // refuses if it changed on disk since it was opened).
+    if (!window.confirm(`${S.name} exists; replace it with this mission?`)) { say("not saved"); return; }
+    body.overwrite = true;
+  }
   let answer = await api("POST", "/api/save", body);
   if (answer.status === 409 && answer.data.conflict === "exists") {
     if (!window.confirm(`${answer.data.error}?`)) { say("not saved"); return; }
@@ -372,6 +378,7 @@ async function save(path) {
   }
   if (!answer.ok) { say(answer.data.error, true); return; }
   S.version = answer.data.version;
+  if (!path) S.exists = true;
   if (path) { S.name = answer.data.path; $("mission-name").textContent = S.name; }
   const n = answer.data.problems.length;
   say(`saved ${answer.data.path}${n ? ` (with ${n} problem${n > 1 ? "s" : ""})` : ""}`);
@@ -440,7 +447,7 @@ function drawRun(run) {
   if (run.error) text += ` · ${run.error}`;
   setStatus(run.status, text);
   renderList();
-  if (run.done) showReport(run);
+  if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); }
 }
 function showReport(run) {
   const r = run.report;
@@ -483,6 +490,7 @@ async function main() {
   S.version = answer.data.version;
   S.units = answer.data.units;
   S.name = answer.data.name;
+  S.exists = answer.data.exists;
   S.problems = answer.data.problems;
   $("mission-name").textContent = answer.data.path || S.name;
   if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
