@@ -8,15 +8,11 @@ import time
 from pathlib import Path
 
 import pytest
+from starlette.testclient import TestClient
 
-pytest.importorskip("starlette")
-pytest.importorskip("httpx")
-
-from starlette.testclient import TestClient  # noqa: E402
-
-from navseq.mission import load_mission  # noqa: E402
-from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app  # noqa: E402
-from navseq.studio.security import FileRoots  # noqa: E402
+from navseq.mission import load_mission
+from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
+from navseq.studio.security import FileRoots
 
 REPO = Path(__file__).resolve().parents[1]
 TOKEN = "test-token"
@@ -115,7 +111,9 @@ def test_a_checked_draft_gets_validate_problems_and_planned_legs(client: TestCli
     answer = client.post("/api/check", json={"mission": document}).json()
     assert [problem["waypoint"] for problem in answer["problems"]] == [2]
     problem = answer["problems"][0]
-    assert problem["text"].startswith("turtlebot3_world.yaml, waypoint 3 'inner-east': at (1.00, 0.00)")
+    assert problem["text"].startswith(
+        "turtlebot3_world.yaml, waypoint 3 'inner-east': at (1.00, 0.00)"
+    )
     assert "obstacle" in problem["message"]
 
 
@@ -162,9 +160,7 @@ def test_a_body_over_the_limit_is_refused(client: TestClient) -> None:
     assert answer.status_code == 413
 
 
-def test_files_outside_the_studios_folders_are_refused(
-    client: TestClient, workspace: Path
-) -> None:
+def test_files_outside_the_studios_folders_are_refused(client: TestClient, workspace: Path) -> None:
     document = opened(client)["mission"]
     outside = workspace / "elsewhere"
     outside.mkdir()
@@ -216,7 +212,11 @@ def test_a_stale_version_is_a_conflict_and_nothing_is_lost(
     assert ok.status_code == 200
     stale = client.post(
         "/api/save",
-        json={"mission": second_tab["mission"], "version": second_tab["version"], "overwrite": True},
+        json={
+            "mission": second_tab["mission"],
+            "version": second_tab["version"],
+            "overwrite": True,
+        },
     )
     assert stale.status_code == 409 and stale.json()["conflict"] == "changed"
     assert "changed on disk since it was opened" in stale.json()["error"]

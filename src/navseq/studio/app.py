@@ -426,7 +426,9 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
 
     @api
     async def get_map(request: Request) -> Response:
-        return JSONResponse(await run_in_threadpool(studio.map_info, request.query_params.get("map")))
+        return JSONResponse(
+            await run_in_threadpool(studio.map_info, request.query_params.get("map"))
+        )
 
     @api
     async def get_map_image(request: Request) -> Response:

@@ -12,6 +12,7 @@ on the robot's costmap, and only legs whose ends moved are planned again.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import tempfile
 import threading
@@ -198,9 +199,7 @@ class CheckedDraft:
     map_path: Path | None
 
 
-def check_draft(
-    document: Any, *, roots: FileRoots, base_dir: Path, shown_as: str
-) -> CheckedDraft:
+def check_draft(document: Any, *, roots: FileRoots, base_dir: Path, shown_as: str) -> CheckedDraft:
     """Every problem of a draft document (file problems and pre-flight), and its mission.
 
     ``base_dir`` is the folder of the mission file the draft belongs to (its ``map:``
@@ -300,7 +299,7 @@ def legs_of(mission: Mission, planner: LegPlanner) -> list[dict[str, Any]]:
         places.append(("start", (mission.start.x, mission.start.y)))
     for index, waypoint in enumerate(mission.waypoints):
         places.append((str(index), (waypoint.x, waypoint.y)))
-    pairs = [(a, b, False) for a, b in zip(places, places[1:], strict=False)]
+    pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
     if mission.loops != 1 and len(mission.waypoints) > 1:
         pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
     legs = []

@@ -285,4 +285,3 @@ def _latest_report(folder: Path | None) -> dict[str, Any] | None:
     except (OSError, ValueError):
         return None
     return loaded if isinstance(loaded, dict) else None
-

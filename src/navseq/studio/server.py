@@ -40,6 +40,15 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
+def _has_display() -> bool:
+    """False on a Linux machine without a graphical session (ssh, CI): nothing to open."""
+    import os
+
+    if not sys.platform.startswith("linux"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
 def url_of(sock: socket.socket, host: str, token: str) -> str:
     port = sock.getsockname()[1]
     shown = "127.0.0.1" if host in ("0.0.0.0", "") else "[::1]" if host == "::" else host
@@ -57,7 +66,12 @@ def serve(
     out: TextIO | None = None,
     err: TextIO | None = None,
 ) -> int:
-    """Serve until interrupted; exit status 0 (a clean Ctrl-C included)."""
+    """Serve until interrupted.
+
+    Returns 0 when the server stops by itself; Ctrl-C (SIGINT, which uvicorn hands on
+    once it has shut down) ends the process with 130 as for ``navseq run``, after a
+    running simulation was cancelled and its report written.
+    """
     import uvicorn
 
     out = out if out is not None else sys.stdout
@@ -85,8 +99,10 @@ def serve(
             lifespan="off",
         )
     )
-    if open_browser:
+    if open_browser and _has_display():
         threading.Timer(0.3, webbrowser.open, args=(url,)).start()
+    elif open_browser:
+        print("navseq studio: no display here; open the URL above in a browser", file=err)
     try:
         server.run(sockets=[sock])
     finally:
