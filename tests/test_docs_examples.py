@@ -155,6 +155,8 @@ RULES: tuple[Rule, ...] = (
     ),
     # A patrol runs until stopped, and so does its resume (it continues as journaled).
     Rule(r"--loops forever|--resume navseq-out/patrol-", "interrupt"),
+    # The studio serves until Ctrl-C (tests/test_studio_browser.py drives its page).
+    Rule(r"(^|/)navseq studio\b", "interrupt"),
     Rule(r"(^|/)navseq\b", "run"),
 )
 

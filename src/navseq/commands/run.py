@@ -36,6 +36,7 @@ from navseq.navigators.registry import (
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
+    from navseq.executor.control import MissionControl
     from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
@@ -160,6 +161,8 @@ class RunSetup:
     part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
+    # Operator requests (stop, pause, skip) from another thread: the studio's buttons.
+    control: MissionControl | None = None
 
 
 def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumePoint, JournalState]:
@@ -527,6 +530,7 @@ def _run_with_sinks(
                     resume=setup.resume,
                     signals=signals,
                     robot=setup.robot,
+                    control=setup.control,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:

@@ -76,7 +76,7 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import AttemptResult, MissionResult, WaypointResult
+from navseq.executor.result import AttemptResult, MissionResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D, normalize_angle, remaining_along_path
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
@@ -197,10 +197,11 @@ class MissionExecutor:
         self._robot = robot or mission.robot or DEFAULT_PROFILE
         self._listeners: list[MissionListener] = []
         self._state = ExecutorState.IDLE
-        self._visits: dict[tuple[int, int], WaypointResult] = {}
+        # Finished visits: counted per waypoint, the latest kept in full (bounded memory).
+        self._log = VisitLog(mission.waypoints, mission.loops)
         if resume is not None:
-            for done in resume.done:
-                self._visits[(done.loop, done.index)] = _result_for(mission, done)
+            for done in sorted(resume.done, key=lambda v: (v.loop, v.index)):
+                self._log.add(_result_for(mission, done))
         self._visit: _Visit | None = None
         self._attempt: _Attempt | None = None
         self._next_goal_id = 1
@@ -256,22 +257,29 @@ class MissionExecutor:
 
     @property
     def result(self) -> MissionResult:
-        """The run so far: every visit of the mission, NOT_RUN for the ones not tried.
+        """The run so far: every visit counted per waypoint, the latest listed in full.
 
-        For a mission that loops forever only the visits that happened are listed.
+        A small finite mission lists every visit, NOT_RUN for the ones not tried; a
+        patrol or a huge mission lists what :class:`~navseq.executor.result.VisitLog`
+        keeps. The visit under way is listed as NOT_RUN with its attempts so far.
         """
-        visits = [replace(v) for v in self._all_visits()]
         started = self._started_at if self._started_at is not None else self._now
         previous = self._resume.previous_duration if self._resume else 0.0
-        return MissionResult(
+        return self._log.result(
             success=self._success,
             reason=self._reason,
-            visits=visits,
             duration=(self._now - started) + previous,
-            distance_driven=sum(v.distance_driven for v in visits),
             loops_completed=self._loops_completed,
             start_pose=self._start_pose,
+            active=self._active_result(),
         )
+
+    def _active_result(self) -> WaypointResult | None:
+        """The current visit's result while it is not finished (not yet in the log)."""
+        visit = self._visit
+        if visit is None or (visit.loop, visit.index) in self._log:
+            return None
+        return visit.result
 
     @property
     def robot(self) -> RobotProfile:
@@ -495,7 +503,6 @@ class MissionExecutor:
             y=waypoint.y,
             yaw_rad=waypoint.yaw_rad,
         )
-        self._visits[(loop, index)] = result
         self._visit = _Visit(loop, index, waypoint, self._mission.policy_for(index), result)
         return self._start_attempt(now)
 
@@ -597,11 +604,10 @@ class MissionExecutor:
         following = self._next_position(visit.loop, visit.index)
         if following is None:
             self._loops_completed += 1
-            reached = all(v.outcome is WaypointOutcome.REACHED for v in self._all_visits())
-            if reached:
+            if self._log.all_reached(self._active_result()):
                 self._finish_mission(now, "completed")
             else:
-                missed = sum(v.outcome is not WaypointOutcome.REACHED for v in self._all_visits())
+                missed = self._log.not_reached(self._active_result())
                 visits = "waypoint visit" if missed == 1 else "waypoint visits"
                 self._finish_mission(now, f"completed: {missed} {visits} not reached")
             return []
@@ -624,6 +630,8 @@ class MissionExecutor:
         result.reason = reason
         result.passed_through = passed_through
         result.duration = (end - start) if (start is not None and end is not None) else 0.0
+        if (visit.loop, visit.index) not in self._log:
+            self._log.add(result)
         self._attempt = None
         self._emit(
             WaypointFinished(
@@ -644,28 +652,8 @@ class MissionExecutor:
         self._visit = None
         self._attempt = None
         self._reason = reason
-        self._success = all(v.outcome is WaypointOutcome.REACHED for v in self._all_visits())
+        self._success = self._log.all_reached(self._active_result())
         self._emit(MissionFinished(t=now, success=self._success, reason=reason))
-
-    def _all_visits(self) -> list[WaypointResult]:
-        """Every visit in mission order; for finite missions also the ones not tried."""
-        if self._mission.loops is None:
-            return [self._visits[key] for key in sorted(self._visits)]
-        visits = []
-        for loop in range(self._mission.loops):
-            for index, waypoint in enumerate(self._mission.waypoints):
-                visit = self._visits.get((loop, index))
-                if visit is None:
-                    visit = WaypointResult(
-                        index=index,
-                        loop=loop,
-                        name=waypoint.name,
-                        x=waypoint.x,
-                        y=waypoint.y,
-                        yaw_rad=waypoint.yaw_rad,
-                    )
-                visits.append(visit)
-        return visits
 
     # ------------------------------------------------------------------ failures
 
