@@ -326,3 +326,71 @@ def test_a_new_mission_on_a_map(workspace: Path) -> None:
     answer = client.post("/api/save", json={"mission": document, "version": None})
     assert answer.status_code == 200
     assert load_mission(mission_path).waypoints[0].x == -0.55
+
+
+# --- performance on big maps: the costmap is built once per (map, robot) --------------
+
+
+def test_validate_checks_against_a_costmap_it_is_given(workspace: Path) -> None:
+    """The core's ``costmaps`` parameter: pre-flight uses the costmap it hands back."""
+    from navseq.commands.common import costmap_for_robot
+    from navseq.commands.validate import mission_file_problems
+    from navseq.sim.occupancy import OccupancyGrid
+
+    path = workspace / "examples/turtlebot3_world.yaml"
+    asked: list[tuple[Path, str]] = []
+
+    def walled(map_path: Path, robot: object) -> object:
+        # The arena's map with every cell occupied: every waypoint is in an obstacle.
+        asked.append((map_path, robot.name))  # type: ignore[attr-defined]
+        from navseq.sim.occupancy import load_map
+
+        grid = load_map(map_path)
+        full = OccupancyGrid(grid.data * 0 + 100, grid.resolution, grid.origin, grid.source)
+        return costmap_for_robot(full)
+
+    _, plain = mission_file_problems(path)
+    _, errors = mission_file_problems(path, costmaps=walled)  # type: ignore[arg-type]
+    assert plain == []
+    assert asked == [((workspace / "maps/turtlebot3_world.yaml").resolve(), "turtlebot3_burger")]
+    assert len(errors) == 8 and all("obstacle" in error.message for error in errors)
+
+
+def test_checks_inflate_the_map_once_until_its_file_changes(
+    client: TestClient, workspace: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import navseq.commands.common as common
+
+    built: list[object] = []
+    real = common.costmap_for_robot
+
+    def counting(grid: object, robot: object = None) -> object:
+        built.append(robot)
+        return real(grid, robot)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(common, "costmap_for_robot", counting)
+    document = opened(client)["mission"]
+    for step in range(4):  # a drag: the same mission, one waypoint moved a little each time
+        document["waypoints"][2]["x"] = 0.55 + 0.01 * step
+        assert client.post("/api/check", json={"mission": document}).json()["problems"] == []
+    assert len(built) == 1
+    # Another robot is another costmap; the first one is still kept.
+    document["robot"] = "turtlebot3_waffle"
+    client.post("/api/check", json={"mission": document})
+    del document["robot"]
+    client.post("/api/check", json={"mission": document})
+    assert len(built) == 2
+    # The map's image changes on disk (a wall drawn over the third waypoint): the next
+    # check reads it again and says so.
+    import numpy as np
+    from PIL import Image
+
+    image_path = workspace / "maps/turtlebot3_world.pgm"
+    pixels = np.array(Image.open(image_path))
+    # The image's top row is y = -10 + 384 * 0.05 = 9.2 m; x starts at -10 m.
+    row, col = round((9.2 - 0.55) / 0.05), round((0.58 + 10.0) / 0.05)  # (0.58, 0.55)
+    pixels[row - 4 : row + 4, col - 4 : col + 4] = 0
+    Image.fromarray(pixels).save(image_path)
+    answer = client.post("/api/check", json={"mission": document}).json()
+    assert len(built) == 3
+    assert [problem["waypoint"] for problem in answer["problems"]] == [2]

@@ -45,6 +45,7 @@ from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.mission.robot import RobotProfile
+    from navseq.sim.costmap import Costmap
     from navseq.studio.runs import StudioRun
 
 STATIC = Path(__file__).parent / "static"
@@ -82,7 +83,7 @@ class Studio:
     def __init__(self, config: StudioConfig) -> None:
         self.config = config
         self.roots = config.roots
-        self._maps: dict[Path, tuple[int, MapView]] = {}
+        self._maps: dict[Path, tuple[tuple[int, ...], MapView]] = {}
         self._planners: dict[tuple[Path, RobotProfile], LegPlanner] = {}
         self._lock = threading.Lock()
         self._save_lock = threading.Lock()
@@ -103,7 +104,7 @@ class Studio:
 
     def map_view(self, path: Path) -> MapView:
         """The map at ``path`` (checked against the roots by the caller), reloaded if changed."""
-        stamp = path.stat().st_mtime_ns
+        stamp = map_stamp(path)
         with self._lock:
             cached = self._maps.get(path)
             if cached is not None and cached[0] == stamp:
@@ -112,6 +113,20 @@ class Studio:
         with self._lock:
             self._maps[path] = (stamp, view)
         return view
+
+    def costmap(self, map_path: Path, robot: RobotProfile) -> Costmap:
+        """The map's costmap for ``robot``, built once per (map, robot) and kept.
+
+        Inflating a 2000 x 2000 map takes about a second; a check after each edit
+        would otherwise pay it every time. A changed map file is read again.
+        """
+        try:
+            view = self.map_view(map_path)
+        except OSError:
+            from navseq.commands.common import costmap_for_map
+
+            return costmap_for_map(map_path, robot)  # says what is wrong with the file
+        return view.costmap(robot)
 
     def planner(self, map_path: Path, robot: RobotProfile) -> LegPlanner:
         view = self.map_view(map_path)
@@ -186,7 +201,11 @@ class Studio:
         from navseq.commands.common import choose_robot
 
         checked = check_draft(
-            document, roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+            document,
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
         )
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
@@ -231,7 +250,11 @@ class Studio:
                 "yet; edit that file by hand so that nothing is lost",
             )
         checked = check_draft(
-            document, roots=self.roots, base_dir=target.parent, shown_as=printable(target.name)
+            document,
+            roots=self.roots,
+            base_dir=target.parent,
+            shown_as=printable(target.name),
+            costmaps=self.costmap,
         )
         if checked.mission is None:
             raise ApiError(
@@ -288,7 +311,11 @@ class Studio:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
         checked = check_draft(
-            body.get("mission"), roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+            body.get("mission"),
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
         )
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
@@ -318,6 +345,23 @@ class Studio:
         run = self.run
         if run is not None:
             run.stop_and_wait(reason)
+
+
+def map_stamp(path: Path) -> tuple[int, ...]:
+    """What changes when the map at ``path`` does: its YAML's and its image's mtimes.
+
+    Raises OSError when the YAML cannot be read (the loader then says why).
+    """
+    stamp = [path.stat().st_mtime_ns]
+    try:
+        import yaml
+
+        image = yaml.safe_load(path.read_text(encoding="utf-8")).get("image")
+        image_path = path.parent / str(image)
+        stamp.append(image_path.stat().st_mtime_ns)
+    except Exception:  # the loader says what is wrong with a bad map; the YAML's stamp will do
+        pass
+    return tuple(stamp)
 
 
 # --- HTTP ------------------------------------------------------------------------------

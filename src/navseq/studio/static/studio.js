@@ -69,10 +69,17 @@ async function loadMap(fit) {
   const sep = query ? "&" : "?";
   // Layers are added once the map has a view (Leaflet defers them until then).
   if (fit || !map._loaded) map.fitBounds(focusBounds(bounds), { padding: [20, 20] });
-  S.layers.map = L.imageOverlay(`/api/map/image${query}${sep}layer=map`, bounds).addTo(map);
+  // One PNG for the whole map (not a shape per cell): a 2000 x 2000 map pans and zooms
+  // as smoothly as a small one. The promise settles when the image is drawn.
+  const drawn = new Promise((resolve) => {
+    S.layers.map = L.imageOverlay(`/api/map/image${query}${sep}layer=map`, bounds);
+    S.layers.map.once("load error", resolve);
+    S.layers.map.addTo(map);
+  });
   S.layers.map.getElement().dataset.testid = "map-image";
   S.layers.cost = L.imageOverlay(`/api/map/image${query}${sep}layer=costmap`, bounds, { zIndex: 2 });
   if ($("costmap-toggle").checked) S.layers.cost.addTo(map);
+  await drawn;
 }
 // Fit on the mission when it has waypoints (a small mission on a big map stays readable).
 function focusBounds(mapBounds) {
