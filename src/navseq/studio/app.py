@@ -53,6 +53,10 @@ STATIC = Path(__file__).parent / "static"
 MAX_BODY_BYTES = 2_000_000
 #: How often the live view is sent while a run goes on (s): at most 20 updates/s.
 LIVE_PERIOD_S = 0.05
+#: What the page offers to import: every format navseq's loader reads.
+MISSION_SUFFIXES = (".yaml", ".yml", ".launch", ".xml", ".csv")
+#: Files listed at most for the import choice.
+MAX_FILES_LISTED = 500
 #: Pace choices the page offers: None is as fast as the CPU goes.
 MAX_REALTIME = 1000.0
 
@@ -243,12 +247,6 @@ class Studio:
             target = self.roots.resolve(path_text, "path")
         if target.suffix.lower() not in (".yaml", ".yml"):
             raise ApiError(422, "path: a navseq mission is saved as .yaml or .yml")
-        if isinstance(document, dict) and document.get("robot") is not None:
-            raise ApiError(
-                422,
-                "this mission has a robot: section, which the mission writer does not write "
-                "yet; edit that file by hand so that nothing is lost",
-            )
         checked = check_draft(
             document,
             roots=self.roots,
@@ -293,6 +291,115 @@ class Studio:
             "version": version,
             "problems": [problem.as_json() for problem in checked.problems],
         }
+
+    # -- files: import, export -----------------------------------------------------------
+
+    def files(self) -> dict[str, Any]:
+        """Mission files the page may import (any format the loader reads), under the roots."""
+        found: set[Path] = set()
+        for folder in self.roots.folders:
+            for depth in ("*", "*/*", "*/*/*"):
+                for path in folder.glob(depth):
+                    if (
+                        path.suffix.lower() in MISSION_SUFFIXES
+                        and "navseq-out" not in path.parts
+                        and path.is_file()
+                        and self.roots.contains(path)
+                    ):
+                        found.add(path.resolve())
+                    if len(found) >= MAX_FILES_LISTED:
+                        break
+        return {"missions": sorted(self.roots.relative(path) for path in found)}
+
+    def import_file(self, body: dict[str, Any]) -> dict[str, Any]:
+        """A mission file of any format (navseq YAML, launch, rosparam YAML, CSV) as a
+        document, for the page to take in place of its waypoints (an undoable edit)."""
+        path = self._existing_file(body.get("path"), "path")
+        document, errors = open_document(path, self.base_dir)
+        problems = [problem.as_json() for problem in problems_of(errors)]
+        if document is None:
+            raise ApiError(
+                422,
+                f"{printable(path.name)} cannot be imported: it has problems",
+                problems=problems,
+            )
+        return {"path": self.roots.relative(path), "mission": document, "problems": problems}
+
+    def export_launch(self, body: dict[str, Any]) -> dict[str, Any]:
+        """The draft as the tutorial's launch file (``p_seq`` / ``yea_seq``)."""
+        from navseq.mission.tutorial_export import write_tutorial_launch
+
+        path_text = body.get("path")
+        if not isinstance(path_text, str):
+            raise ApiError(400, "path: give the launch file's name (e.g. move_base_seq.launch)")
+        target = self.roots.resolve(path_text, "path")
+        if target.suffix.lower() not in (".launch", ".xml"):
+            raise ApiError(422, "path: the tutorial's launch file is saved as .launch or .xml")
+        checked = check_draft(
+            body.get("mission"),
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
+        )
+        if checked.mission is None:
+            raise ApiError(
+                422,
+                "the mission has problems that stop it being read; fix them before exporting",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        with self._save_lock:
+            exists = target.exists()
+            if exists and body.get("overwrite") is not True:
+                raise ApiError(
+                    409,
+                    f"{printable(target.name)} exists; confirm to replace it",
+                    conflict="exists",
+                )
+            launch = write_tutorial_launch(checked.mission, target, overwrite=exists)
+        return {"path": self.roots.relative(target), "left_out": list(launch.left_out)}
+
+    def _existing_file(self, text: Any, what: str) -> Path:
+        if not isinstance(text, str):
+            raise ApiError(400, f"{what}: give a file name")
+        path = self.roots.resolve(text, what)
+        if not path.is_file():
+            raise ApiError(404, f"no such file: {printable(self.roots.relative(path))}")
+        return path
+
+    # -- past runs ---------------------------------------------------------------------
+
+    @property
+    def run_roots(self) -> FileRoots:
+        """Where run folders may be read: the studio's folders and its navseq-out/."""
+        return FileRoots(
+            [*self.roots.folders, self.config.out_base / "navseq-out"], self.config.out_base
+        )
+
+    def runs(self) -> dict[str, Any]:
+        from navseq.studio.replay import run_folders, run_summary
+
+        roots = self.run_roots
+        searched = [self.config.out_base / "navseq-out"]
+        searched += [folder / "navseq-out" for folder in self.roots.folders]
+        return {
+            "runs": [
+                run_summary(folder, roots.relative(folder))
+                for folder in run_folders(searched)
+                if roots.contains(folder)
+            ]
+        }
+
+    def replay(self, folder_text: str | None) -> dict[str, Any]:
+        from navseq.studio.replay import replay_of
+
+        if not folder_text:
+            raise ApiError(400, "folder: give a run folder (navseq-out/...)")
+        roots = self.run_roots
+        folder = roots.resolve(folder_text, "folder")
+        if not folder.is_dir():
+            raise ApiError(404, f"no such run folder: {printable(folder_text)}")
+        return replay_of(folder, roots.relative(folder), self.base_dir)
 
     def start_run(self, body: dict[str, Any]) -> dict[str, Any]:
         from navseq.studio.runs import RunRequest, StudioRun
@@ -499,6 +606,29 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         return JSONResponse(await run_in_threadpool(studio.start_run, body))
 
     @api
+    async def get_files(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(studio.files))
+
+    @api
+    async def post_import(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.import_file, body))
+
+    @api
+    async def post_export(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.export_launch, body))
+
+    @api
+    async def get_runs(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(studio.runs))
+
+    @api
+    async def get_replay(request: Request) -> Response:
+        folder = request.query_params.get("folder")
+        return JSONResponse(await run_in_threadpool(studio.replay, folder))
+
+    @api
     async def get_run(request: Request) -> Response:
         return JSONResponse(studio.current_run().view.snapshot())
 
@@ -538,6 +668,11 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/map/image", get_map_image),
         Route("/api/check", post_check, methods=["POST"]),
         Route("/api/save", post_save, methods=["POST"]),
+        Route("/api/files", get_files),
+        Route("/api/import", post_import, methods=["POST"]),
+        Route("/api/export", post_export, methods=["POST"]),
+        Route("/api/runs", get_runs),
+        Route("/api/replay", get_replay),
         Route("/api/run", post_run, methods=["POST"]),
         Route("/api/run", get_run),
         Route("/api/run/events", run_events),
