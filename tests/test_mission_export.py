@@ -127,3 +127,16 @@ def test_the_launch_writer_refuses_to_overwrite_or_write_nothing(tmp_path: Path)
     assert load_mission(target).waypoints[0].x == 1.0
     with pytest.raises(NavseqError, match="no waypoints"):
         write_tutorial_launch(Mission(()), tmp_path / "empty.launch")
+
+
+def test_navseq_convert_writes_the_launch_file_for_a_launch_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from navseq.cli import main
+
+    target = tmp_path / "tour.launch"
+    assert main(["convert", str(REPO / "examples/turtlebot3_world.yaml"), str(target)]) == 0
+    assert len(load_mission(target).waypoints) == 7
+    assert "p_seq" in target.read_text(encoding="utf-8")
+    assert "no place for: waypoint names" in capsys.readouterr().err
+    assert main(["convert", str(REPO / "examples/turtlebot3_world.yaml"), str(target)]) == 2

@@ -82,7 +82,9 @@ def write_tutorial_launch(
     target = Path(path)
     source = str(target)
     if not mission.waypoints:
-        raise NavseqError("has no waypoints to write; the tutorial's p_seq needs one", source=source)
+        raise NavseqError(
+            "has no waypoints to write; the tutorial's p_seq needs one", source=source
+        )
     if target.is_dir():
         raise NavseqError("is a folder; give the path of the launch file to write", source=source)
     if not target.parent.is_dir():

@@ -177,7 +177,9 @@ def _exact_degrees(radians: float, to_rad: float) -> float | int:
     for _ in range(8):
         if candidate * to_rad == radians:
             return candidate
-        candidate = math.nextafter(candidate, math.inf if candidate * to_rad < radians else -math.inf)
+        candidate = math.nextafter(
+            candidate, math.inf if candidate * to_rad < radians else -math.inf
+        )
     return _tidy(degrees)
 
 
