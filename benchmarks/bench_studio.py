@@ -34,6 +34,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
+from math import cos, sin
 from pathlib import Path
 from typing import Any
 
@@ -105,13 +106,13 @@ def spread_waypoints(map_yaml: Path, count: int, seed: int) -> list[tuple[float,
     return picked
 
 
-def nearby_free(map_yaml: Path, x: float, y: float, metres: float) -> tuple[float, float]:
-    """The roomy free spot nearest to (x + metres, y): where the drag goes."""
+def nearby_free(map_yaml: Path, x: float, y: float, dx: float, dy: float) -> tuple[float, float]:
+    """The roomy free spot nearest to (x + dx, y + dy): where the drag goes."""
     from navseq.commands.common import costmap_for_map
 
     costmap = costmap_for_map(map_yaml)
     cells = np.argwhere(costmap.free_mask() & (costmap.clearance >= 0.4))
-    row, col = costmap.world_to_cell(x + metres, y)
+    row, col = costmap.world_to_cell(x + dx, y + dy)
     nearest = cells[np.argmin(((cells - (row, col)) ** 2).sum(axis=1))]
     fx, fy = costmap.cell_to_world(int(nearest[0]), int(nearest[1]))
     return round(fx, 2), round(fy, 2)
@@ -185,19 +186,25 @@ class Served:
 
 def page_figures(
     served: Served, moves: list[tuple[float, float]], repeat: int
-) -> tuple[float, float]:
-    """(median page ready, median drag -> problems drawn), seconds."""
+) -> tuple[float, float, float]:
+    """(first page ready, median page ready, median drag -> problems drawn), seconds.
+
+    The first load is the studio's first: the map's PNG is made then (later loads get it
+    from the studio's memory and the browser's cache is bypassed by a fresh page each time).
+    """
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        page = browser.new_page(viewport={"width": 1400, "height": 860})
         ready = []
         for _ in range(repeat):
+            page = browser.new_page(viewport={"width": 1400, "height": 860})
             began = time.perf_counter()
             page.goto(served.url)
             page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
             ready.append(time.perf_counter() - began)
+            if len(ready) < repeat:
+                page.close()
         drags = []
         for x, y in moves:
             marker = page.get_by_test_id("waypoint-marker").nth(2).bounding_box()
@@ -220,7 +227,7 @@ def page_figures(
             )
             drags.append(time.perf_counter() - began)
         browser.close()
-    return statistics.median(ready), statistics.median(drags)
+    return ready[0], statistics.median(ready[1:] or ready), statistics.median(drags)
 
 
 def live_rate(served: Served, seconds: float) -> tuple[float, float]:
@@ -291,8 +298,11 @@ def main() -> int:
             # Waypoint 3 (index 2) dragged to a new free spot each time, so that its two
             # legs are planned again every time (none comes from the leg cache).
             x, y = points[3]
-            step = 0.25 if "2000" in name else 0.08  # beyond a screen pixel at the fit zoom
-            moves = [nearby_free(map_yaml, x, y, step * (k + 1)) for k in range(args.repeat)]
+            step = 0.6 if "2000" in name else 0.08  # several pixels at the fit zoom: a drag
+            moves = [
+                nearby_free(map_yaml, x, y, *(step * (k + 1) * f(2.4 * k) for f in (cos, sin)))
+                for k in range(args.repeat)
+            ]
             assert len(set(moves)) == len(moves), moves
             cases[name] = (mission, map_yaml, moves)
 
@@ -302,11 +312,12 @@ def main() -> int:
             cached = check_latency(mission, moves, cached=True)
             served = Served(mission)
             try:
-                ready, drag = page_figures(served, moves, args.repeat)
+                first, ready, drag = page_figures(served, moves, args.repeat)
                 live, moving = live_rate(served, args.live_seconds)
             finally:
                 served.close()
             figures[name] = {
+                "first": first,
                 "ready": ready,
                 "drag": drag,
                 "rebuilt": rebuilt,
@@ -315,7 +326,8 @@ def main() -> int:
                 "moving": moving,
             }
         targets = {
-            "ready": ("page ready [s]", "<= 1 / 2", lambda v: f"{v:.2f}"),
+            "first": ("page ready, first load [s]", "<= 1 / 2", lambda v: f"{v:.2f}"),
+            "ready": ("page ready, later loads [s]", "<= 1 / 2", lambda v: f"{v:.2f}"),
             "drag": (
                 "drag -> problems drawn, page [ms]",
                 "<= 150 / 500",
@@ -337,7 +349,7 @@ def main() -> int:
         for key, (label, target, shown) in targets.items():
             format_: Callable[[float], str] = shown
             table.add_row(label, *(format_(figures[name][key]) for name in cases), target)
-        Console().print(table)
+        Console(width=120).print(table)
     finally:
         shutil.rmtree(base, ignore_errors=True)
     return 0

@@ -91,6 +91,7 @@ class Studio:
         self._planners: dict[tuple[Path, RobotProfile], LegPlanner] = {}
         self._lock = threading.Lock()
         self._save_lock = threading.Lock()
+        self._check_lock = threading.Lock()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
         self.run: StudioRun | None = None
 
@@ -202,6 +203,16 @@ class Studio:
         return path
 
     def check(self, document: Any) -> dict[str, Any]:
+        """Problems and planned legs of a draft (``POST /api/check``).
+
+        One check at a time: a check that comes while another builds a costmap or plans
+        legs waits for it and then finds them made, instead of doing the same work
+        beside it on the same cores (the page's first check and :meth:`warm_up`).
+        """
+        with self._check_lock:
+            return self._check(document)
+
+    def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
         checked = check_draft(
@@ -446,6 +457,17 @@ class Studio:
         if self.run is None:
             raise ApiError(404, "no run yet")
         return self.run
+
+    def warm_up(self) -> None:
+        """Do what the page's first load asks for, ahead of it: the map image, the
+        costmap and the opened mission's planned legs. Problems are the page's to show."""
+        try:
+            opened = self.mission()
+            if opened["mission"] is not None:
+                self.check(opened["mission"])
+                self.map_image(opened["mission"].get("map") or None, "map")
+        except Exception:  # the same request from the page reports it
+            pass
 
     def close(self, reason: str = "the studio was stopped") -> None:
         """Cancel a running simulation and wait until its outputs are written."""
