@@ -1,5 +1,8 @@
 """Writing a Mission as navseq YAML: readable (yaw in degrees, one line per waypoint)
-and exact (reading the file back gives the same mission).
+and exact (reading the file back gives the same mission, its ``robot:`` section included).
+
+The tutorial's launch file (``p_seq`` / ``yea_seq``) is written by
+:mod:`navseq.mission.tutorial_export`.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
+from navseq.mission.robot import BUILTIN_PROFILES, RobotProfile
 from navseq.mission.yaml_doc import EXPONENT_FLOAT
 
 HEADER = "# navseq mission (format reference: docs/mission-format.md)\n"
@@ -27,6 +31,10 @@ _ROUNDED_YAW_DECIMALS = 6
 
 class _FlowMapping(dict):
     """A mapping written on one line: a waypoint, the start pose."""
+
+
+class _FlowList(list):
+    """A list written on one line: a footprint point."""
 
 
 class _MissionDumper(yaml.SafeDumper):
@@ -53,6 +61,10 @@ _MissionDumper.add_representer(
     _FlowMapping,
     lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=True),
 )
+_MissionDumper.add_representer(
+    _FlowList,
+    lambda dumper, data: dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=True),
+)
 
 
 def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
@@ -68,6 +80,8 @@ def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
         doc["start"] = _pose(mission.start)
     doc["loops"] = FOREVER if mission.loops is None else mission.loops
     doc["server_timeout"] = mission.server_timeout
+    if mission.robot is not None:
+        doc["robot"] = robot_section(mission.robot)
     doc["defaults"] = _policy_values(mission.defaults, POLICY_FIELDS)
     doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
     return HEADER + yaml.dump(
@@ -123,6 +137,50 @@ def _tidy(value: float) -> float | int:
     if value.is_integer() and abs(value) < 2**53:
         return int(value)
     return value
+
+
+def robot_section(robot: RobotProfile) -> str | dict[str, Any]:
+    """A profile as a ``robot:`` section (docs/mission-format.md) that reads back equal.
+
+    A built-in profile unchanged is its name; any other is written in full (name,
+    outline, every number), in the file's units: degrees for angular speeds and the
+    yaw tolerance, metres and seconds otherwise.
+    """
+    if BUILTIN_PROFILES.get(robot.name) == robot:
+        return robot.name
+    to_rad = math.pi / 180.0  # robot_format's factor for deg/s and deg/s²
+    return {
+        "name": robot.name,
+        "footprint": [_FlowList([x, y]) for x, y in robot.footprint],
+        "inflation_radius": robot.inflation_radius,
+        "cost_scaling_factor": robot.cost_scaling_factor,
+        "clearance_margin": robot.clearance_margin_m,
+        "max_linear_speed": robot.max_linear_speed,
+        "max_angular_speed": _exact_degrees(robot.max_angular_speed, to_rad),
+        "max_linear_accel": robot.max_linear_accel,
+        "max_angular_accel": _exact_degrees(robot.max_angular_accel, to_rad),
+        "xy_goal_tolerance": robot.goal_tolerance.xy_m,
+        "yaw_goal_tolerance": _exact_degrees(robot.goal_tolerance.yaw_rad, to_rad),
+    }
+
+
+def _exact_degrees(radians: float, to_rad: float) -> float | int:
+    """The shortest degrees that the reader turns back into exactly ``radians``."""
+    degrees = math.degrees(radians)
+    for decimals in range(16):
+        candidate = round(degrees, decimals)
+        if candidate * to_rad == radians:
+            return _tidy(candidate)
+    # No short decimal does (3.2 rad/s² is 183.346... deg/s²): a neighbouring float of
+    # the quotient does, written in full.
+    candidate = radians / to_rad
+    for _ in range(8):
+        if candidate * to_rad == radians:
+            return candidate
+        candidate = math.nextafter(
+            candidate, math.inf if candidate * to_rad < radians else -math.inf
+        )
+    return _tidy(degrees)
 
 
 def _map_text(map_path: Path, base_dir: Path | None) -> str:
