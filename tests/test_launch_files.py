@@ -171,10 +171,14 @@ def test_multi_robot_launch_drives_two_namespaced_robots_at_once(
     assert "TF_REPEATED_DATA" not in launch.output(), launch.output()[-4000:]
 
 
-def test_demo_launch_completes_the_example_mission(ros_master: RosMaster):
+def test_demo_launch_completes_the_example_mission_and_ends_quietly(ros_master: RosMaster):
     demo = roslaunch(ros_master, "demo.launch", f"speed:={SPEED}")
-    demo.wait(timeout=240)
-    assert "mission succeeded" in demo.output(), demo.output()[-4000:]
+    assert demo.wait(timeout=240) == 0, demo.output()[-4000:]
+    output = demo.output()
+    assert "mission succeeded" in output, output[-4000:]
+    # The node ends the launch as Ctrl-C would: no red banner for a mission that finished.
+    assert "ending the launch (~end_launch)" in output, output[-4000:]
+    assert "REQUIRED process" not in output and "has died" not in output, output[-4000:]
 
 
 def test_navseq_launch_with_only_the_tutorial_params_completes_on_the_sim(

@@ -233,3 +233,15 @@ def test_keep_alive_that_is_not_a_boolean_is_a_bad_param(ros_master: RosMaster):
     node = start_node(ros_master, keep_alive="sometimes")
     assert node.wait(timeout=30) == 2
     assert "keep_alive" in node.output() and "Traceback" not in node.output()
+
+
+def test_end_launch_outside_roslaunch_signals_nobody_and_exits_with_the_mission(
+    ros_master: RosMaster, tmp_path: Path
+):
+    """Under rosrun (here: the test's own process as parent) nobody is sent SIGINT."""
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = start_node(ros_master, end_launch=True)
+    assert node.wait(timeout=60) == 0, node.output()
+    assert "~end_launch: the parent process" in node.output(), node.output()
+    assert "is not roslaunch; the node just exits" in node.output(), node.output()
