@@ -19,6 +19,10 @@ below), ``~settle`` (s of wall time between a
 result and the next goal, against move_base's SUCCEEDED race; default 0.05, 0 = off),
 ``~odom_frame`` (default ``odom``).
 
+It logs (rospy) the lines ``navseq run`` prints in a pipe, one per waypoint event
+(going to, attempt failed, dwelling, reached / skipped / failed, paused, resumed, server
+lost) and the distance to go every 10 s of mission time; trouble is a warning.
+
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
 and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``
@@ -58,18 +62,16 @@ from std_srvs.srv import Trigger, TriggerResponse
 
 from navseq.errors import NavseqError
 from navseq.executor.control import MissionControl, StopRequested
-from navseq.executor.events import (
-    MissionEvent,
-    WaypointFinished,
-    WaypointOutcome,
-)
+from navseq.executor.events import MissionFinished
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
+from navseq.mission.robot import DEFAULT_PROFILE
 from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros1.params import bool_param
+from navseq.sinks.progress import LogLine, LogProgress
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -93,19 +95,17 @@ SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
 KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a shutdown while kept alive
 
 
-def log_waypoint_outcome(event: MissionEvent) -> None:
-    """A mission listener logging each waypoint not reached, with the reason.
+def log_line(line: LogLine) -> None:
+    """One of ``navseq run``'s plain progress lines, through rospy's log.
 
-    The waypoint an interruption ends is left to the interruption's own log line.
+    The lines are :class:`~navseq.sinks.progress.LogProgress`'s (one per waypoint event,
+    the distance to go every 10 s of mission time); a line about trouble is a warning.
+    The mission's end is left to :func:`run_node`'s own line, which also says what the
+    node does next.
     """
-    if (
-        isinstance(event, WaypointFinished)
-        and event.outcome in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
-        and not event.reason.startswith("interrupted")
-    ):
-        rospy.logwarn(
-            "navseq: waypoint %d %s (%s)", event.index + 1, event.outcome.value, event.reason
-        )
+    if isinstance(line.event, MissionFinished):
+        return
+    (rospy.logwarn if line.attention else rospy.loginfo)("navseq: %s", line.text)
 
 
 class ShutdownWatch:
@@ -215,7 +215,9 @@ def run_node() -> int:
         result = run_mission(
             mission,
             navigator,
-            [topics, log_waypoint_outcome],
+            # The robot the executor assumes (the mission's, else the default) also
+            # gives the log's time still to go.
+            [topics, LogProgress(mission, log_line, robot=mission.robot or DEFAULT_PROFILE)],
             tick=float(settings["tick"]),
             control=control,
         )

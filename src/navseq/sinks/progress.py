@@ -4,7 +4,8 @@ Three listeners share one model of the run, :class:`RunView`:
 
 - :class:`LiveProgress`: a rich live panel for terminals (current waypoint n/N and
   name, status, distance remaining, mission-clock elapsed time, loop, attempt);
-- :class:`LogProgress`: one plain line per thing that happened, for logs and pipes;
+- :class:`LogProgress`: one plain line per thing that happened, for logs and pipes
+  (and, through its ``out`` callable, for the ROS node's rospy log);
 - :class:`~navseq.sinks.json_events.JsonProgress`: one JSON object per event, for
   programs (``--json``; its own module).
 
@@ -18,7 +19,8 @@ from __future__ import annotations
 import math
 import sys
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import IO
 
 from rich.console import Console, Group, RenderableType
@@ -325,6 +327,23 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     return None  # WaypointProgress, WaypointPlan
 
 
+def needs_attention(event: MissionEvent) -> bool:
+    """Whether the line about ``event`` tells of something that went wrong.
+
+    A waypoint not reached, a failed attempt, a lost server, a mission that did not
+    reach every waypoint: what a log shows as a warning.
+    """
+    if isinstance(event, WaypointFinished):
+        return WaypointOutcome(event.outcome) in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
+    if isinstance(event, AttemptFailed):
+        return True
+    if isinstance(event, ServerStatusChanged):
+        return not event.available
+    if isinstance(event, MissionFinished):
+        return not event.success
+    return False
+
+
 def final_status(reason: str, success: bool) -> str:
     """How the mission ended, in one sentence that says each thing once.
 
@@ -339,17 +358,31 @@ def final_status(reason: str, success: bool) -> str:
     return f"{reason}; not every waypoint reached"
 
 
+@dataclass(frozen=True)
+class LogLine:
+    """One line of :class:`LogProgress`, before it is written anywhere."""
+
+    text: str
+    elapsed: float  # s of mission time since the mission started
+    attention: bool  # something went wrong (:func:`needs_attention`): a warning
+    event: MissionEvent  # what the line is about
+
+
 class LogProgress:
     """Plain one-line log messages, for output that is not a terminal.
 
     Progress (distance to go) is logged at most once per ``progress_period`` seconds
     of mission time, so a log of a long run stays readable.
+
+    ``out`` is a stream (each line written as ``[elapsed s] text``) or a callable given
+    each :class:`LogLine`: the ROS node logs the same lines through rospy, which stamps
+    them itself, so which events make a line and what it says live here only.
     """
 
     def __init__(
         self,
         mission: Mission,
-        stream: IO[str],
+        out: IO[str] | Callable[[LogLine], None],
         *,
         progress_period: float = 10.0,
         robot: RobotProfile = DEFAULT_PROFILE,
@@ -357,7 +390,8 @@ class LogProgress:
     ):
         self.view = RunView(mission, numbers)
         self.robot = robot
-        self.stream = stream
+        self.stream = None if callable(out) else out
+        self._emit = out if callable(out) else self._write
         self.progress_period = progress_period
         self._last_progress_t = -math.inf
 
@@ -365,11 +399,16 @@ class LogProgress:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        if self.stream is not None:
+            self.stream.flush()
+
+    def _write(self, line: LogLine) -> None:
+        assert self.stream is not None  # the default emitter only exists with a stream
+        self.stream.write(f"[{line.elapsed:8.1f} s] {line.text}\n")
         self.stream.flush()
 
-    def _log(self, text: str) -> None:
-        self.stream.write(f"[{self.view.elapsed:8.1f} s] {text}\n")
-        self.stream.flush()
+    def _log(self, text: str, event: MissionEvent) -> None:
+        self._emit(LogLine(text, self.view.elapsed, needs_attention(event), event))
 
     def __call__(self, event: MissionEvent) -> None:
         view = self.view
@@ -388,12 +427,13 @@ class LogProgress:
                 )
                 self._log(
                     f"{view.waypoint_label(event.index)}: {to_go}"
-                    f"{event.distance_driven:.2f} m driven"
+                    f"{event.distance_driven:.2f} m driven",
+                    event,
                 )
             return
         text = describe(event, view)
         if text is not None:
-            self._log(text)
+            self._log(text, event)
 
 
 ProgressSink = LiveProgress | LogProgress | JsonProgress
