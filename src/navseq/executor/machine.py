@@ -709,7 +709,7 @@ class MissionExecutor:
         if policy.on_failure is FailureAction.SKIP:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
             return commands + self._advance(now)
-        label = visit.waypoint.label(visit.index)
+        label = self._mission.waypoint_label(visit.index)
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, f"stopped: {label} failed ({reason})")
         return commands

@@ -147,9 +147,30 @@ class Mission:
     server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
     robot: RobotProfile | None = None  # the mission's robot: section; None: not said
     source: str = field(default="<memory>", compare=False)  # where it was read from
+    # For a part of a mission file (``--from``/``--to``/``--only``, see
+    # navseq.mission.part): each waypoint's 0-based position in the file, so that every
+    # message numbers it as the file does. None: the waypoints are the file's, in order.
+    numbers: tuple[int, ...] | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.numbers is not None and len(self.numbers) != len(self.waypoints):
+            raise ValueError(
+                f"numbers has {len(self.numbers)} entries for {len(self.waypoints)} waypoints"
+            )
 
     def policy_for(self, index: int) -> Policy:
         return self.defaults.with_overrides(self.waypoints[index].overrides)
+
+    def number(self, index: int) -> int:
+        """The 1-based number a person knows waypoint ``index`` by: its number in the file."""
+        if self.numbers is not None and 0 <= index < len(self.numbers):
+            return self.numbers[index] + 1
+        return index + 1
+
+    def waypoint_label(self, index: int) -> str:
+        """``waypoint 5 'dock'``: waypoint ``index`` as messages name it (the file's number)."""
+        name = self.waypoints[index].name if 0 <= index < len(self.waypoints) else None
+        return f"waypoint {self.number(index)}" + (f" '{name}'" if name else "")
 
     def __len__(self) -> int:
         return len(self.waypoints)

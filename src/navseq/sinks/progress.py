@@ -91,7 +91,7 @@ class RunView:
     def __init__(self, mission: Mission, numbers: Sequence[int] | None = None):
         self.mission = mission
         # The waypoints' positions in the file when the mission is a part of it.
-        self.numbers = numbers
+        self.numbers = numbers if numbers is not None else mission.numbers
         self.count = len(mission.waypoints)
         self.loops = mission.loops
         self.t = 0.0
@@ -109,6 +109,12 @@ class RunView:
     @property
     def elapsed(self) -> float:
         return self.t - self.t_start if self.t_start is not None else 0.0
+
+    def number(self, index: int) -> int:
+        """The waypoint's 1-based number in the mission file (as the summary table says)."""
+        if self.numbers is not None and 0 <= index < len(self.numbers):
+            return self.numbers[index] + 1
+        return index + 1
 
     def waypoint_label(self, index: int) -> str:
         name = self.mission.waypoints[index].name if index < self.count else None
@@ -256,12 +262,13 @@ class LiveProgress:
             marks = Text()
             for index in range(view.count):
                 outcome = view.loop_outcomes.get(index)
+                number = view.number(index)
                 if outcome is not None:
-                    marks.append(f"{index + 1}{OUTCOME_MARK[outcome]} ", OUTCOME_STYLE[outcome])
+                    marks.append(f"{number}{OUTCOME_MARK[outcome]} ", OUTCOME_STYLE[outcome])
                 elif index == view.index and view.finished is None:
-                    marks.append(f"{index + 1}▶ ", "bold cyan")
+                    marks.append(f"{number}▶ ", "bold cyan")
                 else:
-                    marks.append(f"{index + 1}· ", "grey50")
+                    marks.append(f"{number}· ", "grey50")
             rows.append(marks)
         rows.extend(
             Text(line, style="dim", overflow="ellipsis", no_wrap=True) for line in self.recent
@@ -278,7 +285,7 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     if isinstance(event, MissionStarted):
         loops = "forever" if event.loops is None else _plural(event.loops, "loop")
         resumed = (
-            f", resuming at waypoint {event.resumed_from + 1}"
+            f", resuming at waypoint {view.number(event.resumed_from)}"
             if event.resumed_from is not None
             else ""
         )
@@ -453,8 +460,9 @@ def make_progress(
     ``numbers``: the waypoints' positions in the file when ``mission`` is a part of it.
     """
     stream = stream if stream is not None else sys.stdout
+    numbers = numbers if numbers is not None else mission.numbers
     if json_lines:
-        return JsonProgress(stream)
+        return JsonProgress(stream, numbers)
     console = Console(file=stream)
     if console.is_terminal:
         return LiveProgress(mission, console, robot=robot, numbers=numbers)

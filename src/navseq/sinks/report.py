@@ -1,12 +1,12 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 3; the unit is in every field's name where there is one:
+Schema (``schema_version`` 4; the unit is in every field's name where there is one:
 ``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
 mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
 ``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
-      "schema_version": 3,
+      "schema_version": 4,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
@@ -26,7 +26,9 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
                   "attempts": [{"number", "reached", "status", "reason", "text",
                                 "duration_s", "distance_m"}],
                   "duration_s", "distance_m", "reason", "passed_through"}],
-      "files": {"journal", "picture", ...}
+      "files": {"journal", "picture", ...},
+      "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
+      "clock": {"navigator_s", "wall_s", "real_time_factor"}   # (not navseq report)
     }
 
 ``index`` is 0-based (as in events and the journal), ``number`` 1-based (as in
@@ -42,6 +44,8 @@ waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but
 robot was not there), ``text`` the stack's own result text. Version 1 had
 ``attempts`` as a count: it is the length of the list now. Version 2 had the map's
 ``resolution``, ``width``, ``height`` and an ``origin`` list with its yaw in radians.
+Version 3 had no ``clock`` (how fast the navigator's clock ran, see
+:func:`navseq.sinks.json_events.clock_record`).
 """
 
 from __future__ import annotations
@@ -64,7 +68,7 @@ from navseq.mission.model import Mission
 if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
 
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 #: ``start_source`` when the report's start is the robot's own first pose.
 START_FROM_ROBOT = "robot"
 
