@@ -360,8 +360,8 @@ def mission_figure(
     drew_radius = False
     for index, (waypoint, outcome) in enumerate(zip(waypoints, outcomes, strict=True)):
         colour = OUTCOME_COLOURS[outcome]
-        radius = mission.policy_for(index).pass_through
-        if radius and index != last and mission.policy_for(index).dwell == 0:
+        radius = mission.policy_for(index).pass_through_m
+        if radius and index != last and mission.policy_for(index).dwell_s == 0:
             ax.add_patch(
                 Circle(
                     (waypoint.x, waypoint.y),
