@@ -15,9 +15,11 @@ import os
 import sys
 from pathlib import Path
 
-from setuptools import Extension, find_packages, setup
+from setuptools import Extension, find_namespace_packages, setup
 
-PACKAGES = find_packages("src")
+# Namespace discovery: the studio's static folders (no __init__.py) are packages of
+# data files, so setuptools ships them without a "package would be ignored" warning.
+PACKAGES = find_namespace_packages("src", include=["navseq", "navseq.*"])
 PACKAGE_DIR = {"": "src"}
 
 

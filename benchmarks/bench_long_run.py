@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 from rich.console import Console
@@ -35,6 +37,13 @@ PATROL = ROOT / "examples" / "patrol.yaml"
 def resident_mb() -> float:
     for line in Path("/proc/self/status").read_text().splitlines():
         if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def peak_mb() -> float:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmHWM:"):
             return int(line.split()[1]) / 1024.0
     return float("nan")
 
@@ -85,6 +94,12 @@ def main() -> None:
             trajectory=[(recorder.mission_time(t), x, y) for t, x, y in navigator.trajectory],
         )
         drawn = time.perf_counter() - drawing
+        # What the journal holds, by record type: does it grow by events or by time?
+        by_type: Counter[str] = Counter()
+        with journal_path.open("rb") as lines:
+            for line in lines:
+                by_type[str(json.loads(line).get("type", "header/resumed"))] += len(line)
+        journal_total = sum(by_type.values())
 
     table = Table(title=f"patrol.yaml for {args.seconds:,.0f} simulated seconds")
     for header in (
@@ -101,8 +116,16 @@ def main() -> None:
     console = Console()
     console.print(table)
     console.print(
-        f"visits: {len(result.visits):,}; picture: {len(png) / 1e3:.0f} kB drawn in {drawn:.1f} s"
+        f"visits: {result.total_visits:,} ({len(result.visits):,} listed in full); "
+        f"picture: {len(png) / 1e3:.0f} kB drawn in {drawn:.1f} s; "
+        f"peak resident {peak_mb():.0f} MB"
     )
+    shares = Table(title="journal by record type")
+    for header in ("type", "MB", "share"):
+        shares.add_column(header, justify="right")
+    for kind, size in by_type.most_common():
+        shares.add_row(kind, f"{size / 1e6:.1f}", f"{100 * size / journal_total:.0f} %")
+    console.print(shares)
 
 
 if __name__ == "__main__":

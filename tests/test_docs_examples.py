@@ -143,12 +143,20 @@ RULES: tuple[Rule, ...] = (
     ),
     Rule(r"--navigator ros1", "ros", "tests/test_cli_ros1.py::test_ros1_run_completes_and_reports"),
     Rule(
+        r"--navigator nav2",
+        "ros",
+        "tests/test_ros2_navigator.py::"
+        "test_the_example_mission_completes_with_the_same_visits_as_on_the_simulator",
+    ),
+    Rule(
         r"navseq record\b",
         "ros",
         "tests/test_ros_record.py::test_every_goal_pose_becomes_a_waypoint_and_survives_ctrl_c",
     ),
     # A patrol runs until stopped, and so does its resume (it continues as journaled).
     Rule(r"--loops forever|--resume navseq-out/patrol-", "interrupt"),
+    # The studio serves until Ctrl-C (tests/test_studio_browser.py drives its page).
+    Rule(r"(^|/)navseq studio\b", "interrupt"),
     Rule(r"(^|/)navseq\b", "run"),
 )
 

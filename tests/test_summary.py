@@ -176,3 +176,27 @@ def test_in_a_pipe_names_are_never_cut():
     assert long_name in text
     assert "the navigation stack gave up after 3 plans" in text
     assert "…" not in text
+
+
+def test_a_patrol_longer_than_the_report_lists_is_counted_from_the_totals():
+    """A patrol keeps only its last visits in full: the table still counts every one."""
+    from navseq.executor.result import VisitLog
+
+    mission = mission_of(5, loops=None)
+    log = VisitLog(mission.waypoints, None)
+    failure = AttemptResult(1, status="ABORTED", reason="aborted", text="no valid plan")
+    for loop in range(1445):
+        for i in range(5):
+            if (loop, i) == (1, 2):
+                log.add(visit(2, FAILED, 1, attempt_results=[failure], reason="aborted"))
+            else:
+                log.add(visit(i, REACHED, loop))
+    result = log.result(
+        success=False, reason="interrupted: SIGINT", duration=72250.0, loops_completed=1445
+    )
+    assert result.omitted_visits > 0  # the premise: not every visit is listed
+    text = text_of(summary_table(mission, result))
+    wp3 = next(row for row in data_rows(text) if "wp3" in row)
+    assert "1445" in wp3 and "1444" in wp3  # visits, reached: counted, not just listed
+    assert "aborted: no valid plan" in wp3
+    assert "14450.0" in wp3

@@ -59,6 +59,9 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "run the simulated robot with a Nav2 stand-in as ROS 2 nodes (--ros2)",
         "navseq.commands.sim",
     ),
+    Subcommand(
+        "studio", "make, check and run missions on the map in a browser", "navseq.commands.studio"
+    ),
     # Lives with the ROS code; it imports rospy only when recording starts.
     Subcommand(
         "record",

@@ -110,45 +110,39 @@ def rebuild_outputs(journal: Path) -> Rebuilt:
 
 
 def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
-    """The run's result as its journal tells it (visits not finished are not run)."""
+    """The run's result as its journal tells it (visits not finished are not run).
+
+    Built through the same :class:`~navseq.executor.result.VisitLog` as a live run's,
+    so a rebuilt report lists and counts visits as the run's own would have.
+    """
     from dataclasses import replace
 
     from navseq.executor.events import WaypointOutcome
-    from navseq.executor.result import MissionResult, WaypointResult
-
-    def visit(loop: int, index: int) -> WaypointResult:
-        waypoint = mission.waypoints[index]
-        known = state.visits.get((loop, index))
-        if known is not None:
-            return replace(
-                known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad
-            )
-        return WaypointResult(index, loop, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw_rad)
+    from navseq.executor.result import VisitLog
 
     count = len(mission.waypoints)
     started = state.mission_started
     loops = started.loops if started is not None else mission.loops
-    if loops is None:
-        keys = sorted(key for key in state.visits if 0 <= key[1] < count)
-    else:
-        keys = [(loop, index) for loop in range(loops) for index in range(count)]
-    visits = [visit(loop, index) for loop, index in keys]
-    success = bool(visits) and all(v.outcome is WaypointOutcome.REACHED for v in visits)
-    loops_completed = sum(
-        all(
-            state.visits.get((loop, index)) is not None
-            and state.visits[(loop, index)].outcome is not WaypointOutcome.NOT_RUN
-            for index in range(count)
+    log = VisitLog(mission.waypoints, loops)
+    done_per_loop: dict[int, int] = {}
+    for key in sorted(key for key in state.visits if 0 <= key[1] < count):
+        loop, index = key
+        if loops is not None and loop >= loops:
+            continue
+        known = state.visits[key]
+        if known.outcome is WaypointOutcome.NOT_RUN:
+            continue  # never finished: listed (or counted) as not run
+        waypoint = mission.waypoints[index]
+        log.add(
+            replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
         )
-        for loop in range(max((key[0] for key in state.visits), default=-1) + 1)
-    )
-    return MissionResult(
+        done_per_loop[loop] = done_per_loop.get(loop, 0) + 1
+    success = log.finished > 0 and log.all_reached()
+    return log.result(
         success=success and state.finish_reason is not None,
         reason=state.finish_reason or UNFINISHED_REASON,
-        visits=visits,
         duration=state.previous_duration,
-        distance_driven=sum(v.distance_driven for v in visits),
-        loops_completed=loops_completed,
+        loops_completed=sum(done == count for done in done_per_loop.values()),
     )
 
 

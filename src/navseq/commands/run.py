@@ -36,6 +36,7 @@ from navseq.navigators.registry import (
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
+    from navseq.executor.control import MissionControl
     from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
@@ -160,6 +161,8 @@ class RunSetup:
     part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
+    # Operator requests (stop, pause, skip) from another thread: the studio's buttons.
+    control: MissionControl | None = None
 
 
 def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumePoint, JournalState]:
@@ -282,11 +285,11 @@ def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
     """Options that only the embedded simulator can honour, refused for a real robot."""
     from navseq.errors import NavseqError
 
-    if args.navigator == "ros1" and start_given:
+    if not navigator_kind(args.navigator).places_robot and start_given:
         raise NavseqError(
-            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
-            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
-            "which publishes /initialpose)",
+            f"sets the simulated robot's start pose; with --navigator {args.navigator} the "
+            "robot is where it is. Leave --start out (set a robot's pose with RViz's 2D Pose "
+            "Estimate, which publishes /initialpose)",
             source="--start",
         )
     if args.navigator != "sim" and args.realtime is not None:
@@ -534,6 +537,7 @@ def _run_with_sinks(
                     resume=setup.resume,
                     signals=signals,
                     robot=setup.robot,
+                    control=setup.control,
                 )
                 exit_code, interrupted = result.exit_code, None
             except MissionInterrupted as stop:

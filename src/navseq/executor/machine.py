@@ -76,7 +76,7 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import AttemptResult, MissionResult, WaypointResult
+from navseq.executor.result import AttemptResult, MissionResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D, normalize_angle, remaining_along_path
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
@@ -163,6 +163,9 @@ class _Visit:
     reached_at: float | None = None
     attempt_sent_at: float = 0.0  # when the current attempt's goal was first sent
     attempt_start_distance: float = 0.0  # the visit's distance driven at that moment
+    # The stack's count of recovery behaviours for the current attempt's goal, when the
+    # stack gives one (Nav2's number_of_recoveries); None: not known.
+    attempt_recoveries: int | None = None
 
 
 class MissionExecutor:
@@ -194,10 +197,11 @@ class MissionExecutor:
         self._robot = robot or mission.robot or DEFAULT_PROFILE
         self._listeners: list[MissionListener] = []
         self._state = ExecutorState.IDLE
-        self._visits: dict[tuple[int, int], WaypointResult] = {}
+        # Finished visits: counted per waypoint, the latest kept in full (bounded memory).
+        self._log = VisitLog(mission.waypoints, mission.loops)
         if resume is not None:
-            for done in resume.done:
-                self._visits[(done.loop, done.index)] = _result_for(mission, done)
+            for done in sorted(resume.done, key=lambda v: (v.loop, v.index)):
+                self._log.add(_result_for(mission, done))
         self._visit: _Visit | None = None
         self._attempt: _Attempt | None = None
         self._next_goal_id = 1
@@ -253,22 +257,29 @@ class MissionExecutor:
 
     @property
     def result(self) -> MissionResult:
-        """The run so far: every visit of the mission, NOT_RUN for the ones not tried.
+        """The run so far: every visit counted per waypoint, the latest listed in full.
 
-        For a mission that loops forever only the visits that happened are listed.
+        A small finite mission lists every visit, NOT_RUN for the ones not tried; a
+        patrol or a huge mission lists what :class:`~navseq.executor.result.VisitLog`
+        keeps. The visit under way is listed as NOT_RUN with its attempts so far.
         """
-        visits = [replace(v) for v in self._all_visits()]
         started = self._started_at if self._started_at is not None else self._now
         previous = self._resume.previous_duration if self._resume else 0.0
-        return MissionResult(
+        return self._log.result(
             success=self._success,
             reason=self._reason,
-            visits=visits,
             duration=(self._now - started) + previous,
-            distance_driven=sum(v.distance_driven for v in visits),
             loops_completed=self._loops_completed,
             start_pose=self._start_pose,
+            active=self._active_result(),
         )
+
+    def _active_result(self) -> WaypointResult | None:
+        """The current visit's result while it is not finished (not yet in the log)."""
+        visit = self._visit
+        if visit is None or (visit.loop, visit.index) in self._log:
+            return None
+        return visit.result
 
     @property
     def robot(self) -> RobotProfile:
@@ -492,7 +503,6 @@ class MissionExecutor:
             y=waypoint.y,
             yaw_rad=waypoint.yaw_rad,
         )
-        self._visits[(loop, index)] = result
         self._visit = _Visit(loop, index, waypoint, self._mission.policy_for(index), result)
         return self._start_attempt(now)
 
@@ -501,6 +511,7 @@ class MissionExecutor:
         visit.result.attempts += 1
         visit.attempt_sent_at = now
         visit.attempt_start_distance = visit.result.distance_driven
+        visit.attempt_recoveries = None
         return self._send_goal(now)
 
     def _passes_through(self, visit: _Visit) -> bool:
@@ -524,6 +535,7 @@ class MissionExecutor:
             text=text,
             duration=max(0.0, now - visit.attempt_sent_at),
             distance_driven=visit.result.distance_driven - visit.attempt_start_distance,
+            recoveries=visit.attempt_recoveries,
         )
         visit.result.attempt_results.append(record)
         return record
@@ -592,11 +604,10 @@ class MissionExecutor:
         following = self._next_position(visit.loop, visit.index)
         if following is None:
             self._loops_completed += 1
-            reached = all(v.outcome is WaypointOutcome.REACHED for v in self._all_visits())
-            if reached:
+            if self._log.all_reached(self._active_result()):
                 self._finish_mission(now, "completed")
             else:
-                missed = sum(v.outcome is not WaypointOutcome.REACHED for v in self._all_visits())
+                missed = self._log.not_reached(self._active_result())
                 visits = "waypoint visit" if missed == 1 else "waypoint visits"
                 self._finish_mission(now, f"completed: {missed} {visits} not reached")
             return []
@@ -619,6 +630,8 @@ class MissionExecutor:
         result.reason = reason
         result.passed_through = passed_through
         result.duration = (end - start) if (start is not None and end is not None) else 0.0
+        if (visit.loop, visit.index) not in self._log:
+            self._log.add(result)
         self._attempt = None
         self._emit(
             WaypointFinished(
@@ -639,28 +652,8 @@ class MissionExecutor:
         self._visit = None
         self._attempt = None
         self._reason = reason
-        self._success = all(v.outcome is WaypointOutcome.REACHED for v in self._all_visits())
+        self._success = self._log.all_reached(self._active_result())
         self._emit(MissionFinished(t=now, success=self._success, reason=reason))
-
-    def _all_visits(self) -> list[WaypointResult]:
-        """Every visit in mission order; for finite missions also the ones not tried."""
-        if self._mission.loops is None:
-            return [self._visits[key] for key in sorted(self._visits)]
-        visits = []
-        for loop in range(self._mission.loops):
-            for index, waypoint in enumerate(self._mission.waypoints):
-                visit = self._visits.get((loop, index))
-                if visit is None:
-                    visit = WaypointResult(
-                        index=index,
-                        loop=loop,
-                        name=waypoint.name,
-                        x=waypoint.x,
-                        y=waypoint.y,
-                        yaw_rad=waypoint.yaw_rad,
-                    )
-                visits.append(visit)
-        return visits
 
     # ------------------------------------------------------------------ failures
 
@@ -699,6 +692,7 @@ class MissionExecutor:
                 duration=record.duration,
                 distance_driven=record.distance_driven,
                 loop=visit.loop,
+                recoveries=record.recoveries,
             )
         )
         if will_retry:
@@ -809,6 +803,8 @@ class MissionExecutor:
         attempt = self._attempt
         assert attempt is not None
         attempt.feedback_seen = True
+        if event.recoveries is not None:
+            self._current.attempt_recoveries = event.recoveries
         if not self._tick_pose_seen:
             self._accumulate_distance(event.pose)
         self._see_pose(event.pose)
@@ -817,7 +813,7 @@ class MissionExecutor:
             remaining = event.distance_remaining
             if remaining is None:
                 remaining = self._remaining(attempt, event.pose)
-            self._emit_progress(now, event.pose, remaining)
+            self._emit_progress(now, event.pose, remaining, event.recoveries, event.navigation_time)
         return commands
 
     @staticmethod
@@ -930,7 +926,14 @@ class MissionExecutor:
             return True
         return False
 
-    def _emit_progress(self, now: float, pose: Pose2D, remaining: float | None) -> None:
+    def _emit_progress(
+        self,
+        now: float,
+        pose: Pose2D,
+        remaining: float | None,
+        recoveries: int | None = None,
+        navigation_time: float | None = None,
+    ) -> None:
         visit = self._current
         self._emit(
             WaypointProgress(
@@ -941,6 +944,8 @@ class MissionExecutor:
                 yaw=pose.yaw,
                 distance_remaining=remaining,
                 distance_driven=visit.result.distance_driven,
+                recoveries=recoveries,
+                navigation_time=navigation_time,
             )
         )
 

@@ -9,7 +9,7 @@ code only builds these trees; one set of field readers turns them into a Mission
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 from navseq.errors import NavseqError
@@ -18,18 +18,41 @@ from navseq.errors import NavseqError
 MAX_DEPTH = 64
 
 
-@dataclass(frozen=True)
+_NO_KEYS: Mapping[str, str] = MappingProxyType({})
+
+
 class Located:
     """One value of a parsed document and where it came from.
 
     ``value`` is a scalar (None, bool, int, float, str), a ``list[Located]`` or a
     ``dict[str, Located]``. For mappings ``key_where`` gives the place of each key,
     which is where an unknown key is reported.
+
+    A plain class with slots, not a dataclass: a 100 000-waypoint mission makes half
+    a million of these, and a frozen dataclass's ``__init__`` cost a second of it.
+    Treat instances as immutable.
     """
 
-    value: Any
-    where: str
-    key_where: Mapping[str, str] = field(default_factory=dict)
+    __slots__ = ("key_where", "value", "where")
+
+    def __init__(self, value: Any, where: str, key_where: Mapping[str, str] = _NO_KEYS):
+        self.value = value
+        self.where = where
+        self.key_where = key_where
+
+    def __repr__(self) -> str:
+        return f"Located({self.value!r}, {self.where!r})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Located):
+            return NotImplemented
+        return (self.value, self.where, dict(self.key_where)) == (
+            other.value,
+            other.where,
+            dict(other.key_where),
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # mutable contents (lists, dicts)
 
     @property
     def is_mapping(self) -> bool:
@@ -41,7 +64,8 @@ class Located:
 
     def get(self, key: str) -> Located | None:
         """The entry ``key`` of a mapping (None when absent or when this is no mapping)."""
-        return self.value.get(key) if isinstance(self.value, dict) else None
+        value = self.value
+        return value.get(key) if type(value) is dict else None
 
     def where_key(self, key: str) -> str:
         return self.key_where.get(key, self.where)

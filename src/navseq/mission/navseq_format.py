@@ -22,7 +22,7 @@ import difflib
 import functools
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -212,8 +212,47 @@ def read_numbered_waypoints(
     return tuple(w for _, w in kept), tuple(i for i, _ in kept)
 
 
+# The keys of most waypoints: read without the problem bookkeeping (see _plain_waypoint).
+_PLAIN_WAYPOINT_KEYS = frozenset(("name", "x", "y", "z", "yaw"))
+_NO_OVERRIDES: Mapping[str, Any] = MappingProxyType({})
+
+
+def _plain_waypoint(node: Located) -> Waypoint | None:
+    """A waypoint of only name, x, y, z, yaw that reads without a problem, else None.
+
+    The same readers as :func:`read_waypoint`, without building labels and recording
+    problems for each value: a 100 000-waypoint mission spent most of its reading time
+    there. Any problem (or any other key) returns None, and the general reader then
+    reports it exactly as before.
+    """
+    values = node.value
+    if type(values) is not dict or not values.keys() <= _PLAIN_WAYPOINT_KEYS:
+        return None
+    x, y = values.get("x"), values.get("y")
+    if x is None or y is None:
+        return None
+    try:
+        name_node = values.get("name")
+        name = fields.text(name_node, "", allow_numbers=True) if name_node is not None else None
+        z_node, yaw_node = values.get("z"), values.get("yaw")
+        return Waypoint(
+            x=fields.coordinate(x, ""),
+            y=fields.coordinate(y, ""),
+            z=(fields.coordinate(z_node, "") or 0.0) if z_node is not None else 0.0,
+            yaw_rad=fields.yaw_degrees(yaw_node, "") if yaw_node is not None else 0.0,
+            name=name,
+            overrides=_NO_OVERRIDES,
+            where=node.where,
+        )
+    except NavseqError:
+        return None
+
+
 def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | None:
     """One waypoint: a mapping, or the short form ``[x, y]`` / ``[x, y, yaw_degrees]``."""
+    plain = _plain_waypoint(node)
+    if plain is not None:
+        return plain
     if node.is_list:
         return _waypoint_from_list(node, index, problems)
     label = f"waypoint {index + 1}"

@@ -8,12 +8,24 @@ any other tag is an error. Aliases are allowed, but before anything is built the
 document's size *with aliases expanded* is computed on the node graph (linear in
 the written size): an "alias bomb" (a few lines that expand to billions of values)
 or an alias that contains itself is refused at once.
+
+Composing costs: PyYAML's composer resolves every scalar with Python regexes, and
+the node graph is walked twice more (alias check, Located values): 100 000 waypoints
+took 18 s and 620 MB. Most documents use nothing but plain mappings, lists and
+scalars, so :func:`parse_yaml` first tries a fast path, :class:`_EventBuilder`: one
+pass over libyaml's parse events, building the Located values directly and reading
+the common scalars (plain decimal ints and floats, plain words no YAML 1.1 rule
+applies to) with exact shortcuts, every other scalar as the slow path does. Anything
+the slow path would treat specially (anchors, aliases, merge keys, explicit tags,
+duplicate keys, surrogates, several documents, too many values, a syntax error)
+abandons the fast path and the document is read the slow way, so values, problems
+and messages are the same either way (``tests/test_yaml_fast_path.py`` compares).
 """
 
 from __future__ import annotations
 
 import re
-from typing import Any
+from typing import Any, NoReturn
 
 import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
@@ -58,9 +70,24 @@ def parse_yaml(
     file). ``budget`` bounds the values read, across documents if shared. Returns
     None for an empty document.
     """
-    offset = first_line - 1
+    budget = budget or ValueBudget()
+    if _FAST_LOADER is not yaml.SafeLoader:
+        try:
+            root, count = _EventBuilder(source, problems, first_line - 1, budget.left).build(text)
+        except _SlowPath:
+            pass
+        else:
+            budget.left -= count
+            return root
+    return _parse_slowly(text, source, problems, first_line - 1, budget)
+
+
+def _parse_slowly(
+    text: str, source: str, problems: Problems, offset: int, budget: ValueBudget
+) -> Located | None:
+    """Compose the node graph, check its aliases, then walk it into Located values."""
     try:
-        _spend_values(text, source, offset, budget or ValueBudget())
+        _spend_values(text, source, offset, budget)
         root = _compose(text)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
@@ -291,3 +318,157 @@ class _Walker:
                 names.add(name)
                 kept.append((key_node, value_node))
         return kept + explicit
+
+
+class _SlowPath(Exception):
+    """The document needs the composer's full treatment (see the module docstring)."""
+
+
+def _slow_path() -> NoReturn:
+    raise _SlowPath
+
+
+def _standard_resolvers(first: str, tags: tuple[str, ...]) -> bool:
+    resolvers = yaml.resolver.Resolver.yaml_implicit_resolvers.get(first, [])
+    return tuple(tag for tag, _ in resolvers) == tuple(_TAG + tag for tag in tags)
+
+
+# Shortcuts valid only while PyYAML resolves numbers as it always has (nothing added).
+_SHORTCUTS = _standard_resolvers("-", ("float", "int")) and all(
+    _standard_resolvers(digit, ("float", "int", "timestamp")) for digit in "0123456789"
+)
+# Plain scalars whose YAML 1.1 reading is certain and cheap: a decimal int without
+# leading zeros or "_" (PyYAML: int(value)); digits '.' digits (PyYAML: float(value));
+# a word starting with a character no implicit resolver is registered for (text).
+_PLAIN_INT = re.compile(r"-?+(?:0|[1-9][0-9]*+)")
+_PLAIN_FLOAT = re.compile(r"-?+[0-9]++\.[0-9]++")
+_PLAIN_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*+")
+_RESOLVED_FIRST = frozenset(yaml.resolver.Resolver.yaml_implicit_resolvers)
+_SURROGATE = re.compile("[\ud800-\udfff]")
+
+
+class _EventBuilder:
+    """The fast path: Located values straight from libyaml's events, or :class:`_SlowPath`."""
+
+    def __init__(self, source: str, problems: Problems, offset: int, budget_left: int):
+        self.source = source
+        self.offset = offset
+        self.budget_left = budget_left
+        self.walker = _Walker(source, problems, offset)  # for the scalars it must read
+        self.places: dict[int, str] = {}
+
+    def where(self, mark: Any) -> str:
+        line = mark.line
+        place = self.places.get(line)
+        if place is None:
+            place = self.places[line] = f"{self.source}:{line + 1 + self.offset}"
+        return place
+
+    def build(self, text: str) -> tuple[Located | None, int]:
+        """The document's root (None when empty) and how many values it holds."""
+        if _SURROGATE.search(text):
+            _slow_path()  # the slow path names the value that holds one
+        parser = _FAST_LOADER(text)
+        try:
+            return self._build(parser.get_event)
+        except (yaml.YAMLError, NavseqError):
+            # The slow path reports it, after any problem it finds first (a syntax
+            # error further on, an alias bomb), with the same message and line.
+            _slow_path()
+        finally:
+            parser.dispose()
+
+    def _build(self, next_event: Any) -> tuple[Located | None, int]:
+        # Each open container: [value (dict or list), where, key_where, pending key].
+        stack: list[list[Any]] = []
+        root: Located | None = None
+        documents = 0
+        count = 0
+        budget_left = self.budget_left
+        located, where, scalar = Located, self.where, self.scalar
+        places = self.places
+        scalar_event, mapping_start, sequence_start = (
+            yaml.ScalarEvent,
+            yaml.MappingStartEvent,
+            yaml.SequenceStartEvent,
+        )
+        end_events = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
+        stream_end = yaml.StreamEndEvent
+        while True:
+            event = next_event()
+            kind = type(event)
+            if kind is scalar_event:
+                count += 1
+                if event.anchor is not None or event.tag is not None:
+                    _slow_path()
+                place = places.get(event.start_mark.line) or where(event.start_mark)
+                top = stack[-1] if stack else None
+                if top is not None and top[3] is None and type(top[0]) is dict:
+                    # A key: its text as written, once, not a merge key.
+                    key = event.value
+                    if key in top[0] or (key == "<<" and not event.style):
+                        _slow_path()
+                    if event.style == '"' and text_problem(key, single_line=False):
+                        _slow_path()
+                    top[3] = key
+                    top[2][key] = place
+                    continue
+                node = located(scalar(event), place)
+            elif kind is mapping_start or kind is sequence_start:
+                count += 1
+                if event.anchor is not None or event.tag is not None:
+                    _slow_path()
+                if len(stack) >= MAX_DEPTH or count > budget_left:
+                    _slow_path()
+                top = stack[-1] if stack else None
+                if top is not None and top[3] is None and type(top[0]) is dict:
+                    _slow_path()  # a list or mapping as a key
+                if kind is mapping_start:
+                    stack.append([{}, where(event.start_mark), {}, None])
+                else:
+                    stack.append([[], where(event.start_mark), None, None])
+                continue
+            elif kind in end_events:
+                value, place, key_where, _ = stack.pop()
+                if key_where is None:
+                    node = located(value, place)
+                else:
+                    node = located(value, place, key_where)
+            elif kind is stream_end:
+                return root, count
+            elif kind is yaml.DocumentStartEvent:
+                documents += 1
+                if documents > 1:
+                    _slow_path()  # the composer's error names the line
+                continue
+            elif kind is yaml.AliasEvent:
+                _slow_path()
+            else:
+                continue  # stream start, document end
+            if count > budget_left:
+                _slow_path()  # the slow path refuses it with the line
+            if not stack:
+                root = node
+                continue
+            top = stack[-1]
+            if type(top[0]) is dict:
+                top[0][top[3]] = node
+                top[3] = None
+            else:
+                top[0].append(node)
+
+    def scalar(self, event: Any) -> Any:
+        value: str = event.value
+        if not event.style:
+            if _SHORTCUTS:
+                if _PLAIN_FLOAT.fullmatch(value):
+                    return float(value)
+                if _PLAIN_INT.fullmatch(value):
+                    return int(value)
+            if value[:1] not in _RESOLVED_FIRST and _PLAIN_WORD.fullmatch(value):
+                return value
+            tag = self.walker.constructor.resolve(ScalarNode, value, event.implicit)
+        else:
+            tag = _TAG + "str"  # quoted or a block scalar (implicit tags only: no '!')
+        node = ScalarNode(tag, value, event.start_mark, event.end_mark, event.style)
+        return self.walker.scalar(node)  # as the slow path reads it, errors included

@@ -392,6 +392,9 @@ class _VisitTrail:
     key: tuple[int, int]
     sent_at: dict[int, float] = field(default_factory=dict)  # attempt number -> first send
     failures: dict[int, AttemptResult] = field(default_factory=dict)
+    # The stack's recovery count last journaled for the latest attempt (thinned
+    # WaypointProgress events: the count may lag the live report's by a second).
+    recoveries: int | None = None
 
 
 def _check_header_text(value: Any, key: str, where: str) -> None:
@@ -443,6 +446,10 @@ def _replay(state: JournalState, records: list[tuple[int, dict[str, Any] | None]
             if trail is None or trail.key != key:
                 trail = _VisitTrail(key)
             trail.sent_at.setdefault(event.attempt, event.t)
+            trail.recoveries = None
+        elif isinstance(event, ev.WaypointProgress) and trail is not None:
+            if event.recoveries is not None:
+                trail.recoveries = event.recoveries
         elif isinstance(event, ev.AttemptFailed) and trail is not None:
             # The visit is the one last started: older journals name no loop here.
             trail.failures[event.attempt] = _attempt_of(event)
@@ -463,6 +470,7 @@ def _attempt_of(event: ev.AttemptFailed) -> AttemptResult:
         text=event.text,
         duration=event.duration,
         distance_driven=event.distance_driven,
+        recoveries=event.recoveries,
     )
 
 
@@ -495,6 +503,7 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
                 reason="" if reached else event.reason,
                 duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
                 distance_driven=max(0.0, event.distance_driven - before),
+                recoveries=trail.recoveries if trail is not None else None,
             )
         )
     return attempts

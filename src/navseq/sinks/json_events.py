@@ -1,19 +1,21 @@
 """Mission events as JSON records: ``navseq run --json``, and the public API's records.
 
-One record per event, one line each: ``{"event": "<type>", "schema_version": 2,
+One record per event, one line each: ``{"event": "<type>", "schema_version": 3,
 "t_s": ..., ...}``. The record is the event's fields under the names the run report
 uses, with the unit in the name: ``t_s``, ``duration_s``, ``distance_m``,
-``distance_remaining_m``, ``dwell_s``, ``yaw_deg`` (degrees, like the report and
-mission files; the executor's events carry radians). ``x`` and ``y`` are metres in the
-mission's frame, ``index`` is 0-based (the position in the mission run: in a part of
-a file, ``--from``/``--to``/``--only``, the position in the part) and ``number`` the
-waypoint's 1-based number in the file (what messages and the summary table say, as in
-the report's visits), ``loops`` is a count or ``"forever"``. Numbers
+``distance_remaining_m``, ``navigation_time_s``, ``dwell_s``, ``yaw_deg`` (degrees, like
+the report and mission files; the executor's events carry radians). ``x`` and ``y``
+are metres in the mission's frame, ``index`` is 0-based (the position in the mission
+run: in a part of a file, ``--from``/``--to``/``--only``, the position in the part) and
+``number`` the waypoint's 1-based number in the file (what messages and the summary
+table say, as in the report's visits), ``loops`` is a count or ``"forever"``. Numbers
 are rounded to six decimals (micrometres, microseconds: below what any navigation
 stack resolves, and ``8.7`` rather than ``8.700000000000001``). The
 JSON Schema is ``docs/schemas/events.schema.json``; :data:`SCHEMA_VERSION` goes up
-whenever a field is renamed, removed or changes meaning, or the records gain fields
-(version 2: ``number`` beside every ``index``, and ``RunFinished``'s ``clock``).
+whenever a field is renamed, removed or changes meaning, and when one is added
+(version 2: ``recoveries`` and ``navigation_time_s`` in ``WaypointProgress``,
+``recoveries`` in ``AttemptFailed``, from stacks that count them, like Nav2; version 3:
+``number`` beside every ``index``, and ``RunFinished``'s ``clock``).
 
 The renames live in one table, :data:`FIELDS`, applied to every event type, so a
 field means the same in every record; a new event field without an entry is written
@@ -31,7 +33,7 @@ from typing import IO, Any
 from navseq.executor.events import MissionEvent, WaypointOutcome
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 
 #: Decimals kept in every number of a record.
@@ -61,6 +63,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "duration": ("duration_s", None),
     "distance_driven": ("distance_m", None),
     "distance_remaining": ("distance_remaining_m", None),
+    "navigation_time": ("navigation_time_s", None),
     "seconds": ("dwell_s", None),
     # WaypointFinished's count; the report's ``attempts`` is the list of attempts.
     "attempts": ("attempt_count", None),

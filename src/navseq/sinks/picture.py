@@ -1,22 +1,38 @@
 """The mission picture: map, waypoints, planned legs and driven trajectory in one PNG.
 
-Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display needed):
+Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display needed),
+readable from 1 to 100 000 waypoints and drawn in bounded time (a run that got a
+signal waits for it):
 
 - the occupancy grid in metres with its true extent and orientation (free white,
-  occupied black, unknown grey, as in map_server images and RViz);
-- every waypoint numbered, with an arrow along its yaw, coloured by outcome (reached
-  green, skipped orange, failed red, not run grey) and its pass-through radius dashed;
-- each leg's planned path (thin, dashed) and the driven trajectory coloured by time;
-- the start pose, a legend, and a title with the mission name and its result;
-- the view cropped to the area of interest (the mission plus the mapped surroundings).
+  occupied black, unknown grey, as in map_server images and RViz), cropped to the
+  view and reduced to about one cell per pixel (:mod:`navseq.sinks.picture_thin`);
+- every waypoint coloured by its meaningful outcome (:func:`waypoint_outcomes`):
+  reached green, skipped orange, failed red, interrupted pink, not run grey. While
+  there is room, each waypoint is a numbered disc with an arrow along its yaw and its
+  pass-through radius dashed; a crowded mission gets small dots instead;
+- labels that never collide with one another, with the markers that matter or with
+  the legend (which sits outside the axes): all of them when they fit, else the
+  first, the last, the failures and a spread-out sample (:mod:`~navseq.sinks.picture_labels`);
+- waypoints on top of one another drawn as one marker with a count ("×3") and the
+  list of their numbers; waypoints outside the view drawn as triangles on its border,
+  pointing towards them, with their coordinates;
+- each leg's planned path (thin, dashed) and the driven trajectory coloured by time,
+  both thinned to what the pixels can show;
+- the start pose, a legend and a colour bar beside the map, and a title with the
+  mission name and its result.
+
+This module reads the run (:func:`waypoint_outcomes` is the only place that reads a
+result's visits) and puts the picture together; the helpers draw: ``picture_view``
+(view, layout, map, paths), ``picture_marks`` (markers and labels), ``picture_legend``
+(side panel), with ``picture_style`` (colours, sizes, budgets), ``picture_thin`` and
+``picture_labels`` (the numpy and placement work).
 """
 
 from __future__ import annotations
 
 import io
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -27,218 +43,133 @@ from navseq.executor.result import MissionResult
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
+from navseq.sinks.picture_legend import side_panel
+from navseq.sinks.picture_marks import (
+    draw_markers,
+    draw_numbered_details,
+    group_markers,
+    place_labels,
+    square,
+)
+from navseq.sinks.picture_style import (
+    DISC,
+    STATUS_COLOURS,
+    STATUS_LABELS,
+    STATUSES,
+    Status,
+    WaypointOutcomes,
+)
+from navseq.sinks.picture_view import (
+    Box,
+    area_of_interest,
+    draw_map,
+    draw_plans,
+    draw_start,
+    draw_trajectory,
+    make_layout,
+    occupancy_rgb,
+)
 from navseq.text import printable
 
 if TYPE_CHECKING:
-    from matplotlib.axes import Axes
-    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
     from navseq.mission.robot import RobotProfile
     from navseq.sim.occupancy import OccupancyGrid
 
-OUTCOME_COLOURS = {
-    WaypointOutcome.REACHED: "#2ca02c",
-    WaypointOutcome.SKIPPED: "#ff8c00",
-    WaypointOutcome.FAILED: "#d62728",
-    WaypointOutcome.NOT_RUN: "#8c8c8c",
-}
-OUTCOME_LABELS = {
-    WaypointOutcome.REACHED: "reached",
-    WaypointOutcome.SKIPPED: "skipped",
-    WaypointOutcome.FAILED: "failed",
-    WaypointOutcome.NOT_RUN: "not run",
-}
-# How bad an outcome is, to colour a patrol waypoint by its worst visit.
-_SEVERITY = {
-    WaypointOutcome.NOT_RUN: 0,
-    WaypointOutcome.REACHED: 1,
-    WaypointOutcome.SKIPPED: 2,
-    WaypointOutcome.FAILED: 3,
-}
-PLAN_COLOUR = "#1f5fbf"
-START_COLOUR = "#7b2cbf"
-UNKNOWN_GREY = 205 / 255  # map_server writes unknown cells as 205
-OCCUPIED_GREY = 0.12
+__all__ = [
+    "STATUS_COLOURS",
+    "STATUS_LABELS",
+    "Box",
+    "Status",
+    "WaypointOutcomes",
+    "area_of_interest",
+    "draw_mission_picture",
+    "mission_figure",
+    "mission_picture_png",
+    "occupancy_rgb",
+    "waypoint_outcomes",
+]
 
 Path2D = Sequence[tuple[float, float]]
 
 
-@dataclass(frozen=True)
-class Box:
-    """An axis-aligned rectangle in metres."""
-
-    xmin: float
-    ymin: float
-    xmax: float
-    ymax: float
-
-    @classmethod
-    def around(cls, points: np.ndarray) -> Box:
-        return cls(*points.min(axis=0), *points.max(axis=0))
-
-    @property
-    def width(self) -> float:
-        return self.xmax - self.xmin
-
-    @property
-    def height(self) -> float:
-        return self.ymax - self.ymin
-
-    def grown(self, margin: float) -> Box:
-        return Box(self.xmin - margin, self.ymin - margin, self.xmax + margin, self.ymax + margin)
-
-    def union(self, other: Box) -> Box:
-        return Box(
-            min(self.xmin, other.xmin),
-            min(self.ymin, other.ymin),
-            max(self.xmax, other.xmax),
-            max(self.ymax, other.ymax),
-        )
-
-    def clipped(self, other: Box) -> Box:
-        return Box(
-            max(self.xmin, other.xmin),
-            max(self.ymin, other.ymin),
-            min(self.xmax, other.xmax),
-            min(self.ymax, other.ymax),
-        )
+# How bad a visit's outcome is. WaypointOutcome is a str enum, so these keys also
+# match the plain strings ("reached") of a result read back from JSON.
+_SEVERITY: dict[Any, int] = {
+    WaypointOutcome.REACHED: 1,
+    WaypointOutcome.SKIPPED: 2,
+    WaypointOutcome.FAILED: 3,
+}
 
 
-def waypoint_outcomes(result: MissionResult, count: int) -> list[WaypointOutcome]:
-    """One outcome per waypoint: its worst visit that ran (not run if none ran)."""
-    outcomes = [WaypointOutcome.NOT_RUN] * count
-    for visit in result.visits:
-        if 0 <= visit.index < count:
-            outcome = WaypointOutcome(visit.outcome)
-            if _SEVERITY[outcome] > _SEVERITY[outcomes[visit.index]]:
-                outcomes[visit.index] = outcome
-    return outcomes
+def _is_interruption(visit: Any) -> bool:
+    """A visit ended by a signal or crash, not by the robot: the run's end, not its failure."""
+    return str(getattr(visit, "reason", "")).startswith("interrupted")
 
 
-def occupancy_rgb(data: np.ndarray) -> np.ndarray:
-    """RGB image (rows as in ``data``) of occupancy values: 0 white .. 100 black, -1 grey."""
-    values = np.clip(data.astype(np.float32), 0.0, 100.0)
-    grey = 1.0 - (1.0 - OCCUPIED_GREY) * values / 100.0
-    # Only -1 is unknown; other negative values (raw mode) are obstacles to costmap_2d.
-    grey = np.where(data == -1, UNKNOWN_GREY, np.where(data < -1, OCCUPIED_GREY, grey))
-    return np.repeat(grey[:, :, None], 3, axis=2)
+def waypoint_outcomes(result: MissionResult, count: int) -> WaypointOutcomes:
+    """What each waypoint's marker says: the one place the picture reads a result's visits.
 
-
-def _known_box(grid: OccupancyGrid) -> Box | None:
-    """The world box around every mapped (not unknown) cell, or None if all are unknown."""
-    rows, cols = np.nonzero(grid.data != -1)
-    if rows.size == 0:
-        return None
-    corners_rows = np.array([rows.min(), rows.min(), rows.max() + 1, rows.max() + 1]) - 0.5
-    corners_cols = np.array([cols.min(), cols.max() + 1, cols.min(), cols.max() + 1]) - 0.5
-    return Box.around(grid.cells_to_world(corners_rows, corners_cols))
-
-
-def _map_box(grid: OccupancyGrid) -> Box:
-    rows = np.array([0, 0, grid.height, grid.height]) - 0.5
-    cols = np.array([0, grid.width, 0, grid.width]) - 0.5
-    return Box.around(grid.cells_to_world(rows, cols))
-
-
-def area_of_interest(mission_points: np.ndarray, grid: OccupancyGrid | None) -> Box:
-    """What to show: the mission with a margin, plus the mapped area if it is not huge.
-
-    A small arena is shown whole (its walls give the mission context); on a large
-    map only the neighbourhood of the mission is shown.
+    The meaningful outcome of a waypoint is its worst visit that ran to an end: failed,
+    else skipped, else reached. A visit cut short by Ctrl-C or a signal is not a
+    failure of the waypoint: a patrol point reached 1806 times and interrupted once is
+    reached (drawn with an "interrupted here" ring), and a waypoint whose only visit
+    was interrupted is *interrupted*, not failed. Never visited: not run.
     """
-    box = Box.around(mission_points)
-    margin = max(0.5, 0.12 * max(box.width, box.height))
-    box = box.grown(margin)
-    if grid is not None:
-        known = _known_box(grid)
-        if known is not None and known.width * known.height <= 4.0 * box.width * box.height:
-            box = box.union(known.grown(2 * grid.resolution))
-        box = box.clipped(_map_box(grid)) if grid is not None else box
-    # Never a degenerate box (a single waypoint on a map that does not contain it).
-    if box.width <= 0 or box.height <= 0:
-        box = Box.around(mission_points).grown(1.0)
-    return box
+    worst = np.zeros(count, dtype=np.int8)
+    reached = np.zeros(count, dtype=np.int64)
+    ended = np.zeros(count, dtype=np.int64)
+    interrupted = np.zeros(count, dtype=bool)
+    for visit in result.visits:
+        index = visit.index
+        severity = _SEVERITY.get(visit.outcome, 0)  # 0: not run
+        if severity == 0 or not 0 <= index < count:
+            continue
+        if severity == 3 and _is_interruption(visit):
+            interrupted[index] = True
+            continue
+        ended[index] += 1
+        if severity == 1:
+            reached[index] += 1
+        if severity > worst[index]:
+            worst[index] = severity
+    if result.omitted_visits and result.waypoints:
+        # A long patrol lists only some visits in full; the per-waypoint totals count
+        # them all (an interruption is counted as failed there: at most one per run).
+        for totals in result.waypoints:
+            index = totals.index
+            if not 0 <= index < count:
+                continue
+            failures = totals.failed - int(interrupted[index])
+            reached[index] = totals.reached
+            ended[index] = totals.reached + totals.skipped + failures
+            severity = 3 if failures > 0 else 2 if totals.skipped else 1 if totals.reached else 0
+            worst[index] = max(int(worst[index]), severity)
+    code = {status: STATUSES.index(status) for status in Status}
+    status = np.select(
+        [worst == 3, worst == 2, worst == 1, interrupted],
+        [code[Status.FAILED], code[Status.SKIPPED], code[Status.REACHED], code[Status.INTERRUPTED]],
+        default=code[Status.NOT_RUN],
+    ).astype(np.int8)
+    return WaypointOutcomes(status, reached, ended, interrupted)
 
 
-def _draw_map(ax: Axes, grid: OccupancyGrid) -> None:
-    from matplotlib.transforms import Affine2D
-
-    extent = (
-        grid.origin.x,
-        grid.origin.x + grid.width * grid.resolution,
-        grid.origin.y,
-        grid.origin.y + grid.height * grid.resolution,
-    )
-    image = ax.imshow(
-        occupancy_rgb(grid.data),
-        origin="lower",  # row 0 of the grid is the bottom of the map
-        extent=extent,
-        interpolation="nearest",
-        zorder=0,
-    )
-    if grid.origin.yaw:
-        rotation = Affine2D().rotate_around(grid.origin.x, grid.origin.y, grid.origin.yaw)
-        image.set_transform(rotation + ax.transData)
-
-
-def _draw_pose_arrow(
-    ax: Axes, pose: Pose2D, length: float, colour: str, *, zorder: float, width: float
-) -> None:
-    from matplotlib.patches import FancyArrow
-
-    ax.add_patch(
-        FancyArrow(
-            pose.x,
-            pose.y,
-            length * math.cos(pose.yaw),
-            length * math.sin(pose.yaw),
-            width=width,
-            head_width=3.2 * width,
-            head_length=3.0 * width,
-            length_includes_head=True,
-            facecolor=colour,
-            edgecolor="black",
-            linewidth=0.6,
-            zorder=zorder,
-        )
-    )
-
-
-def _draw_trajectory(ax: Axes, trajectory: np.ndarray) -> LineCollection | None:
-    """Driven path coloured by mission time; returns the collection for a colour bar."""
-    from matplotlib.collections import LineCollection
-
-    if len(trajectory) < 2:
-        return None
-    points = trajectory[:, 1:3]
-    segments = np.stack([points[:-1], points[1:]], axis=1)
-    times = trajectory[:-1, 0]
-    # A NaN row is a break (between the segments of a resumed run): no line across it.
-    drawn = np.isfinite(segments).all(axis=(1, 2)) & np.isfinite(times)
-    if not drawn.any():
-        return None
-    lines = LineCollection(
-        segments[drawn], cmap="viridis", linewidths=2.4, capstyle="round", zorder=3
-    )
-    lines.set_array(times[drawn])
-    ax.add_collection(lines)
-    return lines
-
-
-def _title(mission: Mission, result: MissionResult, interrupted: str | None) -> str:
+def _title(
+    mission: Mission, result: MissionResult, outcomes: WaypointOutcomes, interrupted: str | None
+) -> str:
     name = printable(Path(mission.source).stem) if mission.source else "mission"
-    reached = sum(
-        1 for visit in result.visits if WaypointOutcome(visit.outcome) == WaypointOutcome.REACHED
-    )
+    visits = int(outcomes.ended.sum() + outcomes.interrupted.sum())
     verdict = (
         "success"
         if result.success
         else (f"interrupted ({interrupted})" if interrupted else result.reason)
     )
+    count = len(outcomes)
     return (
-        f"{name} — {verdict}\n"
-        f"{reached}/{len(result.visits)} visits reached · {result.duration:.1f} s · "
+        f"{name} — {printable(verdict)}\n"
+        f"{count:,} waypoint{'s' if count != 1 else ''} · "
+        f"{int(outcomes.reached.sum()):,}/{visits:,} visits reached · {result.duration:.1f} s · "
         f"{result.distance_driven:.1f} m driven"
     )
 
@@ -285,15 +216,10 @@ def mission_picture_png(
         robot=robot,
     )
     png = io.BytesIO()
-    # "tight" keeps the legend and axis labels that sit outside the axes.
-    fig.savefig(png, format="png", bbox_inches="tight", pad_inches=0.15)
+    # The layout is fixed (legend and colour bar in their own panel): no "tight"
+    # bounding box, which would draw the whole figure twice.
+    fig.savefig(png, format="png")
     return png.getvalue()
-
-
-def _placed_outline(robot: RobotProfile, pose: Pose2D) -> list[tuple[float, float]]:
-    """The robot's footprint polygon at ``pose``, world coordinates."""
-    c, s = math.cos(pose.yaw), math.sin(pose.yaw)
-    return [(pose.x + c * x - s * y, pose.y + s * x + c * y) for x, y in robot.footprint]
 
 
 def mission_figure(
@@ -315,196 +241,68 @@ def mission_figure(
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Circle
 
-    waypoints = mission.waypoints
+    count = len(mission.waypoints)
+    positions = np.array([(w.x, w.y) for w in mission.waypoints], dtype=float).reshape(-1, 2)
+    yaws = np.array([w.yaw_rad for w in mission.waypoints], dtype=float)
     traj = np.asarray(trajectory, dtype=float).reshape(-1, 3)
     plan_arrays = [np.asarray(p, dtype=float).reshape(-1, 2) for p in plans if len(p) > 1]
     driven = traj[np.isfinite(traj).all(axis=1), 1:3]
-    point_sets = [np.array([[w.x, w.y] for w in waypoints]).reshape(-1, 2), driven]
-    point_sets += plan_arrays
+    point_sets = [positions, driven, *plan_arrays]
     if start is not None:
         point_sets.append(np.array([[start.x, start.y]]))
     all_points = np.concatenate([p for p in point_sets if len(p)] or [np.zeros((1, 2))])
-    box = area_of_interest(all_points, grid)
+    layout = make_layout(area_of_interest(all_points, grid, positions if count else None), dpi)
+    view = layout.view
 
-    # Size the figure to the box so the map fills it; the colour bar takes a strip.
-    aspect = box.height / box.width
-    fig_width = 9.0
-    fig = Figure(figsize=(fig_width, min(max(fig_width * aspect * 0.92, 4.0), 12.0)), dpi=dpi)
+    fig = Figure(figsize=layout.size, dpi=dpi)
     FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+    ax = fig.add_axes(layout.fraction(layout.axes))
     ax.set_facecolor("white")
-    if grid is not None:
-        _draw_map(ax, grid)
-
-    scale = max(box.width, box.height)
-    arrow_length = 0.055 * scale
-    arrow_width = 0.0045 * scale
-
-    for plan in plan_arrays:
-        ax.plot(
-            plan[:, 0],
-            plan[:, 1],
-            linestyle=(0, (4, 3)),
-            linewidth=1.0,
-            color=PLAN_COLOUR,
-            alpha=0.85,
-            zorder=2,
-        )
-    lines = _draw_trajectory(ax, traj)
-
-    outcomes = waypoint_outcomes(result, len(waypoints))
-    last = len(waypoints) - 1
-    drew_radius = False
-    for index, (waypoint, outcome) in enumerate(zip(waypoints, outcomes, strict=True)):
-        colour = OUTCOME_COLOURS[outcome]
-        radius = mission.policy_for(index).pass_through_m
-        if radius and index != last and mission.policy_for(index).dwell_s == 0:
-            ax.add_patch(
-                Circle(
-                    (waypoint.x, waypoint.y),
-                    radius,
-                    fill=False,
-                    edgecolor=colour,
-                    linestyle=(0, (2, 2)),
-                    linewidth=1.0,
-                    zorder=4,
-                )
-            )
-            drew_radius = True
-        _draw_pose_arrow(ax, waypoint.pose, arrow_length, colour, zorder=5, width=arrow_width)
-        ax.plot(
-            waypoint.x,
-            waypoint.y,
-            marker="o",
-            markersize=15,
-            color=colour,
-            markeredgecolor="black",
-            markeredgewidth=0.8,
-            zorder=6,
-        )
-        ax.text(
-            waypoint.x,
-            waypoint.y,
-            str(index + 1),
-            ha="center",
-            va="center",
-            fontsize=7.5,
-            fontweight="bold",
-            color="white",
-            zorder=7,
-        )
-        if waypoint.name:
-            ax.annotate(
-                printable(waypoint.name),
-                (waypoint.x, waypoint.y),
-                xytext=(9, -12),
-                textcoords="offset points",
-                fontsize=7,
-                color="#222222",
-                zorder=7,
-                bbox={
-                    "boxstyle": "round,pad=0.15",
-                    "facecolor": "white",
-                    "edgecolor": "none",
-                    "alpha": 0.75,
-                },
-            )
-
-    if start is not None and robot is not None:
-        from matplotlib.patches import Polygon
-
-        outline = _placed_outline(robot, start)
-        ax.add_patch(
-            Polygon(outline, closed=True, fill=False, edgecolor="black", linewidth=0.9, zorder=6.5)
-        )
-    if start is not None:
-        # Under the waypoint markers and a little larger, so that a waypoint at the
-        # start pose (a tour that returns home) stays visible with the square around it.
-        _draw_pose_arrow(ax, start, arrow_length, START_COLOUR, zorder=4.5, width=arrow_width)
-        ax.plot(
-            start.x,
-            start.y,
-            marker="s",
-            markersize=17,
-            color=START_COLOUR,
-            markeredgecolor="black",
-            markeredgewidth=0.8,
-            zorder=5.5,
-        )
-
-    handles = [
-        Line2D(
-            [],
-            [],
-            marker="o",
-            linestyle="none",
-            markersize=9,
-            color=OUTCOME_COLOURS[o],
-            markeredgecolor="black",
-            label=OUTCOME_LABELS[o],
-        )
-        for o in WaypointOutcome
-        if o in outcomes or o == WaypointOutcome.REACHED
-    ]
-    if start is not None:
-        handles.append(
-            Line2D(
-                [],
-                [],
-                marker="s",
-                linestyle="none",
-                markersize=8,
-                color=START_COLOUR,
-                markeredgecolor="black",
-                label="start",
-            )
-        )
-    if start is not None and robot is not None:
-        handles.append(Line2D([], [], color="black", linewidth=0.9, label=f"{robot.name} outline"))
-    if plan_arrays:
-        handles.append(
-            Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR, label="planned path")
-        )
-    if drew_radius:
-        handles.append(
-            Line2D(
-                [],
-                [],
-                marker="o",
-                markersize=11,
-                fillstyle="none",
-                linestyle="none",
-                markeredgecolor="#555555",
-                label="pass-through radius",
-            )
-        )
-    if lines is not None:
-        handles.append(Line2D([], [], linewidth=2.4, color="#21918c", label="driven path"))
-    ax.legend(
-        handles=handles,
-        loc="upper left",
-        bbox_to_anchor=(1.02, 1.0),
-        borderaxespad=0.0,
-        fontsize=8,
-        frameon=False,
-    )
-    if lines is not None:
-        bar = fig.colorbar(
-            lines, ax=ax, location="right", fraction=0.035, pad=0.02, anchor=(0.0, 0.0), shrink=0.55
-        )
-        bar.set_label("mission time [s]", fontsize=8)
-        bar.ax.tick_params(labelsize=7)
-
-    ax.set_xlim(box.xmin, box.xmax)
-    ax.set_ylim(box.ymin, box.ymax)
+    ax.set_xlim(view.xmin, view.xmax)
+    ax.set_ylim(view.ymin, view.ymax)
     ax.set_aspect("equal")
+    if grid is not None:
+        draw_map(ax, grid, layout)
+    outcomes = waypoint_outcomes(result, count)
+    markers = group_markers(positions, outcomes, layout, dpi) if count else None
+    crowded = markers is not None and not markers.numbered
+    drew_plans = draw_plans(ax, plan_arrays, layout)
+    # Thinner among a crowd of dots, so that the dots stay visible.
+    lines = draw_trajectory(ax, traj, layout, width=1.2 if crowded else 2.4)
+    drew_radius = False
+    labels = 0
+    if markers is not None:
+        draw_markers(ax, markers, outcomes, positions, layout)
+        if markers.numbered:
+            drew_radius = draw_numbered_details(ax, mission, markers, positions, yaws, layout)
+    arrow_length = 1.8 * DISC / 72.0 * dpi / layout.scale
+    obstacles = np.zeros((0, 4))
+    if start is not None:
+        draw_start(ax, start, robot, arrow_length)
+        start_px = layout.to_pixels(np.array([[start.x, start.y]]))
+        obstacles = square(start_px, 0.5 * (DISC + 2) / 72.0 * dpi)
+    if markers is not None:
+        labels = place_labels(
+            ax, fig, mission, markers, outcomes, positions, layout, obstacles, yaws
+        )
+
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.tick_params(labelsize=8)
     ax.grid(True, color="#9aa5b1", linewidth=0.4, alpha=0.5, zorder=1)
     ax.set_axisbelow(False)
-    ax.set_title(_title(mission, result, interrupted), fontsize=10, loc="left")
+    ax.set_title(_title(mission, result, outcomes, interrupted), fontsize=10, loc="left")
+    side_panel(
+        fig,
+        layout,
+        outcomes,
+        markers,
+        labels=labels,
+        start=start,
+        robot=robot,
+        drew_plans=drew_plans,
+        drew_radius=drew_radius,
+        lines=lines,
+    )
     return fig

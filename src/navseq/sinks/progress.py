@@ -69,6 +69,14 @@ def _plural(count: int, word: str) -> str:
     return f"{count} {word}{'' if count == 1 else 's'}"
 
 
+def recoveries_text(recoveries: int | None) -> str:
+    """``, 2 recoveries`` once the navigation stack ran recovery behaviours for the goal
+    (spins, backing up, costmap clearing: a sign the robot is struggling); else nothing."""
+    if not recoveries:
+        return ""
+    return f", {recoveries} recover{'y' if recoveries == 1 else 'ies'}"
+
+
 def _why(reason: str, text: str) -> str:
     """navseq's reason with the navigation stack's own words after it, when it gave any."""
     reason, text = printable(reason), printable(text.strip())
@@ -102,6 +110,7 @@ class RunView:
         self.status = "starting"
         self.distance_remaining: float | None = None
         self.distance_driven = 0.0
+        self.recoveries: int | None = None  # the stack's count for the current goal
         self.loop_outcomes: dict[int, WaypointOutcome] = {}
         self.totals: dict[WaypointOutcome, int] = dict.fromkeys(WaypointOutcome, 0)
         self.finished: MissionFinished | None = None
@@ -138,12 +147,14 @@ class RunView:
         elif isinstance(event, WaypointStarted):
             self.loop, self.index, self.attempt = event.loop, event.index, event.attempt
             self.distance_remaining = None
+            self.recoveries = None
             self.distance_driven = 0.0 if event.attempt == 1 else self.distance_driven
             self.status = "driving" if event.attempt == 1 else f"driving (attempt {event.attempt})"
         elif isinstance(event, WaypointProgress):
             self.index = event.index
             self.distance_remaining = event.distance_remaining
             self.distance_driven = event.distance_driven
+            self.recoveries = event.recoveries
         elif isinstance(event, AttemptFailed):
             then = "will retry" if event.will_retry else "giving up"
             why = _why(event.reason, event.text)
@@ -252,7 +263,7 @@ class LiveProgress:
                     ProgressBar(total=total, completed=view.distance_driven, width=40),
                     Text(
                         f"{remaining:6.2f} m to go ({eta_text(remaining, self.robot)}), "
-                        f"{view.distance_driven:6.2f} m driven"
+                        f"{view.distance_driven:6.2f} m driven{recoveries_text(view.recoveries)}"
                     ),
                 )
                 rows.append(bar)
@@ -434,7 +445,7 @@ class LogProgress:
                 )
                 self._log(
                     f"{view.waypoint_label(event.index)}: {to_go}"
-                    f"{event.distance_driven:.2f} m driven",
+                    f"{event.distance_driven:.2f} m driven{recoveries_text(event.recoveries)}",
                     event,
                 )
             return

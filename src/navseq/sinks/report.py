@@ -1,12 +1,12 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 4; the unit is in every field's name where there is one:
+Schema (``schema_version`` 5; the unit is in every field's name where there is one:
 ``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
 mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
 ``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
-      "schema_version": 4,
+      "schema_version": 5,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
@@ -21,10 +21,13 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
       "interrupted": "SIGINT" | "SIGTERM" | null,
       "exit_code": 0 | 1 | 130 | 143,
       "totals": {"visits", "reached", "skipped", "failed", "not_run",
-                 "duration_s", "distance_m", "loops_completed"},
+                 "duration_s", "distance_m", "loops_completed"},   # over ALL visits
+      "waypoints": [{"index", "number", "name", "visits", "reached", "skipped",
+                     "failed", "not_run", "attempts", "duration_s", "distance_m"}],
+      "visits_listed": {"listed", "omitted", "kept"},
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
                   "attempts": [{"number", "reached", "status", "reason", "text",
-                                "duration_s", "distance_m"}],
+                                "duration_s", "distance_m", "recoveries"}],
                   "duration_s", "distance_m", "reason", "passed_through"}],
       "files": {"journal", "picture", ...},
       "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
@@ -41,10 +44,21 @@ Each attempt is one goal sent: ``status`` is the navigation stack's terminal sta
 (SUCCEEDED, ABORTED, ...; null when navseq ended the attempt: timeout, stalled,
 interrupt), ``reason`` navseq's verdict (empty for the attempt that reached the
 waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but the
-robot was not there), ``text`` the stack's own result text. Version 1 had
+robot was not there), ``text`` the stack's own result text, ``recoveries`` the
+recovery behaviours the stack ran for the goal (Nav2's count; null from stacks that
+do not count them; version 4 added it). Version 1 had
 ``attempts`` as a count: it is the length of the list now. Version 2 had the map's
 ``resolution``, ``width``, ``height`` and an ``origin`` list with its yaw in radians.
-Version 3 had no ``clock`` (how fast the navigator's clock ran, see
+
+A patrol that loops for days, or a mission of 100 000 waypoints, makes more visits
+than a report can list: ``visits`` lists a small finite mission's every visit, else
+the last 1000 visits and up to 1000 earlier visits that were not reached (see
+:class:`~navseq.executor.result.VisitLog`); ``visits_listed`` says how many are
+listed, how many omitted and what was kept. ``totals`` and ``waypoints`` (one entry
+per mission waypoint, its visits over every loop: counts, summed time and distance)
+count every visit. Versions 2 and 3 had neither ``waypoints`` nor
+``visits_listed`` and listed every visit; readers of reports (``navseq report``) accept both.
+Version 4 had no ``clock`` (how fast the navigator's clock ran, see
 :func:`navseq.sinks.json_events.clock_record`).
 """
 
@@ -53,14 +67,20 @@ from __future__ import annotations
 import datetime
 import json
 import math
-from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq import __version__
 from navseq.executor.events import WaypointOutcome
-from navseq.executor.result import AttemptResult, MissionResult, WaypointResult
+from navseq.executor.result import (
+    KEEP_LAST_VISITS,
+    KEEP_NOT_REACHED_VISITS,
+    AttemptResult,
+    MissionResult,
+    WaypointResult,
+    WaypointTotals,
+)
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
@@ -68,7 +88,12 @@ from navseq.mission.model import Mission
 if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
 
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
+#: What ``visits_listed.kept`` says when a run made more visits than the report lists.
+KEPT_VISITS = (
+    f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
+    "visits not reached; totals and waypoints count every visit"
+)
 #: ``start_source`` when the report's start is the robot's own first pose.
 START_FROM_ROBOT = "robot"
 
@@ -105,6 +130,7 @@ def _attempt_dict(attempt: AttemptResult) -> dict[str, Any]:
         "text": attempt.text,
         "duration_s": _rounded(attempt.duration, 2),
         "distance_m": _rounded(attempt.distance_driven),
+        "recoveries": attempt.recoveries,
     }
 
 
@@ -124,6 +150,35 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "reason": visit.reason,
         "passed_through": visit.passed_through,
     }
+
+
+def _totals_dict(totals: WaypointTotals) -> dict[str, Any]:
+    return {
+        "index": totals.index,
+        "number": totals.index + 1,
+        "name": totals.name,
+        "visits": totals.visits,
+        "reached": totals.reached,
+        "skipped": totals.skipped,
+        "failed": totals.failed,
+        "not_run": totals.not_run,
+        "attempts": totals.attempts,
+        "duration_s": _rounded(totals.duration, 2),
+        "distance_m": _rounded(totals.distance_driven),
+    }
+
+
+def _waypoint_totals(mission: Mission, result: MissionResult) -> list[WaypointTotals]:
+    """The result's per-waypoint totals; counted from ``visits`` for a result without."""
+    if result.waypoints:
+        return result.waypoints
+    totals = [
+        WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(mission.waypoints)
+    ]
+    for visit in result.visits:
+        if 0 <= visit.index < len(totals):
+            totals[visit.index].add(visit)
+    return totals
 
 
 def build_report(
@@ -151,7 +206,8 @@ def build_report(
         actual, actual_source = result.start_pose, START_FROM_ROBOT
     else:
         actual, actual_source = start, start_source if start is not None else None
-    counts = Counter(WaypointOutcome(visit.outcome).value for visit in result.visits)
+    counts = result.outcome_counts()
+    omitted = result.omitted_visits
     return {
         "schema_version": SCHEMA_VERSION,
         "navseq_version": __version__,
@@ -174,11 +230,17 @@ def build_report(
         "interrupted": interrupted,
         "exit_code": exit_code,
         "totals": {
-            "visits": len(result.visits),
-            **{outcome.value: counts.get(outcome.value, 0) for outcome in WaypointOutcome},
+            "visits": result.total_visits,
+            **{outcome.value: counts.get(outcome, 0) for outcome in WaypointOutcome},
             "duration_s": _rounded(result.duration, 2),
             "distance_m": _rounded(result.distance_driven),
             "loops_completed": result.loops_completed,
+        },
+        "waypoints": [_totals_dict(t) for t in _waypoint_totals(mission, result)],
+        "visits_listed": {
+            "listed": len(result.visits),
+            "omitted": omitted,
+            "kept": KEPT_VISITS if omitted else "every visit",
         },
         "visits": [_visit_dict(visit) for visit in result.visits],
         "files": dict(files or {}),

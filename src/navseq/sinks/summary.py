@@ -143,6 +143,18 @@ def waypoint_stats(mission: Mission, result: MissionResult) -> list[WaypointStat
             stats[visit.index].add_visit(visit)
             if visit.name is not None:  # the name the run knew it by
                 stats[visit.index].name = visit.name
+    if result.omitted_visits and result.waypoints:
+        # A long patrol lists only some visits in full: the counts come from the
+        # per-waypoint totals, which count every visit; reasons from the listed ones.
+        for totals in result.waypoints:
+            if 0 <= totals.index < len(stats):
+                row = stats[totals.index]
+                listed_reached = row.reached
+                row.reached, row.skipped, row.failed = totals.reached, totals.skipped, totals.failed
+                row.not_run, row.attempts = totals.not_run, totals.attempts
+                row.duration, row.distance = totals.duration, totals.distance_driven
+                if listed_reached:  # pass-throughs in the same share as among listed visits
+                    row.passed_through = round(row.passed_through * row.reached / listed_reached)
     return stats
 
 

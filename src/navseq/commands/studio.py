@@ -1,0 +1,112 @@
+"""``navseq studio [MISSION] [--map MAP]``: make, check and run missions in the browser.
+
+Serves the studio (``navseq.studio``) on 127.0.0.1 with a fresh token, prints
+``navseq studio: http://127.0.0.1:PORT/?token=...`` as the first line on stdout and
+opens the browser (unless ``--no-browser``). The page may read and write files only
+under the mission's and the map's folders, or ``--root``. Ctrl-C stops it; a running
+simulation is cancelled first and its report written. See docs/studio.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "mission",
+        type=Path,
+        nargs="?",
+        metavar="MISSION",
+        help="mission file to open (navseq YAML, launch, rosparam YAML, CSV); a new file "
+        "is created on the first save if it does not exist",
+    )
+    parser.add_argument(
+        "--map",
+        type=Path,
+        metavar="MAP",
+        help="map_server YAML to edit on (default: the mission's map:)",
+    )
+    parser.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default: 127.0.0.1)"
+    )
+    parser.add_argument(
+        "--port", type=int, default=0, help="port to listen on (default: 0, a free one)"
+    )
+    parser.add_argument(
+        "--no-browser", action="store_true", help="print the URL only; do not open a browser"
+    )
+    parser.add_argument(
+        "--root",
+        type=Path,
+        metavar="DIR",
+        help="the only folder the studio may read and write files under "
+        "(default: the mission's and the map's folders)",
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    import secrets
+
+    from navseq.commands.common import require_file
+    from navseq.errors import NavseqError
+    from navseq.studio.app import StudioConfig
+    from navseq.studio.security import FileRoots
+    from navseq.studio.server import serve
+
+    mission: Path | None = args.mission
+    if mission is not None and mission.exists():
+        require_file(mission, "MISSION")
+    elif mission is not None and mission.suffix.lower() not in (".yaml", ".yml"):
+        raise NavseqError(
+            "does not exist; a new mission is saved as navseq YAML (.yaml)", source=str(mission)
+        )
+    if mission is not None and not mission.exists() and not mission.parent.is_dir():
+        raise NavseqError(f"the folder {mission.parent} does not exist", source=str(mission))
+    if args.map is not None:
+        require_file(args.map, "--map")
+    if not 0 <= args.port <= 65535:
+        raise NavseqError("must be between 0 and 65535", source="--port")
+    base = (mission.parent if mission is not None else Path.cwd()).resolve()
+    if args.root is not None:
+        if not args.root.is_dir():
+            raise NavseqError("is not a folder", source=f"--root {args.root}")
+        folders = [args.root]
+    else:
+        folders = [base]
+        if args.map is not None:
+            folders.append(args.map.resolve().parent)
+        elif mission is not None and mission.exists():
+            map_folder = _mission_map_folder(mission)
+            if map_folder is not None:
+                folders.append(map_folder)
+    roots = FileRoots(folders, base)
+    map_path = None
+    if args.map is not None:
+        map_path = roots.resolve(str(args.map.resolve()), "--map")
+    if mission is not None:
+        roots.resolve(str(mission.resolve()), "MISSION")  # refused outside --root
+    config = StudioConfig(
+        token=secrets.token_urlsafe(24),
+        roots=roots,
+        mission_path=mission.resolve() if mission is not None else None,
+        map_path=map_path,
+    )
+    return serve(config, args.host, args.port, open_browser=not args.no_browser)
+
+
+def _mission_map_folder(mission: Path) -> Path | None:
+    """The folder of the map the mission names (its ``map:``), if it reads."""
+    from navseq.errors import NavseqError
+    from navseq.mission import inspect_mission_file
+
+    try:
+        loaded, problems = inspect_mission_file(mission)
+    except NavseqError:
+        return None
+    if loaded is None and problems.salvage is not None:
+        loaded = problems.salvage.mission
+    if loaded is None or loaded.map is None:
+        return None
+    return Path(loaded.map).resolve().parent

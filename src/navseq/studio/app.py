@@ -1,0 +1,506 @@
+"""The studio's HTTP API (documented in docs/studio.md) and its static page.
+
+Every handler translates JSON to a call of navseq's core and back: the mission loader
+and writer, ``navseq validate``'s :func:`~navseq.commands.validate.mission_file_problems`,
+the planner, ``navseq run``'s setup and outputs. Bad input of any kind — bad JSON, a
+body too big, a mission with problems, a path outside the studio's folders — is a
+4xx answer carrying the same messages as the CLI; the server keeps serving.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import math
+import threading
+from collections.abc import AsyncIterator, Awaitable, Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
+from starlette.routing import Mount, Route
+from starlette.staticfiles import StaticFiles
+from starlette.types import ASGIApp, Receive, Scope, Send
+
+from navseq.errors import NavseqError
+from navseq.studio.documents import (
+    UNITS,
+    DraftRefused,
+    LegPlanner,
+    check_draft,
+    empty_document,
+    legs_of,
+    open_document,
+    problems_of,
+    route_summary,
+    version_of,
+)
+from navseq.studio.mapview import MapView
+from navseq.studio.security import COOKIE_NAME, TOKEN_HEADER, FileRoots, token_matches
+from navseq.text import printable
+
+if TYPE_CHECKING:
+    from navseq.mission.robot import RobotProfile
+    from navseq.studio.runs import StudioRun
+
+STATIC = Path(__file__).parent / "static"
+#: Largest request body taken (a mission of several thousand waypoints fits).
+MAX_BODY_BYTES = 2_000_000
+#: How often the live view is sent while a run goes on (s): at most 20 updates/s.
+LIVE_PERIOD_S = 0.05
+#: Pace choices the page offers: None is as fast as the CPU goes.
+MAX_REALTIME = 1000.0
+
+
+@dataclass
+class StudioConfig:
+    """What ``navseq studio`` was started with."""
+
+    token: str
+    roots: FileRoots
+    mission_path: Path | None = None  # the mission file opened (may not exist yet)
+    map_path: Path | None = None  # --map
+    out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
+
+
+class ApiError(Exception):
+    """An answer other than 200, with the JSON to send."""
+
+    def __init__(self, status: int, message: str, **extra: Any) -> None:
+        super().__init__(message)
+        self.status = status
+        self.body = {"error": message, **extra}
+
+
+class Studio:
+    """The studio's state: the opened mission, loaded maps, the run."""
+
+    def __init__(self, config: StudioConfig) -> None:
+        self.config = config
+        self.roots = config.roots
+        self._maps: dict[Path, tuple[int, MapView]] = {}
+        self._planners: dict[tuple[Path, RobotProfile], LegPlanner] = {}
+        self._lock = threading.Lock()
+        self._save_lock = threading.Lock()
+        self.robot: RobotProfile | None = None  # the last checked draft's robot
+        self.run: StudioRun | None = None
+
+    # -- where things are --------------------------------------------------------------
+
+    @property
+    def base_dir(self) -> Path:
+        """The mission's folder: relative paths in the mission start there."""
+        return self.roots.base
+
+    @property
+    def shown_name(self) -> str:
+        path = self.config.mission_path
+        return printable(path.name) if path is not None else "new mission"
+
+    def map_view(self, path: Path) -> MapView:
+        """The map at ``path`` (checked against the roots by the caller), reloaded if changed."""
+        stamp = path.stat().st_mtime_ns
+        with self._lock:
+            cached = self._maps.get(path)
+            if cached is not None and cached[0] == stamp:
+                return cached[1]
+        view = MapView.load(path)
+        with self._lock:
+            self._maps[path] = (stamp, view)
+        return view
+
+    def planner(self, map_path: Path, robot: RobotProfile) -> LegPlanner:
+        view = self.map_view(map_path)
+        with self._lock:
+            planner = self._planners.get((map_path, robot))
+            if planner is None or planner.costmap.grid is not view.grid:
+                planner = LegPlanner(view.costmap(robot))
+                self._planners[(map_path, robot)] = planner
+            return planner
+
+    # -- the API's work (run in a worker thread) ---------------------------------------
+
+    def mission(self) -> dict[str, Any]:
+        path = self.config.mission_path
+        map_text = (
+            self.roots.relative(self.config.map_path) if self.config.map_path is not None else None
+        )
+        if path is None or not path.exists():
+            return {
+                "name": self.shown_name,
+                "path": self.roots.relative(path) if path is not None else None,
+                "exists": False,
+                "version": None,
+                "units": UNITS,
+                "mission": empty_document(map_text),
+                "problems": [],
+            }
+        document, errors = open_document(path, self.base_dir)
+        if document is None:
+            raise ApiError(
+                422,
+                f"{self.shown_name} cannot be opened",
+                problems=[problem.as_json() for problem in problems_of(errors)],
+            )
+        if map_text is not None:
+            document["map"] = map_text  # --map wins, as for navseq validate --map
+        return {
+            "name": self.shown_name,
+            "path": self.roots.relative(path),
+            "exists": True,
+            "version": version_of(path),
+            "units": UNITS,
+            "mission": document,
+            "problems": [problem.as_json() for problem in problems_of(errors)],
+        }
+
+    def map_info(self, map_text: str | None) -> dict[str, Any]:
+        path = self._map_path(map_text)
+        view = self.map_view(path)
+        return {"map": self.roots.relative(path), **view.info()}
+
+    def map_image(self, map_text: str | None, layer: str) -> bytes:
+        from navseq.mission.robot import DEFAULT_PROFILE
+
+        if layer not in ("map", "costmap"):
+            raise ApiError(400, f"unknown layer {printable(layer)!r}; map or costmap")
+        view = self.map_view(self._map_path(map_text))
+        return view.image(layer, self.robot or DEFAULT_PROFILE)
+
+    def _map_path(self, map_text: str | None) -> Path:
+        if map_text:
+            path = self.roots.resolve(map_text, "map")
+        elif self.config.map_path is not None:
+            path = self.config.map_path
+        else:
+            raise ApiError(404, "no map: give the mission a map: or start the studio with --map")
+        if not path.is_file():
+            raise ApiError(404, f"no such map file: {printable(self.roots.relative(path))}")
+        return path
+
+    def check(self, document: Any) -> dict[str, Any]:
+        from navseq.commands.common import choose_robot
+
+        checked = check_draft(
+            document, roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+        )
+        answer: dict[str, Any] = {
+            "problems": [problem.as_json() for problem in checked.problems],
+            "readable": checked.mission is not None,
+            "legs": [],
+            "total_length_m": None,
+            "estimated_duration": "",
+        }
+        mission = checked.mission
+        if mission is None:
+            return answer
+        robot = choose_robot(None, mission)
+        self.robot = robot
+        answer["robot"] = robot.name
+        if checked.map_path is not None and checked.map_path.is_file():
+            try:
+                planner = self.planner(checked.map_path, robot)
+            except NavseqError:
+                return answer  # the map's own problem is in the list already
+            legs = legs_of(mission, planner)
+            answer["legs"] = legs
+            answer.update(route_summary(legs, robot))
+        return answer
+
+    def save(self, body: dict[str, Any]) -> dict[str, Any]:
+        from navseq.mission.writer import write_mission
+
+        document = body.get("mission")
+        path_text = body.get("path")
+        if path_text is None and self.config.mission_path is not None:
+            target = self.config.mission_path
+        else:
+            if not isinstance(path_text, str):
+                raise ApiError(400, "path: give the mission file's name (e.g. mission.yaml)")
+            target = self.roots.resolve(path_text, "path")
+        if target.suffix.lower() not in (".yaml", ".yml"):
+            raise ApiError(422, "path: a navseq mission is saved as .yaml or .yml")
+        if isinstance(document, dict) and document.get("robot") is not None:
+            raise ApiError(
+                422,
+                "this mission has a robot: section, which the mission writer does not write "
+                "yet; edit that file by hand so that nothing is lost",
+            )
+        checked = check_draft(
+            document, roots=self.roots, base_dir=target.parent, shown_as=printable(target.name)
+        )
+        if checked.mission is None:
+            raise ApiError(
+                422,
+                "the mission has problems that stop it being read; fix them before saving",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        overwrite = body.get("overwrite") is True
+        expected = body.get("version")
+        with self._save_lock:
+            exists = target.exists()
+            if exists:
+                if not target.is_file():
+                    raise ApiError(409, f"{printable(target.name)} is not a regular file")
+                current = version_of(target)
+                if isinstance(expected, dict) and expected.get("sha256") != current["sha256"]:
+                    raise ApiError(
+                        409,
+                        f"{printable(target.name)} changed on disk since it was opened (another "
+                        "tab or program saved it); nothing was written. Reload it, or save "
+                        "under another name",
+                        conflict="changed",
+                        version=current,
+                    )
+                if not overwrite:
+                    raise ApiError(
+                        409,
+                        f"{printable(target.name)} exists; confirm to replace it",
+                        conflict="exists",
+                        version=current,
+                    )
+            write_mission(checked.mission, target, overwrite=exists)
+            version = version_of(target)
+        return {
+            "path": self.roots.relative(target),
+            "version": version,
+            "problems": [problem.as_json() for problem in checked.problems],
+        }
+
+    def start_run(self, body: dict[str, Any]) -> dict[str, Any]:
+        from navseq.studio.runs import RunRequest, StudioRun
+
+        realtime = body.get("realtime")
+        if realtime is not None and not (
+            isinstance(realtime, int | float)
+            and not isinstance(realtime, bool)
+            and math.isfinite(realtime)
+            and 0 < realtime <= MAX_REALTIME
+        ):
+            raise ApiError(
+                400, f"realtime: a factor above 0 and up to {MAX_REALTIME:g}, or null (fastest)"
+            )
+        with self._lock:
+            if self.run is not None and self.run.alive:
+                raise ApiError(409, "a run is going on; stop it first")
+        checked = check_draft(
+            body.get("mission"), roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+        )
+        if checked.problems:
+            # navseq run refuses them too (pre-flight); said here against the draft.
+            raise ApiError(
+                422,
+                "the mission has problems; navseq run would not start it",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        assert checked.mission is not None
+        stem = self.config.mission_path.stem if self.config.mission_path else "mission"
+        run = StudioRun(
+            RunRequest(checked.mission, stem, None if realtime is None else float(realtime)),
+            self.config.out_base,
+        )
+        run.start()  # NavseqError (pre-flight problems) -> 422 with them
+        with self._lock:
+            self.run = run
+        return {"folder": run.view.folder, "status": run.view.status}
+
+    def current_run(self) -> StudioRun:
+        if self.run is None:
+            raise ApiError(404, "no run yet")
+        return self.run
+
+    def close(self, reason: str = "the studio was stopped") -> None:
+        """Cancel a running simulation and wait until its outputs are written."""
+        run = self.run
+        if run is not None:
+            run.stop_and_wait(reason)
+
+
+# --- HTTP ------------------------------------------------------------------------------
+
+
+class TokenGate:
+    """ASGI middleware: every request must carry the token (query, header or cookie).
+
+    State-changing requests from another origin are refused too, so that a page from
+    elsewhere that somehow got the cookie sent cannot drive the studio.
+    """
+
+    def __init__(self, app: ASGIApp, token: str) -> None:
+        self.app = app
+        self.token = token
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        request = Request(scope)
+        given = (
+            request.query_params.get("token")
+            or request.headers.get(TOKEN_HEADER)
+            or request.cookies.get(COOKIE_NAME)
+        )
+        if not token_matches(given, self.token):
+            response: Response = JSONResponse(
+                {"error": "this navseq studio needs its token: open the URL it printed at start"},
+                status_code=403,
+            )
+            await response(scope, receive, send)
+            return
+        origin = request.headers.get("origin")
+        if request.method not in ("GET", "HEAD") and origin is not None:
+            host = request.headers.get("host", "")
+            if origin.split("://", 1)[-1] != host:
+                response = JSONResponse({"error": "cross-origin request refused"}, 403)
+                await response(scope, receive, send)
+                return
+        await self.app(scope, receive, send)
+
+
+async def read_json(request: Request, limit: int = MAX_BODY_BYTES) -> dict[str, Any]:
+    """The request's JSON object; 413 past ``limit`` bytes, 400 for anything not JSON."""
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise ApiError(413, f"the request body is over the limit of {limit} bytes")
+    chunks: list[bytes] = []
+    size = 0
+    async for chunk in request.stream():
+        size += len(chunk)
+        if size > limit:
+            raise ApiError(413, f"the request body is over the limit of {limit} bytes")
+        chunks.append(chunk)
+    try:
+        body = json.loads(b"".join(chunks).decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ApiError(400, "the request body is not UTF-8 text") from None
+    except (ValueError, RecursionError) as error:
+        raise ApiError(400, f"the request body is not valid JSON: {error}") from None
+    if not isinstance(body, dict):
+        raise ApiError(400, "the request body must be a JSON object")
+    return body
+
+
+Handler = Callable[[Request], Awaitable[Response]]
+
+
+def api(handler: Handler) -> Handler:
+    """Turn the studio's errors into 4xx JSON answers (never a traceback to the page)."""
+
+    async def wrapped(request: Request) -> Response:
+        try:
+            response = await handler(request)
+        except ApiError as error:
+            response = JSONResponse(error.body, status_code=error.status)
+        except DraftRefused as error:
+            response = JSONResponse({"error": str(error)}, status_code=400)
+        except NavseqError as error:
+            problems = problems_of([error])
+            response = JSONResponse(
+                {"error": str(error), "problems": [problem.as_json() for problem in problems]},
+                status_code=422,
+            )
+        response.headers["cache-control"] = "no-store"
+        return response
+
+    return wrapped
+
+
+def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
+    """The studio as an ASGI app (``TestClient(create_app(...))`` in tests)."""
+    studio = studio if studio is not None else Studio(config)
+
+    async def index(request: Request) -> Response:
+        response = FileResponse(STATIC / "index.html", headers={"cache-control": "no-store"})
+        token = request.query_params.get("token")
+        if token is not None and token_matches(token, config.token):
+            response.set_cookie(COOKIE_NAME, token, httponly=True, samesite="strict")
+        return response
+
+    @api
+    async def get_mission(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(studio.mission))
+
+    @api
+    async def get_map(request: Request) -> Response:
+        return JSONResponse(
+            await run_in_threadpool(studio.map_info, request.query_params.get("map"))
+        )
+
+    @api
+    async def get_map_image(request: Request) -> Response:
+        png = await run_in_threadpool(
+            studio.map_image,
+            request.query_params.get("map"),
+            request.query_params.get("layer", "map"),
+        )
+        return Response(png, media_type="image/png")
+
+    @api
+    async def post_check(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.check, body.get("mission")))
+
+    @api
+    async def post_save(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.save, body))
+
+    @api
+    async def post_run(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.start_run, body))
+
+    @api
+    async def get_run(request: Request) -> Response:
+        return JSONResponse(studio.current_run().view.snapshot())
+
+    @api
+    async def run_request(request: Request) -> Response:
+        kind = {"stop": "cancel", "pause": "pause", "resume": "resume", "skip": "skip"}.get(
+            request.path_params["action"]
+        )
+        if kind is None:
+            raise ApiError(404, "unknown run action; stop, pause, resume or skip")
+        run = studio.current_run()
+        reason = "stopped from the studio" if kind == "cancel" else f"{kind} from the studio"
+        ok, message = await run_in_threadpool(run.operate, kind, reason)
+        return JSONResponse({"ok": ok, "message": message}, status_code=200 if ok else 409)
+
+    @api
+    async def run_events(request: Request) -> Response:
+        run = studio.current_run()
+
+        async def stream() -> AsyncIterator[str]:
+            sent = -1
+            while True:
+                snapshot = run.view.snapshot()
+                if snapshot["version"] != sent or not run.view.done:
+                    sent = snapshot["version"]
+                    yield f"data: {json.dumps(snapshot)}\n\n"
+                if run.view.done or await request.is_disconnected():
+                    return
+                await asyncio.sleep(LIVE_PERIOD_S)
+
+        return StreamingResponse(stream(), media_type="text/event-stream")
+
+    routes = [
+        Route("/", index),
+        Route("/api/mission", get_mission),
+        Route("/api/map", get_map),
+        Route("/api/map/image", get_map_image),
+        Route("/api/check", post_check, methods=["POST"]),
+        Route("/api/save", post_save, methods=["POST"]),
+        Route("/api/run", post_run, methods=["POST"]),
+        Route("/api/run", get_run),
+        Route("/api/run/events", run_events),
+        Route("/api/run/{action}", run_request, methods=["POST"]),
+        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+    ]
+    app = Starlette(routes=routes)
+    app.state.studio = studio
+    app.add_middleware(TokenGate, token=config.token)
+    return app

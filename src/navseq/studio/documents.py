@@ -1,0 +1,352 @@
+"""A mission as the page edits it: a JSON document, checked and planned by navseq's core.
+
+The JSON document *is* a navseq mission file (docs/mission-format.md) with JSON
+syntax: the same keys, the same units (metres, degrees, seconds), so there is one set
+of rules for what a mission may hold — the loader's. A draft is checked by writing it
+as navseq YAML (one line per waypoint, so a problem's line names its waypoint) and
+handing that file to :func:`navseq.commands.validate.mission_file_problems`, the code
+``navseq validate --map`` runs. Legs are planned with :func:`navseq.sim.planner.plan_path`
+on the robot's costmap, and only legs whose ends moved are planned again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import tempfile
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import yaml
+
+from navseq.errors import MissionErrors, NavseqError
+from navseq.text import printable
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
+    from navseq.sim.costmap import Costmap
+    from navseq.studio.security import FileRoots
+
+#: The units of the document's numbers, sent with every mission so no client guesses.
+UNITS: dict[str, str] = {
+    "x": "m",
+    "y": "m",
+    "z": "m",
+    "yaw": "deg",
+    "server_timeout": "s",
+    "goal_timeout": "s",
+    "stall_timeout": "s",
+    "pass_through": "m",
+    "dwell": "s",
+    "xy_tolerance": "m",
+    "yaw_tolerance": "deg",
+}
+
+
+class DraftRefused(NavseqError):
+    """A draft that is not a mission document at all (HTTP 400/422, said in one line)."""
+
+
+def version_of(path: Path) -> dict[str, Any]:
+    """What identifies the file's content now: its SHA-256 (and mtime, for display)."""
+    data = path.read_bytes()
+    return {
+        "sha256": hashlib.sha256(data).hexdigest(),
+        "mtime_ns": path.stat().st_mtime_ns,
+        "size": len(data),
+    }
+
+
+def document_of(mission: Mission, base_dir: Path) -> dict[str, Any]:
+    """The mission as a JSON-ready document: what the mission writer would write.
+
+    The map path is relative to ``base_dir`` (the mission file's folder), as in a file.
+    """
+    from navseq.mission.writer import dump_mission_yaml
+
+    document = yaml.safe_load(dump_mission_yaml(mission, base_dir=base_dir))
+    assert isinstance(document, dict)
+    return document
+
+
+def open_document(path: Path, base_dir: Path) -> tuple[dict[str, Any] | None, list[NavseqError]]:
+    """The document of a mission file of any format, and the file's problems.
+
+    A navseq YAML file with problems is still opened as written (its raw mapping), so
+    that the user can fix it on the map; other formats with problems give None.
+    """
+    from navseq.mission import inspect_mission_file
+
+    mission, problems = inspect_mission_file(path)
+    if mission is not None:
+        return document_of(mission, base_dir), []
+    if path.suffix.lower() in (".yaml", ".yml"):
+        try:
+            raw = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (yaml.YAMLError, OSError, UnicodeDecodeError, RecursionError):
+            raw = None
+        if isinstance(raw, dict) and "navseq" in raw:
+            return json.loads(json.dumps(raw, default=str)), list(problems.errors)
+    return None, list(problems.errors)
+
+
+def empty_document(map_text: str | None) -> dict[str, Any]:
+    """A new mission with no waypoints (on ``map_text``, relative to the mission folder)."""
+    document: dict[str, Any] = {"navseq": 1, "frame": "map"}
+    if map_text is not None:
+        document["map"] = map_text
+    document["loops"] = 1
+    document["waypoints"] = []
+    return document
+
+
+@dataclass
+class DraftText:
+    """A draft written as navseq YAML, and which line holds what."""
+
+    text: str
+    waypoint_lines: dict[int, int] = field(default_factory=dict)  # line -> waypoint index
+    key_lines: dict[int, str] = field(default_factory=dict)  # line -> top-level key
+
+
+def draft_text(document: dict[str, Any]) -> DraftText:
+    """The draft as YAML: one line per top-level key and per waypoint (JSON flow style).
+
+    JSON is YAML, so every value is written exactly as the page sent it and the loader
+    judges it; the line of each waypoint is known, so problems point at waypoints.
+    """
+    lines = ["# navseq studio draft"]
+    drafted = DraftText("")
+    for key, value in document.items():
+        if key == "waypoints" and isinstance(value, list):
+            lines.append("waypoints:")
+            drafted.key_lines[len(lines)] = key
+            for index, waypoint in enumerate(value):
+                lines.append("  - " + json.dumps(waypoint, ensure_ascii=True))
+                drafted.waypoint_lines[len(lines)] = index
+            if not value:
+                lines[-1] = "waypoints: []"
+            continue
+        lines.append(f"{json.dumps(str(key))}: {json.dumps(value, ensure_ascii=True)}")
+        drafted.key_lines[len(lines)] = str(key)
+    drafted.text = "\n".join(lines) + "\n"
+    return drafted
+
+
+@dataclass
+class Problem:
+    """One problem as the page lists it: the line the CLI prints, and what it is about."""
+
+    text: str
+    message: str
+    subject: str | None
+    waypoint: int | None  # 0-based index of the waypoint concerned
+    key: str | None  # the top-level key concerned (start, defaults, map ...)
+
+    def as_json(self) -> dict[str, Any]:
+        return {
+            "text": self.text,
+            "message": self.message,
+            "subject": self.subject,
+            "waypoint": self.waypoint,
+            "key": self.key,
+        }
+
+
+def flatten(errors: list[NavseqError]) -> list[NavseqError]:
+    found: list[NavseqError] = []
+    for error in errors:
+        found += flatten(error.errors) if isinstance(error, MissionErrors) else [error]
+    return found
+
+
+def problems_of(
+    errors: list[NavseqError],
+    *,
+    drafted: DraftText | None = None,
+    draft_path: Path | None = None,
+    shown_as: str = "draft",
+) -> list[Problem]:
+    """``errors`` for the page; sources in the draft's temporary file become ``shown_as``."""
+    problems: list[Problem] = []
+    for error in flatten(errors):
+        source, waypoint, key = error.source, None, None
+        if draft_path is not None and source is not None and source.startswith(str(draft_path)):
+            _, _, line_text = source.rpartition(":")
+            line = int(line_text) if line_text.isdigit() else None
+            if drafted is not None and line is not None:
+                waypoint = drafted.waypoint_lines.get(line)
+                key = drafted.key_lines.get(line)
+            source = shown_as
+        if error.subject == "start":
+            key = "start"
+        shown = NavseqError(error.message, source=source, subject=error.subject)
+        problems.append(Problem(str(shown), error.message, error.subject, waypoint, key))
+    return problems
+
+
+@dataclass
+class CheckedDraft:
+    """A draft checked as ``navseq validate --map`` checks a file."""
+
+    mission: Mission | None  # None when the file's own problems stop it reading
+    problems: list[Problem]
+    map_path: Path | None
+
+
+def check_draft(document: Any, *, roots: FileRoots, base_dir: Path, shown_as: str) -> CheckedDraft:
+    """Every problem of a draft document (file problems and pre-flight), and its mission.
+
+    ``base_dir`` is the folder of the mission file the draft belongs to (its ``map:``
+    is relative to it). Raises :class:`DraftRefused` for something that is not a
+    navseq mission document, and :class:`NavseqError` for a map outside the studio's
+    folders.
+    """
+    from navseq.commands.validate import mission_file_problems
+
+    if not isinstance(document, dict):
+        raise DraftRefused("the mission must be a JSON object (a navseq mission document)")
+    if "navseq" not in document:
+        raise DraftRefused("the mission document needs its format version: navseq: 1")
+    document = dict(document)
+    map_path: Path | None = None
+    map_value = document.get("map")
+    if isinstance(map_value, str):
+        # Resolved (and refused outside the studio's folders) before anything reads it.
+        map_path = roots.resolve(map_value, "map", base=base_dir)
+        document["map"] = str(map_path)
+    drafted = draft_text(document)
+    with tempfile.TemporaryDirectory(prefix="navseq-studio-") as folder:
+        path = Path(folder) / "draft.yaml"
+        path.write_text(drafted.text, encoding="utf-8")
+        mission, errors = mission_file_problems(path)
+        problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
+    return CheckedDraft(mission, problems, map_path)
+
+
+# --- planned legs ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Leg:
+    """The planned path from one place to the next (None: no path)."""
+
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    points: list[tuple[float, float]] | None
+    length_m: float | None
+
+
+class LegPlanner:
+    """Plans legs on one costmap, keeping the last plans so that unchanged legs are free.
+
+    Dragging one waypoint changes the two legs touching it; the others come from the
+    cache (keyed by their exact end points).
+    """
+
+    def __init__(self, costmap: Costmap, capacity: int = 4096) -> None:
+        self.costmap = costmap
+        self._cache: OrderedDict[tuple[float, float, float, float], Leg] = OrderedDict()
+        self._capacity = capacity
+        self._lock = threading.Lock()
+        self.planned = 0  # plans computed (not taken from the cache), for benchmarks
+
+    def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg:
+        from navseq.sim.planner import plan_path
+
+        key = (start[0], start[1], goal[0], goal[1])
+        with self._lock:
+            cached = self._cache.get(key)
+            if cached is not None:
+                self._cache.move_to_end(key)
+                return cached
+        plan = plan_path(self.costmap, start, goal)
+        if plan is None:
+            leg = Leg(start, goal, None, None)
+        else:
+            leg = Leg(start, goal, corners(plan.points), round(plan.length, 3))
+        with self._lock:
+            self.planned += 1
+            self._cache[key] = leg
+            while len(self._cache) > self._capacity:
+                self._cache.popitem(last=False)
+        return leg
+
+
+def corners(points: Any) -> list[tuple[float, float]]:
+    """The plan's cells thinned to where its direction changes (what a line needs)."""
+    import numpy as np
+
+    array = np.asarray(points, dtype=float)
+    if len(array) <= 2:
+        return [(round(float(x), 3), round(float(y), 3)) for x, y in array]
+    steps = np.diff(array, axis=0)
+    turn = np.abs(steps[1:, 0] * steps[:-1, 1] - steps[1:, 1] * steps[:-1, 0]) > 1e-12
+    keep = np.concatenate(([True], turn, [True]))
+    return [(round(float(x), 3), round(float(y), 3)) for x, y in array[keep]]
+
+
+def legs_of(mission: Mission, planner: LegPlanner) -> list[dict[str, Any]]:
+    """Each leg of ``mission`` as the page draws it: from the start pose (when there is
+    one) through every waypoint, plus the way back to the first for a patrol."""
+    places: list[tuple[str, tuple[float, float]]] = []
+    if mission.start is not None:
+        places.append(("start", (mission.start.x, mission.start.y)))
+    for index, waypoint in enumerate(mission.waypoints):
+        places.append((str(index), (waypoint.x, waypoint.y)))
+    pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
+    if mission.loops != 1 and len(mission.waypoints) > 1:
+        pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
+    legs = []
+    for (from_name, start), (to_name, goal), loop in pairs:
+        leg = planner.leg(start, goal)
+        legs.append(
+            {
+                "from": from_name,
+                "to": int(to_name),
+                "points": leg.points,
+                "length_m": leg.length_m,
+                "loop": loop,
+            }
+        )
+    return legs
+
+
+def route_summary(legs: list[dict[str, Any]], robot: RobotProfile) -> dict[str, Any]:
+    """Total length of the legs and the time they take at the robot's top speed."""
+    from navseq.sinks.progress import eta_text
+
+    lengths = [leg["length_m"] for leg in legs if not leg["loop"]]
+    if any(length is None for length in lengths):
+        return {"total_length_m": None, "estimated_duration": "", "unplanned_legs": True}
+    total = float(sum(lengths))
+    return {
+        "total_length_m": round(total, 3),
+        "estimated_duration": eta_text(total, robot),
+        "unplanned_legs": False,
+    }
+
+
+def shown_path(path: Path) -> str:
+    return printable(str(path))
+
+
+__all__ = [
+    "UNITS",
+    "CheckedDraft",
+    "DraftRefused",
+    "LegPlanner",
+    "Problem",
+    "check_draft",
+    "document_of",
+    "empty_document",
+    "legs_of",
+    "open_document",
+    "route_summary",
+    "version_of",
+]

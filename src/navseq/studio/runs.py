@@ -1,0 +1,287 @@
+"""A mission run on the embedded simulator from the studio, in a thread, watched live.
+
+The run is ``navseq run``'s own: the draft is written by the mission writer into a new
+output folder (``navseq-out/<mission>-<time>/``, like ``navseq run``'s), then
+:func:`navseq.commands.run.prepare` and :func:`~navseq.commands.run.execute` run it
+with their journal, progress, report and picture, so the folder is the one the CLI
+leaves and ``navseq run --resume`` / ``navseq report`` work on it. The studio adds a
+mission listener (:class:`LiveView`) that folds the mission events into what the page
+draws, and a :class:`~navseq.executor.control.MissionControl` through which the page's
+stop, pause and skip reach the run's thread as executor inputs (stop cancels the goal,
+as Ctrl-C does).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import os
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from navseq.executor.control import MissionControl
+    from navseq.executor.events import MissionEvent
+    from navseq.mission.model import Mission
+    from navseq.navigators.base import Navigator
+
+#: Trail points kept for the page (older ones are thinned to every other one).
+MAX_TRAIL_POINTS = 4000
+#: The trail gets a point when the robot moved this far (m).
+TRAIL_STEP_M = 0.02
+
+
+@dataclass(frozen=True)
+class RunRequest:
+    """What the page asked to run: the checked mission and the pace."""
+
+    mission: Mission
+    stem: str  # the mission file's name without extension, for the folder's name
+    realtime: float | None  # None: as fast as the CPU goes
+
+
+class LiveView:
+    """The run as the page shows it, folded from mission events (any thread may read).
+
+    ``version`` grows with every change, so a watcher sends only what is new.
+    """
+
+    def __init__(self, mission: Mission, footprint: list[tuple[float, float]]) -> None:
+        self._lock = threading.Lock()
+        self.version = 0
+        self.status = "starting"
+        self.reason = ""
+        self.clock_s = 0.0
+        self.current: int | None = None
+        self.loop = 0
+        self.waypoints = ["pending"] * len(mission.waypoints)
+        self.pose: tuple[float, float, float] | None = None
+        self.plan: list[tuple[float, float]] = []
+        self.trail: list[tuple[float, float]] = []
+        self.footprint = footprint
+        self.report: dict[str, Any] | None = None
+        self.folder: str | None = None
+        self.error: str | None = None
+        self.navigator: Navigator | None = None
+        self._start_t: float | None = None
+
+    # -- the run's thread --------------------------------------------------------------
+
+    def __call__(self, event: MissionEvent) -> None:
+        from navseq.executor import events as ev
+
+        with self._lock:
+            if self._start_t is None:
+                self._start_t = event.t
+            self.clock_s = event.t - self._start_t
+            if isinstance(event, ev.MissionStarted):
+                self.status = "running"
+            elif isinstance(event, ev.LoopStarted):
+                self.loop = event.loop
+                self.waypoints = ["pending"] * len(self.waypoints)
+            elif isinstance(event, ev.WaypointStarted):
+                self.current = event.index
+                self.waypoints[event.index] = "driving"
+                self.plan = []
+            elif isinstance(event, ev.WaypointProgress):
+                self._moved(event.x, event.y, event.yaw)
+            elif isinstance(event, ev.WaypointPlan):
+                self.plan = [(round(x, 3), round(y, 3)) for x, y in event.path]
+            elif isinstance(event, ev.WaypointDwelling):
+                self.waypoints[event.index] = "dwelling"
+            elif isinstance(event, ev.WaypointFinished):
+                self.waypoints[event.index] = event.outcome.value
+            elif isinstance(event, ev.MissionPaused):
+                self.status = "paused"
+            elif isinstance(event, ev.MissionResumed):
+                self.status = "running"
+            elif isinstance(event, ev.MissionFinished):
+                self.status = "finishing"  # the outputs are written next
+                self.reason = event.reason
+                self.current = None
+            self.version += 1
+
+    def _moved(self, x: float, y: float, yaw: float) -> None:
+        self.pose = (x, y, yaw)
+        if not self.trail or math.dist(self.trail[-1], (x, y)) >= TRAIL_STEP_M:
+            self.trail.append((round(x, 3), round(y, 3)))
+            if len(self.trail) > MAX_TRAIL_POINTS:
+                self.trail = self.trail[::2]
+
+    def finished(self, status: str, report: dict[str, Any] | None, error: str | None) -> None:
+        with self._lock:
+            self.status = status
+            self.report = report
+            self.error = error
+            self.current = None
+            self.version += 1
+
+    # -- any thread --------------------------------------------------------------------
+
+    @property
+    def done(self) -> bool:
+        return self.status in ("completed", "failed", "stopped", "error")
+
+    def snapshot(self) -> dict[str, Any]:
+        """Everything the page draws; the robot's pose read from the simulator itself."""
+        with self._lock:
+            pose = self.pose
+            navigator = self.navigator
+            if navigator is not None and not self.done:
+                live = navigator.robot_pose()  # an immutable Pose2D: safe to read
+                if live is not None:
+                    pose = (live.x, live.y, live.yaw)
+                    self._moved(*pose)
+            return {
+                "version": self.version,
+                "status": self.status,
+                "reason": self.reason,
+                "clock_s": round(self.clock_s, 2),
+                "current": self.current,
+                "loop": self.loop,
+                "waypoints": list(self.waypoints),
+                "pose": None
+                if pose is None
+                else {"x_m": pose[0], "y_m": pose[1], "yaw_deg": math.degrees(pose[2])},
+                "footprint_m": self.footprint,
+                "plan": list(self.plan),
+                "trail": list(self.trail),
+                "folder": self.folder,
+                "report": self.report,
+                "error": self.error,
+            }
+
+
+class StudioRun:
+    """One run: its thread, its control mailbox and its live view."""
+
+    def __init__(self, request: RunRequest, out_base: Path) -> None:
+        from navseq.executor.control import MissionControl
+
+        self.request = request
+        self.out_base = out_base
+        self.control: MissionControl = MissionControl()
+        robot = request.mission.robot
+        from navseq.mission.robot import DEFAULT_PROFILE
+
+        footprint = [(float(x), float(y)) for x, y in (robot or DEFAULT_PROFILE).footprint]
+        self.view = LiveView(request.mission, footprint)
+        self._thread: threading.Thread | None = None
+        self.folder: Path | None = None
+        self.stop_requested = False
+
+    def start(self) -> None:
+        """Prepare as ``navseq run`` does (raises NavseqError), then run in a thread."""
+        from navseq.commands import run as run_command
+
+        setup, args = self._prepare(run_command)
+        self._thread = threading.Thread(
+            target=self._run, args=(run_command, setup, args), name="navseq-studio-run"
+        )
+        self._thread.start()
+
+    def _prepare(self, run_command: Any) -> tuple[Any, argparse.Namespace]:
+        from navseq.commands.output import create_run_folder, default_run_folder
+        from navseq.mission.writer import write_mission
+
+        folder = create_run_folder(
+            self.out_base / default_run_folder(self.request.stem), fresh=True
+        )
+        mission_file = folder / f"{self.request.stem}.yaml"
+        try:
+            # The mission as run, beside its journal: --resume and `navseq report` need it.
+            write_mission(self.request.mission, mission_file)
+            parser = argparse.ArgumentParser(prog="navseq run")
+            run_command.configure(parser)
+            argv = [str(mission_file), "--out", str(folder)]
+            if self.request.realtime is not None:
+                argv += ["--realtime", repr(self.request.realtime)]
+            args = parser.parse_args(argv)
+            setup = run_command.prepare(args)
+        except BaseException:
+            mission_file.unlink(missing_ok=True)
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+            raise
+        setup.control = self.control
+        setup.listeners.append(self.view)
+        make_navigator = setup.make_navigator
+
+        def watched_navigator() -> Navigator:
+            navigator = make_navigator()
+            self.view.navigator = navigator
+            return navigator
+
+        setup.make_navigator = watched_navigator
+        self.folder = folder
+        # Shown as navseq run says it: relative to where the studio was started.
+        self.view.folder = os.path.relpath(folder, self.out_base)
+        return setup, args
+
+    def _run(self, run_command: Any, setup: Any, args: argparse.Namespace) -> None:
+        report: dict[str, Any] | None = None
+        error: str | None = None
+        code: int | None = None
+        try:
+            code = run_command.execute(setup, args)
+        except NavseqError as failure:
+            error = str(failure)
+        except Exception as failure:  # shown on the page; the server goes on
+            error = f"{type(failure).__name__}: {failure}"
+        report = _latest_report(self.folder)
+        if error is not None and report is None:
+            status = "error"
+        elif self.stop_requested:
+            status = "stopped"
+        elif code == 0:
+            status = "completed"
+        else:
+            status = "failed"
+        self.view.finished(status, report, error)
+
+    # -- operator requests (any thread) ------------------------------------------------
+
+    def operate(self, kind: str, reason: str) -> tuple[bool, str]:
+        """File ``kind`` (cancel, pause, resume, skip) and wait for the run's answer."""
+        if kind == "cancel":
+            self.stop_requested = True
+        return self.control.request(kind, reason, timeout=5.0)
+
+    def stop_and_wait(self, reason: str, timeout: float = 30.0) -> None:
+        """Cancel the goal and end the run (as Ctrl-C does), then wait for its outputs."""
+        if self._thread is None:
+            return
+        if self._thread.is_alive():
+            self.stop_requested = True
+            self.control.request("cancel", reason, timeout=None)
+        self._thread.join(timeout)
+
+    @property
+    def alive(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        if self._thread is None:
+            return True
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+
+def _latest_report(folder: Path | None) -> dict[str, Any] | None:
+    """The report the run wrote (``report.json``, or ``report-N.json`` if that was taken)."""
+    if folder is None:
+        return None
+    reports = sorted(folder.glob("report*.json"), key=lambda path: path.stat().st_mtime_ns)
+    if not reports:
+        return None
+    try:
+        loaded = json.loads(reports[-1].read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return loaded if isinstance(loaded, dict) else None

@@ -1,0 +1,87 @@
+"""What the studio lets a request do: the token, and the folders files may be under.
+
+The studio runs on the user's machine with the user's rights, so a web page from
+elsewhere must not be able to use it (the token, compared in constant time, and a
+SameSite cookie), and the page itself may touch only the folders the user named at
+start: the mission's and the map's folders, or ``--root``. A path that leaves them
+(``..``, a symlink pointing out, an absolute path elsewhere) is refused with a
+message saying which folders are allowed.
+"""
+
+from __future__ import annotations
+
+import hmac
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from navseq.errors import NavseqError
+from navseq.text import printable
+
+#: The cookie that carries the token after the first page load.
+COOKIE_NAME = "navseq_studio_token"
+#: The request header an API client may send the token in instead.
+TOKEN_HEADER = "x-navseq-token"
+
+
+def token_matches(given: str | None, expected: str) -> bool:
+    """True when ``given`` is the token; the comparison takes the same time either way."""
+    if not given:
+        return False
+    return hmac.compare_digest(given.encode("utf-8", "replace"), expected.encode("utf-8"))
+
+
+class FileRoots:
+    """The folders the studio may read and write files under.
+
+    ``base`` is where relative paths start (the mission's folder). Paths are resolved
+    (symlinks followed) before they are checked, so a link pointing out is refused.
+    """
+
+    def __init__(self, folders: Iterable[Path], base: Path) -> None:
+        roots: list[Path] = []
+        for folder in folders:
+            resolved = folder.resolve()
+            if resolved not in roots:
+                roots.append(resolved)
+        if not roots:
+            raise ValueError("at least one folder is needed")
+        self.folders: Sequence[Path] = tuple(roots)
+        self.base = base.resolve()
+
+    def describe(self) -> str:
+        return ", ".join(printable(str(folder)) for folder in self.folders)
+
+    def contains(self, path: Path) -> bool:
+        resolved = path.resolve()
+        return any(resolved == root or resolved.is_relative_to(root) for root in self.folders)
+
+    def resolve(self, text: str, what: str, *, base: Path | None = None) -> Path:
+        """The file ``text`` names (relative to ``base``, default :attr:`base`), checked.
+
+        Raises :class:`NavseqError` naming ``what`` when the path is empty, not valid,
+        or outside every allowed folder.
+        """
+        if not isinstance(text, str) or not text.strip():
+            raise NavseqError("no file name given", source=what)
+        if "\x00" in text:
+            raise NavseqError("is not a valid file name (NUL byte)", source=what)
+        start = base if base is not None else self.base
+        candidate = Path(os.path.expanduser(text)) if text.startswith("~") else Path(text)
+        if not candidate.is_absolute():
+            candidate = start / candidate
+        try:
+            resolved = candidate.resolve()
+        except (OSError, RuntimeError) as error:  # a symlink loop
+            raise NavseqError(f"cannot be resolved: {error}", source=what) from None
+        if not self.contains(resolved):
+            raise NavseqError(
+                f"{printable(text)} is outside the folders the studio may use "
+                f"({self.describe()}); start it with --root to allow another folder",
+                source=what,
+            )
+        return resolved
+
+    def relative(self, path: Path, base: Path | None = None) -> str:
+        """``path`` as the page shows it: relative to ``base`` (default :attr:`base`)."""
+        return os.path.relpath(path.resolve(), base if base is not None else self.base)

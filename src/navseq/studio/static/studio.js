@@ -1,0 +1,502 @@
+// navseq studio page: plain JS over Leaflet (CRS.Simple: lat = y, lng = x, in metres).
+// The mission is the navseq document the API returns (docs/studio.md); every rule about
+// it (validation, pre-flight, plans, writing) is the server's: this file only draws and
+// sends edits.
+"use strict";
+
+const S = {
+  doc: null, version: null, name: "", units: {},
+  problems: [], legs: [], route: {}, selected: null,
+  undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
+  layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
+  mapKey: null, events: null, run: null,
+};
+const WP_FIELDS = [
+  ["name", "text"], ["x", "number"], ["y", "number"], ["yaw", "number"],
+  ["pass_through", "number"], ["dwell", "number"], ["retries", "number"],
+  ["on_failure", ["", "stop", "skip", "retry"]], ["goal_timeout", "number"], ["stall_timeout", "number"],
+];
+const $ = (id) => document.getElementById(id);
+
+// ---- API -------------------------------------------------------------------------------
+async function api(method, path, body) {
+  const response = await fetch(path, {
+    method, headers: body ? { "content-type": "application/json" } : {},
+    body: body ? JSON.stringify(body) : undefined, credentials: "same-origin",
+  });
+  let data = null;
+  try { data = await response.json(); } catch (e) { data = { error: response.statusText }; }
+  return { ok: response.ok, status: response.status, data };
+}
+function say(text, error) { const m = $("message"); m.textContent = text; m.className = error ? "error" : ""; }
+
+// ---- map -------------------------------------------------------------------------------
+const map = L.map("map", { crs: L.CRS.Simple, minZoom: -6, maxZoom: 9, zoomSnap: 0.25, zoomDelta: 0.5,
+  attributionControl: false, doubleClickZoom: false, boxZoom: false });
+L.control.scale({ metric: true, imperial: false, maxWidth: 160 }).addTo(map);
+const cursorControl = L.control({ position: "bottomright" });
+cursorControl.onAdd = () => { const d = L.DomUtil.create("div", "cursor-xy"); d.textContent = "x —, y —"; return d; };
+cursorControl.addTo(map);
+map.on("mousemove", (e) => {
+  cursorControl.getContainer().textContent = `x ${e.latlng.lng.toFixed(2)} m, y ${e.latlng.lat.toFixed(2)} m`;
+});
+const costControl = L.control({ position: "topright" });
+costControl.onAdd = () => {
+  const d = L.DomUtil.create("label", "costmap-toggle");
+  d.innerHTML = '<input type="checkbox" id="costmap-toggle"> inflated costmap';
+  L.DomEvent.disableClickPropagation(d);
+  return d;
+};
+costControl.addTo(map);
+$("costmap-toggle").addEventListener("change", (e) => {
+  if (!S.layers.cost) return;
+  if (e.target.checked) S.layers.cost.addTo(map); else S.layers.cost.remove();
+});
+const ll = (x, y) => L.latLng(y, x);
+
+async function loadMap(fit) {
+  const key = S.doc.map || "";
+  if (key === S.mapKey) return;
+  S.mapKey = key;
+  if (S.layers.map) S.layers.map.remove();
+  if (S.layers.cost) S.layers.cost.remove();
+  S.layers.map = S.layers.cost = null;
+  const query = key ? `?map=${encodeURIComponent(key)}` : "";
+  const info = await api("GET", `/api/map${query}`);
+  if (!info.ok) { say(info.data.error, true); if (!map._loaded) map.setView([0, 0], 4); return; }
+  const b = info.data.bounds_m;
+  const bounds = L.latLngBounds(ll(b.xmin, b.ymin), ll(b.xmax, b.ymax));
+  const sep = query ? "&" : "?";
+  // Layers are added once the map has a view (Leaflet defers them until then).
+  if (fit || !map._loaded) map.fitBounds(focusBounds(bounds), { padding: [20, 20] });
+  S.layers.map = L.imageOverlay(`/api/map/image${query}${sep}layer=map`, bounds).addTo(map);
+  S.layers.map.getElement().dataset.testid = "map-image";
+  S.layers.cost = L.imageOverlay(`/api/map/image${query}${sep}layer=costmap`, bounds, { zIndex: 2 });
+  if ($("costmap-toggle").checked) S.layers.cost.addTo(map);
+}
+// Fit on the mission when it has waypoints (a small mission on a big map stays readable).
+function focusBounds(mapBounds) {
+  const pts = S.doc.waypoints.filter(okPoint).map((w) => ll(w.x, w.y));
+  if (S.doc.start && okPoint(S.doc.start)) pts.push(ll(S.doc.start.x, S.doc.start.y));
+  if (pts.length < 2) return mapBounds;
+  return L.latLngBounds(pts).pad(0.25);
+}
+const okPoint = (p) => p && typeof p.x === "number" && typeof p.y === "number";
+
+// ---- editing ---------------------------------------------------------------------------
+function snapshot() { return JSON.stringify({ doc: S.doc, selected: S.selected }); }
+function edit(change) {
+  S.undo.push(snapshot());
+  if (S.undo.length > 200) S.undo.shift();
+  S.redo = [];
+  change();
+  changed();
+}
+function restore(from, to) {
+  if (!from.length) return;
+  to.push(snapshot());
+  const state = JSON.parse(from.pop());
+  S.doc = state.doc; S.selected = state.selected;
+  changed();
+}
+function changed() { render(); check(); }
+const round = (v, d) => Math.round(v * 10 ** d) / 10 ** d;
+
+map.on("click", (e) => {
+  if (S.run && !S.run.done) return;
+  edit(() => {
+    S.doc.waypoints.push({ x: round(e.latlng.lng, 2), y: round(e.latlng.lat, 2), yaw: 0 });
+    S.selected = S.doc.waypoints.length - 1;
+  });
+});
+document.addEventListener("keydown", (e) => {
+  if (e.target.closest("input, select")) return;
+  const z = e.key.toLowerCase() === "z" && (e.ctrlKey || e.metaKey);
+  if (z && !e.shiftKey) { e.preventDefault(); restore(S.undo, S.redo); }
+  else if ((z && e.shiftKey) || (e.key.toLowerCase() === "y" && e.ctrlKey)) { e.preventDefault(); restore(S.redo, S.undo); }
+  else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null) {
+    e.preventDefault(); removeWaypoint(S.selected);
+  }
+});
+$("undo").onclick = () => restore(S.undo, S.redo);
+$("redo").onclick = () => restore(S.redo, S.undo);
+function removeWaypoint(i) {
+  edit(() => { S.doc.waypoints.splice(i, 1); S.selected = null; });
+}
+function moveWaypoint(from, to) {
+  if (to < 0 || to >= S.doc.waypoints.length || from === to) return;
+  edit(() => {
+    const [w] = S.doc.waypoints.splice(from, 1);
+    S.doc.waypoints.splice(to, 0, w);
+    S.selected = to;
+  });
+}
+
+// ---- drawing ---------------------------------------------------------------------------
+function problemsOf(i) { return S.problems.filter((p) => p.waypoint === i); }
+function wpIcon(w, i, extra) {
+  const yaw = typeof w.yaw === "number" ? w.yaw : 0;
+  const cls = ["wp-icon", extra || ""];
+  if (w.pass_through) cls.push("pass");
+  if (i !== null && problemsOf(i).length) cls.push("bad");
+  if (i !== null && i === S.selected) cls.push("selected");
+  return L.divIcon({
+    className: cls.join(" "), iconSize: [26, 26], iconAnchor: [13, 13],
+    html: `<div class="arrow" style="transform: rotate(${-yaw}deg)"></div><div class="dot">${i === null ? "S" : i + 1}</div>`,
+  });
+}
+function render() {
+  S.layers.markers.forEach((m) => m.remove());
+  S.layers.markers = [];
+  if (S.layers.start) S.layers.start.remove();
+  S.layers.start = null;
+  const start = S.doc.start;
+  if (okPoint(start)) {
+    S.layers.start = L.marker(ll(start.x, start.y), { icon: wpIcon(start, null, "start"), draggable: true,
+      title: "start pose", zIndexOffset: -100 }).addTo(map);
+    S.layers.start.on("dragend", (e) => {
+      const p = e.target.getLatLng();
+      edit(() => { S.doc.start.x = round(p.lng, 2); S.doc.start.y = round(p.lat, 2); });
+    });
+    S.layers.start.on("click", (e) => L.DomEvent.stopPropagation(e));
+  }
+  S.doc.waypoints.forEach((w, i) => {
+    if (!okPoint(w)) return;
+    const m = L.marker(ll(w.x, w.y), { icon: wpIcon(w, i), draggable: true, title: w.name || `waypoint ${i + 1}` });
+    m.addTo(map);
+    const el = m.getElement();
+    el.dataset.testid = "waypoint-marker";
+    el.dataset.index = String(i);
+    m.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = i; render(); });
+    m.on("dragstart", () => { S.selected = i; drawHandle(); });
+    m.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, w.yaw || 0); });
+    m.on("dragend", (e) => {
+      const p = e.target.getLatLng();
+      edit(() => { w.x = round(p.lng, 2); w.y = round(p.lat, 2); });
+    });
+    S.layers.markers.push(m);
+  });
+  drawLegs();
+  drawHandle();
+  renderList();
+  renderEditor();
+  renderSettings();
+  renderProblems();
+  $("undo").disabled = !S.undo.length;
+  $("redo").disabled = !S.redo.length;
+}
+function drawLegs() {
+  if (S.layers.legs) S.layers.legs.remove();
+  S.layers.legs = L.layerGroup().addTo(map);
+  for (const leg of S.legs) {
+    if (!leg.points) continue;
+    const line = L.polyline(leg.points.map(([x, y]) => ll(x, y)),
+      { color: leg.loop ? "#6b7280" : "#0ea5e9", weight: 3, opacity: 0.85, dashArray: leg.loop ? "6 6" : null, interactive: false });
+    line.addTo(S.layers.legs);
+    const mid = leg.points[Math.floor(leg.points.length / 2)];
+    L.tooltip({ permanent: true, direction: "center", className: "leg-label", interactive: false })
+      .setLatLng(ll(mid[0], mid[1])).setContent(`${leg.length_m.toFixed(2)} m`).addTo(S.layers.legs);
+  }
+}
+// The yaw handle of the selected waypoint: drag it around the point to set the heading.
+function handleOffset() { return 40 / 2 ** map.getZoom(); }  // 40 px in metres
+function drawHandle() {
+  if (S.layers.handle) S.layers.handle.remove();
+  S.layers.handle = null;
+  const w = S.selected !== null ? S.doc.waypoints[S.selected] : null;
+  if (!w || !okPoint(w)) return;
+  const yaw = ((w.yaw || 0) * Math.PI) / 180;
+  const r = handleOffset();
+  S.layers.handle = L.marker(ll(w.x + r * Math.cos(yaw), w.y + r * Math.sin(yaw)), {
+    icon: L.divIcon({ className: "yaw-handle", iconSize: [12, 12] }), draggable: true, zIndexOffset: 1000,
+    title: "drag to set the heading",
+  }).addTo(map);
+  S.layers.handle.on("click", (e) => L.DomEvent.stopPropagation(e));
+  S.layers.handle.on("drag", (e) => {
+    const p = e.target.getLatLng();
+    const deg = Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI);
+    const arrow = S.layers.markers.find((m) => m.getElement().dataset.index === String(S.selected));
+    if (arrow) arrow.getElement().querySelector(".arrow").style.transform = `rotate(${-deg}deg)`;
+  });
+  S.layers.handle.on("dragend", (e) => {
+    const p = e.target.getLatLng();
+    edit(() => { w.yaw = Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI); });
+  });
+}
+function moveHandle(x, y, yawDeg) {
+  if (!S.layers.handle) return;
+  const r = handleOffset(), yaw = (yawDeg * Math.PI) / 180;
+  S.layers.handle.setLatLng(ll(x + r * Math.cos(yaw), y + r * Math.sin(yaw)));
+}
+map.on("zoomend", drawHandle);
+
+function renderList() {
+  const list = $("waypoints");
+  list.textContent = "";
+  S.doc.waypoints.forEach((w, i) => {
+    const li = document.createElement("li");
+    li.dataset.testid = "waypoint-row";
+    li.draggable = true;
+    if (i === S.selected) li.classList.add("selected");
+    if (problemsOf(i).length) li.classList.add("bad");
+    const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
+    const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
+    li.innerHTML = `<span class="num"></span><span class="label"></span><span class="state"></span>
+      <button title="move up">▲</button><button title="move down">▼</button><button title="delete">✕</button>`;
+    li.querySelector(".num").textContent = i + 1;
+    li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
+    li.querySelector(".state").textContent = state;
+    const [up, down, del] = li.querySelectorAll("button");
+    up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
+    down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
+    del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
+    li.onclick = () => { S.selected = i; render(); if (okPoint(w)) map.panTo(ll(w.x, w.y)); };
+    li.ondragstart = (e) => { e.dataTransfer.setData("text/plain", String(i)); };
+    li.ondragover = (e) => { e.preventDefault(); li.classList.add("drop-target"); };
+    li.ondragleave = () => li.classList.remove("drop-target");
+    li.ondrop = (e) => { e.preventDefault(); moveWaypoint(Number(e.dataTransfer.getData("text/plain")), i); };
+    list.appendChild(li);
+  });
+}
+function field(form, label, value, kind, onChange, placeholder) {
+  const l = document.createElement("label");
+  l.textContent = label;
+  let input;
+  if (Array.isArray(kind)) {
+    input = document.createElement("select");
+    for (const option of kind) {
+      const o = document.createElement("option");
+      o.value = option; o.textContent = option || "(default)";
+      input.appendChild(o);
+    }
+    input.value = value ?? "";
+  } else {
+    input = document.createElement("input");
+    input.type = kind; if (kind === "number") input.step = "any";
+    input.value = value ?? "";
+    if (placeholder !== undefined) input.placeholder = placeholder;
+  }
+  input.name = label;
+  input.addEventListener("change", () => onChange(input.value));
+  form.append(l, input);
+}
+function fieldValue(kind, text) {
+  if (text === "") return undefined;
+  if (kind === "number") { const n = Number(text); return Number.isFinite(n) ? n : text; }
+  return text;
+}
+function renderEditor() {
+  const w = S.selected !== null ? S.doc.waypoints[S.selected] : null;
+  $("editor").hidden = !w;
+  if (!w) return;
+  $("editor-title").textContent = `${S.selected + 1}`;
+  const form = $("fields");
+  form.textContent = "";
+  const defaults = S.doc.defaults || {};
+  for (const [key, kind] of WP_FIELDS) {
+    const unit = S.units[key] ? ` [${S.units[key]}]` : "";
+    const inherited = defaults[key] === undefined || defaults[key] === null ? "" : `default ${defaults[key]}`;
+    field(form, key + unit, w[key], kind, (text) => edit(() => {
+      const value = fieldValue(kind, text);
+      if (value === undefined) delete w[key]; else w[key] = value;
+    }), ["x", "y", "yaw", "name"].includes(key) ? "" : inherited);
+  }
+}
+function renderSettings() {
+  const form = $("settings");
+  if (form.contains(document.activeElement)) return;
+  form.textContent = "";
+  field(form, "loops", S.doc.loops, "text", (t) => edit(() => {
+    S.doc.loops = t === "forever" ? "forever" : fieldValue("number", t) ?? 1;
+  }));
+  field(form, "frame", S.doc.frame, "text", (t) => edit(() => { S.doc.frame = t; }));
+  field(form, "map", S.doc.map, "text", (t) => edit(() => { S.doc.map = t || null; }));
+  const st = S.doc.start;
+  field(form, "start x,y,yaw", okPoint(st) ? `${st.x}, ${st.y}, ${st.yaw ?? 0}` : "", "text", (t) => edit(() => {
+    const parts = t.split(",").map((v) => Number(v.trim()));
+    if (!t.trim()) delete S.doc.start;
+    else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
+  }), "none: the simulator's");
+}
+function renderProblems() {
+  const list = $("problems");
+  list.textContent = "";
+  for (const p of S.problems) {
+    const li = document.createElement("li");
+    li.dataset.testid = "problem";
+    li.textContent = p.text;
+    if (p.waypoint !== null) li.onclick = () => { S.selected = p.waypoint; render(); };
+    list.appendChild(li);
+  }
+  $("problem-count").textContent = S.problems.length ? `(${S.problems.length})` : "";
+  const save = $("save");
+  save.classList.toggle("warn", S.problems.length > 0);
+  save.textContent = S.problems.length ? `Save (${S.problems.length} problem${S.problems.length > 1 ? "s" : ""})` : "Save";
+  const r = S.route;
+  $("route").textContent = r.total_length_m != null
+    ? `${S.doc.waypoints.length} waypoints · ${r.total_length_m.toFixed(2)} m · ${r.estimated_duration}`
+    : `${S.doc.waypoints.length} waypoints${r.unplanned_legs ? " · some legs have no path" : ""}`;
+}
+
+// ---- checking (the same code as navseq validate --map) ----------------------------------
+async function check() {
+  if (S.checkBusy) { S.checkAgain = true; return; }
+  S.checkBusy = true;
+  const seq = ++S.checkSeq;
+  const sent = JSON.parse(JSON.stringify(S.doc));
+  const answer = await api("POST", "/api/check", { mission: sent });
+  S.checkBusy = false;
+  if (S.checkAgain) { S.checkAgain = false; check(); return; }
+  if (seq !== S.checkSeq) return;
+  if (!answer.ok) {
+    S.problems = answer.data.problems || [{ text: answer.data.error, waypoint: null }];
+    S.legs = []; S.route = {};
+  } else {
+    S.problems = answer.data.problems;
+    S.legs = answer.data.legs;
+    S.route = answer.data;
+  }
+  await loadMap(false);
+  render();
+  document.body.dataset.checked = String(seq);
+}
+
+// ---- files -------------------------------------------------------------------------------
+async function save(path) {
+  const body = { mission: S.doc, version: path ? null : S.version };
+  if (path) body.path = path;
+  if (!path && S.exists) {
+    // The opened file is replaced only once the user says so (and the server still
+    // refuses if it changed on disk since it was opened).
+    if (!window.confirm(`${S.name} exists; replace it with this mission?`)) { say("not saved"); return; }
+    body.overwrite = true;
+  }
+  let answer = await api("POST", "/api/save", body);
+  if (answer.status === 409 && answer.data.conflict === "exists") {
+    if (!window.confirm(`${answer.data.error}?`)) { say("not saved"); return; }
+    answer = await api("POST", "/api/save", { ...body, overwrite: true });
+  }
+  if (!answer.ok) { say(answer.data.error, true); return; }
+  S.version = answer.data.version;
+  if (!path) S.exists = true;
+  if (path) { S.name = answer.data.path; $("mission-name").textContent = S.name; }
+  const n = answer.data.problems.length;
+  say(`saved ${answer.data.path}${n ? ` (with ${n} problem${n > 1 ? "s" : ""})` : ""}`);
+}
+$("save").onclick = () => save(null);
+$("save-as").onclick = () => {
+  const path = window.prompt("Save as (a .yaml file in the mission's folder):", "mission.yaml");
+  if (path) save(path);
+};
+
+// ---- running -----------------------------------------------------------------------------
+function setStatus(status, text) {
+  const el = $("run-status");
+  el.dataset.status = status;
+  el.textContent = text;
+}
+$("run").onclick = async () => {
+  const speed = $("speed").value;
+  const answer = await api("POST", "/api/run", { mission: S.doc, realtime: speed ? Number(speed) : null });
+  if (!answer.ok) {
+    if (answer.data.problems) { S.problems = answer.data.problems; render(); }
+    setStatus("error", "not started"); say(answer.data.error, true); return;
+  }
+  say(`running; outputs in ${answer.data.folder}`);
+  $("report").hidden = true;
+  setStatus("starting", "starting");
+  watchRun();
+};
+$("stop").onclick = () => api("POST", "/api/run/stop");
+$("skip").onclick = () => api("POST", "/api/run/skip");
+$("pause").onclick = () => api("POST", S.run && S.run.status === "paused" ? "/api/run/resume" : "/api/run/pause");
+
+function watchRun() {
+  if (S.events) S.events.close();
+  S.events = new EventSource("/api/run/events");
+  S.events.onmessage = (e) => {
+    const run = JSON.parse(e.data);
+    run.done = ["completed", "failed", "stopped", "error"].includes(run.status);
+    S.run = run;
+    drawRun(run);
+    if (run.done) { S.events.close(); S.events = null; }
+  };
+  S.events.onerror = () => { if (S.events && S.run && S.run.done) S.events.close(); };
+}
+function drawRun(run) {
+  if (!S.layers.run) S.layers.run = L.layerGroup().addTo(map);
+  S.layers.run.clearLayers();
+  if (run.trail.length > 1) L.polyline(run.trail.map(([x, y]) => ll(x, y)), { color: "#16a34a", weight: 3, interactive: false }).addTo(S.layers.run);
+  if (run.plan.length > 1) L.polyline(run.plan.map(([x, y]) => ll(x, y)), { color: "#f97316", weight: 2, dashArray: "4 4", interactive: false }).addTo(S.layers.run);
+  if (run.pose) {
+    const { x_m: x, y_m: y, yaw_deg: deg } = run.pose;
+    const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
+    const outline = run.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.run);
+    body.getElement().dataset.testid = "robot";
+    L.polyline([ll(x, y), ll(x + 0.25 * c, y + 0.25 * s)], { color: "#111827", weight: 2, interactive: false }).addTo(S.layers.run);
+  }
+  const busy = !run.done;
+  $("stop").disabled = !busy; $("skip").disabled = !busy; $("pause").disabled = !busy;
+  $("pause").textContent = run.status === "paused" ? "Resume" : "Pause";
+  $("run").disabled = busy;
+  const at = run.current !== null ? ` · waypoint ${run.current + 1} ${run.waypoints[run.current]}` : "";
+  const loop = run.loop ? ` · loop ${run.loop + 1}` : "";
+  let text = `${run.status} · ${run.clock_s.toFixed(1)} s${at}${loop}`;
+  if (run.done && run.report) text = `${run.status} · ${run.report.totals.reached}/${run.report.totals.visits} reached · ${run.report.totals.duration_s} s`;
+  if (run.error) text += ` · ${run.error}`;
+  setStatus(run.status, text);
+  renderList();
+  if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); }
+}
+function showReport(run) {
+  const r = run.report;
+  $("report").hidden = false;
+  const body = $("report-body");
+  body.textContent = "";
+  const note = document.createElement("div");
+  note.textContent = `${run.reason || run.status}; folder ${run.folder}`;
+  body.appendChild(note);
+  if (!r) return;
+  const table = document.createElement("table");
+  table.innerHTML = "<thead><tr><th>#</th><th>name</th><th>outcome</th><th>tries</th><th>time [s]</th><th>dist [m]</th></tr></thead><tbody></tbody>";
+  const tbody = table.querySelector("tbody");
+  for (const v of r.visits) {
+    const tr = document.createElement("tr");
+    for (const [value, numeric] of [[v.number, true], [v.name || "", false], [v.outcome + (v.passed_through ? " (through)" : ""), false],
+      [v.attempts.length, true], [v.duration_s, true], [v.distance_m, true]]) {
+      const td = document.createElement("td");
+      td.textContent = value; if (numeric) td.className = "n";
+      tr.appendChild(td);
+    }
+    tbody.appendChild(tr);
+  }
+  const t = r.totals;
+  const tr = document.createElement("tr");
+  tr.innerHTML = `<th></th><th>total</th><th>${t.reached} reached</th><th></th><th class="n">${t.duration_s}</th><th class="n">${t.distance_m}</th>`;
+  tbody.appendChild(tr);
+  body.appendChild(table);
+}
+
+// ---- start -------------------------------------------------------------------------------
+async function main() {
+  const answer = await api("GET", "/api/mission");
+  if (!answer.ok) {
+    say(answer.data.error, true);
+    (answer.data.problems || []).forEach((p) => say(`${answer.data.error}: ${p.text}`, true));
+    return;
+  }
+  S.doc = answer.data.mission;
+  S.version = answer.data.version;
+  S.units = answer.data.units;
+  S.name = answer.data.name;
+  S.exists = answer.data.exists;
+  S.problems = answer.data.problems;
+  $("mission-name").textContent = answer.data.path || S.name;
+  if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
+  await loadMap(true);
+  render();
+  await check();
+  document.body.dataset.ready = "true";
+}
+main();

@@ -1,0 +1,328 @@
+"""navseq studio's JSON API, in process with Starlette's test client (docs/studio.md)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+from starlette.testclient import TestClient
+
+from navseq.mission import load_mission
+from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
+from navseq.studio.security import FileRoots
+
+REPO = Path(__file__).resolve().parents[1]
+TOKEN = "test-token"
+PILLAR = (1.0, 0.0)  # on the west face of the arena's middle east pillar (an occupied cell)
+
+
+@pytest.fixture
+def workspace(tmp_path: Path) -> Path:
+    shutil.copytree(REPO / "examples", tmp_path / "examples")
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    return tmp_path
+
+
+def make_client(workspace: Path, mission: str = "examples/turtlebot3_world.yaml") -> TestClient:
+    mission_path = (workspace / mission).resolve()
+    roots = FileRoots([mission_path.parent, workspace / "maps"], mission_path.parent)
+    config = StudioConfig(
+        token=TOKEN, roots=roots, mission_path=mission_path, out_base=workspace / "out"
+    )
+    return TestClient(create_app(config), headers={"x-navseq-token": TOKEN})
+
+
+@pytest.fixture
+def client(workspace: Path) -> TestClient:
+    return make_client(workspace)
+
+
+def opened(client: TestClient) -> dict:
+    answer = client.get("/api/mission")
+    assert answer.status_code == 200
+    return answer.json()
+
+
+def test_every_request_needs_the_token(client: TestClient) -> None:
+    bare = TestClient(client.app)
+    for path in ("/", "/api/mission", "/static/studio.js", "/api/map"):
+        answer = bare.get(path)
+        assert answer.status_code == 403, path
+        assert "token" in answer.json()["error"]
+    assert bare.get("/api/mission", headers={"x-navseq-token": "wrong"}).status_code == 403
+    # The page's URL sets a cookie that carries the token from then on.
+    page = bare.get(f"/?token={TOKEN}")
+    assert page.status_code == 200 and "navseq studio" in page.text
+    assert bare.get("/api/mission").status_code == 200
+
+
+def test_a_post_from_another_origin_is_refused(client: TestClient) -> None:
+    answer = client.post(
+        "/api/check", json={"mission": {}}, headers={"origin": "http://evil.example"}
+    )
+    assert answer.status_code == 403
+
+
+def test_the_mission_comes_as_its_document_with_units_and_version(
+    client: TestClient, workspace: Path
+) -> None:
+    body = opened(client)
+    mission = body["mission"]
+    assert body["units"]["yaw"] == "deg" and body["units"]["x"] == "m"
+    assert len(mission["waypoints"]) == 7
+    assert mission["waypoints"][1] == {"name": "east-dock", "x": 1.75, "y": -0.55, "yaw": 90}
+    assert mission["map"] == "../maps/turtlebot3_world.yaml"
+    data = (workspace / "examples/turtlebot3_world.yaml").read_bytes()
+    import hashlib
+
+    assert body["version"]["sha256"] == hashlib.sha256(data).hexdigest()
+    assert body["problems"] == []
+
+
+def test_the_map_and_its_costmap_are_served_in_metres(client: TestClient) -> None:
+    info = client.get("/api/map", params={"map": "../maps/turtlebot3_world.yaml"}).json()
+    assert info["resolution_m"] == 0.05
+    assert info["bounds_m"]["xmin"] == -10.0 and info["width_cells"] == 384
+    for layer in ("map", "costmap"):
+        image = client.get(
+            "/api/map/image", params={"map": "../maps/turtlebot3_world.yaml", "layer": layer}
+        )
+        assert image.status_code == 200 and image.content.startswith(b"\x89PNG")
+        from io import BytesIO
+
+        from PIL import Image
+
+        assert Image.open(BytesIO(image.content)).size == (384, 384)
+
+
+def test_a_checked_draft_gets_validate_problems_and_planned_legs(client: TestClient) -> None:
+    document = opened(client)["mission"]
+    answer = client.post("/api/check", json={"mission": document}).json()
+    assert answer["problems"] == []
+    assert len(answer["legs"]) == 7  # start -> 1, then 1 -> 2 ... 6 -> 7
+    assert all(leg["length_m"] > 0 and len(leg["points"]) >= 2 for leg in answer["legs"])
+    assert answer["total_length_m"] == pytest.approx(sum(leg["length_m"] for leg in answer["legs"]))
+    assert answer["estimated_duration"].endswith("at 0.22 m/s")
+
+    document["waypoints"][2].update(x=PILLAR[0], y=PILLAR[1])
+    answer = client.post("/api/check", json={"mission": document}).json()
+    assert [problem["waypoint"] for problem in answer["problems"]] == [2]
+    problem = answer["problems"][0]
+    assert problem["text"].startswith(
+        "turtlebot3_world.yaml, waypoint 3 'inner-east': at (1.00, 0.00)"
+    )
+    assert "obstacle" in problem["message"]
+
+
+def test_the_draft_problems_are_those_of_navseq_validate(
+    client: TestClient, workspace: Path
+) -> None:
+    from navseq.commands.validate import mission_file_problems
+
+    document = opened(client)["mission"]
+    document["waypoints"][0]["x"] = PILLAR[0]
+    document["waypoints"][0]["y"] = PILLAR[1]
+    document["waypoints"][4]["retries"] = -2
+    answer = client.post("/api/check", json={"mission": document}).json()
+    # The same draft written as a file and checked by validate's own function.
+    path = workspace / "examples/edited.yaml"
+    path.write_text(json.dumps(document), encoding="utf-8")
+    _, errors = mission_file_problems(path)
+    assert [p["message"] for p in answer["problems"]] == [e.message for e in errors]
+    assert answer["readable"] is False
+    # The file problem first, then pre-flight of the waypoints that did read (as validate).
+    assert [p["waypoint"] for p in answer["problems"]] == [4, 0]
+
+
+@pytest.mark.parametrize(
+    ("body", "status", "said"),
+    [
+        (b"{not json", 400, "not valid JSON"),
+        (b"[1, 2]", 400, "JSON object"),
+        (b'{"mission": [1]}', 400, "JSON object"),
+        (b'{"mission": {"waypoints": []}}', 400, "navseq: 1"),
+        (b"\xff\xfe", 400, "UTF-8"),
+    ],
+)
+def test_bad_requests_get_a_4xx_with_a_message(
+    client: TestClient, body: bytes, status: int, said: str
+) -> None:
+    answer = client.post("/api/check", content=body)
+    assert answer.status_code == status
+    assert said in answer.json()["error"]
+
+
+def test_a_body_over_the_limit_is_refused(client: TestClient) -> None:
+    answer = client.post("/api/check", content=b" " * (MAX_BODY_BYTES + 1))
+    assert answer.status_code == 413
+
+
+def test_files_outside_the_studios_folders_are_refused(client: TestClient, workspace: Path) -> None:
+    document = opened(client)["mission"]
+    outside = workspace / "elsewhere"
+    outside.mkdir()
+    shutil.copy(workspace / "maps/turtlebot3_world.yaml", outside / "m.yaml")
+    (workspace / "examples/link.yaml").symlink_to(outside / "m.yaml")
+    for map_text in ("../../elsewhere/m.yaml", str(outside / "m.yaml"), "link.yaml", "/etc/passwd"):
+        answer = client.post("/api/check", json={"mission": {**document, "map": map_text}})
+        assert answer.status_code == 422, map_text
+        assert "outside the folders the studio may use" in answer.json()["error"]
+        assert client.get("/api/map", params={"map": map_text}).status_code == 422
+    for path in ("../../elsewhere/new.yaml", "/tmp/new.yaml"):
+        answer = client.post("/api/save", json={"mission": document, "path": path})
+        assert answer.status_code == 422 and "outside" in answer.json()["error"]
+    assert not (outside / "new.yaml").exists()
+
+
+def test_save_replaces_the_opened_file_only_when_confirmed(
+    client: TestClient, workspace: Path
+) -> None:
+    body = opened(client)
+    document, version = body["mission"], body["version"]
+    document["waypoints"].append({"x": 0.5, "y": -1.6, "yaw": 45, "name": "added"})
+    answer = client.post("/api/save", json={"mission": document, "version": version})
+    assert answer.status_code == 409 and answer.json()["conflict"] == "exists"
+    path = workspace / "examples/turtlebot3_world.yaml"
+    assert len(load_mission(path).waypoints) == 7  # unchanged
+    answer = client.post(
+        "/api/save", json={"mission": document, "version": version, "overwrite": True}
+    )
+    assert answer.status_code == 200
+    saved = load_mission(path)
+    assert [w.name for w in saved.waypoints][-1] == "added"
+    assert saved.waypoints[-1].yaw_deg == pytest.approx(45)
+    assert saved.map == (workspace / "maps/turtlebot3_world.yaml").resolve()
+    assert "map: ../maps/turtlebot3_world.yaml" in path.read_text()
+    assert answer.json()["version"] == opened(client)["version"]
+
+
+def test_a_stale_version_is_a_conflict_and_nothing_is_lost(
+    client: TestClient, workspace: Path
+) -> None:
+    first_tab, second_tab = opened(client), opened(client)
+    first_tab["mission"]["waypoints"][0]["name"] = "first"
+    second_tab["mission"]["waypoints"][0]["name"] = "second"
+    ok = client.post(
+        "/api/save",
+        json={"mission": first_tab["mission"], "version": first_tab["version"], "overwrite": True},
+    )
+    assert ok.status_code == 200
+    stale = client.post(
+        "/api/save",
+        json={
+            "mission": second_tab["mission"],
+            "version": second_tab["version"],
+            "overwrite": True,
+        },
+    )
+    assert stale.status_code == 409 and stale.json()["conflict"] == "changed"
+    assert "changed on disk since it was opened" in stale.json()["error"]
+    assert load_mission(workspace / "examples/turtlebot3_world.yaml").waypoints[0].name == "first"
+
+
+def test_save_as_a_new_file_and_a_mission_with_pre_flight_problems(
+    client: TestClient, workspace: Path
+) -> None:
+    document = opened(client)["mission"]
+    document["waypoints"][0].update(x=PILLAR[0], y=PILLAR[1])
+    answer = client.post("/api/save", json={"mission": document, "path": "copy.yaml"})
+    assert answer.status_code == 200
+    assert len(answer.json()["problems"]) == 1  # saved, and said
+    assert load_mission(workspace / "examples/copy.yaml").waypoints[0].x == PILLAR[0]
+    document["waypoints"][0]["yaw"] = "north"
+    answer = client.post("/api/save", json={"mission": document, "path": "bad.yaml"})
+    assert answer.status_code == 422 and answer.json()["problems"]
+    assert not (workspace / "examples/bad.yaml").exists()
+
+
+def wait_for_run(client: TestClient, timeout: float = 60.0) -> dict:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        state = client.get("/api/run").json()
+        if state["status"] in ("completed", "failed", "stopped", "error"):
+            return state
+        time.sleep(0.05)
+    raise AssertionError(f"the run did not end within {timeout} s: {state}")
+
+
+def test_a_run_writes_the_usual_output_folder(client: TestClient, workspace: Path) -> None:
+    document = opened(client)["mission"]
+    started = client.post("/api/run", json={"mission": document})
+    assert started.status_code == 200
+    state = wait_for_run(client)
+    assert state["status"] == "completed", state
+    assert state["waypoints"] == ["reached"] * 7
+    folder = workspace / "out" / state["folder"]
+    assert folder.parent == workspace / "out/navseq-out"
+    names = {path.name for path in folder.iterdir()}
+    assert {"journal.jsonl", "report.json", "mission.png", "turtlebot3_world.yaml"} <= names
+    report = json.loads((folder / "report.json").read_text())
+    assert report["totals"]["reached"] == 7 and report == state["report"]
+    assert len(state["trail"]) > 50 and state["pose"] is not None
+    # The folder is navseq run's own: navseq report rebuilds from its journal.
+    from navseq.sinks.journal import read_journal
+
+    assert read_journal(folder / "journal.jsonl").mission_started is not None
+
+
+def test_a_run_with_pre_flight_problems_is_refused_with_them(client: TestClient) -> None:
+    document = opened(client)["mission"]
+    document["waypoints"][3].update(x=PILLAR[0], y=PILLAR[1])
+    answer = client.post("/api/run", json={"mission": document})
+    assert answer.status_code == 422
+    assert [p["waypoint"] for p in answer.json()["problems"]] == [3]
+    assert client.get("/api/run").status_code == 404
+
+
+def test_stop_cancels_the_goal_and_the_report_is_written(client: TestClient) -> None:
+    document = opened(client)["mission"]
+    assert client.post("/api/run", json={"mission": document, "realtime": 2}).status_code == 200
+    again = client.post("/api/run", json={"mission": document})
+    assert again.status_code == 409  # one run at a time
+    time.sleep(1.0)
+    paused = client.post("/api/run/pause").json()
+    assert paused["ok"] and client.get("/api/run").json()["status"] == "paused"
+    assert client.post("/api/run/resume").json()["ok"]
+    stopped = client.post("/api/run/stop").json()
+    assert stopped["ok"], stopped
+    state = wait_for_run(client)
+    assert state["status"] == "stopped"
+    assert state["report"]["reason"] == "stopped from the studio"
+    assert state["report"]["totals"]["reached"] < 7
+    assert client.post("/api/run/stop").status_code == 409  # nothing left to stop
+
+
+def test_the_live_view_streams_server_sent_events(client: TestClient) -> None:
+    document = opened(client)["mission"]
+    assert client.post("/api/run", json={"mission": document}).status_code == 200
+    snapshots = []
+    with client.stream("GET", "/api/run/events") as stream:
+        assert stream.headers["content-type"].startswith("text/event-stream")
+        for line in stream.iter_lines():
+            if line.startswith("data: "):
+                snapshots.append(json.loads(line[6:]))
+    assert snapshots[-1]["status"] == "completed"  # the stream ends with the run
+    assert snapshots[-1]["report"]["totals"]["reached"] == 7
+    assert len(snapshots[-1]["footprint_m"]) >= 3
+
+
+def test_a_new_mission_on_a_map(workspace: Path) -> None:
+    mission_path = workspace / "examples/new.yaml"
+    roots = FileRoots([mission_path.parent, workspace / "maps"], mission_path.parent)
+    config = StudioConfig(
+        token=TOKEN,
+        roots=roots,
+        mission_path=mission_path,
+        map_path=(workspace / "maps/turtlebot3_world.yaml").resolve(),
+    )
+    client = TestClient(create_app(config), headers={"x-navseq-token": TOKEN})
+    body = client.get("/api/mission").json()
+    assert body["exists"] is False and body["mission"]["waypoints"] == []
+    document = body["mission"]
+    document["waypoints"] = [{"x": -0.55, "y": -1.75, "yaw": 0}]
+    answer = client.post("/api/save", json={"mission": document, "version": None})
+    assert answer.status_code == 200
+    assert load_mission(mission_path).waypoints[0].x == -0.55

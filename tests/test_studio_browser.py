@@ -1,0 +1,201 @@
+"""navseq studio in a real headless Chromium (Debian's ``chromium``, driven by Playwright).
+
+``navseq studio`` runs as a subprocess, as a user starts it; the test reads the URL
+from its first stdout line and uses the page as a user would: click, drag, save, run.
+Skipped with a reason where Chromium or Playwright is missing
+(``scripts/install-browser.sh`` installs Chromium; ``.ci/run`` runs it).
+
+``NAVSEQ_UPDATE_SCREENSHOT=1`` writes the README's screenshot, docs/images/studio.png.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from navseq.mission import load_mission
+
+REPO = Path(__file__).resolve().parents[1]
+CHROMIUM = os.environ.get("NAVSEQ_CHROMIUM", "/usr/bin/chromium")
+PILLAR = (1.0, 0.0)  # an occupied cell: the west face of the arena's middle east pillar
+FREE_SPOT = (0.55, -1.2)
+
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+
+def _skip_reason() -> str | None:
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        return "Playwright is not installed (pip install playwright)"
+    if not Path(CHROMIUM).exists():
+        return f"no Chromium at {CHROMIUM} (scripts/install-browser.sh installs Debian's)"
+    return None
+
+
+@pytest.fixture
+def studio(tmp_path: Path) -> Iterator[tuple[str, Path, subprocess.Popen[str]]]:
+    reason = _skip_reason()
+    if reason is not None:
+        if os.environ.get("NAVSEQ_EXPECT_BROWSER") == "1":  # CI installed it: must not skip
+            pytest.fail(reason)
+        pytest.skip(reason)
+    shutil.copytree(REPO / "examples", tmp_path / "examples")
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "navseq",
+            "studio",
+            "examples/turtlebot3_world.yaml",
+            "--no-browser",
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert process.stdout is not None
+    first = process.stdout.readline()
+    assert first.startswith("navseq studio: http://127.0.0.1:"), first
+    url = first.split(": ", 1)[1].strip()
+    try:
+        yield url, tmp_path, process
+    finally:
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+            try:
+                process.wait(20)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+
+
+@pytest.fixture
+def page(studio: tuple[str, Path, Any]) -> Iterator[Any]:
+    from playwright.sync_api import sync_playwright
+
+    url = studio[0]
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1400, "height": 860})
+        page.errors = []  # type: ignore[attr-defined]
+        page.on(
+            "console",
+            lambda message: page.errors.append(message.text) if message.type == "error" else None,
+        )
+        page.on("pageerror", lambda error: page.errors.append(str(error)))
+        page.goto(url)
+        page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+        try:
+            yield page
+        finally:
+            browser.close()
+
+
+def screen_point(page: Any, x: float, y: float) -> tuple[float, float]:
+    """Where the world point (x, y) in metres is on the screen."""
+    box = page.get_by_test_id("map").bounding_box()
+    point = page.evaluate(
+        "([x, y]) => { const p = map.latLngToContainerPoint(L.latLng(y, x)); return [p.x, p.y]; }",
+        [x, y],
+    )
+    return box["x"] + point[0], box["y"] + point[1]
+
+
+def checked_after(page: Any, action: Any) -> None:
+    """Do ``action`` and wait until the page's check of the change has come back."""
+    before = page.evaluate("Number(document.body.dataset.checked || 0)")
+    action()
+    page.wait_for_function(f"Number(document.body.dataset.checked || 0) > {before}", timeout=10_000)
+
+
+def test_make_check_save_and_run_a_mission_in_the_browser(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    _, workspace, process = studio
+    markers = page.get_by_test_id("waypoint-marker")
+    assert page.get_by_test_id("map").is_visible()
+    assert page.locator("[data-testid=map-image]").count() == 1
+    assert markers.count() == 7
+    assert page.get_by_test_id("waypoint-row").count() == 7
+    assert page.get_by_test_id("problem").count() == 0
+
+    # Click free space: an eighth waypoint, no problem.
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    assert markers.count() == 8
+    assert page.get_by_test_id("problem").count() == 0
+
+    # Drag it onto a pillar: a problem names it, and saving is still allowed but marked.
+    start = screen_point(page, *FREE_SPOT)
+    target = screen_point(page, *PILLAR)
+
+    def drag() -> None:
+        page.mouse.move(*start)
+        page.mouse.down()
+        page.mouse.move(*target, steps=12)
+        page.mouse.up()
+
+    checked_after(page, drag)
+    problems = page.get_by_test_id("problem")
+    assert problems.count() == 1
+    assert "waypoint 8" in problems.first.inner_text()
+    assert "obstacle" in problems.first.inner_text() or "cannot turn" in problems.first.inner_text()
+    assert "warn" in (page.get_by_test_id("save").get_attribute("class") or "")
+    assert page.get_by_test_id("save").is_enabled()
+
+    # Save: replacing the opened file is confirmed first.
+    dialogs: list[str] = []
+
+    def accept(dialog: Any) -> None:
+        dialogs.append(dialog.message)
+        dialog.accept()
+
+    page.on("dialog", accept)
+    page.get_by_test_id("save").click()
+    page.wait_for_function("document.getElementById('message').textContent.startsWith('saved')")
+    assert dialogs and "exists" in dialogs[0]
+    saved = load_mission(workspace / "examples/turtlebot3_world.yaml")
+    assert len(saved.waypoints) == 8
+    assert saved.waypoints[7].x == pytest.approx(PILLAR[0], abs=0.03)
+    assert saved.waypoints[7].y == pytest.approx(PILLAR[1], abs=0.03)
+    assert saved.waypoints[0].name == "south-gate"
+
+    # Undo the drag and the click: back to the 7 waypoints, which run.
+    checked_after(page, lambda: page.keyboard.press("Control+z"))
+    checked_after(page, lambda: page.keyboard.press("Control+z"))
+    assert markers.count() == 7 and page.get_by_test_id("problem").count() == 0
+
+    page.get_by_test_id("run").click()
+    status = page.get_by_test_id("run-status")
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'completed'",
+        timeout=60_000,
+    )
+    assert "7/7 reached" in status.inner_text()
+    assert page.get_by_test_id("robot").count() == 1
+    assert page.locator("#report-body tbody tr").count() == 8  # 7 visits + total
+    runs = list((workspace / "navseq-out").iterdir())
+    assert len(runs) == 1 and (runs[0] / "report.json").exists()
+
+    shot = (
+        REPO / "docs/images/studio.png"
+        if os.environ.get("NAVSEQ_UPDATE_SCREENSHOT") == "1"
+        else workspace / "studio.png"
+    )
+    page.get_by_test_id("waypoint-row").nth(1).click()  # a selected waypoint, its editor
+    page.locator("#costmap-toggle").check()
+    page.wait_for_function("[...document.images].every((image) => image.complete)")
+    page.mouse.move(*screen_point(page, 0.9, -0.9))
+    page.screenshot(path=str(shot))
+    assert page.errors == []  # type: ignore[attr-defined]
+    assert process.poll() is None  # still serving
