@@ -114,7 +114,7 @@ RULES: tuple[Rule, ...] = (
     Rule(
         r"roslaunch navseq demo\.launch",
         "ros",
-        "tests/test_launch_files.py::test_demo_launch_completes_the_example_mission",
+        "tests/test_launch_files.py::test_demo_launch_completes_the_example_mission_and_ends_quietly",
     ),
     Rule(
         r"roslaunch navseq sim\.launch",

@@ -17,7 +17,7 @@ import yaml
 from navseq.errors import NavseqError
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
-from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
+from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
 from navseq.mission.robot import BUILTIN_PROFILES, RobotProfile
 from navseq.mission.yaml_doc import EXPONENT_FLOAT
@@ -82,7 +82,7 @@ def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
     doc["server_timeout"] = mission.server_timeout
     if mission.robot is not None:
         doc["robot"] = robot_section(mission.robot)
-    doc["defaults"] = _policy_values(mission.defaults, POLICY_FIELDS)
+    doc["defaults"] = _policy_values(mission.defaults, POLICY_KEYS)
     doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
     return HEADER + yaml.dump(
         doc,
@@ -219,14 +219,15 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
     entry.update(
         _policy_values(
             Policy().with_overrides(waypoint.overrides),
-            [key for key in POLICY_FIELDS if key in waypoint.overrides],
+            [key for key, name in POLICY_KEYS.items() if name in waypoint.overrides],
         )
     )
     return entry
 
 
 def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
-    values = {key: getattr(policy, key) for key in keys}
+    """The file keys ``keys`` with ``policy``'s values, in the file's units."""
+    values = {key: getattr(policy, POLICY_KEYS[key]) for key in keys}
     if values.get("yaw_tolerance") is not None:
         values["yaw_tolerance"] = round(math.degrees(values["yaw_tolerance"]), 6)
     return {
