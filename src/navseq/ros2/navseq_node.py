@@ -43,6 +43,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.task import Future
 from std_srvs.srv import Trigger
 
@@ -66,6 +67,13 @@ from navseq.text import printable
 
 NODE_NAME = "navseq"
 SERVICE_ANSWER_WAIT = 5.0  # s of wall time a service waits for the mission's answer
+# The executor's reason for each request; a cancel's starts with "cancelled", which is
+# how the status topic and the exit log tell it from a failure.
+_REASONS = {
+    "pause": "paused by the operator (~/pause)",
+    "resume": "resumed by the operator (~/resume)",
+    "cancel": "cancelled by the operator (~/cancel)",
+}
 KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a signal while kept alive
 
 
@@ -105,8 +113,14 @@ class OperatorServices:
         self.session = session
         self.control = control
         self.state = topics.state
+        # A group of their own: while a handler awaits the mission's answer its group is
+        # busy, and in the node's default group that would hold back /clock, Nav2's
+        # feedback and results - which the mission needs to answer.
+        group = MutuallyExclusiveCallbackGroup()
         for name in ("pause", "resume", "skip", "cancel"):
-            session.node.create_service(Trigger, f"~/{name}", self._handler(name))
+            session.node.create_service(
+                Trigger, f"~/{name}", self._handler(name), callback_group=group
+            )
 
     def _handler(self, name: str) -> Any:
         async def handle(_request: Any, response: Any) -> Any:
@@ -132,8 +146,10 @@ class OperatorServices:
         def wake(request: OperatorRequest) -> None:
             if not answered.done():
                 answered.set_result(request)
+                # The awaiting handler runs again when the executor looks next: now.
+                self.session.executor.wake()
 
-        request = self.control.submit(name, f"{name} requested by the operator (~/{name})", wake)
+        request = self.control.submit(name, _REASONS[name], wake)
         # The run answers within one tick; the timer only guards against a stuck run.
         timer = threading.Timer(SERVICE_ANSWER_WAIT, lambda: wake(request))
         timer.daemon = True
@@ -202,7 +218,7 @@ def run_node(session: Ros2Session) -> int:
         return 1
     else:
         if result.reason.startswith("cancelled"):
-            logger.warning("navseq: mission cancelled by the operator (~/cancel)")
+            logger.warning("mission cancelled by the operator (~/cancel)")
             topics.state.over = "the mission was cancelled"
         elif result.success:
             logger.info(f"mission succeeded ({result.reason})")
@@ -226,7 +242,7 @@ def stay_up(session: Ros2Session, mission_code: int) -> int:
     should not see a finished mission as a failure.
     """
     logger = session.node.get_logger()
-    logger.info("navseq: mission over; staying up (keep_alive) until stopped")
+    logger.info("mission over; staying up (keep_alive) until stopped")
     stop_signal: list[str] = []
     stopping = threading.Event()
 
@@ -256,7 +272,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         session = Ros2Session(NODE_NAME, args=args, any_parameter=True)
     except Exception as error:  # rclpy's own: bad --ros-args, a params file it cannot read
-        print(f"cannot start the ROS 2 node: {error}", file=sys.stderr)
+        print(f"navseq: cannot start the ROS 2 node: {error}", file=sys.stderr)
         return 2
     try:
         return run_node(session)
