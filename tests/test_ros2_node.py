@@ -60,7 +60,8 @@ got = {}
 node.create_subscription(MarkerArray, "/navseq/waypoints", lambda m: got.setdefault("markers", [
     [k.ns, k.id, k.text, k.pose.position.x, k.pose.position.y,
      [k.color.r, k.color.g, k.color.b]] for k in m.markers]), qos)
-node.create_subscription(String, "/navseq/status", lambda m: got.setdefault("status", json.loads(m.data)), qos)
+node.create_subscription(
+    String, "/navseq/status", lambda m: got.setdefault("status", json.loads(m.data)), qos)
 deadline = time.monotonic() + 30
 while len(got) < 2 and time.monotonic() < deadline:
     rclpy.spin_once(node, timeout_sec=0.1)
@@ -91,7 +92,7 @@ class NavseqNode:
                 self._changed.notify_all()
 
     def wait_for(self, text: str, timeout: float = 90) -> str:
-        """The first log line containing ``text``, waiting for it."""
+        """The first log line containing ``text``, waiting for it (not past the node's end)."""
         deadline = time.monotonic() + timeout
         with self._changed:
             while True:
@@ -99,13 +100,9 @@ class NavseqNode:
                     if text in line:
                         return line
                 left = deadline - time.monotonic()
-                if left <= 0 or self.process.poll() is not None and not self._more():
+                if left <= 0 or self.process.poll() is not None:
                     raise AssertionError(f"no {text!r} in the node's log:\n" + self.log())
                 self._changed.wait(min(left, 0.5))
-
-    def _more(self) -> bool:
-        time.sleep(0.2)  # the reader may still hold the last lines
-        return False
 
     def finish(self, timeout: float = 120) -> int:
         code = self.process.wait(timeout=timeout)
@@ -319,12 +316,8 @@ def test_the_same_mission_gives_the_same_visits_on_sim_ros1_and_nav2(
         out = tmp_path / navigator
         # The in-process simulator needs the map as its world; pre-flight, which would
         # refuse the pillar before the robot moves, is off so its planner meets it too.
-        extra = (
-            ["--map", str(REPO / "maps" / "turtlebot3_world.yaml"), "--start=-2,-0.5,0"]
-            + ["--no-preflight"]
-            if navigator == "sim"
-            else []
-        )
+        world = ["--map", str(REPO / "maps" / "turtlebot3_world.yaml"), "--start=-2,-0.5,0"]
+        extra = [*world, "--no-preflight"] if navigator == "sim" else []
         done = subprocess.run(
             [NAVSEQ, "run", str(mission), "--navigator", navigator, "--out", str(out), *extra],
             env=run_env,
