@@ -26,6 +26,9 @@ private ``ROS_DOMAIN_ID`` with discovery on the loopback, and is stopped at the 
    mission on the in-process simulator (``navseq run``). Mission time is simulated time
    from the journal's MissionStarted to MissionFinished; the ratio says what going
    through ROS 2 (feedback at 10 Hz wall, the executor's tick, DDS) costs the robot.
+   Efficiency is mission time over the lower bound that ``bench_sim.py`` uses (the
+   shortest collision-free leg lengths from the start pose, at top speed); issue 11's
+   target is the same efficiency through ROS 2 as in process, within 5 %.
 """
 
 from __future__ import annotations
@@ -352,8 +355,25 @@ def run_cli(env: dict[str, str] | None, variant: str, out: Path, *extra: str) ->
     return MissionRun(variant, success, mission_s, wall, report["totals"]["distance_m"])
 
 
+def example_lower_bound() -> float:
+    """Seconds the example mission needs at least, from the start the sim node is given."""
+    sys.path.insert(0, str(THIS_SCRIPT.parent))
+    from bench_sim import lower_bound
+
+    from navseq.geometry import Pose2D
+    from navseq.mission import load_mission
+    from navseq.navigators.sim import SimNavigator
+
+    mission = load_mission(EXAMPLE)
+    assert mission.map is not None
+    return lower_bound(mission, SimNavigator.from_map(mission.map, Pose2D(-2.0, -0.5, 0.0)))
+
+
 def mission_table(env: dict[str, str], workdir: Path, speed: float) -> Table:
-    in_process = run_cli(None, "in-process simulator (navseq run)", workdir / "sim")
+    bound = example_lower_bound()
+    in_process = run_cli(
+        None, "in-process simulator (navseq run)", workdir / "sim", "--start=-2,-0.5,0"
+    )
     sim = start(
         env,
         sys.executable,
@@ -376,14 +396,26 @@ def mission_table(env: dict[str, str], workdir: Path, speed: float) -> Table:
         )
     finally:
         stop(sim)
-    table = Table(title=f"{EXAMPLE.name}: mission time (simulated s) and wall time")
-    for column in ("navigator", "all reached", "mission s", "vs in-process", "driven m", "wall s"):
+    table = Table(
+        title=f"{EXAMPLE.name}: mission time (simulated s) vs its lower bound ({bound:.1f} s)"
+    )
+    columns = (
+        "navigator",
+        "all reached",
+        "mission s",
+        "efficiency",
+        "vs in-process",
+        "driven m",
+        "wall s",
+    )
+    for column in columns:
         table.add_column(column, justify="right")
     for run in (in_process, nav2):
         table.add_row(
             run.variant,
             "yes" if run.success else "NO",
             f"{run.mission_s:.1f}",
+            f"{run.mission_s / bound:.3f}",
             f"{run.mission_s / in_process.mission_s:.3f}x",
             f"{run.distance_m:.2f}",
             f"{run.wall_s:.1f}",

@@ -55,6 +55,19 @@ RULES: tuple[Rule, ...] = (
     Rule(r"^make demo\b", "make"),
     Rule(r"(^|/)pytest\b", "collect"),
     Rule(
+        r"colcon build|^sudo apt install ros-|^source install/|~/ws|rosdep install --from-paths"
+        r"|^ros2 launch (navseq |launch/)sim_navseq\.launch\.py",
+        "ros",
+        "tests/test_ros2_package.py::"
+        "test_colcon_builds_the_package_and_ros2_run_and_launch_complete_the_mission",
+    ),
+    Rule(
+        r"ros2 run navseq navseq_node|-m navseq\.ros2\.(navseq_node|sim_node --speed)|^PATH=",
+        "ros",
+        "tests/test_ros2_node.py::"
+        "test_the_tutorial_params_alone_complete_with_one_log_line_per_waypoint_event",
+    ),
+    Rule(
         r"^source /opt/ros/",
         "ros",
         "tests/test_ros2_environment.py::test_a_ros2_process_talks_to_itself_on_a_private_domain",

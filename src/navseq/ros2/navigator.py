@@ -40,8 +40,11 @@ simulation does) it is ROS time from ``/clock``; :meth:`wait_for_server` then wa
 bounded, for a valid (non-zero) clock, so no timeout counts from time 0. Goals are
 stamped with that clock.
 
-rclpy is initialised in a context of this navigator's own, without rclpy's signal
-handlers (navseq's runner handles SIGINT/SIGTERM), and shut down by :meth:`close`.
+The node: by default a :class:`~navseq.ros2.session.Ros2Session` of the navigator's
+own (rclpy in a context of its own, without rclpy's signal handlers: navseq's runner
+handles SIGINT/SIGTERM), shut down by :meth:`close`. The ROS 2 ``navseq_node`` hands
+its own session instead, so that its parameters, topics, services and the navigator's
+clients are one node; :meth:`close` then leaves the session to its owner.
 """
 
 from __future__ import annotations
@@ -54,18 +57,11 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-import rclpy
 from nav2_msgs.action import NavigateToPose
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path as PathMsg
 from rclpy.action import ActionClient
-from rclpy.executors import (
-    ExternalShutdownException,
-    ShutdownException,
-    SingleThreadedExecutor,
-)
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (
     DurabilityPolicy,
@@ -73,7 +69,6 @@ from rclpy.qos import (
     ReliabilityPolicy,
     qos_profile_sensor_data,
 )
-from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
@@ -97,6 +92,7 @@ from navseq.ros2.messages import (
     seconds_of,
     terminal_status,
 )
+from navseq.ros2.session import Ros2Session
 
 DEFAULT_ACTION = "navigate_to_pose"
 DEFAULT_NODE_NAME = "navseq"
@@ -132,7 +128,8 @@ class Nav2Navigator:
     simulator's and ROS 1's convention) and as plain ``odom`` ... on ``/robot1/tf``
     (Nav2's multi-robot launch). ``frame`` overrides each goal's frame (None: the
     goal's own). ``use_sim_time``: True, False, or None to follow ``/clock`` when it is
-    published (see the module docstring).
+    published (see the module docstring). ``session``: the node to use (its namespace
+    then applies, not ``namespace``'s node placement) instead of one of its own.
     """
 
     def __init__(
@@ -149,6 +146,7 @@ class Nav2Navigator:
         clock_wait: float = CLOCK_WAIT,
         cancel_wait: float = CANCEL_WAIT,
         lost_after: float = LOST_AFTER,
+        session: Ros2Session | None = None,
     ) -> None:
         self.namespace = namespace.strip("/")
         self.action = action
@@ -183,24 +181,27 @@ class Nav2Navigator:
         prefix = f"{self.namespace}/" if self.namespace else ""
         self._tf_base_frames = tuple(prefix + base for base in self.base_frames)
 
-        self._context = rclpy.Context()
-        rclpy.init(context=self._context, signal_handler_options=SignalHandlerOptions.NO)
-        try:
+        self._owns_session = session is None
+        if session is None:
             overrides = [Parameter("use_sim_time", value=True)] if use_sim_time else []
-            self._node = Node(
+            session = Ros2Session(
                 f"{node_name}_{os.getpid()}",  # unique, as ROS 1's anonymous nodes
                 namespace=self.namespace or None,
-                context=self._context,
                 parameter_overrides=overrides,
+                thread_name="navseq-nav2",
             )
-            self._setup_node(odom_topic, plan_topic, bool(use_sim_time))
+        self._session = session
+        self._context = session.context
+        self._node = session.node
+        try:
+            sim_time = bool(use_sim_time) or bool(self._node.get_parameter("use_sim_time").value)
+            # On a shared session the executor already spins: rclpy guards the node's
+            # entity lists, and no goal is out before these exist.
+            self._setup_node(odom_topic, plan_topic, sim_time)
         except BaseException:
-            rclpy.try_shutdown(context=self._context)
+            if self._owns_session:
+                session.close()
             raise
-        self._executor = SingleThreadedExecutor(context=self._context)
-        self._executor.add_node(self._node)
-        self._thread = threading.Thread(target=self._spin_ros, name="navseq-nav2", daemon=True)
-        self._thread.start()
 
     def _setup_node(self, odom_topic: str, plan_topic: str | None, sim_time: bool) -> None:
         node = self._node
@@ -223,14 +224,10 @@ class Nav2Navigator:
         if sim_time:
             self._watch_clock()
 
-    def _spin_ros(self) -> None:
-        with contextlib.suppress(ExternalShutdownException, ShutdownException):
-            self._executor.spin()
-
     def _in_ros(self, callback: Any, *args: Any) -> None:
         """Run ``callback(*args)`` on the executor's thread (rclpy is not used from two)."""
         if not self._closed:
-            self._executor.create_task(callback, *args)
+            self._session.call_soon(callback, *args)
 
     # -- Navigator protocol -----------------------------------------------------------
 
@@ -399,13 +396,10 @@ class Nav2Navigator:
         self._cancel_answered.wait(self.cancel_wait)
         self.now()  # keep the clock's last value for after close
         self._closed = True
-        self._executor.shutdown(timeout_sec=2.0)
-        self._thread.join(timeout=2.0)
-        with contextlib.suppress(Exception):
-            self._client.destroy()
-        with contextlib.suppress(Exception):
-            self._node.destroy_node()
-        rclpy.try_shutdown(context=self._context)
+        if self._owns_session:
+            with contextlib.suppress(Exception):
+                self._client.destroy()
+            self._session.close()
 
     # -- lookups -----------------------------------------------------------------------
 
