@@ -55,6 +55,7 @@ from __future__ import annotations
 import signal
 import sys
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import rospy
@@ -264,24 +265,29 @@ def run_node() -> int:
 
 def end_launch(mission_code: int) -> int:
     """Ask the roslaunch that started the node to shut down, then wait for it to stop us."""
-    why_not = end_parent_launch()
-    if why_not is not None:
-        rospy.logwarn("navseq: ~end_launch: %s; the node just exits", why_not)
-        return mission_code
-    return stay_up(mission_code, "mission over; ending the launch (~end_launch)")
+
+    def signal_roslaunch() -> str | None:
+        why_not = end_parent_launch()
+        return None if why_not is None else f"~end_launch: {why_not}"
+
+    return stay_up(
+        mission_code, "mission over; ending the launch (~end_launch)", then=signal_roslaunch
+    )
 
 
 def stay_up(
     mission_code: int,
     why: str = "mission over; staying up (~keep_alive) until shut down",
+    then: Callable[[], str | None] | None = None,
 ) -> int:
     """Keep the node (its latched topics and services) up until it is shut down.
 
     Returns ``mission_code`` however the node is stopped: the mission is over, so a
     signal interrupts nothing, and roslaunch (which stops nodes with SIGINT) should
-    not see a finished mission as a failure.
+    not see a finished mission as a failure. ``then`` runs once the node's signal
+    handlers are in place (ending the launch sends a SIGINT that comes straight back);
+    a reason it returns means there is nothing to wait for: the node just exits.
     """
-    rospy.loginfo("navseq: %s", why)
     # rospy's own signal handlers are off (see ensure_node); the node's are set here.
     stop_signal: list[str] = []
     stopping = threading.Event()
@@ -292,6 +298,10 @@ def stay_up(
 
     previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
+        rospy.loginfo("navseq: %s", why)
+        if then is not None and (why_not := then()) is not None:
+            rospy.logwarn("navseq: %s; the node just exits", why_not)
+            return mission_code
         while not stopping.is_set() and not rospy.core.is_shutdown_requested():
             stopping.wait(KEEP_ALIVE_POLL)
     finally:
