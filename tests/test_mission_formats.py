@@ -30,6 +30,18 @@ def poses(mission: Mission) -> list[tuple[float, float, float]]:
 # --- the tutorial's formats ----------------------------------------------------------
 
 
+def test_a_ros2_params_file_for_the_node_named_navseq_is_the_tutorials_lists():
+    """`navseq: {ros__parameters: {p_seq, yea_seq}}`: the node's name, not a format version."""
+    mission = load_mission(EXAMPLES / "tutorial_params_ros2.yaml")
+    assert [(w.x, w.y) for w in mission.waypoints] == [
+        (-1.6, -0.5),
+        (0.5, -1.6),
+        (1.6, 0.5),
+        (-0.5, 1.6),
+    ]
+    assert [w.yaw_deg for w in mission.waypoints] == pytest.approx([-30.0, 60.0, 150.0, -120.0])
+
+
 def test_tutorial_launch_file_gives_its_three_waypoints_with_yaws_in_radians():
     mission = load_mission(EXAMPLES / "tutorial_move_base_seq.launch")
     assert [(w.x, w.y, w.z) for w in mission.waypoints] == [

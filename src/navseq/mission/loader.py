@@ -128,10 +128,24 @@ def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mi
 
 
 def _is_rosparam_tree(doc: Located | None) -> bool:
-    """A mapping without navseq's own top-level keys, giving p_seq/yea_seq somewhere."""
-    if doc is None or not doc.is_mapping or any(key in doc.value for key in _NAVSEQ_KEYS):
+    """A mapping without navseq's own top-level keys, giving p_seq/yea_seq somewhere.
+
+    A ROS 2 params file for the node named ``navseq`` (``navseq: {ros__parameters:
+    {p_seq: ...}}``) is a parameter tree too: its ``navseq`` key is a node's name, not
+    the format version of a navseq mission.
+    """
+    if doc is None or not doc.is_mapping:
+        return False
+    own_keys = [key for key in doc.value if key in _NAVSEQ_KEYS]
+    if own_keys != [] and not (
+        own_keys == ["navseq"] and _is_ros2_node_section(doc.value["navseq"])
+    ):
         return False
     return bool(find_mission_namespaces(doc))
+
+
+def _is_ros2_node_section(node: Located) -> bool:
+    return node.is_mapping and "ros__parameters" in node.value
 
 
 def _read_launch(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:

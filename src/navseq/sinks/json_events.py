@@ -114,7 +114,7 @@ def clock_record(navigator_seconds: float, wall_seconds: float) -> dict[str, flo
     factor = navigator_seconds / wall_seconds if wall_seconds > 0.0 else None
     return {
         "navigator_s": round(navigator_seconds, 3),
-        "wall_s": round(wall_seconds, 3),
+        "wall_s": round(wall_seconds, 6),
         "real_time_factor": round(factor, 3) if factor is not None else None,
     }
 
