@@ -23,8 +23,8 @@ A patrol journals for weeks, so the journal grows with the events that matter, n
 with time: every visit's start, finish and failed attempts are kept, with the first
 plan of each attempt (as corners, :data:`PATH_TOLERANCE`); the driven path is kept as
 a thinned polyline of ``WaypointProgress`` events (:mod:`navseq.sinks.journal_progress`:
-its corners, one at every visit's end, and one at least every :data:`HEARTBEAT`
-seconds). Positions in progress and plans are written to 0.1 mm.
+its corners, the pose at every arrival, and one at least every :data:`HEARTBEAT`
+seconds). Times and positions in progress and plans are written to 0.1 mm (0.1 ms).
 
 Every line ends with ``"chain"``: the first 16 hex digits of the sha256 of the previous
 line's chain and this line's record. A journal whose lines were edited, deleted or
@@ -75,8 +75,8 @@ from navseq.sinks.journal_state import (
 )
 from navseq.track import simplify_path
 
-#: Decimals of the positions (m), angles (rad) and distances written in progress and
-#: plan records: 0.1 mm, where the full float took 18 digits for nothing.
+#: Decimals of the times (s), positions (m), angles (rad) and distances written in
+#: progress and plan records: 0.1 mm, where the full float took 18 digits for nothing.
 POSITION_DECIMALS = 4
 
 
@@ -208,8 +208,8 @@ class JournalWriter:
             self._plan_journaled = False
         elif isinstance(event, ev.WaypointStarted):
             self._plan_journaled = False
-        elif isinstance(event, (ev.WaypointFinished, ev.MissionPaused, ev.MissionFinished)):
-            latest = self._progress.flush()  # where the robot was at the end
+        elif isinstance(event, _ARRIVALS):
+            latest = self._progress.flush()  # where the robot was when it arrived or stopped
             if latest is not None:
                 self._write_event(latest)
         self._write_event(event)
@@ -217,9 +217,10 @@ class JournalWriter:
     def _write_event(self, event: ev.MissionEvent) -> None:
         record = {"kind": "event", "type": type(event).__name__, **dataclasses.asdict(event)}
         if isinstance(event, ev.WaypointProgress):
-            for name in ("x", "y", "yaw", "distance_remaining", "distance_driven"):
+            for name in ("t", "x", "y", "yaw", "distance_remaining", "distance_driven"):
                 record[name] = _rounded(record[name])
         elif isinstance(event, ev.WaypointPlan):
+            record["t"] = _rounded(record["t"])
             corners = simplify_path(event.path, PATH_TOLERANCE)
             record["path"] = [[_rounded(x), _rounded(y)] for x, y in corners]
         self._write(record)
@@ -255,6 +256,10 @@ class JournalWriter:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+
+#: Events before which the latest pose is journaled, so the path ends where the robot was.
+_ARRIVALS = (ev.WaypointDwelling, ev.WaypointFinished, ev.MissionPaused, ev.MissionFinished)
 
 
 def _rounded(value: float | None) -> float | None:

@@ -116,9 +116,23 @@ def event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | N
         return None
     values: dict[str, Any] = {}
     try:
-        for name, convert in _field_converters(cls):
-            if name in record:
-                values[name] = convert(record[name])
+        # The common field types are checked inline: a long journal has millions of
+        # lines, and reading it must stay a matter of seconds. JSON gives exact types.
+        for name, kind, convert in _field_specs(cls):
+            if name not in record:
+                continue
+            value = record[name]
+            if kind is float:
+                if type(value) is int:
+                    value = float(value)
+                elif type(value) is not float:
+                    raise TypeError(f"expected a float, got {value!r}")
+            elif kind is not None:
+                if type(value) is not kind:
+                    raise TypeError(f"expected a {kind.__name__}, got {value!r}")
+            else:
+                value = convert(value)
+            values[name] = value
         return cls(**values)
     except (TypeError, ValueError) as error:
         raise NavseqError(
@@ -127,14 +141,18 @@ def event_from_record(record: dict[str, Any], where: str) -> ev.MissionEvent | N
 
 
 @functools.cache
-def _field_converters(cls: type) -> tuple[tuple[str, Callable[[Any], Any]], ...]:
-    """Each field's name and checking converter, built once per event class.
-
-    Built once rather than inspecting the type hints on every line: a long journal has
-    millions of lines, and reading it must stay a matter of seconds.
-    """
+def _field_specs(cls: type) -> tuple[tuple[str, type | None, Callable[[Any], Any]], ...]:
+    """Each field's name, its plain type (float, int, str, bool) or None, and a checking
+    converter for the others; built once per event class, not once per line."""
     hints = get_type_hints(cls)
-    return tuple((spec.name, _converter(hints[spec.name])) for spec in dataclasses.fields(cls))
+    return tuple(
+        (
+            spec.name,
+            hints[spec.name] if hints[spec.name] in (float, int, str, bool) else None,
+            _converter(hints[spec.name]),
+        )
+        for spec in dataclasses.fields(cls)
+    )
 
 
 def _converter(hint: Any) -> Callable[[Any], Any]:
