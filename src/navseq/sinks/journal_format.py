@@ -161,6 +161,8 @@ def _converter(hint: Any) -> Callable[[Any], Any]:
     if origin in (Union, types.UnionType):
         options = get_args(hint)
         optional = type(None) in options
+        if optional and len(options) == 2 and float in options:
+            return _optional_float
         inner = [_converter(option) for option in options if option is not type(None)]
 
         def union(value: Any) -> Any:
@@ -185,6 +187,8 @@ def _converter(hint: Any) -> Callable[[Any], Any]:
                 return tuple(each(item) for item in value)
 
             return sequence
+        if items == (float, float):
+            return _point
         fixed = [_converter(item) for item in items]
 
         def record(value: Any) -> Any:
@@ -216,3 +220,23 @@ def _converter(hint: Any) -> Callable[[Any], Any]:
         raise TypeError(f"expected a {getattr(hint, '__name__', hint)}, got {value!r}")
 
     return unknown
+
+
+def _optional_float(value: Any) -> float | None:
+    kind = type(value)
+    if kind is float or value is None:
+        return value
+    if kind is int:
+        return float(value)
+    raise TypeError(f"expected a float or null, got {value!r}")
+
+
+def _point(value: Any) -> tuple[float, float]:
+    """An (x, y) pair: checked inline, since plans hold thousands of them."""
+    if type(value) is list and len(value) == 2:
+        x, y = value
+        if type(x) is float and type(y) is float:
+            return x, y
+        if type(x) in (int, float) and type(y) in (int, float):
+            return float(x), float(y)
+    raise TypeError(f"expected an [x, y] pair of numbers, got {value!r}")
