@@ -15,7 +15,7 @@
    journal: simulating 10⁶ s takes half an hour; the lines are the writers' own). Then
    measures, each in a fresh process: ``navseq report`` rebuilding the report and
    picture, and ``navseq run --resume`` up to its first goal, then SIGTERM to exit
-   (report and picture written): wall times and peak resident memory. With
+   (report and picture written): wall and CPU times, peak resident memory. With
    ``--before-src DIR`` (the ``src`` folder of an earlier navseq, e.g. from ``git
    archive``) the same commands run with that navseq too, side by side.
 
@@ -244,6 +244,7 @@ def synthetic_journal(source: Path, target: Path, seconds: float) -> tuple[float
 @dataclasses.dataclass
 class Measured:
     wall_s: float
+    cpu_s: float  # user + system, of the whole process
     peak_mb: float
     exit_code: int
     first_goal_s: float | None = None  # --resume: from start to its first goal
@@ -260,11 +261,11 @@ def navseq_command(src: Path | None, journal: Path) -> tuple[list[str], dict[str
     return [sys.executable, "-m", "navseq"], env
 
 
-def wait_measured(process: subprocess.Popen[Any]) -> tuple[int, float]:
-    """Wait for a child; its exit status and peak resident memory (MB)."""
+def wait_measured(process: subprocess.Popen[Any]) -> tuple[int, float, float]:
+    """Wait for a child; its exit status, CPU seconds and peak resident memory (MB)."""
     _, status, usage = os.wait4(process.pid, 0)
     process.returncode = os.waitstatus_to_exitcode(status)
-    return process.returncode, usage.ru_maxrss / 1024.0
+    return process.returncode, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
 
 
 def measure_report(journal: Path, src: Path | None) -> Measured:
@@ -278,11 +279,11 @@ def measure_report(journal: Path, src: Path | None) -> Measured:
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )
-    code, peak = wait_measured(process)
+    code, cpu, peak = wait_measured(process)
     wall = time.perf_counter() - start
     if code != 0:
         print(process.stderr.read().decode() if process.stderr else "", file=sys.stderr)
-    return Measured(wall, peak, code)
+    return Measured(wall, cpu, peak, code)
 
 
 def measure_resume(journal: Path, src: Path | None) -> Measured:
@@ -305,11 +306,11 @@ def measure_resume(journal: Path, src: Path | None) -> Measured:
     signalled = time.perf_counter()
     process.send_signal(signal.SIGTERM)
     process.stdout.read()
-    code, peak = wait_measured(process)
+    code, cpu, peak = wait_measured(process)
     ended = time.perf_counter()
     if code != 143:
         print(process.stderr.read() if process.stderr else "", file=sys.stderr)
-    return Measured(ended - start, peak, code, first_goal, ended - signalled)
+    return Measured(ended - start, cpu, peak, code, first_goal, ended - signalled)
 
 
 def resume_table(
@@ -322,6 +323,7 @@ def resume_table(
         "navseq",
         "command",
         "wall s",
+        "CPU s",
         "peak MB",
         "exit",
         "first goal after s",
@@ -348,6 +350,7 @@ def resume_table(
                     code_name,
                     f"navseq {command}",
                     f"{measured.wall_s:.1f}",
+                    f"{measured.cpu_s:.1f}",
                     f"{measured.peak_mb:.0f}",
                     str(measured.exit_code),
                     "" if measured.first_goal_s is None else f"{measured.first_goal_s:.1f}",

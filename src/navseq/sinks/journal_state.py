@@ -221,7 +221,7 @@ class JournalState:
     finish_reason: str | None = None  # of the last segment, if it finished
     chain: str = ""  # digest of the last intact line: a resumed run chains on from it
     size: int = 0  # bytes read: a resume appends only to the journal it read
-    events: int = 0  # events read
+    event_count: int = 0  # events read
     recorder: RunRecorder = field(default_factory=RunRecorder)  # path and legs, bounded
 
     def is_current(self) -> bool:
@@ -275,7 +275,7 @@ def _fold(state: JournalState, reader: JournalReader) -> None:
             continue
         assert isinstance(entry, Event)
         event = entry.event
-        state.events += 1
+        state.event_count += 1
         recorder(event)
         if isinstance(event, ev.MissionStarted):
             segment_start = event.t
