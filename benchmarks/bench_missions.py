@@ -66,7 +66,7 @@ from navseq.sim.profile import SimSettings
 from navseq.sim.world import SimWorld
 
 POLICIES = {
-    "stall 30 s": Policy(stall_timeout=30.0, on_failure=FailureAction.SKIP),
+    "stall 30 s": Policy(stall_timeout_s=30.0, on_failure=FailureAction.SKIP),
     # The same without the executor's stall measure: what the robot itself achieves.
     "no stall limit": Policy(on_failure=FailureAction.SKIP),
 }
@@ -160,7 +160,7 @@ def run_one(
     world = SimWorld(
         grid, mission.start, costmap=costmap, nav_params=sim.nav_params, footprint=sim.footprint
     )
-    watch = _StallWatch(runnable.defaults.stall_timeout or 0.0)
+    watch = _StallWatch(runnable.defaults.stall_timeout_s or 0.0)
     result = run_mission(runnable, SimNavigator(world), [watch])
     stats.stalls_on_plan += watch.stalls_on_plan
     leg_start: Pose2D | None = mission.start  # None: where the robot gave up, unknown

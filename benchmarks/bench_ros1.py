@@ -139,7 +139,7 @@ def role_navseq_client(goals: int, tick: float, settle: float) -> None:
 
     mission = Mission(
         waypoints=tuple(Waypoint(x, y, yaw_rad=yaw) for x, y, yaw in bench_goals(goals)),
-        defaults=Policy(goal_timeout=10.0, on_failure=FailureAction.STOP),
+        defaults=Policy(goal_timeout_s=10.0, on_failure=FailureAction.STOP),
         source="<bench_ros1>",
     )
     navigator = Ros1Navigator(ACTION, node_name="bench_navseq", settle=settle)

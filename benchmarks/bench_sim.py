@@ -42,7 +42,7 @@ def with_pass_through(mission: Mission, radius: float | None) -> Mission:
     """The mission with every waypoint's pass_through override set to ``radius``."""
     waypoints = tuple(
         dataclasses.replace(
-            wp, overrides=MappingProxyType({**wp.overrides, "pass_through": radius})
+            wp, overrides=MappingProxyType({**wp.overrides, "pass_through_m": radius})
         )
         for wp in mission.waypoints
     )

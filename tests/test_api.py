@@ -60,6 +60,45 @@ def test_a_yaw_without_a_unit_is_refused_with_a_clear_message():
     assert navseq.Waypoint(1.0, 2.0, yaw_rad=math.pi).yaw_deg == pytest.approx(180.0)
 
 
+def test_a_policy_names_its_units_and_refuses_a_name_without_one():
+    with pytest.raises(TypeError, match=r"yaw_tolerance_deg= \(degrees"):
+        navseq.Policy(yaw_tolerance=10)  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match=r"goal_timeout_s= \(seconds"):
+        navseq.Policy(goal_timeout=60)  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match="not both"):
+        navseq.Policy(yaw_tolerance_deg=10, yaw_tolerance_rad=0.2)
+    # Degrees as in mission files, or radians; either way the same policy.
+    by_degrees = navseq.Policy(yaw_tolerance_deg=10, xy_tolerance_m=0.1, dwell_s=2)
+    assert by_degrees == navseq.Policy(
+        yaw_tolerance_rad=math.radians(10), xy_tolerance_m=0.1, dwell_s=2
+    )
+    assert by_degrees.yaw_tolerance_deg == pytest.approx(10)
+    # A waypoint's overrides use the same names, checked when the waypoint is made.
+    with pytest.raises(TypeError, match="dwell_s="):
+        navseq.Waypoint(1.0, 2.0, yaw_deg=0, overrides={"dwell": 5})
+    waypoint = navseq.Waypoint(1.0, 2.0, yaw_deg=0, overrides={"yaw_tolerance_deg": 5})
+    assert dict(waypoint.overrides) == {"yaw_tolerance_rad": pytest.approx(math.radians(5))}
+    assert by_degrees.with_overrides(waypoint.overrides).yaw_tolerance_deg == pytest.approx(5)
+
+
+def test_mission_files_keep_their_keys_and_degrees(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text(
+        "defaults: {goal_timeout: 30, yaw_tolerance: 10, xy_tolerance: 0.1}\n"
+        "waypoints:\n  - {x: 1, y: 2, yaw: 0, dwell: 4, pass_through: 0.3}\n"
+    )
+    mission = navseq.load_mission(path)
+    policy = mission.policy_for(0)
+    assert (policy.goal_timeout_s, policy.xy_tolerance_m) == (30.0, 0.1)
+    assert policy.yaw_tolerance_deg == pytest.approx(10.0)
+    assert (policy.dwell_s, policy.pass_through_m) == (4.0, 0.3)
+    from navseq.mission import dump_mission_yaml
+
+    written = dump_mission_yaml(mission)
+    assert "yaw_tolerance: 10" in written and "goal_timeout: 30" in written
+    assert "dwell: 4" in written and "_s:" not in written and "_m:" not in written
+
+
 def test_check_mission_lists_every_problem_and_simulate_refuses_to_start(tmp_path):
     mission = navseq.Mission(
         (

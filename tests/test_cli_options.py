@@ -74,6 +74,27 @@ def test_from_and_to_run_that_part_numbered_as_in_the_file(tmp_path):
     assert [visit["name"] for visit in report["visits"]] == ["c", "d", "e"]
 
 
+def test_a_part_that_stops_says_the_files_number_everywhere(tmp_path):
+    """Waypoint 4 (the part's second) fails: every message says 4, as the table does."""
+    result = scripted(tmp_path, "--from", "3", "--to", "5", "--scripted-script", "succeed,aborted")
+    assert result.returncode == 1, result.stderr
+    reason = "stopped: waypoint 4 'd' failed (ABORTED)"
+    assert f"mission finished: {reason}" in result.stdout  # the progress line
+    assert f"six.yaml (waypoints 3-5 of 6, --from 3 --to 5): {reason}" in result.stdout
+    assert "waypoint 2 " not in result.stdout and "waypoint 1 " not in result.stdout
+    report = report_of(tmp_path)
+    assert report["reason"] == reason
+    assert [visit["number"] for visit in report["visits"]] == [3, 4, 5]
+    # --json: index is the position in the part, number the file's, as in the report.
+    as_json = scripted(
+        tmp_path, "--from", "3", "--to", "5", "--scripted-script", "succeed,aborted", "--json"
+    )
+    records = [json.loads(line) for line in as_json.stdout.splitlines()]
+    finished = [r for r in records if r["event"] == "WaypointFinished"]
+    assert [(r["index"], r["number"]) for r in finished] == [(0, 3), (1, 4)]
+    assert records[-1]["event"] == "RunFinished" and records[-1]["reason"] == reason
+
+
 def test_only_takes_names_and_numbers_in_the_missions_order(tmp_path):
     result = scripted(tmp_path, "--only", "e,2")
     assert result.returncode == 0, result.stderr

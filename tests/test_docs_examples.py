@@ -55,6 +55,19 @@ RULES: tuple[Rule, ...] = (
     Rule(r"^make demo\b", "make"),
     Rule(r"(^|/)pytest\b", "collect"),
     Rule(
+        r"colcon build|^sudo apt install ros-|^source install/|~/ws|rosdep install --from-paths"
+        r"|^ros2 launch (navseq |launch/)sim_navseq\.launch\.py",
+        "ros",
+        "tests/test_ros2_package.py::"
+        "test_colcon_builds_the_package_and_ros2_run_and_launch_complete_the_mission",
+    ),
+    Rule(
+        r"ros2 run navseq navseq_node|-m navseq\.ros2\.(navseq_node|sim_node --speed)|^PATH=",
+        "ros",
+        "tests/test_ros2_node.py::"
+        "test_the_tutorial_params_alone_complete_with_one_log_line_per_waypoint_event",
+    ),
+    Rule(
         r"^source /opt/ros/",
         "ros",
         "tests/test_ros2_environment.py::test_a_ros2_process_talks_to_itself_on_a_private_domain",
@@ -114,7 +127,7 @@ RULES: tuple[Rule, ...] = (
     Rule(
         r"roslaunch navseq demo\.launch",
         "ros",
-        "tests/test_launch_files.py::test_demo_launch_completes_the_example_mission",
+        "tests/test_launch_files.py::test_demo_launch_completes_the_example_mission_and_ends_quietly",
     ),
     Rule(
         r"roslaunch navseq sim\.launch",
@@ -142,6 +155,12 @@ RULES: tuple[Rule, ...] = (
         "tests/test_ros_race.py::test_the_race_option_gives_a_client_that_sends_at_once_a_far_succeeded",
     ),
     Rule(r"--navigator ros1", "ros", "tests/test_cli_ros1.py::test_ros1_run_completes_and_reports"),
+    Rule(
+        r"--navigator nav2",
+        "ros",
+        "tests/test_ros2_navigator.py::"
+        "test_the_example_mission_completes_with_the_same_visits_as_on_the_simulator",
+    ),
     Rule(
         r"navseq record\b",
         "ros",

@@ -106,12 +106,12 @@ def test_the_robot_profiles_tolerance_applies_where_the_waypoint_sets_none() -> 
 
 def test_the_waypoints_tolerance_wins_over_the_robot_profiles() -> None:
     loose = replace(DEFAULT_PROFILE, goal_tolerance=GoalTolerance(0.5, 1.0))
-    h = Harness(_one_waypoint(xy_tolerance=0.05), robot=loose)
+    h = Harness(_one_waypoint(xy_tolerance_m=0.05), robot=loose)
     h.start(0.0)
     h.succeed(1.0, pose=Pose2D(0.5, 0.0, 0.0))
     assert h.executor.result.visits[0].reason == "succeeded far from goal (0.50 m)"
 
-    lenient = Harness(_one_waypoint(xy_tolerance=1.0, yaw_tolerance=math.pi))
+    lenient = Harness(_one_waypoint(xy_tolerance_m=1.0, yaw_tolerance_rad=math.pi))
     lenient.start(0.0)
     lenient.succeed(1.0, pose=Pose2D(0.2, 0.0, 3.0))
     assert lenient.executor.result.visits[0].outcome is WaypointOutcome.REACHED
@@ -158,7 +158,7 @@ def test_the_yaw_limit_is_the_tolerance_plus_slack() -> None:
 
 
 def test_a_pass_through_visit_is_not_checked() -> None:
-    h = Harness(line_mission(2, pass_through=0.3))
+    h = Harness(line_mission(2, pass_through_m=0.3))
     h.start(0.0)
     h.succeed(0.1, pose=Pose2D(0.0, 0.0, 0.0))  # first visit passes through: not a stop
     assert h.executor.result.visits[0].outcome is WaypointOutcome.REACHED

@@ -37,7 +37,7 @@ def run_with_a_failing_first_attempt(listeners: list = ()):  # type: ignore[no-u
         speed=0.25,
         step=0.05,
     )
-    mission = line_mission(3, retries=1, stall_timeout=3.0, on_failure=FailureAction.SKIP)
+    mission = line_mission(3, retries=1, stall_timeout_s=3.0, on_failure=FailureAction.SKIP)
     return mission, run_mission(mission, navigator, listeners)
 
 
@@ -71,7 +71,7 @@ def test_report_lists_every_attempt_of_every_visit() -> None:
     assert [a["number"] for a in attempts] == [1, 2]
     assert attempts[0]["status"] == "ABORTED" and attempts[0]["text"] == NO_PLAN
     assert set(attempts[0]) == {
-        "number", "reached", "status", "reason", "text", "duration_s", "distance_m",
+        "number", "reached", "status", "reason", "text", "duration_s", "distance_m", "recoveries",
     }  # fmt: skip
     assert report["visits"][1]["attempts"][1]["status"] is None
     assert [a["reached"] for a in report["visits"][2]["attempts"]] == [True]
@@ -91,7 +91,7 @@ def test_summary_table_says_why_a_visit_was_not_reached() -> None:
 
 def test_progress_lines_and_json_carry_the_stacks_text() -> None:
     log, lines = io.StringIO(), io.StringIO()
-    mission = line_mission(3, retries=1, stall_timeout=3.0, on_failure=FailureAction.SKIP)
+    mission = line_mission(3, retries=1, stall_timeout_s=3.0, on_failure=FailureAction.SKIP)
     plain = LogProgress(mission, log)
     as_json = JsonProgress(lines)
     run_with_a_failing_first_attempt([plain, as_json])

@@ -213,7 +213,7 @@ def test_server_lost_during_back_off_waits_before_the_retry() -> None:
 
 
 def test_goal_timeout_cancels_and_counts_from_each_attempts_send() -> None:
-    h = Harness(line_mission(1, goal_timeout=10.0, retries=1))
+    h = Harness(line_mission(1, goal_timeout_s=10.0, retries=1))
     h.start(0.0)
     assert h.tick(9.9) == []
     commands = h.tick(10.0)
@@ -229,7 +229,7 @@ def test_goal_timeout_cancels_and_counts_from_each_attempts_send() -> None:
 
 
 def test_stall_timeout_fires_only_without_progress() -> None:
-    h = Harness(line_mission(1, stall_timeout=5.0))
+    h = Harness(line_mission(1, stall_timeout_s=5.0))
     h.start(0.0)
     h.feedback(1.0, Pose2D(-3.0, 0.0), remaining=4.0)
     # Steady progress keeps it alive well past the stall timeout.
@@ -249,7 +249,7 @@ def test_stall_timeout_fires_only_without_progress() -> None:
 
 
 def test_turning_in_place_at_the_goal_is_progress_but_not_far_away() -> None:
-    h = Harness(line_mission(1, stall_timeout=3.0))
+    h = Harness(line_mission(1, stall_timeout_s=3.0))
     h.start(0.0)
     # At the goal position, turning towards the goal yaw (0) from pi/2.
     for step in range(8):
@@ -258,7 +258,7 @@ def test_turning_in_place_at_the_goal_is_progress_but_not_far_away() -> None:
         h.tick(2.0 * step)
     assert not h.of_type(AttemptFailed)
 
-    far = Harness(line_mission(1, stall_timeout=3.0))
+    far = Harness(line_mission(1, stall_timeout_s=3.0))
     far.start(0.0)
     for step in range(3):
         yaw = math.pi / 2 - 0.2 * step
@@ -268,7 +268,7 @@ def test_turning_in_place_at_the_goal_is_progress_but_not_far_away() -> None:
 
 
 def test_straight_line_progress_from_tick_poses_without_feedback() -> None:
-    h = Harness(line_mission(1, stall_timeout=2.0))
+    h = Harness(line_mission(1, stall_timeout_s=2.0))
     h.start(0.0)
     for step in range(10):
         h.tick(1.0 * step, Pose2D(-5.0 + 0.5 * step, 0.0))
@@ -318,7 +318,7 @@ def test_on_failure_retry_retries_without_limit() -> None:
 
 
 def test_pass_through_sends_next_goal_without_cancel() -> None:
-    h = Harness(line_mission(3, pass_through=0.3))
+    h = Harness(line_mission(3, pass_through_m=0.3))
     h.start(0.0)
     h.feedback(1.0, Pose2D(0.6, 0.0), remaining=0.4)
     assert len(h.goals()) == 1
@@ -341,7 +341,7 @@ def test_pass_through_sends_next_goal_without_cancel() -> None:
 
 
 def test_pass_through_is_off_when_the_waypoint_dwells() -> None:
-    h = Harness(line_mission(2, pass_through=0.5, dwell=3.0))
+    h = Harness(line_mission(2, pass_through_m=0.5, dwell_s=3.0))
     h.start(0.0)
     h.feedback(1.0, Pose2D(0.9, 0.0), remaining=0.1)
     assert len(h.goals()) == 1
@@ -360,7 +360,7 @@ def test_pass_through_is_off_when_the_waypoint_dwells() -> None:
 
 
 def test_loops_n_times_and_passes_through_the_end_of_inner_loops_only() -> None:
-    h = Harness(line_mission(2, loops=2, pass_through=0.3))
+    h = Harness(line_mission(2, loops=2, pass_through_m=0.3))
     h.start(0.0)
     h.feedback(1.0, Pose2D(0.8, 0.0), remaining=0.2)  # pass p1 (loop 0)
     h.feedback(2.0, Pose2D(1.8, 0.0), remaining=0.2)  # pass p2: not last, loop 1 follows
@@ -426,7 +426,7 @@ def test_interrupt_cancels_and_leaves_the_rest_not_run() -> None:
 
 
 def test_operator_skip_goes_on_without_cancel_but_cancels_the_last_goal() -> None:
-    h = Harness(line_mission(3, on_failure=FailureAction.STOP, dwell=2.0))
+    h = Harness(line_mission(3, on_failure=FailureAction.STOP, dwell_s=2.0))
     h.start(0.0)
     commands = h.skip(1.0)
     assert commands == [SendGoal(h.goals()[-1].goal)]

@@ -32,7 +32,7 @@ REACHED = WaypointOutcome.REACHED
 
 
 def test_pause_cancels_the_goal_and_no_timeout_runs_out_while_paused() -> None:
-    h = Harness(line_mission(2, goal_timeout=10.0))
+    h = Harness(line_mission(2, goal_timeout_s=10.0))
     h.start(0.0)
     first = h.goal_id
     assert h._keep(h.executor.pause(4.0)) == [CancelGoal()]
@@ -57,7 +57,7 @@ def test_pause_cancels_the_goal_and_no_timeout_runs_out_while_paused() -> None:
 
 
 def test_the_stall_timeout_also_waits_for_the_resume() -> None:
-    h = Harness(line_mission(1, stall_timeout=5.0))
+    h = Harness(line_mission(1, stall_timeout_s=5.0))
     h.start(0.0)
     h.feedback(3.0, Pose2D(0.0, 0.0, 0.0))
     h.executor.pause(3.0)  # no progress since the goal went out: 3 of the 5 s are used
@@ -68,7 +68,7 @@ def test_the_stall_timeout_also_waits_for_the_resume() -> None:
 
 
 def test_a_dwell_paused_halfway_ends_after_its_remaining_time() -> None:
-    h = Harness(line_mission(2, dwell=10.0))
+    h = Harness(line_mission(2, dwell_s=10.0))
     h.start(0.0)
     h.succeed(2.0, Pose2D(1.0, 0.0, 0.0))
     assert h.executor.state is ExecutorState.DWELLING
@@ -176,7 +176,7 @@ def test_pause_resume_and_cancel_requests_from_another_thread() -> None:
         speed=0.1,
     )
     seen: list[object] = []
-    result = run_mission(line_mission(2, goal_timeout=5.0), nav, [seen.append], control=control)
+    result = run_mission(line_mission(2, goal_timeout_s=5.0), nav, [seen.append], control=control)
     for thread in nav.threads:
         thread.join(5.0)
     assert nav.answers == [

@@ -68,7 +68,7 @@ def far_goal(stall_timeout: float = 3.0) -> Mission:
     """One waypoint 2 m north of the start, as the crow flies."""
     return Mission(
         waypoints=(Waypoint(0.0, 2.0, yaw_rad=math.pi / 2, name="beyond the wall"),),
-        defaults=Policy(stall_timeout=stall_timeout, on_failure=FailureAction.SKIP),
+        defaults=Policy(stall_timeout_s=stall_timeout, on_failure=FailureAction.SKIP),
     )
 
 
@@ -181,7 +181,7 @@ def test_a_long_detour_on_the_simulator_is_driven_to_the_end_not_stalled() -> No
     mission = Mission(
         waypoints=(Waypoint(1.0, 3.0, yaw_rad=math.pi, name="behind the wall"),),
         # Far shorter than the detour takes at 0.22 m/s, longer than any pause on it.
-        defaults=Policy(stall_timeout=20.0, on_failure=FailureAction.SKIP),
+        defaults=Policy(stall_timeout_s=20.0, on_failure=FailureAction.SKIP),
     )
     result = run_mission(mission, navigator)
     visit = result.visits[0]

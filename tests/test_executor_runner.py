@@ -62,7 +62,7 @@ def test_each_failure_status_is_retried_then_skipped(status: str) -> None:
 
 def test_hanging_goal_times_out_is_cancelled_and_retried() -> None:
     nav = ScriptedNavigator([Hang()])
-    result, _ = run(line_mission(1, goal_timeout=5.0, retries=1), nav)
+    result, _ = run(line_mission(1, goal_timeout_s=5.0, retries=1), nav)
     assert result.success and result.visits[0].attempts == 2
     assert len(nav.cancels) == 1
     cancel_time, cancelled_goal = nav.cancels[0]
@@ -72,7 +72,7 @@ def test_hanging_goal_times_out_is_cancelled_and_retried() -> None:
 
 
 def test_stalled_robot_is_cancelled_with_reason_stalled() -> None:
-    mission = line_mission(1, stall_timeout=2.0, retries=1, clear_costmaps_on_retry=True)
+    mission = line_mission(1, stall_timeout_s=2.0, retries=1, clear_costmaps_on_retry=True)
     nav = ScriptedNavigator([Stall(after=0.3)], speed=0.5)
     result, events = run(mission, nav)
     failures = [e for e in events if isinstance(e, AttemptFailed)]
@@ -85,7 +85,7 @@ def test_stalled_robot_is_cancelled_with_reason_stalled() -> None:
 
 def test_slow_turn_at_the_goal_is_not_a_stall() -> None:
     # 3 rad at 0.1 rad/s takes 30 s, ten times the stall timeout.
-    mission = line_mission(1, stall_timeout=3.0)
+    mission = line_mission(1, stall_timeout_s=3.0)
     mission = mission.__class__(
         waypoints=(mission.waypoints[0].__class__(1.0, 0.0, yaw_rad=3.0),),
         defaults=mission.defaults,
@@ -122,7 +122,7 @@ def test_server_lost_for_good_stops_the_mission() -> None:
 
 
 def test_pass_through_never_cancels_and_keeps_the_robot_rolling() -> None:
-    mission = line_mission(4, pass_through=0.25)
+    mission = line_mission(4, pass_through_m=0.25)
     nav = ScriptedNavigator()
     result, _ = run(mission, nav)
     assert result.success
@@ -136,7 +136,7 @@ def test_pass_through_never_cancels_and_keeps_the_robot_rolling() -> None:
 
 def test_dwell_holds_before_the_next_goal() -> None:
     nav = ScriptedNavigator()
-    result, _ = run(line_mission(2, dwell=4.0), nav)
+    result, _ = run(line_mission(2, dwell_s=4.0), nav)
     assert result.success
     assert nav.send_times[1] == pytest.approx(1.0 + 4.0, abs=0.25)
 

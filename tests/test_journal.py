@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 from pathlib import Path
 
@@ -430,3 +431,19 @@ def test_recorder_from_journal_keeps_earlier_segments_on_one_mission_clock(
     replayed = read_journal(path).recorder
     assert replayed.leg_plans() == recorder.leg_plans()
     assert np.allclose(replayed.trajectory(), recorder.trajectory(), equal_nan=True)
+
+
+def test_every_change_of_the_stacks_recovery_count_is_journaled(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    counts = [0] * 20 + [1] * 20 + [2] * 20  # Nav2 ran two recoveries on a straight drive
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        journal(MissionStarted(t=0.0, waypoint_count=1, loops=1))
+        journal(WaypointStarted(0.0, 0, 0, 1, 1, 2.0, 0.0, 0.0))
+        for step, count in enumerate(counts):
+            event = progress_event(step * 0.1, 0.02 * step)
+            journal(dataclasses.replace(event, recoveries=count, navigation_time=step * 0.1))
+        journal(WaypointFinished(6.0, 0, 0, WaypointOutcome.REACHED, 1, 6.0, 1.2))
+    kept = [r["recoveries"] for r in records(path) if r.get("type") == "WaypointProgress"]
+    assert kept == [0, 1, 2, 2]  # the first, each change, the arrival
+    [visit] = read_journal(path).visits.held()
+    assert [a.recoveries for a in visit.attempt_results] == [2]

@@ -92,6 +92,7 @@ def test_events_and_report_use_the_same_names_and_units_for_the_same_things(run)
     started = next(r for r in records if r["event"] == "WaypointStarted" and r["index"] == 1)
     visit = written["visits"][1]
     assert started["yaw_deg"] == visit["yaw_deg"] == 90.0  # degrees in both, not radians
+    assert started["number"] == visit["number"] == 2  # the number messages say
     finished = [r for r in records if r["event"] == "WaypointFinished"]
     for record, visit in zip(finished, written["visits"], strict=True):
         assert record["outcome"] == visit["outcome"]
@@ -103,6 +104,13 @@ def test_events_and_report_use_the_same_names_and_units_for_the_same_things(run)
     assert failed["reason"] == attempt["reason"] == "timeout"
     assert failed["duration_s"] == pytest.approx(attempt["duration_s"], abs=0.01)
     assert records[-1]["files"] == written["files"]
+    # How fast the simulator ran, said the same way in both, its ratio the factor.
+    clock = written["clock"]
+    assert records[-1]["clock"] == clock
+    assert clock["navigator_s"] == pytest.approx(written["totals"]["duration_s"], abs=0.5)
+    assert clock["real_time_factor"] == pytest.approx(
+        clock["navigator_s"] / clock["wall_s"], rel=0.01
+    )
     assert written["map"]["origin"] == {"x": -10.0, "y": -10.0, "yaw_deg": 0.0}
 
 
@@ -119,7 +127,11 @@ def test_the_schemas_catch_drift(run):
     assert problems(validator("events"), renamed)
     visit = {**written["visits"][0], "yaw": math.pi / 2}
     assert problems(validator("report"), {**written, "visits": [visit]})
-    assert problems(validator("report"), {**written, "schema_version": 2})
+    assert problems(validator("report"), {**written, "schema_version": 3})
+    assert problems(validator("report"), {**written, "clock": {"real_time_factor": 2.0}})
+    finished = {**records[-1]}
+    del finished["clock"]
+    assert problems(validator("events"), finished)
 
 
 def test_a_report_rebuilt_from_the_journal_matches_the_schema(run, tmp_path):

@@ -138,7 +138,7 @@ def test_roslaunch_sim_launch_from_the_venv_serves_move_base(ros_master: RosMast
 def test_multi_robot_launch_drives_two_namespaced_robots_at_once(
     ros_master: RosMaster, tmp_path: Path
 ):
-    roslaunch(ros_master, "multi_robot.launch", f"speed:={SPEED}")
+    launch = roslaunch(ros_master, "multi_robot.launch", f"speed:={SPEED}")
     for robot in ("robot1", "robot2"):
         ros_master.wait_for_action_server(f"/{robot}/move_base", timeout=60)
     # robot1 starts at (-2, -0.5), robot2 at (2, 0.5) facing it: each crosses to the
@@ -166,12 +166,19 @@ def test_multi_robot_launch_drives_two_namespaced_robots_at_once(
         assert [r["state"] for r in results] == [SUCCEEDED, SUCCEEDED], results
         for (x, y), result in zip(goals, results, strict=True):
             assert math.dist(result["pose"][:2], (x, y)) < 0.1, result
+    # robot2 follows robot1's /clock: it must not republish its TF at an unchanged stamp
+    # (every TF listener, here each robot watching the other, would warn each time).
+    assert "TF_REPEATED_DATA" not in launch.output(), launch.output()[-4000:]
 
 
-def test_demo_launch_completes_the_example_mission(ros_master: RosMaster):
+def test_demo_launch_completes_the_example_mission_and_ends_quietly(ros_master: RosMaster):
     demo = roslaunch(ros_master, "demo.launch", f"speed:={SPEED}")
-    demo.wait(timeout=240)
-    assert "mission succeeded" in demo.output(), demo.output()[-4000:]
+    assert demo.wait(timeout=240) == 0, demo.output()[-4000:]
+    output = demo.output()
+    assert "mission succeeded" in output, output[-4000:]
+    # The node ends the launch as Ctrl-C would: no red banner for a mission that finished.
+    assert "ending the launch (~end_launch)" in output, output[-4000:]
+    assert "REQUIRED process" not in output and "has died" not in output, output[-4000:]
 
 
 def test_navseq_launch_with_only_the_tutorial_params_completes_on_the_sim(

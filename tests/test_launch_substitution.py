@@ -114,7 +114,7 @@ def test_the_launch_file_users_write(tmp_path, packages):
     mission = load_mission(path)
     assert poses(mission) == [(-1.0, -4.0, 90.0), (1.0, -4.0, 0.0)]
     assert mission.waypoints[0].where == f"{path}:6"
-    assert mission.defaults.goal_timeout == 30.0 and mission.defaults.retries == 2
+    assert mission.defaults.goal_timeout_s == 30.0 and mission.defaults.retries == 2
     assert mission.loops == 2
 
 

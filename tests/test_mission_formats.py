@@ -64,7 +64,7 @@ def test_launch_file_with_rosparam_yaml_body_in_a_group(tmp_path):
     )
     mission = load_mission(path)
     assert poses(mission) == [(0.5, -1.6, 60.0), (1.6, 0.5, 150.0)]
-    assert mission.defaults.goal_timeout == 45.0
+    assert mission.defaults.goal_timeout_s == 45.0
     assert mission.waypoints[0].where == f"{path}:5"
 
 
@@ -195,10 +195,10 @@ def test_patrol_example_has_every_setting():
     assert mission.loops is None  # forever
     assert mission.map == (EXAMPLES.parent / "maps" / "turtlebot3_world.yaml").resolve()
     assert mission.start is not None and (mission.start.x, mission.start.y) == (-2.0, -0.5)
-    assert mission.defaults.pass_through == 0.3
+    assert mission.defaults.pass_through_m == 0.3
     assert mission.defaults.on_failure is FailureAction.SKIP
     assert [w.name for w in mission.waypoints] == ["south", "east", "north", "west"]
-    assert mission.policy_for(3).dwell == 2.0 and mission.policy_for(0).dwell == 0.0
+    assert mission.policy_for(3).dwell_s == 2.0 and mission.policy_for(0).dwell_s == 0.0
 
 
 def test_navseq_yaml_orientation_forms_and_overrides(tmp_path):
@@ -226,9 +226,9 @@ waypoints:
     assert mission.waypoints[1].z == 0.5
     assert (mission.waypoints[5].x, mission.waypoints[5].y) == (1000.0, -0.25)
     assert mission.frame == "odom" and mission.loops == 3 and mission.server_timeout is None
-    assert mission.policy_for(0).pass_through == 0.3
+    assert mission.policy_for(0).pass_through_m == 0.3
     third = mission.policy_for(2)
-    assert third.pass_through is None and third.retries == 2 and third.goal_timeout == 60.0
+    assert third.pass_through_m is None and third.retries == 2 and third.goal_timeout_s == 60.0
     assert third.on_failure is FailureAction.RETRY
 
 
@@ -254,7 +254,7 @@ waypoints:
 """,
     )
     policy = load_mission(path).policy_for(0)
-    assert (policy.goal_timeout, policy.dwell) == (300.0, 5.0)
+    assert (policy.goal_timeout_s, policy.dwell_s) == (300.0, 5.0)
 
 
 def test_map_path_is_resolved_against_the_mission_folder(tmp_path):
@@ -301,8 +301,8 @@ def test_params_naming_a_mission_file_with_overrides():
         {"mission": str(EXAMPLES / "patrol.yaml"), "loops": 2, "goal_timeout": 10}
     )
     assert mission.loops == 2
-    assert mission.defaults.goal_timeout == 10.0
-    assert mission.defaults.pass_through == 0.3  # the file's own default stays
+    assert mission.defaults.goal_timeout_s == 10.0
+    assert mission.defaults.pass_through_m == 0.3  # the file's own default stays
     assert len(mission) == 4
 
 

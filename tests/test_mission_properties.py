@@ -218,13 +218,13 @@ positive = st.floats(min_value=1e-6, max_value=1e6)
 policy_values = st.fixed_dictionaries(
     {},
     optional={
-        "goal_timeout": st.none() | positive,
-        "stall_timeout": st.none() | positive,
+        "goal_timeout_s": st.none() | positive,
+        "stall_timeout_s": st.none() | positive,
         "retries": st.integers(0, 100),
         "clear_costmaps_on_retry": st.booleans(),
         "on_failure": st.sampled_from(FailureAction),
-        "pass_through": st.none() | st.floats(0, 100),
-        "dwell": st.floats(0, 1e4),
+        "pass_through_m": st.none() | st.floats(0, 100),
+        "dwell_s": st.floats(0, 1e4),
     },
 )
 # Names are one line of real text: no control characters, no lone surrogates.

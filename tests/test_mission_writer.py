@@ -46,11 +46,11 @@ def test_dump_is_plain_yaml_with_degrees_and_policy_overrides():
                 2.0,
                 yaw_deg=90,
                 name="dock",
-                overrides={"dwell": 5.0, "on_failure": FailureAction.SKIP},
+                overrides={"dwell_s": 5.0, "on_failure": FailureAction.SKIP},
             ),
             Waypoint(3.0, 4.0, yaw_rad=quaternion_to_yaw(0, 0, math.sqrt(0.5), math.sqrt(0.5))),
         ),
-        defaults=Policy(goal_timeout=60.0),
+        defaults=Policy(goal_timeout_s=60.0),
         loops=None,
     )
     text = dump_mission_yaml(mission)

@@ -30,9 +30,13 @@ def run_help() -> str:
 
 def test_navigator_choices_and_option_groups_come_from_the_registry() -> None:
     text = run_help()
-    assert "--navigator {sim,ros1}" in text  # the hidden test double is not offered
+    assert "--navigator {sim,ros1,nav2}" in text  # the hidden test double is not offered
     assert "sim: the embedded simulator (default); ros1: move_base over actionlib" in text
+    assert "nav2: ROS 2 Nav2's navigate_to_pose over rclpy" in text
     assert "ros1 navigator: --action ACTION" in text and "--settle S" in text
+    # --action, --frame and --ns are shared: listed once, under ros1.
+    assert "nav2 navigator: --server-timeout S" in text
+    assert "--use-sim-time auto|true|false" in text
     assert "scripted" not in text
     args = build_parser().parse_args(["run", "m.yaml", "--navigator", "scripted"])
     assert args.navigator == "scripted" and args.scripted_speed == 0.5
@@ -42,6 +46,8 @@ def test_every_kind_module_creates_a_navigator() -> None:
     for kind in registry.NAVIGATORS:
         if kind.name == "ros1":
             pytest.importorskip("rospy", reason="ROS 1 not installed")
+        if kind.name == "nav2":
+            continue  # imports rclpy: never in pytest's process (test_ros2_navigator.py)
         assert callable(importlib.import_module(kind.module).create), kind.name
 
 

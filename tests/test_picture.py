@@ -55,7 +55,7 @@ WAYPOINTS = (
     Waypoint(2.0, 0.0, yaw_rad=0.0),
     Waypoint(1.0, 1.0, yaw_rad=0.0, name="c"),
 )
-MISSION = Mission(WAYPOINTS, defaults=Policy(pass_through=0.3), source="demo.yaml")
+MISSION = Mission(WAYPOINTS, defaults=Policy(pass_through_m=0.3), source="demo.yaml")
 
 
 def result_of(*outcomes: WaypointOutcome) -> MissionResult:

@@ -136,6 +136,32 @@ def test_live_panel_shows_waypoint_status_distance_loop_and_attempt():
     assert "[    0.0 s] waypoint 1/3 'dock': going to (1.00, 0.00, 0°), attempt 1" in text
 
 
+def test_a_parts_panel_and_lines_number_waypoints_as_the_file_does():
+    """``--from 4`` of a five-waypoint file: the part's waypoints are the file's 4 and 5."""
+    import dataclasses
+
+    from navseq.mission.part import PartSpec
+
+    whole = dataclasses.replace(MISSION, waypoints=MISSION.waypoints + MISSION.waypoints[:2])
+    part = PartSpec(first=4).select(whole).apply(whole)
+    console = Console(file=io.StringIO(), width=100, force_terminal=True, color_system=None)
+    live = LiveProgress(part, console)
+    for event in (
+        MissionStarted(0.0, 2, 1, resumed_from=1),
+        WaypointStarted(0.0, 1, 0, 1, 1, 1.0, 0.0, 0.0),
+        WaypointFinished(5.0, 1, 0, WaypointOutcome.FAILED, 1, 5.0, 1.0, reason="ABORTED"),
+        MissionFinished(5.0, False, "stopped: waypoint 5 failed (ABORTED)"),
+    ):
+        live(event)
+    render = Console(file=io.StringIO(), width=100, record=True)
+    render.print(live.render())
+    text = render.export_text()
+    assert "4· 5✗" in text  # the marks under the panel
+    assert "resuming at waypoint 5" in text
+    assert "waypoint 5 (2/2): failed (ABORTED)" in text
+    assert "waypoint 2" not in text
+
+
 def test_log_lines_give_the_time_still_to_go_at_the_robots_top_speed() -> None:
     from navseq.executor.events import WaypointProgress, WaypointStarted
     from navseq.mission.robot import TURTLEBOT3_WAFFLE

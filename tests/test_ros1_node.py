@@ -60,6 +60,38 @@ def test_node_with_only_the_tutorial_params_completes_the_sequence(
     assert "Traceback" not in node.output()
 
 
+def log_lines(output: str, level: str) -> list[str]:
+    """The node's own rospy lines of one level, without rospy's ``[LEVEL] [stamps]: ``."""
+    return [
+        line.split("]: ", 1)[1]
+        for line in output.splitlines()
+        if line.startswith(f"[{level}]") and "]: navseq: " in line
+    ]
+
+
+def test_node_logs_one_line_per_waypoint_event_as_navseq_run_does_in_a_pipe(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, script="succeed:0.3 abort:0.2", then="succeed:0.3")
+    node = start_node(ros_master, retries=1)
+    assert node.wait(timeout=60) == 0, node.output()
+    info = log_lines(node.output(), "INFO")
+    waypoint_lines = [line for line in info if line.startswith("navseq: waypoint")]
+    assert waypoint_lines[0] == "navseq: waypoint 1/3: going to (-1.00, -4.00, 90°), attempt 1"
+    assert waypoint_lines[1].startswith("navseq: waypoint 1/3: reached after ")
+    assert "navseq: waypoint 2/3: going to (1.00, -4.00, 0°), attempt 2" in waypoint_lines
+    assert waypoint_lines[-1].startswith("navseq: waypoint 3/3: reached after ")
+    assert waypoint_lines[-1].endswith(", 1 attempt")
+    # Trouble is a warning, in the same words as navseq run's.
+    assert log_lines(node.output(), "WARN") == [
+        "navseq: waypoint 2/3: attempt 1 failed (ABORTED: scripted abort), will retry"
+    ]
+    # The end is said once, by the node (not also as "mission finished: ...").
+    assert info[-1] == "navseq: mission succeeded (completed)"
+    assert not any("mission finished" in line for line in info)
+
+
 def test_node_publishes_latched_status_and_markers(ros_master: RosMaster, tmp_path: Path):
     log = tmp_path / "server.jsonl"
     start_server(ros_master, log, then="hang")
@@ -129,7 +161,11 @@ def test_skip_service_skips_a_hanging_goal_and_the_mission_goes_on(
     goals = [(g["x"], g["y"]) for g in events(log, "goal")]
     assert goals == [(-1, -4), (1, -4), (1, -1)]
     assert [d["status"] for d in events(log, "done")] == ["PREEMPTED", "SUCCEEDED", "SUCCEEDED"]
-    assert "waypoint 1 skipped (skipped by the operator (~skip))" in node.output()
+    warnings = log_lines(node.output(), "WARN")
+    assert any(
+        line.startswith("navseq: waypoint 1/3: skipped (skipped by the operator (~skip)) after")
+        for line in warnings
+    ), node.output()
     wait_for(lambda: '\\"outcome\\": \\"skipped\\"' in status.output(), 10, "status")
     assert "Traceback" not in node.output()
 
@@ -233,3 +269,15 @@ def test_keep_alive_that_is_not_a_boolean_is_a_bad_param(ros_master: RosMaster):
     node = start_node(ros_master, keep_alive="sometimes")
     assert node.wait(timeout=30) == 2
     assert "keep_alive" in node.output() and "Traceback" not in node.output()
+
+
+def test_end_launch_outside_roslaunch_signals_nobody_and_exits_with_the_mission(
+    ros_master: RosMaster, tmp_path: Path
+):
+    """Under rosrun (here: the test's own process as parent) nobody is sent SIGINT."""
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = start_node(ros_master, end_launch=True)
+    assert node.wait(timeout=60) == 0, node.output()
+    assert "~end_launch: the parent process" in node.output(), node.output()
+    assert "is not roslaunch; the node just exits" in node.output(), node.output()

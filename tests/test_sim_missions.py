@@ -53,8 +53,8 @@ def test_pass_through_keeps_the_robot_moving() -> None:
         Waypoint(-0.55, -1.75, yaw_rad=0.0, name="corner"),
         Waypoint(1.75, -0.55, yaw_rad=math.pi / 2, name="end"),
     )
-    passing = Mission(waypoints, defaults=Policy(pass_through=0.3))
-    stopping = Mission(waypoints, defaults=Policy(pass_through=None))
+    passing = Mission(waypoints, defaults=Policy(pass_through_m=0.3))
+    stopping = Mission(waypoints, defaults=Policy(pass_through_m=None))
     nav_passing, nav_stopping = sim(), sim()
     result_passing = run_mission(passing, nav_passing)
     result_stopping = run_mission(stopping, nav_stopping)
@@ -69,7 +69,7 @@ def test_pass_through_keeps_the_robot_moving() -> None:
 def test_goal_timeout_cancels_and_skips_to_the_next_waypoint() -> None:
     mission = Mission(
         (
-            Waypoint(1.75, 1.0, yaw_rad=0.0, name="far", overrides={"goal_timeout": 5.0}),
+            Waypoint(1.75, 1.0, yaw_rad=0.0, name="far", overrides={"goal_timeout_s": 5.0}),
             Waypoint(-1.75, 0.55, yaw_rad=0.0, name="near"),
         ),
         defaults=Policy(on_failure=FailureAction.SKIP),

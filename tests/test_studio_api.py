@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import shutil
 import time
@@ -11,6 +12,7 @@ import pytest
 from starlette.testclient import TestClient
 
 from navseq.mission import load_mission
+from navseq.sinks.journal import HEARTBEAT
 from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
 from navseq.studio.security import FileRoots
 
@@ -326,3 +328,203 @@ def test_a_new_mission_on_a_map(workspace: Path) -> None:
     answer = client.post("/api/save", json={"mission": document, "version": None})
     assert answer.status_code == 200
     assert load_mission(mission_path).waypoints[0].x == -0.55
+
+
+# --- performance on big maps: the costmap is built once per (map, robot) --------------
+
+
+def test_validate_checks_against_a_costmap_it_is_given(workspace: Path) -> None:
+    """The core's ``costmaps`` parameter: pre-flight uses the costmap it hands back."""
+    from navseq.commands.common import costmap_for_robot
+    from navseq.commands.validate import mission_file_problems
+    from navseq.sim.occupancy import OccupancyGrid
+
+    path = workspace / "examples/turtlebot3_world.yaml"
+    asked: list[tuple[Path, str]] = []
+
+    def walled(map_path: Path, robot: object) -> object:
+        # The arena's map with every cell occupied: every waypoint is in an obstacle.
+        asked.append((map_path, robot.name))  # type: ignore[attr-defined]
+        from navseq.sim.occupancy import load_map
+
+        grid = load_map(map_path)
+        full = OccupancyGrid(grid.data * 0 + 100, grid.resolution, grid.origin, grid.source)
+        return costmap_for_robot(full)
+
+    _, plain = mission_file_problems(path)
+    _, errors = mission_file_problems(path, costmaps=walled)  # type: ignore[arg-type]
+    assert plain == []
+    assert asked == [((workspace / "maps/turtlebot3_world.yaml").resolve(), "turtlebot3_burger")]
+    assert len(errors) == 8 and all("obstacle" in error.message for error in errors)
+
+
+def test_checks_inflate_the_map_once_until_its_file_changes(
+    client: TestClient, workspace: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import navseq.commands.common as common
+
+    built: list[object] = []
+    real = common.costmap_for_robot
+
+    def counting(grid: object, robot: object = None) -> object:
+        built.append(robot)
+        return real(grid, robot)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(common, "costmap_for_robot", counting)
+    document = opened(client)["mission"]
+    for step in range(4):  # a drag: the same mission, one waypoint moved a little each time
+        document["waypoints"][2]["x"] = 0.55 + 0.01 * step
+        assert client.post("/api/check", json={"mission": document}).json()["problems"] == []
+    assert len(built) == 1
+    # Another robot is another costmap; the first one is still kept.
+    document["robot"] = "turtlebot3_waffle"
+    client.post("/api/check", json={"mission": document})
+    del document["robot"]
+    client.post("/api/check", json={"mission": document})
+    assert len(built) == 2
+    # The map's image changes on disk (a wall drawn over the third waypoint): the next
+    # check reads it again and says so.
+    import numpy as np
+    from PIL import Image
+
+    image_path = workspace / "maps/turtlebot3_world.pgm"
+    pixels = np.array(Image.open(image_path))
+    # The image's top row is y = -10 + 384 * 0.05 = 9.2 m; x starts at -10 m.
+    row, col = round((9.2 - 0.55) / 0.05), round((0.58 + 10.0) / 0.05)  # (0.58, 0.55)
+    pixels[row - 4 : row + 4, col - 4 : col + 4] = 0
+    Image.fromarray(pixels).save(image_path)
+    answer = client.post("/api/check", json={"mission": document}).json()
+    assert len(built) == 3
+    assert [problem["waypoint"] for problem in answer["problems"]] == [2]
+
+
+# --- files: import, export, the robot: section ------------------------------------------
+
+
+def test_the_import_list_offers_every_format_the_loader_reads(client: TestClient) -> None:
+    missions = client.get("/api/files").json()["missions"]
+    assert {
+        "tutorial_move_base_seq.launch",
+        "tutorial_params.yaml",
+        "recorded.csv",
+        "patrol.yaml",
+        "turtlebot3_world.yaml",
+    } <= set(missions)
+
+
+@pytest.mark.parametrize(
+    ("name", "count", "first"),
+    [
+        ("tutorial_move_base_seq.launch", 3, {"x": -1.0, "y": -4.0, "yaw": 90}),
+        ("tutorial_params.yaml", 4, {"x": -1.6, "y": -0.5, "yaw": -30}),
+        ("recorded.csv", 5, {"x": -1.6, "y": -0.5}),
+    ],
+)
+def test_the_tutorials_files_import_as_documents(
+    client: TestClient, name: str, count: int, first: dict
+) -> None:
+    answer = client.post("/api/import", json={"path": name})
+    assert answer.status_code == 200, answer.text
+    body = answer.json()
+    assert body["path"] == name and body["problems"] == []
+    waypoints = body["mission"]["waypoints"]
+    assert len(waypoints) == count
+    for key, value in first.items():
+        assert waypoints[0][key] == pytest.approx(value)
+    # The document checks like any other (a tutorial file names no map: no pre-flight).
+    assert client.post("/api/check", json={"mission": body["mission"]}).json()["readable"]
+
+
+def test_a_bad_or_missing_import_is_a_4xx_with_its_problems(
+    client: TestClient, workspace: Path
+) -> None:
+    (workspace / "examples/bad.launch").write_text(
+        '<launch><node pkg="p" type="t" name="n"><rosparam param="p_seq">[1, 2]</rosparam>'
+        '<rosparam param="yea_seq">[0]</rosparam></node></launch>',
+        encoding="utf-8",
+    )
+    answer = client.post("/api/import", json={"path": "bad.launch"})
+    assert answer.status_code == 422
+    assert "multiple of 3" in answer.json()["problems"][0]["text"]
+    assert client.post("/api/import", json={"path": "nope.csv"}).status_code == 404
+    assert client.post("/api/import", json={"path": "/etc/passwd"}).status_code == 422
+
+
+def test_export_writes_the_tutorials_launch_file_and_says_what_it_leaves_out(
+    client: TestClient, workspace: Path
+) -> None:
+    document = opened(client)["mission"]
+    answer = client.post("/api/export", json={"mission": document, "path": "seq.launch"})
+    assert answer.status_code == 200, answer.text
+    assert answer.json()["path"] == "seq.launch"
+    assert "waypoint names" in answer.json()["left_out"]
+    exported = load_mission(workspace / "examples/seq.launch")
+    assert [(w.x, w.y) for w in exported.waypoints] == [
+        (w["x"], w["y"]) for w in document["waypoints"]
+    ]
+    again = client.post("/api/export", json={"mission": document, "path": "seq.launch"})
+    assert again.status_code == 409 and again.json()["conflict"] == "exists"
+    confirmed = client.post(
+        "/api/export", json={"mission": document, "path": "seq.launch", "overwrite": True}
+    )
+    assert confirmed.status_code == 200
+    wrong = client.post("/api/export", json={"mission": document, "path": "seq.yaml"})
+    assert wrong.status_code == 422 and ".launch" in wrong.json()["error"]
+
+
+def test_a_mission_with_a_robot_section_saves_without_losing_it(
+    client: TestClient, workspace: Path
+) -> None:
+    body = opened(client)
+    document = body["mission"]
+    document["robot"] = {"base": "turtlebot3_waffle", "radius": 0.2, "max_angular_speed": 90}
+    answer = client.post(
+        "/api/save",
+        json={"mission": document, "version": body["version"], "overwrite": True},
+    )
+    assert answer.status_code == 200, answer.text
+    saved = load_mission(workspace / "examples/turtlebot3_world.yaml")
+    assert saved.robot is not None and saved.robot.circumscribed_radius == pytest.approx(0.2)
+    # Opened again, the section comes back as written, and saves again unchanged.
+    reopened = opened(client)
+    assert reopened["mission"]["robot"]["max_angular_speed"] == 90
+    again = client.post(
+        "/api/save",
+        json={"mission": reopened["mission"], "version": reopened["version"], "overwrite": True},
+    )
+    assert again.status_code == 200
+    assert load_mission(workspace / "examples/turtlebot3_world.yaml") == saved
+
+
+# --- past runs ---------------------------------------------------------------------------
+
+
+def test_a_past_run_replays_as_a_timeline(client: TestClient, workspace: Path) -> None:
+    document = opened(client)["mission"]
+    assert client.post("/api/run", json={"mission": document}).status_code == 200
+    finished = wait_for_run(client)
+    runs = client.get("/api/runs").json()["runs"]
+    assert [run["folder"] for run in runs] == [finished["folder"]]
+    assert runs[0]["reached"] == 7 and runs[0]["reason"] == "completed"
+    replay = client.get("/api/replay", params={"folder": finished["folder"]}).json()
+    assert replay["report"] == finished["report"]
+    assert len(replay["mission"]["waypoints"]) == 7
+    assert replay["duration_s"] == pytest.approx(finished["report"]["totals"]["duration_s"], 0.05)
+    times = [pose[0] for pose in replay["poses"]]
+    assert times == sorted(times) and times[-1] <= replay["duration_s"]
+    # The journal keeps the driven path's corners and the pose at every arrival.
+    assert len(replay["poses"]) >= 2 * 7
+    assert max(b - a for a, b in itertools.pairwise(times)) <= HEARTBEAT
+    # Waypoints go driving -> reached in turn; at the end every one is reached.
+    assert replay["states"][-1]["waypoints"] == ["reached"] * 7
+    first_reached = next(s for s in replay["states"] if s["waypoints"][0] == "reached")
+    assert first_reached["waypoints"][1:] in (["pending"] * 6, ["driving"] + ["pending"] * 5)
+    assert replay["plans"] and all(len(plan["points"]) >= 2 for plan in replay["plans"])
+
+
+def test_replay_refuses_what_is_not_a_run_folder(client: TestClient, workspace: Path) -> None:
+    assert client.get("/api/replay", params={"folder": "../../../etc"}).status_code == 422
+    (workspace / "out/navseq-out/empty").mkdir(parents=True)
+    answer = client.get("/api/replay", params={"folder": "navseq-out/empty"})
+    assert answer.status_code == 422 and "journal" in answer.json()["error"]
+    assert client.get("/api/replay").status_code == 400

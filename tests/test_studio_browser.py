@@ -10,6 +10,7 @@ Skipped with a reason where Chromium or Playwright is missing
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import signal
@@ -199,3 +200,161 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     page.screenshot(path=str(shot))
     assert page.errors == []  # type: ignore[attr-defined]
     assert process.poll() is None  # still serving
+
+
+def accept_dialogs(page: Any, answers: list[str] | None = None) -> list[str]:
+    """Accept every dialog (confirm; a prompt with the next of ``answers``).
+
+    Returns the messages seen; a later call on the same page adds answers to the queue.
+    """
+    if not hasattr(page, "dialog_answers"):
+        page.dialog_answers = []
+        page.dialogs_seen = []
+
+        def handle(dialog: Any) -> None:
+            page.dialogs_seen.append(dialog.message)
+            if dialog.type == "prompt" and page.dialog_answers:
+                dialog.accept(page.dialog_answers.pop(0))
+            else:
+                dialog.accept()
+
+        page.on("dialog", handle)
+    page.dialog_answers += answers or []
+    return page.dialogs_seen  # type: ignore[no-any-return]
+
+
+def message_of(page: Any, starts: str) -> str:
+    page.wait_for_function(
+        f"document.getElementById('message').textContent.startsWith({starts!r})", timeout=10_000
+    )
+    return str(page.locator("#message").inner_text())
+
+
+def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    url, workspace, _ = studio
+    second = page.context.browser.new_page(viewport={"width": 1400, "height": 860})
+    second.errors = []  # type: ignore[attr-defined]
+    second.on("pageerror", lambda error: second.errors.append(str(error)))
+    second.goto(url)
+    second.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+    accept_dialogs(page)
+    accept_dialogs(second)
+    # Each tab adds its own waypoint; the first saves, then the second.
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    checked_after(second, lambda: second.mouse.click(*screen_point(second, -0.55, 1.2)))
+    checked_after(second, lambda: second.mouse.click(*screen_point(second, 0.55, 1.2)))
+    page.get_by_test_id("save").click()
+    message_of(page, "saved")
+    second.get_by_test_id("save").click()
+    said = message_of(second, "turtlebot3_world.yaml changed on disk")
+    assert "nothing was written" in said
+    assert "error" in (second.locator("#message").get_attribute("class") or "")
+    saved = load_mission(workspace / "examples/turtlebot3_world.yaml")
+    assert len(saved.waypoints) == 8  # the first tab's mission, whole
+    assert saved.waypoints[7].x == pytest.approx(FREE_SPOT[0], abs=0.03)
+    # The second tab keeps its edits: they can still be saved under another name.
+    assert second.get_by_test_id("waypoint-marker").count() == 9
+    accept_dialogs(second, ["second-tab.yaml"])
+    second.locator("#save-as").click()
+    message_of(second, "saved second-tab.yaml")
+    assert len(load_mission(workspace / "examples/second-tab.yaml").waypoints) == 9
+    assert page.errors == [] and second.errors == []  # type: ignore[attr-defined]
+
+
+def test_import_the_tutorials_launch_file_and_export_one(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    _, workspace, _ = studio
+    prompts = accept_dialogs(page, ["tutorial_params.yaml", "tour.launch"])
+    checked_after(page, lambda: page.locator("#import").click())
+    assert "tutorial_move_base_seq.launch" in prompts[0]  # the choice lists every format
+    assert page.get_by_test_id("waypoint-marker").count() == 4
+    assert "imported 4 waypoints" in page.locator("#message").inner_text()
+    # Still on the arena's map: its pre-flight runs on the imported points.
+    assert page.locator("[data-testid=map-image]").count() == 1
+    page.get_by_test_id("export").click()
+    said = message_of(page, "exported tour.launch")
+    exported = load_mission(workspace / "examples/tour.launch")
+    tutorial = load_mission(workspace / "examples/tutorial_params.yaml")
+    assert [(w.x, w.y, round(w.yaw_deg, 6)) for w in exported.waypoints] == [
+        (w.x, w.y, round(w.yaw_deg, 6)) for w in tutorial.waypoints
+    ]
+    assert "no place for" in said and "map" in said
+    # Undo brings the opened mission back.
+    checked_after(page, lambda: page.keyboard.press("Control+z"))
+    assert page.get_by_test_id("waypoint-marker").count() == 7
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_defaults_loops_and_a_start_pose_placed_and_turned_on_the_map(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    _, workspace, _ = studio
+    accept_dialogs(page)
+    # Defaults: three retries, skip on failure.
+    retries = page.locator("#defaults input[name^=retries]")
+    checked_after(page, lambda: (retries.fill("3"), retries.press("Enter")))
+    failure = page.locator("#defaults select[name^=on_failure]")
+    checked_after(page, lambda: failure.select_option("retry"))
+    # Loops: a patrol of 2 draws the way back to the first waypoint as a leg.
+    loops = page.locator("#settings input[name=loops]")
+    checked_after(page, lambda: (loops.fill("2"), loops.press("Enter")))
+    assert page.evaluate("S.legs.filter((leg) => leg.loop).length") == 1
+    # The start pose: placed with a click, then turned with its handle to face +y.
+    page.locator("#place-start").click()
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, -1.2, -1.2)))
+    start = page.get_by_test_id("start-marker")
+    assert start.count() == 1
+    handle = page.get_by_test_id("yaw-handle").bounding_box()
+    centre = screen_point(page, -1.2, -1.2)
+
+    def turn() -> None:
+        page.mouse.move(handle["x"] + handle["width"] / 2, handle["y"] + handle["height"] / 2)
+        page.mouse.down()
+        page.mouse.move(centre[0], centre[1] - 40, steps=8)  # straight up on the screen
+        page.mouse.up()
+
+    checked_after(page, turn)
+    page.get_by_test_id("save").click()
+    message_of(page, "saved")
+    saved = load_mission(workspace / "examples/turtlebot3_world.yaml")
+    assert saved.defaults.retries == 3 and saved.defaults.on_failure.value == "retry"
+    assert saved.loops == 2
+    assert saved.start is not None
+    assert (saved.start.x, saved.start.y) == pytest.approx((-1.2, -1.2), abs=0.03)
+    assert saved.start.yaw == pytest.approx(math.pi / 2, abs=math.radians(3))
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, Path, Any]) -> None:
+    page.get_by_test_id("run").click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'completed'",
+        timeout=60_000,
+    )
+    runs = page.get_by_test_id("runs")
+    page.wait_for_function("document.getElementById('runs').options.length > 1")
+    runs.select_option(index=1)
+    page.wait_for_selector("[data-testid=replay-waypoint]")
+    slider = page.get_by_test_id("replay-time")
+    duration = float(slider.get_attribute("max") or 0)
+    assert duration > 10
+
+    def at(t: float) -> list[str]:
+        slider.evaluate(
+            "(el, t) => { el.value = String(t); el.dispatchEvent(new Event('input')); }", t
+        )
+        return [
+            str(marker.get_attribute("data-status"))
+            for marker in page.get_by_test_id("replay-waypoint").all()
+        ]
+
+    assert at(0)[1:] == ["pending"] * 6  # the first is driving from t = 0
+    middle = at(duration / 2)
+    assert "reached" in middle and "pending" in middle
+    assert page.get_by_test_id("replay-robot").count() == 1
+    assert "/ " in page.get_by_test_id("replay-clock").inner_text()
+    assert at(duration) == ["reached"] * 7
+    assert page.errors == []  # type: ignore[attr-defined]

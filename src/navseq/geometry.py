@@ -122,3 +122,47 @@ def remaining_along_path(path: Sequence[tuple[float, float]], x: float, y: float
     for (px, py), (qx, qy) in zip(path[best_segment + 1 :], path[best_segment + 2 :], strict=False):
         remaining += math.hypot(qx - px, qy - py)
     return remaining
+
+
+class FrameTree:
+    """The latest planar transform of every frame to its parent, as TF publishes them.
+
+    For a ROS face without tf2's Python libraries (the minimal ROS 2 has none): it
+    keeps only the newest transform per child frame (no history, no interpolation),
+    which is what "where is the robot now" needs. Frame names are taken without a
+    leading ``/`` (ROS 1 style), so ``/map`` and ``map`` are the same frame.
+    """
+
+    #: Longest parent chain followed; TF trees of mobile robots are a handful deep, and
+    #: a loop published by mistake must not hang a lookup.
+    MAX_DEPTH = 32
+
+    def __init__(self) -> None:
+        self._parents: dict[str, tuple[str, Pose2D]] = {}
+
+    def set(self, parent: str, child: str, pose: Pose2D) -> None:
+        """Record that ``child`` is at ``pose`` in ``parent`` (a TransformStamped)."""
+        self._parents[child.lstrip("/")] = (parent.lstrip("/"), pose)
+
+    def lookup(self, target: str, source: str) -> Pose2D | None:
+        """The pose of frame ``source`` in frame ``target``; None when not connected.
+
+        Walks from ``source`` up its parents until ``target``, composing on the way
+        (``map -> odom -> base_footprint`` gives the robot's pose in the map). Only
+        ``target`` being an ancestor of ``source`` (or the same frame) is supported:
+        the case of a robot's pose in its map or odometry frame.
+        """
+        target, frame = target.lstrip("/"), source.lstrip("/")
+        pose = Pose2D(0.0, 0.0, 0.0)
+        for _ in range(self.MAX_DEPTH):
+            if frame == target:
+                return pose
+            link = self._parents.get(frame)
+            if link is None:
+                return None
+            frame, above = link
+            pose = compose(above, pose)
+        return None
+
+    def __contains__(self, frame: str) -> bool:
+        return frame.lstrip("/") in self._parents

@@ -60,7 +60,8 @@ def check_mission(
     the margin of suggested spots; ``costmap`` must have been built for that robot.
     """
     start = start if start is not None else mission.start
-    numbers = range(len(mission.waypoints)) if numbers is None else numbers
+    if numbers is None:  # a part's mission knows its file numbers
+        numbers = mission.numbers if mission.numbers is not None else range(len(mission))
     robot = robot or mission.robot or DEFAULT_PROFILE
     free = _FreeRegions(costmap, robot)
     problems: list[NavseqError] = []

@@ -1,4 +1,6 @@
-"""``navseq convert INPUT OUTPUT [--force]``: any supported mission format to navseq YAML.
+"""``navseq convert INPUT OUTPUT [--force]``: any supported mission format to navseq YAML,
+or, for an OUTPUT ending in ``.launch``, to the tutorial's launch file (``p_seq`` /
+``yea_seq``; what that format cannot hold is said on stderr).
 
 Never overwrites an existing file unless ``--force`` is given.
 """
@@ -16,7 +18,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="INPUT",
         help="mission file (navseq YAML, launch, rosparam, CSV)",
     )
-    parser.add_argument("output", type=Path, metavar="OUTPUT", help="navseq YAML file to write")
+    parser.add_argument(
+        "output",
+        type=Path,
+        metavar="OUTPUT",
+        help="navseq YAML file to write (.launch: the tutorial's launch file, p_seq/yea_seq)",
+    )
     parser.add_argument("--force", action="store_true", help="overwrite OUTPUT if it exists")
 
 
@@ -30,7 +37,20 @@ def run(args: argparse.Namespace) -> int:
             "exists already; not overwriting it (use --force to replace it)",
             source=str(args.output),
         )
-    write_mission(mission, args.output, overwrite=args.force)
+    if args.output.suffix.lower() == ".launch":
+        import sys
+
+        from navseq.mission.tutorial_export import write_tutorial_launch
+
+        launch = write_tutorial_launch(mission, args.output, overwrite=args.force)
+        if launch.left_out:
+            print(
+                f"navseq convert: the tutorial's format has no place for: "
+                f"{'; '.join(launch.left_out)}",
+                file=sys.stderr,
+            )
+    else:
+        write_mission(mission, args.output, overwrite=args.force)
     count = len(mission.waypoints)
     print(f"wrote {args.output} ({count} waypoint{'s' if count != 1 else ''} from {args.input})")
     return 0

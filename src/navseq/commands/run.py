@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -285,11 +285,11 @@ def _refuse_sim_options(args: argparse.Namespace, start_given: bool) -> None:
     """Options that only the embedded simulator can honour, refused for a real robot."""
     from navseq.errors import NavseqError
 
-    if args.navigator == "ros1" and start_given:
+    if not navigator_kind(args.navigator).places_robot and start_given:
         raise NavseqError(
-            "sets the simulated robot's start pose; with --navigator ros1 the robot is where "
-            "it is. Leave --start out (set a robot's pose with RViz's 2D Pose Estimate, "
-            "which publishes /initialpose)",
+            f"sets the simulated robot's start pose; with --navigator {args.navigator} the "
+            "robot is where it is. Leave --start out (set a robot's pose with RViz's 2D Pose "
+            "Estimate, which publishes /initialpose)",
             source="--start",
         )
     if args.navigator != "sim" and args.realtime is not None:
@@ -443,6 +443,13 @@ class RunOutcome:
     navigator_seconds: float = 0.0
     wall_seconds: float = 0.0
 
+    @property
+    def clock(self) -> dict[str, float | None]:
+        """The report's and ``RunFinished``'s ``clock``: how fast the navigator's clock ran."""
+        from navseq.sinks.json_events import clock_record
+
+        return clock_record(self.navigator_seconds, self.wall_seconds)
+
 
 def _output_folder(setup: RunSetup, args: argparse.Namespace) -> tuple[Path, bool]:
     """The folder to write into, and whether this run created it."""
@@ -556,11 +563,15 @@ def _run_with_sinks(
     )
 
 
-def real_time_text(simulated: float, wall: float) -> str:
-    """``simulated 62.4 s in 0.9 s: 69x real time``: how fast the simulator ran."""
-    if wall <= 0.0:
+def real_time_text(clock: Mapping[str, float | None]) -> str:
+    """``simulated 62.4 s in 0.9 s: 69x real time``: how fast the simulator ran.
+
+    ``clock`` is :func:`~navseq.sinks.json_events.clock_record`'s, as the report says it.
+    """
+    simulated, wall, factor = clock["navigator_s"], clock["wall_s"], clock["real_time_factor"]
+    assert simulated is not None and wall is not None
+    if factor is None:
         return f"simulated {simulated:.1f} s"
-    factor = simulated / wall
     shown = f"{factor:.0f}" if factor >= 10 else f"{factor:.2g}"
     return f"simulated {simulated:.1f} s in {wall:.1f} s: {shown}x real time"
 
@@ -632,7 +643,7 @@ def _execute_locked(
     )
     notes = []
     if setup.navigator_info.get("kind") == "sim":
-        notes.append(real_time_text(outcome.navigator_seconds, outcome.wall_seconds))
+        notes.append(real_time_text(outcome.clock))
     if outcome.json_lines is not None:
         try:
             outcome.json_lines.run_finished(
@@ -641,6 +652,7 @@ def _execute_locked(
                 exit_code=exit_code,
                 interrupted=outcome.interrupted,
                 files=files.paths,
+                clock=outcome.clock,
             )
         except BrokenPipeError:
             silence_stdout()
@@ -693,6 +705,8 @@ def _report(
         files=files,
     )
     number_visits(report, setup.part)
+    # Not in a report rebuilt from the journal (navseq report): it keeps no wall time.
+    report["clock"] = outcome.clock
     return report
 
 

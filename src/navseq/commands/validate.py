@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,6 +21,12 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
+    from navseq.sim.costmap import Costmap
+
+#: Gives the costmap of a map file for a robot. A long-lived caller (the studio, which
+#: checks a mission on every edit) passes one that keeps costmaps it already built, so
+#: an edit costs the pre-flight check, not the map's inflation again.
+CostmapSource = Callable[["Path", "RobotProfile"], "Costmap"]
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -91,14 +97,16 @@ def mission_file_problems(
     map_path: Path | None = None,
     start: Pose2D | None = None,
     robot: str | RobotProfile | None = None,
+    costmaps: CostmapSource | None = None,
 ) -> tuple[Mission | None, list[NavseqError]]:
     """The mission in ``path`` (None if it cannot be read) and every problem found.
 
     The file's own problems and, when a map is known (``map_path``, else the mission's
     ``map:``), the pre-flight problems of every waypoint that did read, in one list.
     ``robot`` is a profile, or a built-in name or file as ``--robot`` takes (default:
-    the mission's ``robot:``). ``navseq validate`` and :func:`navseq.validate_file` both
-    call this.
+    the mission's ``robot:``). ``costmaps`` builds (or recalls) the costmap of a map for
+    a robot; by default the map file is read and inflated on each call. ``navseq
+    validate``, :func:`navseq.validate_file` and the studio's checks all call this.
     """
     from navseq.mission import inspect_mission_file
 
@@ -108,11 +116,11 @@ def mission_file_problems(
         # Check the waypoints that did read against the map as well, so that one run
         # of validate lists everything to fix.
         salvage = problems.salvage
-        errors += _map_problems(salvage.mission, map_path, start, robot, salvage.numbers)
+        errors += _map_problems(salvage.mission, map_path, start, robot, salvage.numbers, costmaps)
     elif mission is not None:
-        errors += _map_problems(mission, map_path, start, robot)
+        errors += _map_problems(mission, map_path, start, robot, costmaps=costmaps)
     elif map_path is not None:  # no waypoints to check, but the map can still be read
-        errors += _map_problems(None, map_path, start, robot)
+        errors += _map_problems(None, map_path, start, robot, costmaps=costmaps)
     return mission, errors
 
 
@@ -122,6 +130,7 @@ def _map_problems(
     start: Pose2D | None,
     robot_option: str | RobotProfile | None,
     numbers: Sequence[int] | None = None,
+    costmaps: CostmapSource | None = None,
 ) -> list[NavseqError]:
     """The pre-flight problems of ``mission`` on the map given or named, if any.
 
@@ -135,7 +144,7 @@ def _map_problems(
         return []
     robot = choose_robot(robot_option, mission)
     try:
-        costmap = costmap_for_map(map_path, robot)
+        costmap = (costmaps or costmap_for_map)(map_path, robot)
     except NavseqError as error:  # an unreadable map is one more problem to list
         return [error]
     if mission is None:

@@ -36,10 +36,15 @@ class OperatorRequest:
     ok: bool = False
     message: str = ""
     done: threading.Event = field(default_factory=threading.Event, repr=False)
+    # Called once with the request when it is answered (on the answering thread): lets a
+    # face that must not block, such as an rclpy service handler, wake on the answer.
+    on_answer: Callable[[OperatorRequest], None] | None = field(default=None, repr=False)
 
     def answer(self, ok: bool, message: str) -> None:
         self.ok, self.message = ok, message
         self.done.set()
+        if self.on_answer is not None:
+            self.on_answer(self)
 
 
 class MissionControl:
@@ -57,18 +62,37 @@ class MissionControl:
         Returns (ok, message), as a ``std_srvs/Trigger`` response wants them. With
         ``timeout=None`` the request is only filed: (True, "requested").
         """
-        if kind not in REQUESTS:
-            return False, f"unknown request {kind!r}; one of {', '.join(REQUESTS)}"
-        request = OperatorRequest(kind, reason)
-        with self._lock:
-            if self._closed is not None:
-                return False, f"nothing to {kind}: {self._closed}"
-            self._requests.append(request)
+        request = self.submit(kind, reason)
+        if request.done.is_set():
+            return request.ok, request.message
         if timeout is None:
             return True, "requested"
         if not request.done.wait(timeout):
             return False, f"{kind}: the mission did not respond within {timeout:g} s"
         return request.ok, request.message
+
+    def submit(
+        self,
+        kind: str,
+        reason: str = "",
+        on_answer: Callable[[OperatorRequest], None] | None = None,
+    ) -> OperatorRequest:
+        """File ``kind`` without waiting; the request, answered at once when refused.
+
+        ``on_answer`` is called with the request once it is answered (also when that
+        is at once, on this thread).
+        """
+        request = OperatorRequest(kind, reason, on_answer=on_answer)
+        if kind not in REQUESTS:
+            request.answer(False, f"unknown request {kind!r}; one of {', '.join(REQUESTS)}")
+            return request
+        with self._lock:
+            closed = self._closed
+            if closed is None:
+                self._requests.append(request)
+        if closed is not None:
+            request.answer(False, f"nothing to {kind}: {closed}")
+        return request
 
     def request_skip(self, reason: str = "skipped by operator") -> None:
         """Skip the waypoint being pursued now and go on with the next one."""

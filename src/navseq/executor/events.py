@@ -52,6 +52,10 @@ class WaypointProgress:
     yaw: float
     distance_remaining: float | None
     distance_driven: float
+    # From stacks that count them (Nav2's feedback), else None: recovery behaviours run
+    # for the current goal, and seconds the stack has been on it (its own clock).
+    recoveries: int | None = None
+    navigation_time: float | None = None
 
 
 @dataclass(frozen=True)
@@ -87,6 +91,7 @@ class AttemptFailed:
     duration: float = 0.0
     distance_driven: float = 0.0
     loop: int = 0
+    recoveries: int | None = None  # the stack's recovery count for the goal, if it gives one
 
 
 @dataclass(frozen=True)

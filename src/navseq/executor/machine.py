@@ -163,6 +163,9 @@ class _Visit:
     reached_at: float | None = None
     attempt_sent_at: float = 0.0  # when the current attempt's goal was first sent
     attempt_start_distance: float = 0.0  # the visit's distance driven at that moment
+    # The stack's count of recovery behaviours for the current attempt's goal, when the
+    # stack gives one (Nav2's number_of_recoveries); None: not known.
+    attempt_recoveries: int | None = None
 
 
 class MissionExecutor:
@@ -174,7 +177,7 @@ class MissionExecutor:
     ignored, so late results of replaced or cancelled goals do no harm.
 
     ``robot`` gives the goal tolerance for the arrival check where a waypoint's
-    policy sets none (``xy_tolerance`` / ``yaw_tolerance``); without it the mission's
+    policy sets none (``xy_tolerance_m`` / ``yaw_tolerance_rad``); without it the mission's
     ``robot:`` profile, else :data:`~navseq.mission.robot.DEFAULT_PROFILE`.
     """
 
@@ -289,8 +292,8 @@ class MissionExecutor:
         """The arrival tolerance of a visit: its policy's, else the robot profile's."""
         default = self._robot.goal_tolerance
         return GoalTolerance(
-            default.xy_m if policy.xy_tolerance is None else policy.xy_tolerance,
-            default.yaw_rad if policy.yaw_tolerance is None else policy.yaw_tolerance,
+            default.xy_m if policy.xy_tolerance_m is None else policy.xy_tolerance_m,
+            default.yaw_rad if policy.yaw_tolerance_rad is None else policy.yaw_tolerance_rad,
         )
 
     def start(self, now: float, pose: Pose2D | None = None) -> list[Command]:
@@ -510,13 +513,14 @@ class MissionExecutor:
         visit.result.attempts += 1
         visit.attempt_sent_at = now
         visit.attempt_start_distance = visit.result.distance_driven
+        visit.attempt_recoveries = None
         return self._send_goal(now)
 
     def _passes_through(self, visit: _Visit) -> bool:
         """Whether the visit ends when the robot comes near, without stopping there."""
         return (
-            visit.policy.pass_through is not None
-            and visit.policy.dwell == 0
+            visit.policy.pass_through_m is not None
+            and visit.policy.dwell_s == 0
             and not self._is_last_visit(visit.loop, visit.index)
         )
 
@@ -533,6 +537,7 @@ class MissionExecutor:
             text=text,
             duration=max(0.0, now - visit.attempt_sent_at),
             distance_driven=visit.result.distance_driven - visit.attempt_start_distance,
+            recoveries=visit.attempt_recoveries,
         )
         visit.result.attempt_results.append(record)
         return record
@@ -588,10 +593,10 @@ class MissionExecutor:
         visit.reached_at = now
         self._close_attempt(now, reached=True, status=status, reason="", text=text)
         self._attempt = None
-        if not passed_through and visit.policy.dwell > 0:
+        if not passed_through and visit.policy.dwell_s > 0:
             self._state = ExecutorState.DWELLING
-            self._deadline = now + visit.policy.dwell
-            self._emit(WaypointDwelling(t=now, index=visit.index, seconds=visit.policy.dwell))
+            self._deadline = now + visit.policy.dwell_s
+            self._emit(WaypointDwelling(t=now, index=visit.index, seconds=visit.policy.dwell_s))
             return []
         self._finish_visit(now, WaypointOutcome.REACHED, "", passed_through=passed_through)
         return self._advance(now)
@@ -689,6 +694,7 @@ class MissionExecutor:
                 duration=record.duration,
                 distance_driven=record.distance_driven,
                 loop=visit.loop,
+                recoveries=record.recoveries,
             )
         )
         if will_retry:
@@ -699,7 +705,7 @@ class MissionExecutor:
         if policy.on_failure is FailureAction.SKIP:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
             return commands + self._advance(now)
-        label = visit.waypoint.label(visit.index)
+        label = self._mission.waypoint_label(visit.index)
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, f"stopped: {label} failed ({reason})")
         return commands
@@ -773,10 +779,10 @@ class MissionExecutor:
             attempt = self._attempt
             policy = self._current.policy
             assert attempt is not None
-            if policy.goal_timeout is not None and now - attempt.sent_at >= policy.goal_timeout:
+            if policy.goal_timeout_s is not None and now - attempt.sent_at >= policy.goal_timeout_s:
                 return self._attempt_failed(now, "timeout", cancel=True)
             stalled_for = now - attempt.last_progress_at
-            if policy.stall_timeout is not None and stalled_for >= policy.stall_timeout:
+            if policy.stall_timeout_s is not None and stalled_for >= policy.stall_timeout_s:
                 return self._attempt_failed(now, "stalled", cancel=True)
         elif state is ExecutorState.DWELLING:
             if now >= self._deadline:
@@ -799,6 +805,8 @@ class MissionExecutor:
         attempt = self._attempt
         assert attempt is not None
         attempt.feedback_seen = True
+        if event.recoveries is not None:
+            self._current.attempt_recoveries = event.recoveries
         if not self._tick_pose_seen:
             self._accumulate_distance(event.pose)
         self._see_pose(event.pose)
@@ -807,7 +815,7 @@ class MissionExecutor:
             remaining = event.distance_remaining
             if remaining is None:
                 remaining = self._remaining(attempt, event.pose)
-            self._emit_progress(now, event.pose, remaining)
+            self._emit_progress(now, event.pose, remaining, event.recoveries, event.navigation_time)
         return commands
 
     @staticmethod
@@ -873,7 +881,7 @@ class MissionExecutor:
         assert attempt is not None
         goal = attempt.goal.pose
         straight = pose.distance_to(goal)
-        radius = visit.policy.pass_through
+        radius = visit.policy.pass_through_m
         if radius is not None and straight <= radius and self._passes_through(visit):
             # The next goal replaces this one at once, without a cancel: the robot
             # keeps rolling instead of braking at every intermediate point.
@@ -920,7 +928,14 @@ class MissionExecutor:
             return True
         return False
 
-    def _emit_progress(self, now: float, pose: Pose2D, remaining: float | None) -> None:
+    def _emit_progress(
+        self,
+        now: float,
+        pose: Pose2D,
+        remaining: float | None,
+        recoveries: int | None = None,
+        navigation_time: float | None = None,
+    ) -> None:
         visit = self._current
         self._emit(
             WaypointProgress(
@@ -931,6 +946,8 @@ class MissionExecutor:
                 yaw=pose.yaw,
                 distance_remaining=remaining,
                 distance_driven=visit.result.distance_driven,
+                recoveries=recoveries,
+                navigation_time=navigation_time,
             )
         )
 

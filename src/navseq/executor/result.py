@@ -36,6 +36,9 @@ class AttemptResult:
     text: str = ""
     duration: float = 0.0  # s from the goal sent to its end
     distance_driven: float = 0.0  # m
+    # Recovery behaviours the stack ran for this goal (Nav2's number_of_recoveries, as
+    # last reported); None where the stack does not count them.
+    recoveries: int | None = None
 
     @property
     def duration_s(self) -> float:

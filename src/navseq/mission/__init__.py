@@ -8,13 +8,13 @@
 """
 
 from navseq.mission.loader import inspect_mission_file, load_mission, validate_mission_file
-from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
+from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.params import MISSION_PARAM_KEYS, mission_from_params
 from navseq.mission.writer import dump_mission_yaml, write_mission
 
 __all__ = [
     "MISSION_PARAM_KEYS",
-    "POLICY_FIELDS",
+    "POLICY_KEYS",
     "FailureAction",
     "Mission",
     "Policy",

@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 
 from navseq.errors import NavseqError
 from navseq.mission.located import Located, describe
-from navseq.mission.model import FailureAction
+from navseq.mission.model import POLICY_KEYS, FailureAction
 from navseq.mission.problems import Problems, closest_hint
 from navseq.text import text_problem
 
@@ -286,7 +286,12 @@ POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
 
 
 def policy_values(node: Located, owner: str | None, problems: Problems) -> dict[str, Any]:
-    """The policy keys present in a mapping, checked; other keys are left to the caller."""
+    """The policy keys present in a mapping, checked, by :class:`Policy` field name.
+
+    The file says ``goal_timeout: 30`` and ``yaw_tolerance: 10`` (degrees); the result
+    is ``{"goal_timeout_s": 30.0, "yaw_tolerance_rad": 0.1745...}`` (``POLICY_KEYS``).
+    Other keys are left to the caller.
+    """
     values: dict[str, Any] = {}
     for key, reader in POLICY_READERS.items():
         entry = node.get(key)
@@ -295,5 +300,5 @@ def policy_values(node: Located, owner: str | None, problems: Problems) -> dict[
         before = len(problems)
         value = attempt(problems, functools.partial(reader, entry, field_subject(owner, key)))
         if len(problems) == before:
-            values[key] = value
+            values[POLICY_KEYS[key]] = value
     return values

@@ -31,7 +31,7 @@ from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, quaternion_to_yaw
 from navseq.mission import fields
 from navseq.mission.located import Located, describe
-from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
+from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.problems import Problems, Salvage
 from navseq.mission.robot_format import read_robot
 
@@ -44,7 +44,7 @@ OPTIONAL_SETTINGS = ("map", "start", "robot")  # null: none, like leaving the ke
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
 POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
-WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_FIELDS)
+WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_KEYS)
 
 
 def mission_from_document(
@@ -98,7 +98,7 @@ def read_defaults(node: Located | None, problems: Problems) -> Policy:
         return Policy()
     if fields.attempt(problems, lambda: fields.mapping(node, "field defaults")) is None:
         return Policy()
-    fields.check_keys(node, POLICY_FIELDS, "defaults", problems)
+    fields.check_keys(node, tuple(POLICY_KEYS), "defaults", problems)
     return Policy(**fields.policy_values(node, "defaults", problems))
 
 

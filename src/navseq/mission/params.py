@@ -22,7 +22,7 @@ from typing import Any
 
 from navseq.mission import fields
 from navseq.mission.located import Located, from_plain
-from navseq.mission.model import POLICY_FIELDS, Mission, Policy, Waypoint
+from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import (
     MISSION_SETTINGS,
     read_path,
@@ -33,7 +33,7 @@ from navseq.mission.problems import Problems
 from navseq.mission.tutorial_format import POSITIONS_KEY, YAWS_KEY, waypoints_from_sequences
 
 WAYPOINT_SOURCES = (POSITIONS_KEY, YAWS_KEY, "waypoints", "mission")
-MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_FIELDS)
+MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_KEYS)
 
 # True while loading a file named by a 'mission' parameter: that file may not name
 # another one, so a launch file that names itself cannot recurse.

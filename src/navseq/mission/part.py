@@ -3,9 +3,11 @@
 
 A part is a mission of its own (the selected waypoints, in the file's order, with the
 file's settings), so the executor, the journal and a resume need to know nothing about
-it; :attr:`MissionPart.numbers` keeps each selected waypoint's position in the file so
-that what a person reads (progress, the summary table, pre-flight messages) numbers
-them as the file and a full run's table do. Pure Python: no ROS, no terminal.
+it; :attr:`MissionPart.numbers` keeps each selected waypoint's position in the file, and
+the part's :class:`Mission` carries them too (``Mission.number``), so that what a person
+reads (progress, the executor's stop reason, the summary table, pre-flight messages)
+numbers them as the file and a full run's table do; events, the journal and the report's
+``index`` stay positions in the part. Pure Python: no ROS, no terminal.
 """
 
 from __future__ import annotations
@@ -83,7 +85,7 @@ class MissionPart:
         if self.spec.whole:
             return mission
         waypoints = tuple(mission.waypoints[number] for number in self.numbers)
-        return dataclasses.replace(mission, waypoints=waypoints)
+        return dataclasses.replace(mission, waypoints=waypoints, numbers=self.numbers)
 
     def describe(self) -> str:
         """``waypoints 3-5 of 10, --from 3 --to 5``, for titles."""

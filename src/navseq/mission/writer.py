@@ -1,5 +1,8 @@
 """Writing a Mission as navseq YAML: readable (yaw in degrees, one line per waypoint)
-and exact (reading the file back gives the same mission).
+and exact (reading the file back gives the same mission, its ``robot:`` section included).
+
+The tutorial's launch file (``p_seq`` / ``yea_seq``) is written by
+:mod:`navseq.mission.tutorial_export`.
 """
 
 from __future__ import annotations
@@ -14,8 +17,9 @@ import yaml
 from navseq.errors import NavseqError
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
-from navseq.mission.model import POLICY_FIELDS, FailureAction, Mission, Policy, Waypoint
+from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
+from navseq.mission.robot import BUILTIN_PROFILES, RobotProfile
 from navseq.mission.yaml_doc import EXPONENT_FLOAT
 
 HEADER = "# navseq mission (format reference: docs/mission-format.md)\n"
@@ -27,6 +31,10 @@ _ROUNDED_YAW_DECIMALS = 6
 
 class _FlowMapping(dict):
     """A mapping written on one line: a waypoint, the start pose."""
+
+
+class _FlowList(list):
+    """A list written on one line: a footprint point."""
 
 
 class _MissionDumper(yaml.SafeDumper):
@@ -53,6 +61,10 @@ _MissionDumper.add_representer(
     _FlowMapping,
     lambda dumper, data: dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=True),
 )
+_MissionDumper.add_representer(
+    _FlowList,
+    lambda dumper, data: dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=True),
+)
 
 
 def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
@@ -68,7 +80,9 @@ def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
         doc["start"] = _pose(mission.start)
     doc["loops"] = FOREVER if mission.loops is None else mission.loops
     doc["server_timeout"] = mission.server_timeout
-    doc["defaults"] = _policy_values(mission.defaults, POLICY_FIELDS)
+    if mission.robot is not None:
+        doc["robot"] = robot_section(mission.robot)
+    doc["defaults"] = _policy_values(mission.defaults, POLICY_KEYS)
     doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
     return HEADER + yaml.dump(
         doc,
@@ -125,6 +139,50 @@ def _tidy(value: float) -> float | int:
     return value
 
 
+def robot_section(robot: RobotProfile) -> str | dict[str, Any]:
+    """A profile as a ``robot:`` section (docs/mission-format.md) that reads back equal.
+
+    A built-in profile unchanged is its name; any other is written in full (name,
+    outline, every number), in the file's units: degrees for angular speeds and the
+    yaw tolerance, metres and seconds otherwise.
+    """
+    if BUILTIN_PROFILES.get(robot.name) == robot:
+        return robot.name
+    to_rad = math.pi / 180.0  # robot_format's factor for deg/s and deg/s²
+    return {
+        "name": robot.name,
+        "footprint": [_FlowList([x, y]) for x, y in robot.footprint],
+        "inflation_radius": robot.inflation_radius,
+        "cost_scaling_factor": robot.cost_scaling_factor,
+        "clearance_margin": robot.clearance_margin_m,
+        "max_linear_speed": robot.max_linear_speed,
+        "max_angular_speed": _exact_degrees(robot.max_angular_speed, to_rad),
+        "max_linear_accel": robot.max_linear_accel,
+        "max_angular_accel": _exact_degrees(robot.max_angular_accel, to_rad),
+        "xy_goal_tolerance": robot.goal_tolerance.xy_m,
+        "yaw_goal_tolerance": _exact_degrees(robot.goal_tolerance.yaw_rad, to_rad),
+    }
+
+
+def _exact_degrees(radians: float, to_rad: float) -> float | int:
+    """The shortest degrees that the reader turns back into exactly ``radians``."""
+    degrees = math.degrees(radians)
+    for decimals in range(16):
+        candidate = round(degrees, decimals)
+        if candidate * to_rad == radians:
+            return _tidy(candidate)
+    # No short decimal does (3.2 rad/s² is 183.346... deg/s²): a neighbouring float of
+    # the quotient does, written in full.
+    candidate = radians / to_rad
+    for _ in range(8):
+        if candidate * to_rad == radians:
+            return candidate
+        candidate = math.nextafter(
+            candidate, math.inf if candidate * to_rad < radians else -math.inf
+        )
+    return _tidy(degrees)
+
+
 def _map_text(map_path: Path, base_dir: Path | None) -> str:
     """Relative to the mission's folder when both live in one tree (a project, a
     package), so they can move together; absolute when they only share the root."""
@@ -161,14 +219,15 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
     entry.update(
         _policy_values(
             Policy().with_overrides(waypoint.overrides),
-            [key for key in POLICY_FIELDS if key in waypoint.overrides],
+            [key for key, name in POLICY_KEYS.items() if name in waypoint.overrides],
         )
     )
     return entry
 
 
 def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
-    values = {key: getattr(policy, key) for key in keys}
+    """The file keys ``keys`` with ``policy``'s values, in the file's units."""
+    values = {key: getattr(policy, POLICY_KEYS[key]) for key in keys}
     if values.get("yaw_tolerance") is not None:
         values["yaw_tolerance"] = round(math.degrees(values["yaw_tolerance"]), 6)
     return {

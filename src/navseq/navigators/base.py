@@ -48,11 +48,19 @@ class GoalAccepted:
 
 @dataclass(frozen=True)
 class GoalFeedback:
-    """The robot is on its way. ``distance_remaining`` is along the plan when known."""
+    """The robot is on its way. ``distance_remaining`` is along the plan when known.
+
+    ``recoveries`` (how many recovery behaviours the stack ran for this goal) and
+    ``navigation_time`` (seconds the stack has been on it, on its clock) are given by
+    stacks that count them (Nav2's ``number_of_recoveries`` and ``navigation_time``);
+    None elsewhere.
+    """
 
     goal_id: int
     pose: Pose2D
     distance_remaining: float | None = None
+    recoveries: int | None = None
+    navigation_time: float | None = None
 
 
 @dataclass(frozen=True)

@@ -118,7 +118,9 @@ class KindModule(Protocol):
 @dataclass(frozen=True)
 class NavigatorKind:
     """One ``--navigator NAME``. ``requires`` names what its module needs, for the error
-    a missing dependency becomes; ``hidden`` kinds (test doubles) stay out of ``--help``."""
+    a missing dependency becomes; ``hidden`` kinds (test doubles) stay out of ``--help``.
+    ``places_robot`` is False for a real robot's stack: the robot is where it is, so
+    ``--start`` is refused."""
 
     name: str
     help: str
@@ -126,6 +128,7 @@ class NavigatorKind:
     options: tuple[NavigatorOption, ...] = ()
     requires: str = ""
     hidden: bool = False
+    places_robot: bool = True
 
     def create(self, args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
         from navseq.errors import NavseqError
@@ -161,7 +164,9 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         "navseq.ros1.run_setup",
         options=(
             NavigatorOption(
-                "--action", "MoveBaseAction server name (default: move_base)", "move_base"
+                "--action",
+                "action server name (default: move_base; nav2: navigate_to_pose)",
+                "move_base",
             ),
             NavigatorOption("--frame", "goal frame (default: the mission's frame:, usually map)"),
             NavigatorOption("--ns", "robot namespace, e.g. robot1 (default: none)", ""),
@@ -175,6 +180,37 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
             ),
         ),
         requires="ROS 1's Python packages (rospy, actionlib, move_base_msgs)",
+        places_robot=False,
+    ),
+    NavigatorKind(
+        "nav2",
+        "ROS 2 Nav2's navigate_to_pose over rclpy",
+        "navseq.ros2.run_setup",
+        options=(
+            NavigatorOption("--action", "", "navigate_to_pose"),  # declared by ros1
+            NavigatorOption("--frame", ""),
+            NavigatorOption("--ns", "", ""),
+            NavigatorOption(
+                "--server-timeout",
+                "wall seconds to wait for the navigate_to_pose server before giving up "
+                "(exit 2, nothing moved; default 30). The mission's server_timeout: is how "
+                "long to wait for a server that vanishes during the run",
+                30.0,
+                type=float,
+                metavar="S",
+                journaled=False,
+            ),
+            NavigatorOption(
+                "--use-sim-time",
+                "auto, true or false: run on ROS time from /clock (auto: when /clock is "
+                "published; default auto)",
+                "auto",
+                metavar="auto|true|false",
+            ),
+        ),
+        requires="ROS 2's Python packages (rclpy, nav2_msgs): source ROS 2 first "
+        "(e.g. source /opt/ros/jazzy/setup.bash), then start navseq from that shell",
+        places_robot=False,
     ),
     # A deterministic stand-in for the plumbing's tests; its options are hidden too.
     NavigatorKind(

@@ -9,8 +9,6 @@ mission. Both topics are latched: RViz shows them whenever it connects.
 from __future__ import annotations
 
 import json
-import threading
-from dataclasses import asdict
 from typing import Any
 
 import rosgraph.names
@@ -18,50 +16,50 @@ import rospy
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from navseq.executor.events import (
-    MissionEvent,
-    MissionFinished,
-    MissionPaused,
-    WaypointFinished,
-    WaypointOutcome,
-    WaypointProgress,
-    WaypointStarted,
-)
+from navseq.executor.events import MissionEvent
 from navseq.mission.model import Mission
-from navseq.ros1.markers import MarkerStatus, waypoint_markers
+from navseq.ros1.markers import marker_message
+from navseq.sinks.mission_status import MarkerStatus, MissionStatus
 
-PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 RUN_TOPICS_NS = "navseq"  # where `navseq run` publishes, like the node named navseq
-
-_OUTCOME_MARKERS = {
-    WaypointOutcome.REACHED: MarkerStatus.REACHED,
-    WaypointOutcome.SKIPPED: MarkerStatus.SKIPPED,
-    WaypointOutcome.FAILED: MarkerStatus.FAILED,
-    WaypointOutcome.NOT_RUN: MarkerStatus.PENDING,
-}
 
 
 class MissionTopics:
     """A mission listener publishing ``<ns>/status`` (JSON) and ``<ns>/waypoints`` (markers).
 
     ``namespace`` is ``~`` for a node's private topics, or a name such as ``/navseq``.
+    What is shown is :class:`~navseq.sinks.mission_status.MissionStatus`'s (shared with
+    ROS 2); ``active_waypoint`` and ``over`` are its.
     """
 
     def __init__(self, mission: Mission, namespace: str = "~"):
         self.mission = mission
-        self.statuses: dict[int, MarkerStatus] = {}
+        self.state = MissionStatus(mission)
         prefix = "~" if namespace == "~" else namespace.rstrip("/") + "/"
         self._status_pub = rospy.Publisher(f"{prefix}status", String, queue_size=10, latch=True)
         self._marker_pub = rospy.Publisher(
             f"{prefix}waypoints", MarkerArray, queue_size=2, latch=True
         )
-        self._last_progress = float("-inf")
-        self._lock = threading.Lock()
-        self.active_waypoint: int | None = None  # 0-based index of the visit underway
-        # Set once the mission is over for good; the services then refuse with this reason.
-        self.over: str | None = None
         self.publish_markers()
-        self.publish_status({"state": "waiting_for_server", "waypoints": len(mission)})
+        self.publish_status(self.state.initial_status())
+
+    @property
+    def statuses(self) -> dict[int, MarkerStatus]:
+        return self.state.statuses
+
+    @property
+    def active_waypoint(self) -> int | None:
+        """0-based index of the visit underway, None between visits."""
+        return self.state.active_waypoint
+
+    @property
+    def over(self) -> str | None:
+        """Set once the mission is over for good; the services then refuse with it."""
+        return self.state.over
+
+    @over.setter
+    def over(self, why: str | None) -> None:
+        self.state.over = why
 
     @property
     def topics(self) -> tuple[str, str]:
@@ -69,34 +67,20 @@ class MissionTopics:
         return self._marker_pub.resolved_name, self._status_pub.resolved_name
 
     def publish_markers(self) -> None:
-        self._marker_pub.publish(waypoint_markers(self.mission, self.statuses))
+        stamp = rospy.Time(0)
+        specs = self.state.markers()
+        self._marker_pub.publish(MarkerArray(markers=[marker_message(s, stamp) for s in specs]))
 
     def publish_status(self, fields: dict[str, Any]) -> None:
         self._status_pub.publish(String(data=json.dumps(fields, default=str)))
 
     def __call__(self, event: MissionEvent) -> None:
-        with self._lock:
-            if isinstance(event, WaypointProgress):
-                if event.t - self._last_progress < PROGRESS_PERIOD:
-                    return
-                self._last_progress = event.t
-            if isinstance(event, WaypointStarted):
-                if event.index == 0 and event.attempt == 1:
-                    # A new loop of a patrol: every waypoint is to come again.
-                    self.statuses.clear()
-                self.statuses[event.index] = MarkerStatus.ACTIVE
-                self.active_waypoint = event.index
-                self.publish_markers()
-            elif isinstance(event, WaypointFinished):
-                self.statuses[event.index] = _OUTCOME_MARKERS[event.outcome]
-                self.active_waypoint = None
-                self.publish_markers()
-            elif isinstance(event, MissionFinished):
-                self.active_waypoint = None
-            fields = {"event": type(event).__name__, **asdict(event)}
-            fields["state"] = _state(event)
-            fields["waypoints"] = len(self.mission)
-            self.publish_status(fields)
+        update = self.state.update(event)
+        if update is None:
+            return
+        if update.markers_changed:
+            self.publish_markers()
+        self.publish_status(update.status)
 
 
 def run_topics_namespace(robot_ns: str) -> str:
@@ -106,18 +90,3 @@ def run_topics_namespace(robot_ns: str) -> str:
         if robot_ns.strip("/")
         else "/" + RUN_TOPICS_NS
     )
-
-
-def _state(event: MissionEvent) -> str:
-    """The ``state`` field of a status message: running, paused, succeeded, failed,
-    cancelled or interrupted."""
-    if isinstance(event, MissionPaused):
-        return "paused"
-    if not isinstance(event, MissionFinished):
-        return "running"
-    if event.success:
-        return "succeeded"
-    # The runner's reason for a run ended from outside ("interrupted: SIGINT" ...).
-    if event.reason.startswith("cancelled"):
-        return "cancelled"  # by the operator (~cancel)
-    return "interrupted" if event.reason.startswith("interrupted") else "failed"

@@ -14,9 +14,14 @@ namespace, so ``<group ns="robot1">`` drives ``/robot1/move_base``), ``~server_w
 (s, default 30), ``~stamp`` (``now`` or ``latest``), ``~status_timeout`` (s without
 action status before the server counts as lost, default 2), ``~base_frames``,
 ``~plan_topic``, ``~use_tf``, ``~tick`` (s between executor looks, default 0.1),
-``~keep_alive`` (default false: see below), ``~settle`` (s of wall time between a
+``~keep_alive`` (default false: see below), ``~end_launch`` (default false: see
+below), ``~settle`` (s of wall time between a
 result and the next goal, against move_base's SUCCEEDED race; default 0.05, 0 = off),
 ``~odom_frame`` (default ``odom``).
+
+It logs (rospy) the lines ``navseq run`` prints in a pipe, one per waypoint event
+(going to, attempt failed, dwelling, reached / skipped / failed, paused, resumed, server
+lost) and the distance to go every 10 s of mission time; trouble is a warning.
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
@@ -35,6 +40,14 @@ Meanwhile the services answer that the mission is over. Being stopped is then th
 expected end, not an interruption: whether by SIGINT/SIGTERM (roslaunch's shutdown),
 ``rosnode kill`` or the master, the exit status is the mission's own 0 or 1. Bad
 parameters and a missing action server still exit at once with 2.
+
+With ``~end_launch`` true (demo.launch sets it), a node started by roslaunch ends the
+whole launch when the mission is over: it sends SIGINT to that roslaunch, as Ctrl-C
+would, and stays up until the shutdown reaches it (exit status: the mission's 0 or 1).
+Ending the launch through ``required="true"`` alone would make roslaunch print its red
+"REQUIRED process has died" banner for a mission that simply finished (see
+``navseq.ros1.launch_end``). Bad parameters and a missing action server still exit at
+once with 2, and a ``required`` node's exit then does end the launch, banner and all.
 """
 
 from __future__ import annotations
@@ -42,6 +55,7 @@ from __future__ import annotations
 import signal
 import sys
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import rospy
@@ -49,17 +63,16 @@ from std_srvs.srv import Trigger, TriggerResponse
 
 from navseq.errors import NavseqError
 from navseq.executor.control import MissionControl, StopRequested
-from navseq.executor.events import (
-    MissionEvent,
-    WaypointFinished,
-    WaypointOutcome,
-)
+from navseq.executor.events import MissionFinished
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
+from navseq.mission.robot import DEFAULT_PROFILE
+from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros1.params import bool_param
+from navseq.sinks.progress import LogLine, LogProgress
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -73,6 +86,7 @@ NODE_PARAMS: dict[str, Any] = {
     "use_tf": True,
     "tick": 0.1,
     "keep_alive": False,
+    "end_launch": False,
     "settle": 0.05,
     "odom_frame": "odom",
 }
@@ -82,19 +96,17 @@ SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
 KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a shutdown while kept alive
 
 
-def log_waypoint_outcome(event: MissionEvent) -> None:
-    """A mission listener logging each waypoint not reached, with the reason.
+def log_line(line: LogLine) -> None:
+    """One of ``navseq run``'s plain progress lines, through rospy's log.
 
-    The waypoint an interruption ends is left to the interruption's own log line.
+    The lines are :class:`~navseq.sinks.progress.LogProgress`'s (one per waypoint event,
+    the distance to go every 10 s of mission time); a line about trouble is a warning.
+    The mission's end is left to :func:`run_node`'s own line, which also says what the
+    node does next.
     """
-    if (
-        isinstance(event, WaypointFinished)
-        and event.outcome in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
-        and not event.reason.startswith("interrupted")
-    ):
-        rospy.logwarn(
-            "navseq: waypoint %d %s (%s)", event.index + 1, event.outcome.value, event.reason
-        )
+    if isinstance(line.event, MissionFinished):
+        return
+    (rospy.logwarn if line.attention else rospy.loginfo)("navseq: %s", line.text)
 
 
 class ShutdownWatch:
@@ -132,7 +144,8 @@ def read_params() -> tuple[Mission, dict[str, Any]]:
     """The mission and the node settings from the node's private parameters."""
     private: dict[str, Any] = rospy.get_param("~", {}) or {}
     settings = {key: private.get(key, default) for key, default in NODE_PARAMS.items()}
-    settings["keep_alive"] = bool_param("keep_alive", NODE_PARAMS["keep_alive"])
+    for flag in ("keep_alive", "end_launch"):
+        settings[flag] = bool_param(flag, NODE_PARAMS[flag])
     mission = mission_from_params(private, "param ~", ignore=NODE_PARAMS.keys())
     return mission, settings
 
@@ -203,7 +216,9 @@ def run_node() -> int:
         result = run_mission(
             mission,
             navigator,
-            [topics, log_waypoint_outcome],
+            # The robot the executor assumes (the mission's, else the default) also
+            # gives the log's time still to go.
+            [topics, LogProgress(mission, log_line, robot=mission.robot or DEFAULT_PROFILE)],
             tick=float(settings["tick"]),
             control=control,
         )
@@ -241,19 +256,38 @@ def run_node() -> int:
         code = result.exit_code
     finally:
         navigator.close()
+    if settings["end_launch"]:
+        return end_launch(code)
     if settings["keep_alive"]:
         return stay_up(code)
     return code
 
 
-def stay_up(mission_code: int) -> int:
+def end_launch(mission_code: int) -> int:
+    """Ask the roslaunch that started the node to shut down, then wait for it to stop us."""
+
+    def signal_roslaunch() -> str | None:
+        why_not = end_parent_launch()
+        return None if why_not is None else f"~end_launch: {why_not}"
+
+    return stay_up(
+        mission_code, "mission over; ending the launch (~end_launch)", then=signal_roslaunch
+    )
+
+
+def stay_up(
+    mission_code: int,
+    why: str = "mission over; staying up (~keep_alive) until shut down",
+    then: Callable[[], str | None] | None = None,
+) -> int:
     """Keep the node (its latched topics and services) up until it is shut down.
 
     Returns ``mission_code`` however the node is stopped: the mission is over, so a
     signal interrupts nothing, and roslaunch (which stops nodes with SIGINT) should
-    not see a finished mission as a failure.
+    not see a finished mission as a failure. ``then`` runs once the node's signal
+    handlers are in place (ending the launch sends a SIGINT that comes straight back);
+    a reason it returns means there is nothing to wait for: the node just exits.
     """
-    rospy.loginfo("navseq: mission over; staying up (~keep_alive) until shut down")
     # rospy's own signal handlers are off (see ensure_node); the node's are set here.
     stop_signal: list[str] = []
     stopping = threading.Event()
@@ -264,6 +298,10 @@ def stay_up(mission_code: int) -> int:
 
     previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
+        rospy.loginfo("navseq: %s", why)
+        if then is not None and (why_not := then()) is not None:
+            rospy.logwarn("navseq: %s; the node just exits", why_not)
+            return mission_code
         while not stopping.is_set() and not rospy.core.is_shutdown_requested():
             stopping.wait(KEEP_ALIVE_POLL)
     finally:

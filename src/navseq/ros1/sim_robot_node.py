@@ -298,6 +298,11 @@ class SimRobotNode:
             except rospy.ROSInterruptException:
                 break
             now = rospy.Time.now()
+            if now <= last:
+                # The /clock owner has not ticked since our last step (Rate wakes on any
+                # clock message): stepping by zero would republish TF with the same stamp,
+                # which every TF listener reports as TF_REPEATED_DATA.
+                continue
             self.step(min((now - last).to_sec(), 5 * self.dt))
             last = now
 

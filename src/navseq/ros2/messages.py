@@ -2,6 +2,8 @@
 
 Only message packages are imported here (no rclpy node machinery), so the conversions
 can be used by any ROS 2 face of navseq. Geometry comes from :mod:`navseq.geometry`.
+Serves the simulator node (what it publishes) and the ``nav2`` navigator (the goals it
+sends, and how it reads Nav2's statuses, results and transforms).
 """
 
 from __future__ import annotations
@@ -11,12 +13,20 @@ import math
 from typing import Any
 
 import numpy as np
+from action_msgs.msg import GoalStatus
 from builtin_interfaces.msg import Duration, Time
 from geometry_msgs.msg import Pose, PoseStamped, Quaternion, TransformStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Path
 
-from navseq.geometry import Pose2D, quaternion_to_yaw, yaw_to_quaternion
+from navseq.geometry import (
+    FrameTree,
+    Pose2D,
+    pose2d_from_transform,
+    quaternion_to_yaw,
+    yaw_to_quaternion,
+)
+from navseq.navigators.base import GoalOutcome
 from navseq.ros2.standin import plan_poses
 from navseq.sim.occupancy import OccupancyGrid
 from navseq.sim.planner import Plan
@@ -102,3 +112,60 @@ def path_msg(plan: Plan | None, goal: Pose2D | None, frame: str, stamp: Time) ->
         return path
     path.poses = [pose_stamped(pose, frame, stamp) for pose in plan_poses(plan.points, goal)]
     return path
+
+
+def seconds_of(duration: Any) -> float:
+    """Seconds of a ``builtin_interfaces/Duration`` (or ``Time``)."""
+    return float(duration.sec) + float(duration.nanosec) * 1e-9
+
+
+#: action_msgs/GoalStatus codes of a finished goal, by the name reports keep.
+_TERMINAL = {
+    GoalStatus.STATUS_SUCCEEDED: (GoalOutcome.SUCCEEDED, "SUCCEEDED"),
+    GoalStatus.STATUS_CANCELED: (GoalOutcome.FAILED, "CANCELED"),
+    GoalStatus.STATUS_ABORTED: (GoalOutcome.FAILED, "ABORTED"),
+    # A result "UNKNOWN" comes from a server that does not know the goal: one that was
+    # restarted since it accepted it. The goal is as good as lost.
+    GoalStatus.STATUS_UNKNOWN: (GoalOutcome.LOST, "UNKNOWN"),
+}
+
+
+def terminal_status(code: int) -> tuple[GoalOutcome, str] | None:
+    """The neutral outcome and Nav2's name of a result's status; None if not terminal.
+
+    ACCEPTED, EXECUTING and CANCELING are not terminal (a result never carries them).
+    """
+    return _TERMINAL.get(int(code))
+
+
+def result_text(error_code: int, error_msg: str) -> str:
+    """Nav2's own words about a result: ``error_msg``, and ``error_code`` when set.
+
+    Nav2 (Iron and later) fills both on a failure (``error_code`` 206: the planner's
+    GOAL_OCCUPIED, ...); Humble's results have neither, so both may be empty.
+    """
+    message = error_msg.strip()
+    if error_code:
+        return f"{message} (error_code {error_code})" if message else f"error_code {error_code}"
+    return message
+
+
+def navigate_goal(pose: Pose2D, frame: str, stamp: Time, z: float = 0.0) -> Any:
+    """A ``nav2_msgs/action/NavigateToPose`` goal to ``pose`` in ``frame``.
+
+    ``behavior_tree`` stays empty: bt_navigator's default tree, as RViz sends it.
+    """
+    from nav2_msgs.action import NavigateToPose
+
+    goal = NavigateToPose.Goal()
+    goal.pose = pose_stamped(pose, frame, stamp)
+    goal.pose.pose.position.z = float(z)
+    return goal
+
+
+def add_transforms(tree: FrameTree, message: Any) -> None:
+    """Record every transform of a ``tf2_msgs/TFMessage`` in ``tree`` (planar part)."""
+    for transform in message.transforms:
+        tree.set(
+            transform.header.frame_id, transform.child_frame_id, pose2d_from_transform(transform)
+        )

@@ -23,8 +23,9 @@ A patrol journals for weeks, so the journal grows with the events that matter, n
 with time: every visit's start, finish and failed attempts are kept, with the first
 plan of each attempt (as corners, :data:`PATH_TOLERANCE`); the driven path is kept as
 a thinned polyline of ``WaypointProgress`` events (:mod:`navseq.sinks.journal_progress`:
-its corners, the pose at every arrival, and one at least every :data:`HEARTBEAT`
-seconds). Times and positions in progress and plans are written to 0.1 mm (0.1 ms).
+its corners, the pose at every arrival, every change of the stack's recovery count,
+and one at least every :data:`HEARTBEAT` seconds). Times and positions in progress and
+plans are written to 0.1 mm (0.1 ms).
 
 Every line ends with ``"chain"``: the first 16 hex digits of the sha256 of the previous
 line's chain and this line's record. A journal whose lines were edited, deleted or
@@ -217,7 +218,15 @@ class JournalWriter:
     def _write_event(self, event: ev.MissionEvent) -> None:
         record = {"kind": "event", "type": type(event).__name__, **dataclasses.asdict(event)}
         if isinstance(event, ev.WaypointProgress):
-            for name in ("t", "x", "y", "yaw", "distance_remaining", "distance_driven"):
+            for name in (
+                "t",
+                "x",
+                "y",
+                "yaw",
+                "distance_remaining",
+                "distance_driven",
+                "navigation_time",
+            ):
                 record[name] = _rounded(record[name])
         elif isinstance(event, ev.WaypointPlan):
             record["t"] = _rounded(record["t"])

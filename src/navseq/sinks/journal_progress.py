@@ -5,8 +5,9 @@ resume and a rebuilt picture draw the driven path from, no more: the corners of 
 polyline that stays within :data:`PATH_TOLERANCE` of every pose reported. A straight
 corridor costs two lines however long it is; a lap of a patrol costs its corners. A
 line is also written every :data:`HEARTBEAT` seconds of mission time, however still
-the robot (a ``kill -9`` loses at most that much of the run's duration), and at the
-end of every visit (so the path reaches each waypoint where the robot was).
+the robot (a ``kill -9`` loses at most that much of the run's duration), at every
+arrival (so the path reaches each waypoint where the robot was), and whenever the
+stack's recovery count changes (Nav2 counts them; the report lists them per attempt).
 
 The polyline is found online, one pose at a time, in constant time and memory per
 pose (Williams' cone intersection, the "sleeve" method): from the last pose journaled
@@ -67,7 +68,10 @@ class ProgressThinner:
         anchor = self._anchor
         assert anchor is not None
         # A resumed run's clock may start again from zero: t < anchor.t journals too.
-        if not 0.0 <= event.t - anchor.t < self.heartbeat:
+        # A new recovery count is journaled as it comes: the report counts recoveries.
+        if not 0.0 <= event.t - anchor.t < self.heartbeat or event.recoveries != (
+            anchor.recoveries
+        ):
             kept += self._journal(event)
         return kept
 

@@ -91,6 +91,9 @@ class _VisitTrail:
     key: tuple[int, int]
     sent_at: dict[int, float] = field(default_factory=dict)  # attempt number -> first send
     failures: dict[int, AttemptResult] = field(default_factory=dict)
+    # The stack's recovery count last journaled for the latest attempt (the journal
+    # keeps every progress event whose count changed).
+    recoveries: int | None = None
 
 
 @dataclass
@@ -160,6 +163,11 @@ class VisitHistory:
         if trail is None or trail.key != key:
             trail = self._trail = _VisitTrail(key)
         trail.sent_at.setdefault(event.attempt, event.t)
+        trail.recoveries = None
+
+    def see_progress(self, event: ev.WaypointProgress) -> None:
+        if self._trail is not None and event.recoveries is not None:
+            self._trail.recoveries = event.recoveries
 
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
@@ -283,7 +291,9 @@ def _fold(state: JournalState, reader: JournalReader) -> None:
                 state.mission_started = event
             visits.start_mission(event, f"{path}:{entry.line}")
         segment_end = event.t
-        if isinstance(event, ev.WaypointStarted):
+        if isinstance(event, ev.WaypointProgress):
+            visits.see_progress(event)
+        elif isinstance(event, ev.WaypointStarted):
             visits.start_visit(event)
         elif isinstance(event, ev.AttemptFailed):
             visits.fail_attempt(event)
@@ -341,6 +351,7 @@ def _attempt_of(event: ev.AttemptFailed) -> AttemptResult:
         text=event.text,
         duration=event.duration,
         distance_driven=event.distance_driven,
+        recoveries=event.recoveries,
     )
 
 
@@ -373,6 +384,7 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
                 reason="" if reached else event.reason,
                 duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
                 distance_driven=max(0.0, event.distance_driven - before),
+                recoveries=trail.recoveries if trail is not None else None,
             )
         )
     return attempts

@@ -1,15 +1,21 @@
 """Mission events as JSON records: ``navseq run --json``, and the public API's records.
 
-One record per event, one line each: ``{"event": "<type>", "schema_version": 1,
+One record per event, one line each: ``{"event": "<type>", "schema_version": 3,
 "t_s": ..., ...}``. The record is the event's fields under the names the run report
 uses, with the unit in the name: ``t_s``, ``duration_s``, ``distance_m``,
-``distance_remaining_m``, ``dwell_s``, ``yaw_deg`` (degrees, like the report and
-mission files; the executor's events carry radians). ``x`` and ``y`` are metres in the
-mission's frame, ``index`` is 0-based, ``loops`` is a count or ``"forever"``. Numbers
+``distance_remaining_m``, ``navigation_time_s``, ``dwell_s``, ``yaw_deg`` (degrees, like
+the report and mission files; the executor's events carry radians). ``x`` and ``y``
+are metres in the mission's frame, ``index`` is 0-based (the position in the mission
+run: in a part of a file, ``--from``/``--to``/``--only``, the position in the part) and
+``number`` the waypoint's 1-based number in the file (what messages and the summary
+table say, as in the report's visits), ``loops`` is a count or ``"forever"``. Numbers
 are rounded to six decimals (micrometres, microseconds: below what any navigation
 stack resolves, and ``8.7`` rather than ``8.700000000000001``). The
 JSON Schema is ``docs/schemas/events.schema.json``; :data:`SCHEMA_VERSION` goes up
-whenever a field is renamed, removed or changes meaning.
+whenever a field is renamed, removed or changes meaning, and when one is added
+(version 2: ``recoveries`` and ``navigation_time_s`` in ``WaypointProgress``,
+``recoveries`` in ``AttemptFailed``, from stacks that count them, like Nav2; version 3:
+``number`` beside every ``index``, and ``RunFinished``'s ``clock``).
 
 The renames live in one table, :data:`FIELDS`, applied to every event type, so a
 field means the same in every record; a new event field without an entry is written
@@ -20,14 +26,14 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 from typing import IO, Any
 
 from navseq.executor.events import MissionEvent, WaypointOutcome
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 3
 
 
 #: Decimals kept in every number of a record.
@@ -57,6 +63,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "duration": ("duration_s", None),
     "distance_driven": ("distance_m", None),
     "distance_remaining": ("distance_remaining_m", None),
+    "navigation_time": ("navigation_time_s", None),
     "seconds": ("dwell_s", None),
     # WaypointFinished's count; the report's ``attempts`` is the list of attempts.
     "attempts": ("attempt_count", None),
@@ -80,13 +87,36 @@ def json_safe(value: Any, decimals: int | None = None) -> Any:
     return value
 
 
-def event_record(event: MissionEvent) -> dict[str, Any]:
-    """``event`` as a JSON-ready dict with unit-named fields (see the module docstring)."""
+def event_record(event: MissionEvent, numbers: Sequence[int] | None = None) -> dict[str, Any]:
+    """``event`` as a JSON-ready dict with unit-named fields (see the module docstring).
+
+    ``numbers``: the waypoints' 0-based positions in the mission file when the mission
+    run is a part of it (``Mission.numbers``), for the ``number`` beside ``index``.
+    """
     record: dict[str, Any] = {"event": type(event).__name__, "schema_version": SCHEMA_VERSION}
     for name, value in asdict(event).items():
         renamed, convert = FIELDS.get(name, (name, None))
         record[renamed] = convert(value) if convert is not None and value is not None else value
+        if name == "index" and isinstance(value, int):
+            in_file = numbers is not None and 0 <= value < len(numbers)
+            record["number"] = (numbers[value] if numbers is not None and in_file else value) + 1
     return dict(json_safe(record, DECIMALS))
+
+
+def clock_record(navigator_seconds: float, wall_seconds: float) -> dict[str, float | None]:
+    """How fast the navigator's clock ran: the report's and ``RunFinished``'s ``clock``.
+
+    ``navigator_s`` is the run's time on the navigator's clock (simulated time on the
+    simulator, ROS time with ros1), ``wall_s`` the wall time it took, and
+    ``real_time_factor`` their ratio (``121.3``: 121 times faster than real time; None
+    when no wall time passed).
+    """
+    factor = navigator_seconds / wall_seconds if wall_seconds > 0.0 else None
+    return {
+        "navigator_s": round(navigator_seconds, 3),
+        "wall_s": round(wall_seconds, 3),
+        "real_time_factor": round(factor, 3) if factor is not None else None,
+    }
 
 
 def run_finished_record(
@@ -96,11 +126,12 @@ def run_finished_record(
     exit_code: int,
     interrupted: str | None,
     files: Mapping[str, str],
+    clock: Mapping[str, float | None],
 ) -> dict[str, Any]:
     """The last record of ``navseq run --json``: how the run ended and what it wrote.
 
     ``files`` maps a role (``journal``, ``report``, ``picture``) to its path, as the
-    report's ``files`` does.
+    report's ``files`` does; ``clock`` is :func:`clock_record`'s, as the report's.
     """
     return {
         "event": "RunFinished",
@@ -110,6 +141,7 @@ def run_finished_record(
         "exit_code": exit_code,
         "interrupted": interrupted,
         "files": dict(files),
+        "clock": dict(clock),
     }
 
 
@@ -117,16 +149,20 @@ def _dumps(record: Mapping[str, Any]) -> str:
     return json.dumps(record, ensure_ascii=False, separators=(",", ":"))
 
 
-def event_to_json(event: MissionEvent) -> str:
-    """One event as a single-line JSON object."""
-    return _dumps(event_record(event))
+def event_to_json(event: MissionEvent, numbers: Sequence[int] | None = None) -> str:
+    """One event as a single-line JSON object (``numbers``: see :func:`event_record`)."""
+    return _dumps(event_record(event, numbers))
 
 
 class JsonProgress:
-    """One JSON object per event on ``stream`` (``navseq run --json``)."""
+    """One JSON object per event on ``stream`` (``navseq run --json``).
 
-    def __init__(self, stream: IO[str]):
+    ``numbers``: the waypoints' positions in the file when the mission is a part of it.
+    """
+
+    def __init__(self, stream: IO[str], numbers: Sequence[int] | None = None):
         self.stream = stream
+        self.numbers = numbers
 
     def __enter__(self) -> JsonProgress:
         return self
@@ -135,7 +171,7 @@ class JsonProgress:
         self.stream.flush()
 
     def __call__(self, event: MissionEvent) -> None:
-        self.stream.write(event_to_json(event) + "\n")
+        self.stream.write(event_to_json(event, self.numbers) + "\n")
         self.stream.flush()
 
     def run_finished(
@@ -146,6 +182,7 @@ class JsonProgress:
         exit_code: int,
         interrupted: str | None,
         files: Mapping[str, str],
+        clock: Mapping[str, float | None],
     ) -> None:
         """Write the final ``RunFinished`` record (see :func:`run_finished_record`)."""
         record = run_finished_record(
@@ -154,6 +191,7 @@ class JsonProgress:
             exit_code=exit_code,
             interrupted=interrupted,
             files=files,
+            clock=clock,
         )
         self.stream.write(_dumps(json_safe(record)) + "\n")
         self.stream.flush()

@@ -277,8 +277,8 @@ def draw_numbered_details(
             zorder=7,
         )
         policy = mission.policy_for(first)
-        if policy.pass_through and first != last and policy.dwell == 0:
-            circles.append(Circle(tuple(waypoints[first]), policy.pass_through))
+        if policy.pass_through_m and first != last and policy.dwell_s == 0:
+            circles.append(Circle(tuple(waypoints[first]), policy.pass_through_m))
             circle_colours.append(colour)
     if circles:
         ax.add_collection(

@@ -4,7 +4,8 @@ Three listeners share one model of the run, :class:`RunView`:
 
 - :class:`LiveProgress`: a rich live panel for terminals (current waypoint n/N and
   name, status, distance remaining, mission-clock elapsed time, loop, attempt);
-- :class:`LogProgress`: one plain line per thing that happened, for logs and pipes;
+- :class:`LogProgress`: one plain line per thing that happened, for logs and pipes
+  (and, through its ``out`` callable, for the ROS node's rospy log);
 - :class:`~navseq.sinks.json_events.JsonProgress`: one JSON object per event, for
   programs (``--json``; its own module).
 
@@ -18,7 +19,8 @@ from __future__ import annotations
 import math
 import sys
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import IO
 
 from rich.console import Console, Group, RenderableType
@@ -67,6 +69,14 @@ def _plural(count: int, word: str) -> str:
     return f"{count} {word}{'' if count == 1 else 's'}"
 
 
+def recoveries_text(recoveries: int | None) -> str:
+    """``, 2 recoveries`` once the navigation stack ran recovery behaviours for the goal
+    (spins, backing up, costmap clearing: a sign the robot is struggling); else nothing."""
+    if not recoveries:
+        return ""
+    return f", {recoveries} recover{'y' if recoveries == 1 else 'ies'}"
+
+
 def _why(reason: str, text: str) -> str:
     """navseq's reason with the navigation stack's own words after it, when it gave any."""
     reason, text = printable(reason), printable(text.strip())
@@ -89,7 +99,7 @@ class RunView:
     def __init__(self, mission: Mission, numbers: Sequence[int] | None = None):
         self.mission = mission
         # The waypoints' positions in the file when the mission is a part of it.
-        self.numbers = numbers
+        self.numbers = numbers if numbers is not None else mission.numbers
         self.count = len(mission.waypoints)
         self.loops = mission.loops
         self.t = 0.0
@@ -100,6 +110,7 @@ class RunView:
         self.status = "starting"
         self.distance_remaining: float | None = None
         self.distance_driven = 0.0
+        self.recoveries: int | None = None  # the stack's count for the current goal
         self.loop_outcomes: dict[int, WaypointOutcome] = {}
         self.totals: dict[WaypointOutcome, int] = dict.fromkeys(WaypointOutcome, 0)
         self.finished: MissionFinished | None = None
@@ -107,6 +118,12 @@ class RunView:
     @property
     def elapsed(self) -> float:
         return self.t - self.t_start if self.t_start is not None else 0.0
+
+    def number(self, index: int) -> int:
+        """The waypoint's 1-based number in the mission file (as the summary table says)."""
+        if self.numbers is not None and 0 <= index < len(self.numbers):
+            return self.numbers[index] + 1
+        return index + 1
 
     def waypoint_label(self, index: int) -> str:
         name = self.mission.waypoints[index].name if index < self.count else None
@@ -130,12 +147,14 @@ class RunView:
         elif isinstance(event, WaypointStarted):
             self.loop, self.index, self.attempt = event.loop, event.index, event.attempt
             self.distance_remaining = None
+            self.recoveries = None
             self.distance_driven = 0.0 if event.attempt == 1 else self.distance_driven
             self.status = "driving" if event.attempt == 1 else f"driving (attempt {event.attempt})"
         elif isinstance(event, WaypointProgress):
             self.index = event.index
             self.distance_remaining = event.distance_remaining
             self.distance_driven = event.distance_driven
+            self.recoveries = event.recoveries
         elif isinstance(event, AttemptFailed):
             then = "will retry" if event.will_retry else "giving up"
             why = _why(event.reason, event.text)
@@ -244,7 +263,7 @@ class LiveProgress:
                     ProgressBar(total=total, completed=view.distance_driven, width=40),
                     Text(
                         f"{remaining:6.2f} m to go ({eta_text(remaining, self.robot)}), "
-                        f"{view.distance_driven:6.2f} m driven"
+                        f"{view.distance_driven:6.2f} m driven{recoveries_text(view.recoveries)}"
                     ),
                 )
                 rows.append(bar)
@@ -254,12 +273,13 @@ class LiveProgress:
             marks = Text()
             for index in range(view.count):
                 outcome = view.loop_outcomes.get(index)
+                number = view.number(index)
                 if outcome is not None:
-                    marks.append(f"{index + 1}{OUTCOME_MARK[outcome]} ", OUTCOME_STYLE[outcome])
+                    marks.append(f"{number}{OUTCOME_MARK[outcome]} ", OUTCOME_STYLE[outcome])
                 elif index == view.index and view.finished is None:
-                    marks.append(f"{index + 1}▶ ", "bold cyan")
+                    marks.append(f"{number}▶ ", "bold cyan")
                 else:
-                    marks.append(f"{index + 1}· ", "grey50")
+                    marks.append(f"{number}· ", "grey50")
             rows.append(marks)
         rows.extend(
             Text(line, style="dim", overflow="ellipsis", no_wrap=True) for line in self.recent
@@ -276,7 +296,7 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     if isinstance(event, MissionStarted):
         loops = "forever" if event.loops is None else _plural(event.loops, "loop")
         resumed = (
-            f", resuming at waypoint {event.resumed_from + 1}"
+            f", resuming at waypoint {view.number(event.resumed_from)}"
             if event.resumed_from is not None
             else ""
         )
@@ -325,6 +345,23 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     return None  # WaypointProgress, WaypointPlan
 
 
+def needs_attention(event: MissionEvent) -> bool:
+    """Whether the line about ``event`` tells of something that went wrong.
+
+    A waypoint not reached, a failed attempt, a lost server, a mission that did not
+    reach every waypoint: what a log shows as a warning.
+    """
+    if isinstance(event, WaypointFinished):
+        return WaypointOutcome(event.outcome) in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
+    if isinstance(event, AttemptFailed):
+        return True
+    if isinstance(event, ServerStatusChanged):
+        return not event.available
+    if isinstance(event, MissionFinished):
+        return not event.success
+    return False
+
+
 def final_status(reason: str, success: bool) -> str:
     """How the mission ended, in one sentence that says each thing once.
 
@@ -339,17 +376,31 @@ def final_status(reason: str, success: bool) -> str:
     return f"{reason}; not every waypoint reached"
 
 
+@dataclass(frozen=True)
+class LogLine:
+    """One line of :class:`LogProgress`, before it is written anywhere."""
+
+    text: str
+    elapsed: float  # s of mission time since the mission started
+    attention: bool  # something went wrong (:func:`needs_attention`): a warning
+    event: MissionEvent  # what the line is about
+
+
 class LogProgress:
     """Plain one-line log messages, for output that is not a terminal.
 
     Progress (distance to go) is logged at most once per ``progress_period`` seconds
     of mission time, so a log of a long run stays readable.
+
+    ``out`` is a stream (each line written as ``[elapsed s] text``) or a callable given
+    each :class:`LogLine`: the ROS node logs the same lines through rospy, which stamps
+    them itself, so which events make a line and what it says live here only.
     """
 
     def __init__(
         self,
         mission: Mission,
-        stream: IO[str],
+        out: IO[str] | Callable[[LogLine], None],
         *,
         progress_period: float = 10.0,
         robot: RobotProfile = DEFAULT_PROFILE,
@@ -357,7 +408,8 @@ class LogProgress:
     ):
         self.view = RunView(mission, numbers)
         self.robot = robot
-        self.stream = stream
+        self.stream = None if callable(out) else out
+        self._emit = out if callable(out) else self._write
         self.progress_period = progress_period
         self._last_progress_t = -math.inf
 
@@ -365,11 +417,16 @@ class LogProgress:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        if self.stream is not None:
+            self.stream.flush()
+
+    def _write(self, line: LogLine) -> None:
+        assert self.stream is not None  # the default emitter only exists with a stream
+        self.stream.write(f"[{line.elapsed:8.1f} s] {line.text}\n")
         self.stream.flush()
 
-    def _log(self, text: str) -> None:
-        self.stream.write(f"[{self.view.elapsed:8.1f} s] {text}\n")
-        self.stream.flush()
+    def _log(self, text: str, event: MissionEvent) -> None:
+        self._emit(LogLine(text, self.view.elapsed, needs_attention(event), event))
 
     def __call__(self, event: MissionEvent) -> None:
         view = self.view
@@ -388,12 +445,13 @@ class LogProgress:
                 )
                 self._log(
                     f"{view.waypoint_label(event.index)}: {to_go}"
-                    f"{event.distance_driven:.2f} m driven"
+                    f"{event.distance_driven:.2f} m driven{recoveries_text(event.recoveries)}",
+                    event,
                 )
             return
         text = describe(event, view)
         if text is not None:
-            self._log(text)
+            self._log(text, event)
 
 
 ProgressSink = LiveProgress | LogProgress | JsonProgress
@@ -413,8 +471,9 @@ def make_progress(
     ``numbers``: the waypoints' positions in the file when ``mission`` is a part of it.
     """
     stream = stream if stream is not None else sys.stdout
+    numbers = numbers if numbers is not None else mission.numbers
     if json_lines:
-        return JsonProgress(stream)
+        return JsonProgress(stream, numbers)
     console = Console(file=stream)
     if console.is_terminal:
         return LiveProgress(mission, console, robot=robot, numbers=numbers)

@@ -1,12 +1,12 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 4; the unit is in every field's name where there is one:
+Schema (``schema_version`` 5; the unit is in every field's name where there is one:
 ``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
 mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
 ``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
-      "schema_version": 3,
+      "schema_version": 5,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
@@ -27,9 +27,11 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
       "visits_listed": {"listed", "omitted", "kept"},
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
                   "attempts": [{"number", "reached", "status", "reason", "text",
-                                "duration_s", "distance_m"}],
+                                "duration_s", "distance_m", "recoveries"}],
                   "duration_s", "distance_m", "reason", "passed_through"}],
-      "files": {"journal", "picture", ...}
+      "files": {"journal", "picture", ...},
+      "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
+      "clock": {"navigator_s", "wall_s", "real_time_factor"}   # (not navseq report)
     }
 
 ``index`` is 0-based (as in events and the journal), ``number`` 1-based (as in
@@ -42,7 +44,9 @@ Each attempt is one goal sent: ``status`` is the navigation stack's terminal sta
 (SUCCEEDED, ABORTED, ...; null when navseq ended the attempt: timeout, stalled,
 interrupt), ``reason`` navseq's verdict (empty for the attempt that reached the
 waypoint; ``succeeded far from goal (2.38 m)`` when the stack said SUCCEEDED but the
-robot was not there), ``text`` the stack's own result text. Version 1 had
+robot was not there), ``text`` the stack's own result text, ``recoveries`` the
+recovery behaviours the stack ran for the goal (Nav2's count; null from stacks that
+do not count them; version 4 added it). Version 1 had
 ``attempts`` as a count: it is the length of the list now. Version 2 had the map's
 ``resolution``, ``width``, ``height`` and an ``origin`` list with its yaw in radians.
 
@@ -54,6 +58,8 @@ listed, how many omitted and what was kept. ``totals`` and ``waypoints`` (one en
 per mission waypoint, its visits over every loop: counts, summed time and distance)
 count every visit. Versions 2 and 3 had neither ``waypoints`` nor
 ``visits_listed`` and listed every visit; readers of reports (``navseq report``) accept both.
+Version 4 had no ``clock`` (how fast the navigator's clock ran, see
+:func:`navseq.sinks.json_events.clock_record`).
 """
 
 from __future__ import annotations
@@ -82,7 +88,7 @@ from navseq.mission.model import Mission
 if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
 
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -124,6 +130,7 @@ def _attempt_dict(attempt: AttemptResult) -> dict[str, Any]:
         "text": attempt.text,
         "duration_s": _rounded(attempt.duration, 2),
         "distance_m": _rounded(attempt.distance_driven),
+        "recoveries": attempt.recoveries,
     }
 
 

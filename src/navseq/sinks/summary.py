@@ -227,7 +227,9 @@ def summary_table(
     table = Table(title=title_text, show_footer=True, min_width=title_text.cell_len)
 
     def number(index: int) -> str:
-        return str((numbers[index] if numbers is not None else index) + 1)
+        if numbers is None:  # a part's mission knows its file numbers
+            return str(mission.number(index))
+        return str(numbers[index] + 1)
 
     def label(row: WaypointStats) -> str:
         if row.waypoints == 1:

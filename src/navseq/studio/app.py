@@ -45,6 +45,7 @@ from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.mission.robot import RobotProfile
+    from navseq.sim.costmap import Costmap
     from navseq.studio.runs import StudioRun
 
 STATIC = Path(__file__).parent / "static"
@@ -52,6 +53,10 @@ STATIC = Path(__file__).parent / "static"
 MAX_BODY_BYTES = 2_000_000
 #: How often the live view is sent while a run goes on (s): at most 20 updates/s.
 LIVE_PERIOD_S = 0.05
+#: What the page offers to import: every format navseq's loader reads.
+MISSION_SUFFIXES = (".yaml", ".yml", ".launch", ".xml", ".csv")
+#: Files listed at most for the import choice.
+MAX_FILES_LISTED = 500
 #: Pace choices the page offers: None is as fast as the CPU goes.
 MAX_REALTIME = 1000.0
 
@@ -82,10 +87,11 @@ class Studio:
     def __init__(self, config: StudioConfig) -> None:
         self.config = config
         self.roots = config.roots
-        self._maps: dict[Path, tuple[int, MapView]] = {}
+        self._maps: dict[Path, tuple[tuple[int, ...], MapView]] = {}
         self._planners: dict[tuple[Path, RobotProfile], LegPlanner] = {}
         self._lock = threading.Lock()
         self._save_lock = threading.Lock()
+        self._check_lock = threading.Lock()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
         self.run: StudioRun | None = None
 
@@ -103,7 +109,7 @@ class Studio:
 
     def map_view(self, path: Path) -> MapView:
         """The map at ``path`` (checked against the roots by the caller), reloaded if changed."""
-        stamp = path.stat().st_mtime_ns
+        stamp = map_stamp(path)
         with self._lock:
             cached = self._maps.get(path)
             if cached is not None and cached[0] == stamp:
@@ -112,6 +118,20 @@ class Studio:
         with self._lock:
             self._maps[path] = (stamp, view)
         return view
+
+    def costmap(self, map_path: Path, robot: RobotProfile) -> Costmap:
+        """The map's costmap for ``robot``, built once per (map, robot) and kept.
+
+        Inflating a 2000 x 2000 map takes about a second; a check after each edit
+        would otherwise pay it every time. A changed map file is read again.
+        """
+        try:
+            view = self.map_view(map_path)
+        except OSError:
+            from navseq.commands.common import costmap_for_map
+
+            return costmap_for_map(map_path, robot)  # says what is wrong with the file
+        return view.costmap(robot)
 
     def planner(self, map_path: Path, robot: RobotProfile) -> LegPlanner:
         view = self.map_view(map_path)
@@ -183,10 +203,24 @@ class Studio:
         return path
 
     def check(self, document: Any) -> dict[str, Any]:
+        """Problems and planned legs of a draft (``POST /api/check``).
+
+        One check at a time: a check that comes while another builds a costmap or plans
+        legs waits for it and then finds them made, instead of doing the same work
+        beside it on the same cores (the page's first check and :meth:`warm_up`).
+        """
+        with self._check_lock:
+            return self._check(document)
+
+    def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
         checked = check_draft(
-            document, roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+            document,
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
         )
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
@@ -224,14 +258,12 @@ class Studio:
             target = self.roots.resolve(path_text, "path")
         if target.suffix.lower() not in (".yaml", ".yml"):
             raise ApiError(422, "path: a navseq mission is saved as .yaml or .yml")
-        if isinstance(document, dict) and document.get("robot") is not None:
-            raise ApiError(
-                422,
-                "this mission has a robot: section, which the mission writer does not write "
-                "yet; edit that file by hand so that nothing is lost",
-            )
         checked = check_draft(
-            document, roots=self.roots, base_dir=target.parent, shown_as=printable(target.name)
+            document,
+            roots=self.roots,
+            base_dir=target.parent,
+            shown_as=printable(target.name),
+            costmaps=self.costmap,
         )
         if checked.mission is None:
             raise ApiError(
@@ -271,6 +303,115 @@ class Studio:
             "problems": [problem.as_json() for problem in checked.problems],
         }
 
+    # -- files: import, export -----------------------------------------------------------
+
+    def files(self) -> dict[str, Any]:
+        """Mission files the page may import (any format the loader reads), under the roots."""
+        found: set[Path] = set()
+        for folder in self.roots.folders:
+            for depth in ("*", "*/*", "*/*/*"):
+                for path in folder.glob(depth):
+                    if (
+                        path.suffix.lower() in MISSION_SUFFIXES
+                        and "navseq-out" not in path.parts
+                        and path.is_file()
+                        and self.roots.contains(path)
+                    ):
+                        found.add(path.resolve())
+                    if len(found) >= MAX_FILES_LISTED:
+                        break
+        return {"missions": sorted(self.roots.relative(path) for path in found)}
+
+    def import_file(self, body: dict[str, Any]) -> dict[str, Any]:
+        """A mission file of any format (navseq YAML, launch, rosparam YAML, CSV) as a
+        document, for the page to take in place of its waypoints (an undoable edit)."""
+        path = self._existing_file(body.get("path"), "path")
+        document, errors = open_document(path, self.base_dir)
+        problems = [problem.as_json() for problem in problems_of(errors)]
+        if document is None:
+            raise ApiError(
+                422,
+                f"{printable(path.name)} cannot be imported: it has problems",
+                problems=problems,
+            )
+        return {"path": self.roots.relative(path), "mission": document, "problems": problems}
+
+    def export_launch(self, body: dict[str, Any]) -> dict[str, Any]:
+        """The draft as the tutorial's launch file (``p_seq`` / ``yea_seq``)."""
+        from navseq.mission.tutorial_export import write_tutorial_launch
+
+        path_text = body.get("path")
+        if not isinstance(path_text, str):
+            raise ApiError(400, "path: give the launch file's name (e.g. move_base_seq.launch)")
+        target = self.roots.resolve(path_text, "path")
+        if target.suffix.lower() not in (".launch", ".xml"):
+            raise ApiError(422, "path: the tutorial's launch file is saved as .launch or .xml")
+        checked = check_draft(
+            body.get("mission"),
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
+        )
+        if checked.mission is None:
+            raise ApiError(
+                422,
+                "the mission has problems that stop it being read; fix them before exporting",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        with self._save_lock:
+            exists = target.exists()
+            if exists and body.get("overwrite") is not True:
+                raise ApiError(
+                    409,
+                    f"{printable(target.name)} exists; confirm to replace it",
+                    conflict="exists",
+                )
+            launch = write_tutorial_launch(checked.mission, target, overwrite=exists)
+        return {"path": self.roots.relative(target), "left_out": list(launch.left_out)}
+
+    def _existing_file(self, text: Any, what: str) -> Path:
+        if not isinstance(text, str):
+            raise ApiError(400, f"{what}: give a file name")
+        path = self.roots.resolve(text, what)
+        if not path.is_file():
+            raise ApiError(404, f"no such file: {printable(self.roots.relative(path))}")
+        return path
+
+    # -- past runs ---------------------------------------------------------------------
+
+    @property
+    def run_roots(self) -> FileRoots:
+        """Where run folders may be read: the studio's folders and its navseq-out/."""
+        return FileRoots(
+            [*self.roots.folders, self.config.out_base / "navseq-out"], self.config.out_base
+        )
+
+    def runs(self) -> dict[str, Any]:
+        from navseq.studio.replay import run_folders, run_summary
+
+        roots = self.run_roots
+        searched = [self.config.out_base / "navseq-out"]
+        searched += [folder / "navseq-out" for folder in self.roots.folders]
+        return {
+            "runs": [
+                run_summary(folder, roots.relative(folder))
+                for folder in run_folders(searched)
+                if roots.contains(folder)
+            ]
+        }
+
+    def replay(self, folder_text: str | None) -> dict[str, Any]:
+        from navseq.studio.replay import replay_of
+
+        if not folder_text:
+            raise ApiError(400, "folder: give a run folder (navseq-out/...)")
+        roots = self.run_roots
+        folder = roots.resolve(folder_text, "folder")
+        if not folder.is_dir():
+            raise ApiError(404, f"no such run folder: {printable(folder_text)}")
+        return replay_of(folder, roots.relative(folder), self.base_dir)
+
     def start_run(self, body: dict[str, Any]) -> dict[str, Any]:
         from navseq.studio.runs import RunRequest, StudioRun
 
@@ -288,7 +429,11 @@ class Studio:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
         checked = check_draft(
-            body.get("mission"), roots=self.roots, base_dir=self.base_dir, shown_as=self.shown_name
+            body.get("mission"),
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
         )
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
@@ -313,11 +458,39 @@ class Studio:
             raise ApiError(404, "no run yet")
         return self.run
 
+    def warm_up(self) -> None:
+        """Do what the page's first load asks for, ahead of it: the map image, the
+        costmap and the opened mission's planned legs. Problems are the page's to show."""
+        try:
+            opened = self.mission()
+            if opened["mission"] is not None:
+                self.check(opened["mission"])
+                self.map_image(opened["mission"].get("map") or None, "map")
+        except Exception:  # the same request from the page reports it
+            pass
+
     def close(self, reason: str = "the studio was stopped") -> None:
         """Cancel a running simulation and wait until its outputs are written."""
         run = self.run
         if run is not None:
             run.stop_and_wait(reason)
+
+
+def map_stamp(path: Path) -> tuple[int, ...]:
+    """What changes when the map at ``path`` does: its YAML's and its image's mtimes.
+
+    Raises OSError when the YAML cannot be read (the loader then says why).
+    """
+    stamp = [path.stat().st_mtime_ns]
+    try:
+        import yaml
+
+        image = yaml.safe_load(path.read_text(encoding="utf-8")).get("image")
+        image_path = path.parent / str(image)
+        stamp.append(image_path.stat().st_mtime_ns)
+    except Exception:  # the loader says what is wrong with a bad map; the YAML's stamp will do
+        pass
+    return tuple(stamp)
 
 
 # --- HTTP ------------------------------------------------------------------------------
@@ -455,6 +628,29 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         return JSONResponse(await run_in_threadpool(studio.start_run, body))
 
     @api
+    async def get_files(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(studio.files))
+
+    @api
+    async def post_import(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.import_file, body))
+
+    @api
+    async def post_export(request: Request) -> Response:
+        body = await read_json(request)
+        return JSONResponse(await run_in_threadpool(studio.export_launch, body))
+
+    @api
+    async def get_runs(request: Request) -> Response:
+        return JSONResponse(await run_in_threadpool(studio.runs))
+
+    @api
+    async def get_replay(request: Request) -> Response:
+        folder = request.query_params.get("folder")
+        return JSONResponse(await run_in_threadpool(studio.replay, folder))
+
+    @api
     async def get_run(request: Request) -> Response:
         return JSONResponse(studio.current_run().view.snapshot())
 
@@ -494,6 +690,11 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/map/image", get_map_image),
         Route("/api/check", post_check, methods=["POST"]),
         Route("/api/save", post_save, methods=["POST"]),
+        Route("/api/files", get_files),
+        Route("/api/import", post_import, methods=["POST"]),
+        Route("/api/export", post_export, methods=["POST"]),
+        Route("/api/runs", get_runs),
+        Route("/api/replay", get_replay),
         Route("/api/run", post_run, methods=["POST"]),
         Route("/api/run", get_run),
         Route("/api/run/events", run_events),

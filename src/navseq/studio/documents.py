@@ -27,6 +27,7 @@ from navseq.errors import MissionErrors, NavseqError
 from navseq.text import printable
 
 if TYPE_CHECKING:
+    from navseq.commands.validate import CostmapSource
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
@@ -199,13 +200,21 @@ class CheckedDraft:
     map_path: Path | None
 
 
-def check_draft(document: Any, *, roots: FileRoots, base_dir: Path, shown_as: str) -> CheckedDraft:
+def check_draft(
+    document: Any,
+    *,
+    roots: FileRoots,
+    base_dir: Path,
+    shown_as: str,
+    costmaps: CostmapSource | None = None,
+) -> CheckedDraft:
     """Every problem of a draft document (file problems and pre-flight), and its mission.
 
     ``base_dir`` is the folder of the mission file the draft belongs to (its ``map:``
     is relative to it). Raises :class:`DraftRefused` for something that is not a
     navseq mission document, and :class:`NavseqError` for a map outside the studio's
-    folders.
+    folders. ``costmaps`` recalls costmaps already built (the studio keeps one per map
+    and robot), so that a check after an edit does not inflate the map again.
     """
     from navseq.commands.validate import mission_file_problems
 
@@ -224,7 +233,7 @@ def check_draft(document: Any, *, roots: FileRoots, base_dir: Path, shown_as: st
     with tempfile.TemporaryDirectory(prefix="navseq-studio-") as folder:
         path = Path(folder) / "draft.yaml"
         path.write_text(drafted.text, encoding="utf-8")
-        mission, errors = mission_file_problems(path)
+        mission, errors = mission_file_problems(path, costmaps=costmaps)
         problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
     return CheckedDraft(mission, problems, map_path)
 

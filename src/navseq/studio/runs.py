@@ -52,7 +52,7 @@ class LiveView:
     ``version`` grows with every change, so a watcher sends only what is new.
     """
 
-    def __init__(self, mission: Mission, footprint: list[tuple[float, float]]) -> None:
+    def __init__(self, waypoint_count: int, footprint: list[tuple[float, float]]) -> None:
         self._lock = threading.Lock()
         self.version = 0
         self.status = "starting"
@@ -60,7 +60,7 @@ class LiveView:
         self.clock_s = 0.0
         self.current: int | None = None
         self.loop = 0
-        self.waypoints = ["pending"] * len(mission.waypoints)
+        self.waypoints = ["pending"] * waypoint_count
         self.pose: tuple[float, float, float] | None = None
         self.plan: list[tuple[float, float]] = []
         self.trail: list[tuple[float, float]] = []
@@ -171,7 +171,7 @@ class StudioRun:
         from navseq.mission.robot import DEFAULT_PROFILE
 
         footprint = [(float(x), float(y)) for x, y in (robot or DEFAULT_PROFILE).footprint]
-        self.view = LiveView(request.mission, footprint)
+        self.view = LiveView(len(request.mission.waypoints), footprint)
         self._thread: threading.Thread | None = None
         self.folder: Path | None = None
         self.stop_requested = False

@@ -90,6 +90,10 @@ def serve(
             flush=True,
         )
     print("navseq studio: press Ctrl-C to stop", file=err, flush=True)
+    # While the browser opens: read the map, inflate it and plan the opened mission's
+    # legs, so that the page's first check finds them made (a 2000 x 2000 map takes
+    # over a second). The page's own requests do the same work if they come first.
+    threading.Thread(target=studio.warm_up, name="navseq-studio-warm-up", daemon=True).start()
     server = uvicorn.Server(
         uvicorn.Config(
             app,

@@ -9,14 +9,22 @@ const S = {
   problems: [], legs: [], route: {}, selected: null,
   undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
   layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
-  mapKey: null, events: null, run: null,
+  mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
 };
 const WP_FIELDS = [
   ["name", "text"], ["x", "number"], ["y", "number"], ["yaw", "number"],
   ["pass_through", "number"], ["dwell", "number"], ["retries", "number"],
   ["on_failure", ["", "stop", "skip", "retry"]], ["goal_timeout", "number"], ["stall_timeout", "number"],
 ];
+// Mission-wide defaults (docs/mission-format.md); empty = the loader's default.
+const DEFAULT_FIELDS = [
+  ["goal_timeout", "number"], ["stall_timeout", "number"], ["retries", "number"],
+  ["clear_costmaps_on_retry", ["", "true", "false"]], ["on_failure", ["", "stop", "skip", "retry"]],
+  ["pass_through", "number"], ["dwell", "number"], ["xy_tolerance", "number"], ["yaw_tolerance", "number"],
+];
 const $ = (id) => document.getElementById(id);
+// The point the selection and the yaw handle are about: a waypoint, or the start pose.
+const selectedPoint = () => (S.selected === "start" ? S.doc.start : S.selected !== null ? S.doc.waypoints[S.selected] : null);
 
 // ---- API -------------------------------------------------------------------------------
 async function api(method, path, body) {
@@ -69,10 +77,17 @@ async function loadMap(fit) {
   const sep = query ? "&" : "?";
   // Layers are added once the map has a view (Leaflet defers them until then).
   if (fit || !map._loaded) map.fitBounds(focusBounds(bounds), { padding: [20, 20] });
-  S.layers.map = L.imageOverlay(`/api/map/image${query}${sep}layer=map`, bounds).addTo(map);
+  // One PNG for the whole map (not a shape per cell): a 2000 x 2000 map pans and zooms
+  // as smoothly as a small one. The promise settles when the image is drawn.
+  const drawn = new Promise((resolve) => {
+    S.layers.map = L.imageOverlay(`/api/map/image${query}${sep}layer=map`, bounds);
+    S.layers.map.once("load error", resolve);
+    S.layers.map.addTo(map);
+  });
   S.layers.map.getElement().dataset.testid = "map-image";
   S.layers.cost = L.imageOverlay(`/api/map/image${query}${sep}layer=costmap`, bounds, { zIndex: 2 });
   if ($("costmap-toggle").checked) S.layers.cost.addTo(map);
+  await drawn;
 }
 // Fit on the mission when it has waypoints (a small mission on a big map stays readable).
 function focusBounds(mapBounds) {
@@ -103,7 +118,15 @@ function changed() { render(); check(); }
 const round = (v, d) => Math.round(v * 10 ** d) / 10 ** d;
 
 map.on("click", (e) => {
-  if (S.run && !S.run.done) return;
+  if ((S.run && !S.run.done) || S.replay) return;
+  if (S.placingStart) {
+    placeStart(false);
+    edit(() => {
+      S.doc.start = { x: round(e.latlng.lng, 2), y: round(e.latlng.lat, 2), yaw: okPoint(S.doc.start) ? S.doc.start.yaw ?? 0 : 0 };
+      S.selected = "start";
+    });
+    return;
+  }
   edit(() => {
     S.doc.waypoints.push({ x: round(e.latlng.lng, 2), y: round(e.latlng.lat, 2), yaw: 0 });
     S.selected = S.doc.waypoints.length - 1;
@@ -115,8 +138,11 @@ document.addEventListener("keydown", (e) => {
   if (z && !e.shiftKey) { e.preventDefault(); restore(S.undo, S.redo); }
   else if ((z && e.shiftKey) || (e.key.toLowerCase() === "y" && e.ctrlKey)) { e.preventDefault(); restore(S.redo, S.undo); }
   else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null) {
-    e.preventDefault(); removeWaypoint(S.selected);
+    e.preventDefault();
+    if (S.selected === "start") edit(() => { delete S.doc.start; S.selected = null; });
+    else removeWaypoint(S.selected);
   }
+  else if (e.key === "Escape") placeStart(false);
 });
 $("undo").onclick = () => restore(S.undo, S.redo);
 $("redo").onclick = () => restore(S.redo, S.undo);
@@ -139,7 +165,7 @@ function wpIcon(w, i, extra) {
   const cls = ["wp-icon", extra || ""];
   if (w.pass_through) cls.push("pass");
   if (i !== null && problemsOf(i).length) cls.push("bad");
-  if (i !== null && i === S.selected) cls.push("selected");
+  if ((i !== null && i === S.selected) || (i === null && S.selected === "start")) cls.push("selected");
   return L.divIcon({
     className: cls.join(" "), iconSize: [26, 26], iconAnchor: [13, 13],
     html: `<div class="arrow" style="transform: rotate(${-yaw}deg)"></div><div class="dot">${i === null ? "S" : i + 1}</div>`,
@@ -154,11 +180,14 @@ function render() {
   if (okPoint(start)) {
     S.layers.start = L.marker(ll(start.x, start.y), { icon: wpIcon(start, null, "start"), draggable: true,
       title: "start pose", zIndexOffset: -100 }).addTo(map);
+    S.layers.start.getElement().dataset.testid = "start-marker";
+    S.layers.start.on("dragstart", () => { S.selected = "start"; drawHandle(); });
+    S.layers.start.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, start.yaw || 0); });
     S.layers.start.on("dragend", (e) => {
       const p = e.target.getLatLng();
       edit(() => { S.doc.start.x = round(p.lng, 2); S.doc.start.y = round(p.lat, 2); });
     });
-    S.layers.start.on("click", (e) => L.DomEvent.stopPropagation(e));
+    S.layers.start.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = "start"; render(); });
   }
   S.doc.waypoints.forEach((w, i) => {
     if (!okPoint(w)) return;
@@ -181,6 +210,7 @@ function render() {
   renderList();
   renderEditor();
   renderSettings();
+  renderDefaults();
   renderProblems();
   $("undo").disabled = !S.undo.length;
   $("redo").disabled = !S.redo.length;
@@ -203,7 +233,7 @@ function handleOffset() { return 40 / 2 ** map.getZoom(); }  // 40 px in metres
 function drawHandle() {
   if (S.layers.handle) S.layers.handle.remove();
   S.layers.handle = null;
-  const w = S.selected !== null ? S.doc.waypoints[S.selected] : null;
+  const w = selectedPoint();
   if (!w || !okPoint(w)) return;
   const yaw = ((w.yaw || 0) * Math.PI) / 180;
   const r = handleOffset();
@@ -211,11 +241,13 @@ function drawHandle() {
     icon: L.divIcon({ className: "yaw-handle", iconSize: [12, 12] }), draggable: true, zIndexOffset: 1000,
     title: "drag to set the heading",
   }).addTo(map);
+  S.layers.handle.getElement().dataset.testid = "yaw-handle";
   S.layers.handle.on("click", (e) => L.DomEvent.stopPropagation(e));
   S.layers.handle.on("drag", (e) => {
     const p = e.target.getLatLng();
     const deg = Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI);
-    const arrow = S.layers.markers.find((m) => m.getElement().dataset.index === String(S.selected));
+    const arrow = S.selected === "start" ? S.layers.start
+      : S.layers.markers.find((m) => m.getElement().dataset.index === String(S.selected));
     if (arrow) arrow.getElement().querySelector(".arrow").style.transform = `rotate(${-deg}deg)`;
   });
   S.layers.handle.on("dragend", (e) => {
@@ -286,7 +318,7 @@ function fieldValue(kind, text) {
   return text;
 }
 function renderEditor() {
-  const w = S.selected !== null ? S.doc.waypoints[S.selected] : null;
+  const w = typeof S.selected === "number" ? S.doc.waypoints[S.selected] : null;
   $("editor").hidden = !w;
   if (!w) return;
   $("editor-title").textContent = `${S.selected + 1}`;
@@ -318,6 +350,29 @@ function renderSettings() {
     else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
   }), "none: the simulator's");
 }
+function renderDefaults() {
+  const form = $("defaults");
+  if (form.contains(document.activeElement)) return;
+  form.textContent = "";
+  const defaults = S.doc.defaults || {};
+  for (const [key, kind] of DEFAULT_FIELDS) {
+    const unit = S.units[key] ? ` [${S.units[key]}]` : "";
+    const shown = typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key];
+    field(form, key + unit, shown, kind, (text) => edit(() => {
+      const d = { ...(S.doc.defaults || {}) };
+      const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
+      if (value === undefined) delete d[key]; else d[key] = value;
+      S.doc.defaults = d;
+    }), "loader's default");
+  }
+}
+function placeStart(on) {
+  S.placingStart = on;
+  $("place-start").classList.toggle("active", on);
+  $("map").style.cursor = on ? "copy" : "";
+  if (on) say("click the map to put the start pose there (Esc: cancel)");
+}
+$("place-start").onclick = () => placeStart(!S.placingStart);
 function renderProblems() {
   const list = $("problems");
   list.textContent = "";
@@ -389,6 +444,157 @@ $("save-as").onclick = () => {
   if (path) save(path);
 };
 
+// ---- import / export ---------------------------------------------------------------------
+async function importFile() {
+  const files = await api("GET", "/api/files");
+  const names = files.ok ? files.data.missions : [];
+  const path = window.prompt(`Import the waypoints of (navseq YAML, the tutorial's launch file, rosparam YAML or CSV):\n${names.join("\n")}`, names[0] || "");
+  if (!path) return;
+  const answer = await api("POST", "/api/import", { path });
+  if (!answer.ok) {
+    const first = (answer.data.problems || [])[0];
+    say(first ? `${answer.data.error}: ${first.text}` : answer.data.error, true);
+    return;
+  }
+  const imported = answer.data.mission;
+  // A tutorial file names no map: the mission stays on the map it is made on.
+  if (!imported.map && S.doc.map) imported.map = S.doc.map;
+  if (!Array.isArray(imported.waypoints)) imported.waypoints = [];
+  edit(() => { S.doc = imported; S.selected = null; });
+  say(`imported ${imported.waypoints.length} waypoints from ${answer.data.path} (undo: Ctrl+Z); save to keep them`);
+}
+async function exportLaunch() {
+  const stem = (S.name || "mission").replace(/\.[^.]*$/, "");
+  const path = window.prompt("Export the tutorial's launch file (p_seq / yea_seq) as:", `${stem}.launch`);
+  if (!path) return;
+  let answer = await api("POST", "/api/export", { mission: S.doc, path });
+  if (answer.status === 409 && answer.data.conflict === "exists") {
+    if (!window.confirm(`${answer.data.error}?`)) { say("not exported"); return; }
+    answer = await api("POST", "/api/export", { mission: S.doc, path, overwrite: true });
+  }
+  if (!answer.ok) { say(answer.data.error, true); return; }
+  const left = answer.data.left_out;
+  say(`exported ${answer.data.path}${left.length ? `; the tutorial's format has no place for: ${left.join("; ")}` : ""}`);
+}
+$("import").onclick = importFile;
+$("export").onclick = exportLaunch;
+
+// ---- past runs: replay with a time slider ------------------------------------------------
+async function loadRuns() {
+  const answer = await api("GET", "/api/runs");
+  if (!answer.ok) return;
+  const select = $("runs");
+  const chosen = select.value;
+  select.length = 1;
+  for (const run of answer.data.runs) {
+    const o = document.createElement("option");
+    o.value = run.folder;
+    const verdict = run.reached != null ? ` · ${run.reached}/${run.visits} reached` : run.reason ? ` · ${run.reason}` : "";
+    o.textContent = `${run.folder}${verdict}`;
+    select.appendChild(o);
+  }
+  select.value = chosen;
+}
+$("runs-refresh").onclick = loadRuns;
+$("runs").onchange = async (e) => {
+  if (!e.target.value) { closeReplay(); return; }
+  const answer = await api("GET", `/api/replay?folder=${encodeURIComponent(e.target.value)}`);
+  if (!answer.ok) { say(answer.data.error, true); return; }
+  stopReplayPlay();
+  S.replay = answer.data;
+  $("replay").hidden = false;
+  $("map").classList.add("replaying");
+  const slider = $("replay-time");
+  slider.max = String(S.replay.duration_s);
+  slider.value = "0";
+  drawReplay(0);
+  say(`replaying ${S.replay.folder}${S.replay.finish_reason ? ` (${S.replay.finish_reason})` : ""}`);
+};
+$("replay-time").oninput = (e) => drawReplay(Number(e.target.value));
+$("replay-close").onclick = () => { $("runs").value = ""; closeReplay(); };
+$("replay-play").onclick = () => {
+  if (S.replayTimer) { stopReplayPlay(); return; }
+  const slider = $("replay-time");
+  if (Number(slider.value) >= Number(slider.max)) slider.value = "0";
+  let last = performance.now();
+  $("replay-play").textContent = "❚❚";
+  // Ten times real time: a five-minute run replays in half a minute.
+  const step = (now) => {
+    const t = Math.min(Number(slider.value) + ((now - last) / 1000) * 10, Number(slider.max));
+    last = now;
+    slider.value = String(t);
+    drawReplay(t);
+    if (t >= Number(slider.max)) stopReplayPlay(); else S.replayTimer = requestAnimationFrame(step);
+  };
+  S.replayTimer = requestAnimationFrame(step);
+};
+function stopReplayPlay() {
+  if (S.replayTimer) cancelAnimationFrame(S.replayTimer);
+  S.replayTimer = null;
+  $("replay-play").textContent = "▶";
+}
+function closeReplay() {
+  stopReplayPlay();
+  S.replay = null;
+  $("replay").hidden = true;
+  $("map").classList.remove("replaying");
+  if (S.layers.replay) { S.layers.replay.remove(); S.layers.replay = null; }
+}
+// Index of the last item (sorted by time) at or before t, or null; key: its time field.
+function lastAt(items, t, key) {
+  let lo = 0, hi = items.length - 1, found = null;
+  while (lo <= hi) {
+    const mid = (lo + hi) >> 1;
+    const at = key ? items[mid][key] : items[mid][0];
+    if (at <= t) { found = mid; lo = mid + 1; } else hi = mid - 1;
+  }
+  return found;
+}
+// The run at time t: waypoint states, driven path so far, plan of the current leg, robot.
+function drawReplay(t) {
+  const R = S.replay;
+  if (!R) return;
+  if (!S.layers.replay) S.layers.replay = L.layerGroup().addTo(map);
+  S.layers.replay.clearLayers();
+  const si = lastAt(R.states, t, "t");
+  const state = si === null ? { waypoints: [], current: null, loop: 0, status: "starting" } : R.states[si];
+  const wps = (R.mission || {}).waypoints || [];
+  wps.forEach((w, i) => {
+    if (!okPoint(w)) return;
+    const status = state.waypoints[i] || "pending";
+    const icon = L.divIcon({ className: `wp-icon replay ${status}`, iconSize: [26, 26], iconAnchor: [13, 13],
+      html: `<div class="arrow" style="transform: rotate(${-(w.yaw || 0)}deg)"></div><div class="dot">${i + 1}</div>` });
+    const m = L.marker(ll(w.x, w.y), { icon, interactive: false }).addTo(S.layers.replay);
+    m.getElement().dataset.testid = "replay-waypoint";
+    m.getElement().dataset.status = status;
+  });
+  const pi = lastAt(R.poses, t);
+  if (pi !== null) {
+    const trail = R.poses.slice(0, pi + 1).map(([, px, py]) => ll(px, py));
+    // Between two journal poses (about a second apart) the robot is drawn in between.
+    let [t0, x, y, deg] = R.poses[pi];
+    const next = R.poses[pi + 1];
+    if (next && next[0] > t0 && t > t0) {
+      const f = Math.min((t - t0) / (next[0] - t0), 1);
+      x += (next[1] - x) * f; y += (next[2] - y) * f;
+      let turn = next[3] - deg; turn -= 360 * Math.round(turn / 360);
+      deg += turn * f;
+    }
+    trail.push(ll(x, y));
+    if (trail.length > 1) L.polyline(trail, { color: "#16a34a", weight: 3, interactive: false }).addTo(S.layers.replay);
+    const plan = R.plans[lastAt(R.plans, t, "t")];
+    if (plan && plan.index === state.current && plan.points.length > 1) {
+      L.polyline(plan.points.map(([px, py]) => ll(px, py)), { color: "#f97316", weight: 2, dashArray: "4 4", interactive: false }).addTo(S.layers.replay);
+    }
+    const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
+    const outline = R.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.replay);
+    body.getElement().dataset.testid = "replay-robot";
+  }
+  const at = state.current !== null && state.current !== undefined ? ` · waypoint ${state.current + 1} ${state.waypoints[state.current]}` : "";
+  $("replay-clock").textContent = `${t.toFixed(1)} / ${R.duration_s.toFixed(1)} s${at}`;
+}
+
 // ---- running -----------------------------------------------------------------------------
 function setStatus(status, text) {
   const el = $("run-status");
@@ -447,7 +653,7 @@ function drawRun(run) {
   if (run.error) text += ` · ${run.error}`;
   setStatus(run.status, text);
   renderList();
-  if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); }
+  if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); loadRuns(); }
 }
 function showReport(run) {
   const r = run.report;
@@ -498,5 +704,6 @@ async function main() {
   render();
   await check();
   document.body.dataset.ready = "true";
+  loadRuns();
 }
 main();

@@ -1,0 +1,552 @@
+"""The ``nav2`` navigator: goals to Nav2's ``navigate_to_pose`` action over rclpy.
+
+One ``nav2_msgs/action/NavigateToPose`` goal per waypoint; everything else (timeouts,
+stall, retries, skip/stop, dwell, loops, pass-through, journal, resume) is the
+executor's. How it maps Nav2 onto :class:`~navseq.navigators.base.Navigator`:
+
+- Terminal statuses: SUCCEEDED -> succeeded; ABORTED and CANCELED -> failed, with
+  Nav2's status name and its ``error_msg`` / ``error_code`` as the text (a goal another
+  client preempted ends ABORTED in Nav2: that is a failed attempt too, and the policy
+  decides); a rejected goal -> failed ``REJECTED``; a result ``UNKNOWN`` (a restarted
+  server that never heard of the goal) -> lost.
+- Pass-through: a new goal simply replaces the tracked one; Nav2 preempts its running
+  goal with it, so the robot keeps rolling. The replaced goal's late result (ABORTED,
+  "preempted") is not tracked any more and never reaches the executor.
+- A server that disappears from the ROS graph for ``lost_after`` seconds is
+  :class:`ServerLost` (the goal died with it); once the server is back,
+  :class:`ServerBack`, and the executor resends. How fast DDS notices a killed
+  process is its lease duration (Cyclone DDS: 10 s by default).
+- Costmaps are cleared through Nav2's ``global_costmap/clear_entirely_global_costmap``
+  and ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``),
+  waiting (bounded) for both answers so the retry plans on the cleared maps.
+- Robot pose: ``map -> odom -> base`` composed from ``/tf`` and ``/tf_static`` with
+  :class:`navseq.geometry.FrameTree` (no tf2 Python library needed), else the goal
+  feedback's ``current_pose``. Odometry pose (for distance driven): the ``odom`` topic.
+- Feedback: ``distance_remaining`` (0, which Nav2 sends before it has a path, is
+  "unknown"), ``number_of_recoveries`` and ``navigation_time`` go into
+  :class:`GoalFeedback`.
+
+Threads: rclpy's executor spins one node on a thread of its own; its callbacks only
+record and put events on a queue, which :meth:`poll` drains on the caller's thread.
+Every call into the action client (send, cancel, service calls) is handed to that
+executor thread (``Executor.create_task``), so rclpy's client is never used from two
+threads at once. The caller's thread only waits on events, so Ctrl-C and SIGTERM reach
+it at once; the runner then cancels the goal, and :meth:`close` waits (bounded) for
+Nav2's cancel response before the node goes away.
+
+Time: :meth:`now` is the node's clock. With ``use_sim_time`` (True, or None: "auto",
+on when someone publishes ``/clock`` once the server is found, as Nav2 run in
+simulation does) it is ROS time from ``/clock``; :meth:`wait_for_server` then waits,
+bounded, for a valid (non-zero) clock, so no timeout counts from time 0. Goals are
+stamped with that clock.
+
+The node: by default a :class:`~navseq.ros2.session.Ros2Session` of the navigator's
+own (rclpy in a context of its own, without rclpy's signal handlers: navseq's runner
+handles SIGINT/SIGTERM), shut down by :meth:`close`. The ROS 2 ``navseq_node`` hands
+its own session instead, so that its parameters, topics, services and the navigator's
+clients are one node; :meth:`close` then leaves the session to its owner.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import queue
+import threading
+import time
+from collections.abc import Sequence
+from typing import Any
+
+from nav2_msgs.action import NavigateToPose
+from nav2_msgs.srv import ClearEntireCostmap
+from nav_msgs.msg import Odometry
+from nav_msgs.msg import Path as PathMsg
+from rclpy.action import ActionClient
+from rclpy.parameter import Parameter
+from rclpy.qos import (
+    DurabilityPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_profile_sensor_data,
+)
+from rosgraph_msgs.msg import Clock
+from tf2_msgs.msg import TFMessage
+
+from navseq.errors import NavseqError
+from navseq.geometry import FrameTree, Pose2D, pose2d_from_pose
+from navseq.navigators.base import (
+    Goal,
+    GoalAccepted,
+    GoalDone,
+    GoalFeedback,
+    GoalOutcome,
+    GoalPlan,
+    NavEvent,
+    ServerBack,
+    ServerLost,
+)
+from navseq.ros2.messages import (
+    add_transforms,
+    navigate_goal,
+    result_text,
+    seconds_of,
+    terminal_status,
+)
+from navseq.ros2.session import Ros2Session
+
+DEFAULT_ACTION = "navigate_to_pose"
+DEFAULT_NODE_NAME = "navseq"
+CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
+CANCEL_WAIT = 2.0  # s of wall time close() waits for Nav2's answer to a cancel
+CLEAR_WAIT = 1.0  # s of wall time for each clear-costmap service
+LOST_AFTER = 0.3  # s of wall time the server must be gone from the graph to be lost
+SPIN_SLICE = 0.1  # longest wall-time wait in spin() between looks at the clock
+COSTMAP_SERVICES = (
+    "global_costmap/clear_entirely_global_costmap",
+    "local_costmap/clear_entirely_local_costmap",
+)
+# tf2's listener QoS: /tf reliable and volatile, /tf_static transient local.
+TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+TF_STATIC_QOS = QoSProfile(
+    depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+
+
+def join_name(namespace: str, name: str) -> str:
+    """The absolute ROS 2 name of ``name`` in ``namespace`` (an absolute name stays)."""
+    if name.startswith("/"):
+        return name
+    namespace = namespace.strip("/")
+    return f"/{namespace}/{name}" if namespace else f"/{name}"
+
+
+class Nav2Navigator:
+    """A :class:`~navseq.navigators.base.Navigator` over Nav2's ``navigate_to_pose``.
+
+    ``namespace="robot1"`` talks to ``/robot1/navigate_to_pose`` and reads
+    ``/robot1/odom``; frames are then looked up as ``robot1/odom`` ... on ``/tf`` (the
+    simulator's and ROS 1's convention) and as plain ``odom`` ... on ``/robot1/tf``
+    (Nav2's multi-robot launch). ``frame`` overrides each goal's frame (None: the
+    goal's own). ``use_sim_time``: True, False, or None to follow ``/clock`` when it is
+    published (see the module docstring). ``session``: the node to use (its namespace
+    then applies, not ``namespace``'s node placement) instead of one of its own.
+    """
+
+    def __init__(
+        self,
+        action: str = DEFAULT_ACTION,
+        frame: str | None = None,
+        *,
+        namespace: str = "",
+        use_sim_time: bool | None = None,
+        base_frames: Sequence[str] = ("base_footprint", "base_link"),
+        odom_topic: str = "odom",
+        plan_topic: str | None = "plan",
+        node_name: str = DEFAULT_NODE_NAME,
+        clock_wait: float = CLOCK_WAIT,
+        cancel_wait: float = CANCEL_WAIT,
+        lost_after: float = LOST_AFTER,
+        session: Ros2Session | None = None,
+    ) -> None:
+        self.namespace = namespace.strip("/")
+        self.action = action
+        self.resolved_action = join_name(self.namespace, action)
+        self.frame = frame
+        self.base_frames = tuple(base_frames)
+        self.clock_wait = clock_wait
+        self.cancel_wait = cancel_wait
+        self.lost_after = lost_after
+        self._sim_time_asked = use_sim_time
+
+        self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
+        # Set after an event is queued and on every /clock message: spin() looks again.
+        self._wake = threading.Event()
+        self._lock = threading.Lock()
+        self._send_seq = 0  # goes up with every goal sent (and when one is dropped)
+        self._goal_id: int | None = None  # the executor's id of the goal tracked
+        self._handle: Any = None  # its ClientGoalHandle, once Nav2 accepted it
+        self._cancel_seq = 0  # the send number a cancel was asked for (0: none)
+        self._cancel_answered = threading.Event()
+        self._cancel_answered.set()  # nothing to wait for
+        self._server_up: bool | None = None  # None: not checked yet
+        self._absent_since: float | None = None
+        self._feedback_pose: Pose2D | None = None
+        self._odom_pose: Pose2D | None = None
+        self._last_now = 0.0
+        self._closed = False
+        self._clear_warned = False
+        # /tf with the frames prefixed by the namespace, and the namespace's own tf.
+        self._tf = FrameTree()
+        self._local_tf = FrameTree() if self.namespace else None
+        prefix = f"{self.namespace}/" if self.namespace else ""
+        self._tf_base_frames = tuple(prefix + base for base in self.base_frames)
+
+        self._owns_session = session is None
+        if session is None:
+            overrides = [Parameter("use_sim_time", value=True)] if use_sim_time else []
+            session = Ros2Session(
+                f"{node_name}_{os.getpid()}",  # unique, as ROS 1's anonymous nodes
+                namespace=self.namespace or None,
+                parameter_overrides=overrides,
+                thread_name="navseq-nav2",
+            )
+        self._session = session
+        self._context = session.context
+        self._node = session.node
+        try:
+            sim_time = bool(use_sim_time) or bool(self._node.get_parameter("use_sim_time").value)
+            # On a shared session the executor already spins: rclpy guards the node's
+            # entity lists, and no goal is out before these exist.
+            self._setup_node(odom_topic, plan_topic, sim_time)
+        except BaseException:
+            if self._owns_session:
+                session.close()
+            raise
+
+    def _setup_node(self, odom_topic: str, plan_topic: str | None, sim_time: bool) -> None:
+        node = self._node
+        self._client = ActionClient(node, NavigateToPose, self.action)
+        self._costmap_clients = [
+            node.create_client(ClearEntireCostmap, name) for name in COSTMAP_SERVICES
+        ]
+        node.create_subscription(TFMessage, "/tf", self._on_tf(self._tf), TF_QOS)
+        node.create_subscription(TFMessage, "/tf_static", self._on_tf(self._tf), TF_STATIC_QOS)
+        if self._local_tf is not None:
+            node.create_subscription(TFMessage, "tf", self._on_tf(self._local_tf), TF_QOS)
+            node.create_subscription(
+                TFMessage, "tf_static", self._on_tf(self._local_tf), TF_STATIC_QOS
+            )
+        # Best effort takes both reliable and best-effort publishers (robots use either).
+        node.create_subscription(Odometry, odom_topic, self._on_odom, qos_profile_sensor_data)
+        if plan_topic:
+            node.create_subscription(PathMsg, plan_topic, self._on_plan, 1)
+        self._clock_sub: Any = None
+        if sim_time:
+            self._watch_clock()
+
+    def _in_ros(self, callback: Any, *args: Any) -> None:
+        """Run ``callback(*args)`` on the executor's thread (rclpy is not used from two)."""
+        if not self._closed:
+            self._session.call_soon(callback, *args)
+
+    # -- Navigator protocol -----------------------------------------------------------
+
+    def now(self) -> float:
+        """The node's clock (ROS time under use_sim_time); after close, its last value."""
+        if self._context.ok():
+            self._last_now = self._node.get_clock().now().nanoseconds * 1e-9
+        return self._last_now
+
+    @property
+    def uses_sim_time(self) -> bool:
+        return bool(self._node.get_parameter("use_sim_time").value)
+
+    def spin(self, seconds: float) -> None:
+        """Wait until ``seconds`` of the node's time have passed, or :meth:`poll` has news.
+
+        Under ``use_sim_time`` each ``/clock`` message wakes the wait to look at the
+        time, and a wait begun before the clock starts lasts until ``seconds`` after
+        it does. A clock that jumps back (a restarted simulator) restarts the wait.
+        """
+        start = self.now()
+        while not self._has_news():
+            now = self.now()
+            if start == 0.0 or now < start:
+                start = now
+            elif now - start >= seconds:
+                return
+            if not self._context.ok():
+                raise NavseqError("ROS 2 was shut down", source="rclpy")
+            wait = SPIN_SLICE
+            if self._clock_sub is None:
+                wait = min(wait, max(start + seconds - now, 0.0))
+            self._wake.wait(wait)
+            # Cleared before looking again: a later event sets it anew, an earlier one
+            # is seen by _has_news().
+            self._wake.clear()
+
+    def wait_for_server(self, timeout: float) -> bool:
+        """Wait (wall time) for the server, then settle the clock (module docstring).
+
+        Raises :class:`NavseqError` when the server is there but no valid ROS time
+        comes within ``clock_wait`` seconds.
+        """
+        deadline = time.monotonic() + timeout
+        while not self._client.server_is_ready():
+            if time.monotonic() >= deadline or not self._context.ok():
+                return False
+            time.sleep(0.02)
+        self._server_up = True
+        self._follow_the_stacks_clock()
+        self._wait_for_valid_time()
+        return True
+
+    def require_server(self, timeout: float) -> None:
+        """Like :meth:`wait_for_server`, but a missing server is a clear :class:`NavseqError`."""
+        if not self.wait_for_server(timeout):
+            domain = os.environ.get("ROS_DOMAIN_ID", "0")
+            raise NavseqError(
+                f"no action server '{self.resolved_action}' (nav2_msgs/action/NavigateToPose) "
+                f"answered within {timeout:g} s in ROS_DOMAIN_ID {domain}; is Nav2 (or "
+                "`navseq sim --ros2`) running in the same ROS_DOMAIN_ID, and are the action "
+                "name and namespace (--ns) right?",
+                source=f"action {self.resolved_action}",
+            )
+
+    def _follow_the_stacks_clock(self) -> None:
+        """use_sim_time "auto": on when /clock has a publisher once the server is there."""
+        if self._sim_time_asked is not None or self.uses_sim_time:
+            return
+        if self._node.count_publishers("/clock") == 0:
+            return
+        self._node.set_parameters([Parameter("use_sim_time", value=True)])
+        self._watch_clock()
+
+    def _watch_clock(self) -> None:
+        self._clock_sub = self._node.create_subscription(
+            Clock, "/clock", lambda _msg: self._wake.set(), qos_profile_sensor_data
+        )
+
+    def _wait_for_valid_time(self) -> None:
+        deadline = time.monotonic() + self.clock_wait
+        while self.now() <= 0.0:
+            if time.monotonic() >= deadline:
+                raise NavseqError(
+                    f"ROS time is still 0 after {self.clock_wait:g} s: use_sim_time is on but "
+                    "nothing publishes /clock. Start the simulator that drives /clock, or "
+                    "run with --use-sim-time false for a robot on wall time",
+                    source="/clock",
+                )
+            time.sleep(0.02)
+
+    def send_goal(self, goal: Goal) -> None:
+        frame = self.frame or goal.frame or "map"
+        message = navigate_goal(goal.pose, frame, self._node.get_clock().now().to_msg(), goal.z)
+        with self._lock:
+            # The goal tracked so far is simply dropped: Nav2 preempts it with this one
+            # without stopping the robot. Callbacks carry the send number, so the dropped
+            # goal's late result is ignored, also when the same goal is sent again.
+            self._send_seq += 1
+            seq = self._send_seq
+            self._goal_id = goal.goal_id
+            self._handle = None
+        self._in_ros(self._send, seq, goal.goal_id, message)
+
+    def cancel_goal(self) -> None:
+        """Ask Nav2 to cancel the tracked goal (once); :meth:`close` waits for the answer.
+
+        A goal not accepted yet is cancelled as soon as Nav2 accepts it.
+        """
+        with self._lock:
+            if self._goal_id is None or self._cancel_seq == self._send_seq:
+                return
+            self._cancel_seq = self._send_seq
+            self._cancel_answered.clear()
+            handle = self._handle
+        if handle is not None:
+            self._in_ros(self._send_cancel, handle)
+
+    def clear_costmaps(self) -> None:
+        """Call both clear-costmap services and wait (bounded) for their answers."""
+        answered = [threading.Event() for _ in self._costmap_clients]
+        missing = [
+            COSTMAP_SERVICES[index]
+            for index, client in enumerate(self._costmap_clients)
+            if not client.service_is_ready()
+        ]
+        for client, done in zip(self._costmap_clients, answered, strict=True):
+            if client.service_is_ready():
+                self._in_ros(self._call_clear, client, done)
+            else:
+                done.set()
+        deadline = time.monotonic() + CLEAR_WAIT
+        for done in answered:
+            done.wait(max(deadline - time.monotonic(), 0.0))
+        if missing and not self._clear_warned:
+            self._clear_warned = True
+            self._node.get_logger().warning(
+                f"{', '.join(missing)} unavailable: retrying without clearing that costmap"
+            )
+
+    def robot_pose(self) -> Pose2D | None:
+        frame = self.frame or "map"
+        pose = self._lookup(frame, self.base_frames, self._tf_base_frames)
+        return pose if pose is not None else self._feedback_pose
+
+    def odometry_pose(self) -> Pose2D | None:
+        """The pose the ``odom`` topic gives: continuous (no localisation jumps), so the
+        executor measures distance driven on it. None before the first message."""
+        return self._odom_pose
+
+    def poll(self) -> list[NavEvent]:
+        events: list[NavEvent] = []
+        while True:
+            try:
+                events.append(self._events.get_nowait())
+            except queue.Empty:
+                break
+        events.extend(self._check_server())
+        return events
+
+    def close(self) -> None:
+        """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
+        if self._closed:
+            return
+        self.cancel_goal()
+        self._cancel_answered.wait(self.cancel_wait)
+        self.now()  # keep the clock's last value for after close
+        self._closed = True
+        if self._owns_session:
+            with contextlib.suppress(Exception):
+                self._client.destroy()
+            self._session.close()
+
+    # -- lookups -----------------------------------------------------------------------
+
+    def _lookup(
+        self, target: str, local_sources: Sequence[str], global_sources: Sequence[str]
+    ) -> Pose2D | None:
+        """``target`` <- the first base frame that resolves: the namespace's own tf with
+        plain names first, then /tf with the namespace's prefix."""
+        if self._local_tf is not None:
+            for source in local_sources:
+                pose = self._local_tf.lookup(target, source)
+                if pose is not None:
+                    return pose
+        for source in global_sources:
+            pose = self._tf.lookup(target, source)
+            if pose is not None:
+                return pose
+        return None
+
+    # -- server liveness ---------------------------------------------------------------
+
+    def _has_news(self) -> bool:
+        return not self._events.empty() or self._server_news()
+
+    def _server_news(self) -> bool:
+        """:meth:`_check_server` would report ServerLost or ServerBack now."""
+        if self._server_up is None or not self._context.ok():
+            return False
+        ready = self._client.server_is_ready()
+        if not self._server_up:
+            return bool(ready)
+        if ready:
+            self._absent_since = None
+            return False
+        now = time.monotonic()
+        if self._absent_since is None:
+            self._absent_since = now
+        return now - self._absent_since >= self.lost_after
+
+    def _check_server(self) -> list[NavEvent]:
+        if self._server_up is None:
+            if self._context.ok():
+                self._server_up = bool(self._client.server_is_ready())
+            return []
+        if not self._server_news():
+            return []
+        if self._server_up:
+            self._server_up = False
+            with self._lock:
+                # The goal died with the server: stop tracking it; the executor resends.
+                self._send_seq += 1
+                self._goal_id = None
+                self._handle = None
+                self._cancel_answered.set()
+            return [ServerLost(f"{self.resolved_action} left the ROS graph")]
+        self._server_up = True
+        self._absent_since = None
+        return [ServerBack()]
+
+    def _queue(self, event: NavEvent) -> None:
+        self._events.put(event)
+        self._wake.set()  # after the put, so that a woken spin() finds the event
+
+    # -- on the executor's thread: rclpy calls and callbacks (record and enqueue) --------
+
+    def _send(self, seq: int, goal_id: int, message: Any) -> None:
+        future = self._client.send_goal_async(
+            message, feedback_callback=lambda fb: self._on_feedback(seq, goal_id, fb)
+        )
+        future.add_done_callback(lambda done: self._on_goal_response(seq, goal_id, done))
+
+    def _send_cancel(self, handle: Any) -> None:
+        future = handle.cancel_goal_async()
+        future.add_done_callback(lambda _done: self._cancel_answered.set())
+
+    def _call_clear(self, client: Any, done: threading.Event) -> None:
+        future = client.call_async(ClearEntireCostmap.Request())
+        future.add_done_callback(lambda _future: done.set())
+
+    def _on_goal_response(self, seq: int, goal_id: int, future: Any) -> None:
+        error = future.exception()
+        handle = None if error is not None else future.result()
+        with self._lock:
+            current = seq == self._send_seq and self._goal_id == goal_id
+            if not current:
+                return  # replaced meanwhile: Nav2 preempts it with the newer goal
+            if handle is None or not handle.accepted:
+                self._goal_id = None
+                self._cancel_answered.set()
+                text = f"the goal request failed: {error}" if error else "Nav2 rejected the goal"
+                self._queue(GoalDone.failed(goal_id, "REJECTED", text))
+                return
+            self._handle = handle
+            cancel_now = self._cancel_seq == seq
+            self._queue(GoalAccepted(goal_id))
+        if cancel_now:
+            self._send_cancel(handle)
+        result = handle.get_result_async()
+        result.add_done_callback(lambda done: self._on_result(seq, goal_id, done))
+
+    def _on_result(self, seq: int, goal_id: int, future: Any) -> None:
+        with self._lock:
+            if seq != self._send_seq or self._goal_id != goal_id:
+                return  # a goal we replaced or gave up on
+            self._goal_id = None
+            self._handle = None
+            self._cancel_answered.set()  # a finished goal needs no cancel
+        error = future.exception()
+        if error is not None:
+            self._queue(GoalDone.lost(goal_id, f"no result: {error}"))
+            return
+        response = future.result()
+        outcome, status = terminal_status(response.status) or (GoalOutcome.LOST, "LOST")
+        result = response.result
+        # Humble's NavigateToPose result has neither field.
+        text = result_text(getattr(result, "error_code", 0), getattr(result, "error_msg", ""))
+        if outcome is GoalOutcome.LOST and not text:
+            text = "the server does not know the goal (restarted?)"
+        self._queue(GoalDone(goal_id, outcome, status, text))
+
+    def _on_feedback(self, seq: int, goal_id: int, message: Any) -> None:
+        feedback = message.feedback
+        pose = pose2d_from_pose(feedback.current_pose.pose)
+        self._feedback_pose = pose
+        if seq != self._send_seq or self._goal_id != goal_id:
+            return
+        remaining = float(feedback.distance_remaining)
+        self._queue(
+            GoalFeedback(
+                goal_id,
+                pose,
+                # Nav2 sends 0 until it has a path: unknown, not "arrived".
+                remaining if remaining > 0.0 else None,
+                recoveries=int(feedback.number_of_recoveries),
+                navigation_time=seconds_of(feedback.navigation_time),
+            )
+        )
+
+    def _on_tf(self, tree: FrameTree) -> Any:
+        return lambda message: add_transforms(tree, message)
+
+    def _on_odom(self, message: Any) -> None:
+        self._odom_pose = pose2d_from_pose(message.pose.pose)
+
+    def _on_plan(self, message: Any) -> None:
+        goal_id = self._goal_id
+        if goal_id is None or not message.poses:
+            return
+        points = tuple((p.pose.position.x, p.pose.position.y) for p in message.poses)
+        self._queue(GoalPlan(goal_id, points))

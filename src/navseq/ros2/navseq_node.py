@@ -1,0 +1,286 @@
+"""The navseq ROS 2 node: the tutorial's waypoint sequencer for Nav2, done right.
+
+``ros2 run navseq navseq_node --ros-args -p p_seq:="[...]" -p yea_seq:="[...]"`` (or
+``python -m navseq.ros2.navseq_node``, or a ``Node`` in a launch file) reads the
+mission from its parameters, as the ROS 1 node (:mod:`navseq.ros1.navseq_node`) does:
+
+- ``p_seq`` (double array, x y z triples) and ``yea_seq`` (double array, yaw degrees),
+  exactly like the tutorial's, or
+- ``mission``: the path of a mission file in any format navseq reads, or
+- ``waypoints``: a string holding navseq's YAML waypoint list;
+
+plus the same optional mission keys (``loops``, ``goal_timeout``, ``retries``,
+``on_failure``, ``pass_through`` ...; see :mod:`navseq.ros2.node_params`), and the
+node's own: ``action`` (default ``navigate_to_pose``, relative to the node's
+namespace), ``server_wait`` (s, default 30), ``tick``, ``keep_alive``, ``base_frames``,
+``odom_topic``, ``plan_topic``; ``use_sim_time`` as every ROS 2 node (not given: on as
+soon as ``/clock`` is published).
+
+It drives Nav2 through :class:`~navseq.ros2.navigator.Nav2Navigator` on this node,
+publishes ``~/waypoints`` (``visualization_msgs/msg/MarkerArray``) and ``~/status``
+(``std_msgs/msg/String``, one JSON object per event), both transient local, offers
+``~/pause``, ``~/resume``, ``~/skip`` and ``~/cancel`` (``std_srvs/srv/Trigger``),
+and logs one line per waypoint event. SIGINT / SIGTERM (Ctrl-C, ``ros2 launch``'s
+shutdown) cancel the active goal and wait (bounded) for Nav2's answer before the node
+exits. Exit status: 0 all waypoints reached, 1 not, 2 bad parameters or no action
+server, 130 / 143 interrupted by SIGINT / SIGTERM. With ``keep_alive`` the node stays
+up after the mission (markers and status keep their final state) until it is stopped,
+and then exits with the mission's 0 or 1.
+
+Threads: the node's executor spins on a thread of its own
+(:class:`~navseq.ros2.session.Ros2Session`); the mission runs on the main thread,
+where the signals arrive. Service handlers are coroutines: they file the request with
+:class:`~navseq.executor.control.MissionControl` and await its answer, so the single
+executor thread keeps delivering ``/clock``, feedback and results meanwhile.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from typing import Any
+
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.task import Future
+from std_srvs.srv import Trigger
+
+from navseq.errors import NavseqError
+from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
+from navseq.executor.events import (
+    AttemptFailed,
+    MissionEvent,
+    MissionPaused,
+    WaypointFinished,
+    WaypointOutcome,
+    WaypointProgress,
+)
+from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
+from navseq.ros2.mission_topics import MissionTopics
+from navseq.ros2.navigator import Nav2Navigator
+from navseq.ros2.node_params import NodeSettings, read_node_params
+from navseq.ros2.session import Ros2Session
+from navseq.sinks.progress import RunView, describe
+from navseq.text import printable
+
+NODE_NAME = "navseq"
+SERVICE_ANSWER_WAIT = 5.0  # s of wall time a service waits for the mission's answer
+# The executor's reason for each request; a cancel's starts with "cancelled", which is
+# how the status topic and the exit log tell it from a failure.
+_REASONS = {
+    "pause": "paused by the operator (~/pause)",
+    "resume": "resumed by the operator (~/resume)",
+    "cancel": "cancelled by the operator (~/cancel)",
+}
+KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a signal while kept alive
+
+
+class WaypointLog:
+    """A mission listener logging one line per waypoint event, as ``navseq run`` words it.
+
+    Failed attempts, waypoints not reached and pauses are warnings. The waypoint an
+    interruption ends is left to the interruption's own log line.
+    """
+
+    def __init__(self, mission: Any, logger: Any) -> None:
+        self.view = RunView(mission)
+        self.logger = logger
+
+    def __call__(self, event: MissionEvent) -> None:
+        self.view.update(event)
+        if isinstance(event, WaypointProgress):
+            return
+        if isinstance(event, WaypointFinished) and event.reason.startswith("interrupted"):
+            return
+        text = describe(event, self.view)
+        if text is None:
+            return
+        warn = isinstance(event, MissionPaused | AttemptFailed) or (
+            isinstance(event, WaypointFinished) and event.outcome is not WaypointOutcome.REACHED
+        )
+        if warn:
+            self.logger.warning(f"{text}")
+        else:
+            self.logger.info(f"{text}")
+
+
+class OperatorServices:
+    """``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel``: requests to the mission's thread."""
+
+    def __init__(self, session: Ros2Session, control: MissionControl, topics: MissionTopics):
+        self.session = session
+        self.control = control
+        self.state = topics.state
+        # A group of their own: while a handler awaits the mission's answer its group is
+        # busy, and in the node's default group that would hold back /clock, Nav2's
+        # feedback and results - which the mission needs to answer.
+        group = MutuallyExclusiveCallbackGroup()
+        for name in ("pause", "resume", "skip", "cancel"):
+            session.node.create_service(
+                Trigger, f"~/{name}", self._handler(name), callback_group=group
+            )
+
+    def _handler(self, name: str) -> Any:
+        async def handle(_request: Any, response: Any) -> Any:
+            ok, message = await self._answer(name)
+            response.success, response.message = ok, message
+            return response
+
+        return handle
+
+    async def _answer(self, name: str) -> tuple[bool, str]:
+        if self.state.over is not None:
+            # Nobody takes requests any more: a request would only be refused.
+            return False, f"nothing to {name}: {self.state.over}"
+        if name == "skip":
+            index = self.state.active_waypoint
+            if index is None:
+                # Filed now, the request would skip whichever waypoint comes next.
+                return False, "no waypoint is underway"
+            self.control.request_skip("skipped by the operator (~/skip)")
+            return True, f"waypoint {index + 1} skipped; going on with the next one"
+        answered: Future = Future(executor=self.session.executor)
+
+        def wake(request: OperatorRequest) -> None:
+            if not answered.done():
+                answered.set_result(request)
+                # The awaiting handler runs again when the executor looks next: now.
+                self.session.executor.wake()
+
+        request = self.control.submit(name, _REASONS[name], wake)
+        # The run answers within one tick; the timer only guards against a stuck run.
+        timer = threading.Timer(SERVICE_ANSWER_WAIT, lambda: wake(request))
+        timer.daemon = True
+        timer.start()
+        await answered
+        timer.cancel()
+        if not request.done.is_set():
+            return False, f"{name}: the mission did not respond within {SERVICE_ANSWER_WAIT:g} s"
+        return request.ok, request.message
+
+
+def make_navigator(session: Ros2Session, settings: NodeSettings) -> Nav2Navigator:
+    return Nav2Navigator(
+        settings.action,
+        namespace=session.node.get_namespace(),
+        use_sim_time=settings.use_sim_time,
+        base_frames=settings.base_frames,
+        odom_topic=settings.odom_topic,
+        plan_topic=settings.plan_topic,
+        session=session,
+    )
+
+
+def run_node(session: Ros2Session) -> int:
+    """Run the mission the node's parameters give; the exit status (see module doc)."""
+    node = session.node
+    logger = node.get_logger()
+    given = {name: parameter.value for name, parameter in session.given_parameters().items()}
+    try:
+        mission, settings = read_node_params(given, node.get_fully_qualified_name())
+        navigator = make_navigator(session, settings)
+    except NavseqError as error:
+        logger.error(f"{error}")
+        return 2
+    topics = MissionTopics(node, mission)
+    control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
+    OperatorServices(session, control, topics)
+    code = 2
+    try:
+        logger.info(
+            f"{len(mission)} waypoints from {printable(mission.source)}; "
+            f"waiting for {navigator.resolved_action}"
+        )
+        navigator.require_server(settings.server_wait)
+        result = run_mission(
+            mission,
+            navigator,
+            [topics, WaypointLog(mission, logger)],
+            tick=settings.tick,
+            control=control,
+        )
+    except NavseqError as error:
+        logger.error(f"{error}")
+        topics.publish_status({"state": "error", "reason": str(error)})
+        topics.state.over = "the mission could not run"
+        return 2
+    except MissionInterrupted as interrupted:
+        _log_interrupted(logger, interrupted.signal_name)
+        return interrupted.exit_code
+    except KeyboardInterrupt:
+        # Ctrl-C while still waiting for the action server: no goal is out yet.
+        logger.warning("interrupted (SIGINT) while waiting for the action server")
+        return SIGNAL_EXIT_CODES["SIGINT"]
+    except StopRequested as shutdown:
+        _log_interrupted(logger, str(shutdown))
+        return 1
+    else:
+        if result.reason.startswith("cancelled"):
+            logger.warning("mission cancelled by the operator (~/cancel)")
+            topics.state.over = "the mission was cancelled"
+        elif result.success:
+            logger.info(f"mission succeeded ({result.reason})")
+            topics.state.over = "the mission has ended (succeeded)"
+        else:
+            logger.warning(f"mission ended without reaching every waypoint ({result.reason})")
+            topics.state.over = "the mission has ended (failed)"
+        code = result.exit_code
+    finally:
+        navigator.close()
+    if settings.keep_alive:
+        return stay_up(session, code)
+    return code
+
+
+def stay_up(session: Ros2Session, mission_code: int) -> int:
+    """Keep the node (its latched topics and services) up until it is stopped.
+
+    Returns ``mission_code`` however the node is stopped: the mission is over, so a
+    signal interrupts nothing, and ``ros2 launch`` (which stops nodes with SIGINT)
+    should not see a finished mission as a failure.
+    """
+    logger = session.node.get_logger()
+    logger.info("mission over; staying up (keep_alive) until stopped")
+    stop_signal: list[str] = []
+    stopping = threading.Event()
+
+    def on_signal(signum: int, _frame: Any) -> None:
+        stop_signal.append(signal.Signals(signum).name)
+        stopping.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        while not stopping.is_set() and session.ok():
+            stopping.wait(KEEP_ALIVE_POLL)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if stop_signal:
+        logger.info(f"{stop_signal[0]}; shutting down")
+    return mission_code
+
+
+def _log_interrupted(logger: Any, cause: str) -> None:
+    logger.warning(f"interrupted ({cause}); the active goal was cancelled")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``ros2 run navseq navseq_node [--ros-args ...]``; returns the exit status."""
+    args = list(sys.argv if argv is None else ["navseq_node", *argv])
+    try:
+        session = Ros2Session(NODE_NAME, args=args, any_parameter=True)
+    except Exception as error:  # rclpy's own: bad --ros-args, a params file it cannot read
+        print(f"navseq: cannot start the ROS 2 node: {error}", file=sys.stderr)
+        return 2
+    try:
+        return run_node(session)
+    finally:
+        # Let the last status reach transient-local subscribers already matched.
+        time.sleep(0.05)
+        session.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,76 @@
+"""``navseq run --navigator nav2``: connect to Nav2 before the mission.
+
+Everything that needs the running stack is done here, before the robot moves and before
+any file is written, so a problem is one clear :class:`NavseqError` (exit 2): the
+``navigate_to_pose`` server must answer within ``--server-timeout`` wall seconds and,
+under ``use_sim_time``, its clock must run (:meth:`Nav2Navigator.wait_for_server`).
+The robot profile is ``--robot``, else the mission's ``robot:``, else the default
+(``draft.robot`` already says which); pre-flight runs on ``--map`` / the mission's
+``map:`` when there is one.
+
+This module imports rclpy (through the navigator): the registry imports it only when
+``nav2`` is chosen, and turns an ImportError into one message saying to source ROS 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from navseq.errors import NavseqError
+from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.ros2.navigator import Nav2Navigator
+from navseq.ros2.sim_config import namespace_of
+
+SERVER_WAIT = 30.0  # s of wall time for the action server by default (ROS 1 waits as long)
+
+
+def sim_time_setting(text: str) -> bool | None:
+    """``--use-sim-time auto|true|false`` -> None (auto: follow /clock), True, False."""
+    value = str(text).strip().lower()
+    if value == "auto":
+        return None
+    if value in ("true", "yes", "on", "1"):
+        return True
+    if value in ("false", "no", "off", "0"):
+        return False
+    raise NavseqError(f"expected auto, true or false, not {text!r}", source="--use-sim-time")
+
+
+def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
+    """The connection, then pre-flight on a known map; NavseqError on any problem."""
+    mission = draft.mission
+    frame = args.frame or mission.frame
+    namespace = namespace_of(args.ns or "")
+    use_sim_time = sim_time_setting(args.use_sim_time)
+    server_timeout = float(args.server_timeout)
+    if not 0.0 < server_timeout < float("inf"):
+        raise NavseqError(
+            f"must be > 0 seconds, not {args.server_timeout}", source="--server-timeout"
+        )
+    action = args.action
+    if not action or any(c.isspace() for c in action):
+        raise NavseqError(f"{action!r} is not an action name", source="--action")
+    navigator = Nav2Navigator(action, frame, namespace=namespace, use_sim_time=use_sim_time)
+    try:
+        navigator.require_server(server_timeout)
+        grid = draft.optional_map()
+    except BaseException:
+        navigator.close()
+        raise
+    info: dict[str, object] = {
+        "kind": "nav2",
+        "action": navigator.resolved_action,
+        "frame": frame,
+        "ns": namespace,
+        "use_sim_time": navigator.uses_sim_time,
+        "robot": draft.robot.name,
+    }
+    notes = []
+    if use_sim_time is None and navigator.uses_sim_time:
+        notes.append("/clock is published: navseq runs on simulation time (use_sim_time)")
+    return NavigatorSetup(
+        make_navigator=lambda: navigator,
+        info=info,
+        grid=grid,
+        notes=notes,
+    )

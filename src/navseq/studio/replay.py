@@ -1,0 +1,142 @@
+"""Past runs: the output folders ``navseq run`` (or the studio) left, replayed in time.
+
+A run folder holds the mission as run, ``journal.jsonl`` and ``report.json``. The
+journal is read by :func:`navseq.sinks.journal.read_journal` (its chain checked, as
+``navseq run --resume`` checks it) and its events are folded by the live view's own
+rules (:class:`~navseq.studio.runs.LiveView`), so a replayed waypoint is in the state
+the live page showed at that moment. What the page gets is a timeline it can scrub
+with a slider: robot poses (the journal keeps the driven path's corners, the pose at
+every arrival and one at least every 30 s; the page draws the robot in between), each
+change of the waypoints' states, and each planned path, all on one clock starting at 0.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from navseq.errors import NavseqError
+from navseq.text import printable
+
+JOURNAL_NAME = "journal.jsonl"
+#: Runs listed at most (newest first): a folder of thousands stays quick to open.
+MAX_RUNS_LISTED = 200
+
+
+def run_folders(searched: list[Path]) -> list[Path]:
+    """Folders holding a journal, under each of ``searched`` (one or two levels down)."""
+    found: dict[Path, float] = {}
+    for top in searched:
+        if not top.is_dir():
+            continue
+        for journal in [*top.glob(f"*/{JOURNAL_NAME}"), *top.glob(f"*/*/{JOURNAL_NAME}")]:
+            try:
+                found[journal.parent.resolve()] = journal.stat().st_mtime
+            except OSError:
+                continue
+    return sorted(found, key=lambda folder: found[folder], reverse=True)[:MAX_RUNS_LISTED]
+
+
+def run_summary(folder: Path, shown: str) -> dict[str, Any]:
+    """One line of the runs list: folder, when, and the report's verdict if there is one."""
+    from navseq.studio.runs import _latest_report
+
+    report = _latest_report(folder)
+    totals = report.get("totals", {}) if report else {}
+    return {
+        "folder": shown,
+        "modified_s": (folder / JOURNAL_NAME).stat().st_mtime,
+        "reason": report.get("reason") if report else None,
+        "reached": totals.get("reached"),
+        "visits": totals.get("visits"),
+    }
+
+
+def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
+    """The run in ``folder`` as a timeline (docs/studio.md, ``GET /api/replay``).
+
+    ``base_dir``: the folder the mission document's ``map:`` is made relative to (the
+    studio's mission folder, so the page loads the map as it loads its own).
+    Raises NavseqError when the folder has no readable journal.
+    """
+    from navseq.executor import events as ev
+    from navseq.mission import load_mission
+    from navseq.mission.robot import DEFAULT_PROFILE
+    from navseq.sinks.journal import read_journal
+    from navseq.sinks.journal_reader import journal_events
+    from navseq.studio.documents import document_of
+    from navseq.studio.runs import LiveView, _latest_report
+
+    journal_path = folder / JOURNAL_NAME
+    if not journal_path.is_file():
+        raise NavseqError(f"{printable(shown)} has no {JOURNAL_NAME}: not a run folder")
+    state = read_journal(journal_path)
+    mission_path = _mission_file(folder, state.mission_source)
+    mission = load_mission(mission_path) if mission_path is not None else None
+    events = list(journal_events(journal_path))  # read_journal keeps no event list
+    start_t = events[0].t if events else 0.0
+    if mission is not None:
+        count = len(mission.waypoints)
+    else:
+        count = 1 + max((getattr(event, "index", -1) for event in events), default=-1)
+    fold = LiveView(count, footprint=[])
+    poses: list[list[float]] = []
+    states: list[dict[str, Any]] = []
+    plans: list[dict[str, Any]] = []
+    for event in events:
+        before = (list(fold.waypoints), fold.current, fold.loop, fold.status)
+        fold(event)
+        t = round(event.t - start_t, 3)
+        if isinstance(event, ev.WaypointProgress | ev.WaypointStarted):
+            poses.append(
+                [t, round(event.x, 3), round(event.y, 3), round(math.degrees(event.yaw), 2)]
+            )
+        elif isinstance(event, ev.WaypointPlan):
+            plans.append({"t": t, "index": event.index, "points": _thinned(event.path)})
+        if (list(fold.waypoints), fold.current, fold.loop, fold.status) != before:
+            states.append(
+                {
+                    "t": t,
+                    "waypoints": list(fold.waypoints),
+                    "current": fold.current,
+                    "loop": fold.loop,
+                    "status": fold.status,
+                }
+            )
+    robot = mission.robot if mission is not None and mission.robot else DEFAULT_PROFILE
+    return {
+        "folder": shown,
+        "mission": document_of(mission, base_dir) if mission is not None else None,
+        "report": _latest_report(folder),
+        "duration_s": round(events[-1].t - start_t, 3) if events else 0.0,
+        "finish_reason": state.finish_reason,
+        "damaged_lines": state.damaged_lines,
+        "footprint_m": [[float(x), float(y)] for x, y in robot.footprint],
+        "poses": poses,
+        "states": states,
+        "plans": plans,
+    }
+
+
+def _mission_file(folder: Path, source: str) -> Path | None:
+    """The mission as run: the journal's source when it is in the folder, else the one
+    YAML beside the journal (a folder moved elsewhere keeps its mission)."""
+    named = Path(source)
+    candidates = [folder / named.name] if named.name else []
+    candidates += sorted(path for path in folder.glob("*.yaml") if path.is_file())
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _thinned(path: Any) -> list[list[float]]:
+    from navseq.studio.documents import corners
+
+    return [[x, y] for x, y in corners(path)] if len(path) else []
+
+
+def shown_folder(folder: Path, base: Path) -> str:
+    return printable(os.path.relpath(folder, base))

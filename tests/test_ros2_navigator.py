@@ -1,0 +1,434 @@
+"""``navseq run --navigator nav2`` against the ROS 2 simulator node, over real rclpy.
+
+Every test starts ``python -m navseq.ros2.sim_node`` (Nav2's interfaces around the
+simulator) on a private ROS_DOMAIN_ID at 4x speed, so it publishes ``/clock`` and
+navseq runs on simulation time, and runs ``navseq run ... --navigator nav2`` as a
+subprocess, as a user would from a shell where ROS 2 is sourced. Nothing imports rclpy
+in pytest's process. Robots are watched through ``odom`` by a small rclpy script
+(:data:`ODOM_WATCHER`) run as a subprocess too.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cli_support import NAVSEQ, REPO, journal_events, wait_for, write_mission
+from ros2_support import ros2_environment, ros2_prefix
+
+pytestmark = pytest.mark.ros2
+
+MAP = REPO / "maps" / "turtlebot3_world.yaml"
+EXAMPLE = REPO / "examples" / "turtlebot3_world.yaml"
+CLIENTS = Path(__file__).with_name("ros2_clients.py")
+START = "-2,-0.5,0"
+SPEED = "4"
+CRUISE = 0.22  # m/s: the TurtleBot3 burger the simulator drives by default
+# A killed process leaves the DDS graph after its lease: 10 s by default in Cyclone DDS.
+SHORT_LEASE = (
+    "<CycloneDDS><Domain><Discovery><LeaseDuration>1s</LeaseDuration>"
+    "</Discovery></Domain></CycloneDDS>"
+)
+
+# Prints one JSON line when stopped (SIGINT/SIGTERM): every odom sample as
+# [monotonic time, |linear speed|, x, y]. CLOCK_MONOTONIC is system-wide, so the
+# times compare with the test's own time.monotonic().
+ODOM_WATCHER = r"""
+import json, signal, sys, time
+import rclpy
+from nav_msgs.msg import Odometry
+from rclpy.qos import qos_profile_sensor_data
+rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
+node = rclpy.create_node("odom_watcher")
+samples = []
+stop = []
+def on_odom(m):
+    p = m.pose.pose.position
+    samples.append([time.monotonic(), abs(m.twist.twist.linear.x), p.x, p.y])
+node.create_subscription(Odometry, sys.argv[1], on_odom, qos_profile_sensor_data)
+signal.signal(signal.SIGINT, lambda *a: stop.append(1))
+signal.signal(signal.SIGTERM, lambda *a: stop.append(1))
+print("watching", flush=True)
+while not stop:
+    rclpy.spin_once(node, timeout_sec=0.05)
+print(json.dumps(samples), flush=True)
+"""
+
+
+class SimNode:
+    """A running ``python -m navseq.ros2.sim_node``; its stdout is read as it comes."""
+
+    def __init__(self, env: dict[str, str], *args: str) -> None:
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "navseq.ros2.sim_node", "--map", str(MAP), *args],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        self.ready = threading.Event()
+        threading.Thread(target=self._read, daemon=True).start()
+        if not self.ready.wait(60):
+            self.process.kill()
+            raise AssertionError(f"sim node not ready: {self.process.communicate()}")
+
+    def _read(self) -> None:
+        assert self.process.stdout is not None
+        for line in self.process.stdout:
+            if "ready" in line:
+                self.ready.set()
+
+    def stop(self, signum: int = signal.SIGINT) -> str:
+        """Stop it; its stderr (the node's log)."""
+        if self.process.poll() is None:
+            self.process.send_signal(signum)
+        try:
+            self.process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        assert self.process.stderr is not None
+        return self.process.stderr.read()
+
+
+class OdomWatcher:
+    def __init__(self, env: dict[str, str], topic: str = "/odom") -> None:
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", ODOM_WATCHER, topic],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert self.process.stdout is not None
+        assert self.process.stdout.readline().strip() == "watching"
+
+    def samples(self) -> list[list[float]]:
+        self.process.send_signal(signal.SIGINT)
+        out, err = self.process.communicate(timeout=30)
+        assert self.process.returncode == 0, err
+        return list(json.loads(out.strip().splitlines()[-1]))
+
+
+@pytest.fixture
+def env() -> dict[str, str]:
+    prefix = ros2_prefix()
+    assert prefix is not None
+    return ros2_environment(prefix)
+
+
+@pytest.fixture
+def sim(env: dict[str, str]) -> Iterator[SimNode]:
+    node = SimNode(env, f"--start={START}", "--speed", SPEED)
+    yield node
+    assert "Traceback" not in node.stop()
+
+
+def run_nav2(
+    env: dict[str, str], mission: Path, out: Path, *extra: str, timeout: float = 300
+) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [NAVSEQ, "run", str(mission), "--navigator", "nav2", "--out", str(out), *extra],
+        env=env,
+        cwd=out.parent,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def start_nav2(env: dict[str, str], mission: Path, out: Path, *extra: str) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [NAVSEQ, "run", str(mission), "--navigator", "nav2", "--out", str(out), *extra],
+        env=env,
+        cwd=out.parent,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def report_of(out: Path) -> dict[str, Any]:
+    return dict(json.loads((out / "report.json").read_text()))
+
+
+def test_the_example_mission_completes_with_the_same_visits_as_on_the_simulator(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    done = run_nav2(env, EXAMPLE, tmp_path / "nav2", "--json")
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr
+    on_sim = subprocess.run(
+        [NAVSEQ, "run", str(EXAMPLE), "--out", str(tmp_path / "sim")],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert on_sim.returncode == 0, on_sim.stderr
+    nav2, embedded = report_of(tmp_path / "nav2"), report_of(tmp_path / "sim")
+
+    def visits(report: dict[str, Any]) -> list[tuple[str, str, bool]]:
+        return [(v["name"], v["outcome"], v["passed_through"]) for v in report["visits"]]
+
+    assert visits(nav2) == visits(embedded)
+    assert all(outcome == "reached" for _, outcome, _ in visits(nav2))
+    navigator = nav2["navigator"]
+    assert navigator["kind"] == "nav2"
+    assert navigator["action"] == "/navigate_to_pose"
+    assert navigator["use_sim_time"] is True  # /clock published at --speed 4: followed
+    assert "simulation time" in done.stderr
+    # The robot's pose comes from /tf (map -> odom -> base_footprint): where it started.
+    assert nav2["start_source"] == "robot"
+    assert [nav2["start"]["x"], nav2["start"]["y"]] == pytest.approx([-2.0, -0.5], abs=0.02)
+    # Distance driven is measured on odom: about the same as on the embedded simulator.
+    assert nav2["totals"]["distance_m"] == pytest.approx(embedded["totals"]["distance_m"], rel=0.15)
+    # Nav2's feedback reaches --json: its own time on the goal, its recovery count.
+    records = [json.loads(line) for line in done.stdout.splitlines()]
+    # (Progress from a pose alone, before a goal's first feedback, has neither.)
+    fed = [r for r in records if r["event"] == "WaypointProgress" and r["navigation_time_s"]]
+    assert len(fed) > 20 and all(r["recoveries"] == 0 for r in fed)
+    times = [r["navigation_time_s"] for r in fed if r["index"] == 1]
+    assert times[-1] > 5.0 and times == sorted(times)  # simulated seconds on goal 2
+    assert all(a["recoveries"] == 0 for v in nav2["visits"] for a in v["attempts"])
+    assert (tmp_path / "nav2" / "mission.png").exists()
+
+
+def test_a_goal_in_a_wall_is_aborted_and_the_policy_skips_it(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    # No map: pre-flight cannot catch the wall, Nav2's planner must.
+    mission = write_mission(
+        tmp_path / "wall.yaml",
+        "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0, on_failure: skip}\n"
+        "  - {name: free, x: -1.5, y: -0.5, yaw: 0}\n",
+        "defaults: {retries: 0, goal_timeout: 60}\n",
+    )
+    done = run_nav2(env, mission, tmp_path / "out")
+    assert done.returncode == 1, done.stderr  # not every waypoint reached
+    pillar, free = report_of(tmp_path / "out")["visits"]
+    assert pillar["outcome"] == "skipped"
+    attempt = pillar["attempts"][0]
+    assert attempt["status"] == "ABORTED"
+    assert "(error_code 206)" in attempt["text"]  # Nav2's planner GOAL_OCCUPIED
+    assert free["outcome"] == "reached"
+
+
+def test_no_server_is_a_clear_error_within_the_server_timeout(env: dict[str, str], tmp_path: Path):
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: -1.5, y: -0.5, yaw: 0}\n")
+    started = time.monotonic()
+    done = run_nav2(env, mission, tmp_path / "out", "--server-timeout", "2")
+    took = time.monotonic() - started
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr
+    assert "no action server '/navigate_to_pose'" in done.stderr
+    assert "within 2 s" in done.stderr and "ROS_DOMAIN_ID" in done.stderr
+    assert took < 20  # 2 s of waiting plus starting Python and rclpy
+    assert not (tmp_path / "out").exists()  # nothing written, nothing moved
+
+
+def test_sigint_mid_goal_cancels_it_the_robot_stops_and_the_report_is_written(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    mission = write_mission(tmp_path / "far.yaml", "  - {name: far, x: 1.75, y: -0.55, yaw: 0}\n")
+    out = tmp_path / "out"
+    watcher = OdomWatcher(env)
+    process = start_nav2(env, mission, out)
+    try:
+        wait_for(
+            lambda: len(journal_events(out / "journal.jsonl", "WaypointProgress")) >= 2,
+            90,
+            "the robot driving",
+        )
+        signalled = time.monotonic()
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=30)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    time.sleep(1.5)
+    samples = watcher.samples()
+    assert process.returncode == 130, err
+    assert "Traceback" not in err
+    report = report_of(out)
+    assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130
+    assert report["visits"][0]["outcome"] == "failed"
+    before = [v for t, v, _, _ in samples if t < signalled]
+    after = [(t - signalled, v) for t, v, _, _ in samples if t >= signalled]
+    assert max(before[-10:]) > 0.1  # it was driving
+    stopped_at = next(t for t, v in after if v < 1e-3)
+    assert stopped_at < 1.0, after[:40]
+    assert all(v < 1e-3 for t, v in after if t >= stopped_at)  # and it stays stopped
+    assert "navigate_to_pose: CANCELED" in sim.stop()
+
+
+def test_a_goal_preempted_by_another_client_is_a_failed_attempt_then_retried(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {name: east, x: 1.75, y: -0.55, yaw: 90}\n",
+        "defaults: {retries: 1, goal_timeout: 120, on_failure: stop}\n",
+    )
+    out = tmp_path / "out"
+    process = start_nav2(env, mission, out)
+    try:
+        wait_for(
+            lambda: journal_events(out / "journal.jsonl", "WaypointProgress"),
+            90,
+            "the robot driving",
+        )
+        # Another Nav2 client's goal: Nav2 preempts ours with it (ABORTED).
+        other = subprocess.run(
+            [sys.executable, str(CLIENTS), "navigate", "--", "-1.5,-0.5,0"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        stdout, stderr = process.communicate(timeout=240)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 0, stderr
+    # navseq's retry preempted the other client's goal in turn.
+    assert json.loads(other.stdout.strip().splitlines()[-1])["status"] == "ABORTED"
+    (visit,) = report_of(out)["visits"]
+    assert visit["outcome"] == "reached"
+    first, second = visit["attempts"]
+    assert first["status"] == "ABORTED" and first["text"] == "preempted by a new goal"
+    assert second["status"] == "SUCCEEDED"
+    assert "attempt 1 failed (ABORTED: preempted by a new goal), will retry" in stdout
+
+
+def test_a_server_killed_mid_goal_and_restarted_is_waited_for_and_the_mission_completes(
+    env: dict[str, str], tmp_path: Path
+):
+    env = {**env, "CYCLONEDDS_URI": SHORT_LEASE}
+    first = SimNode(env, f"--start={START}", "--speed", SPEED)
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {name: near, x: -1.0, y: -0.55, yaw: 0}\n",
+        "server_timeout: 60\ndefaults: {goal_timeout: 120}\n",
+    )
+    out = tmp_path / "out"
+    process = start_nav2(env, mission, out)
+    second = None
+    try:
+        wait_for(
+            lambda: journal_events(out / "journal.jsonl", "WaypointProgress"),
+            90,
+            "the robot driving",
+        )
+        first.process.kill()  # no goodbye: the server just vanishes
+        first.process.wait()
+        wait_for(
+            lambda: journal_events(out / "journal.jsonl", "ServerStatusChanged"),
+            30,
+            "navseq noticing the server is gone",
+        )
+        second = SimNode(env, f"--start={START}", "--speed", SPEED)
+        _, stderr = process.communicate(timeout=180)
+    finally:
+        if process.poll() is None:
+            process.kill()
+        if second is not None:
+            second.stop()
+    assert process.returncode == 0, stderr
+    changes = [e["available"] for e in journal_events(out / "journal.jsonl", "ServerStatusChanged")]
+    assert changes == [False, True]
+    (visit,) = report_of(out)["visits"]
+    assert visit["outcome"] == "reached"
+    assert "Traceback" not in stderr
+
+
+def test_the_robot_passes_through_a_pass_through_waypoint_above_half_its_cruise_speed(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    radius = 0.3
+    mission = write_mission(
+        tmp_path / "line.yaml",
+        f"  - {{name: via, x: -1.3, y: -0.5, yaw: 0, pass_through: {radius}}}\n"
+        "  - {name: end, x: -0.55, y: -0.55, yaw: 0}\n",
+    )
+    watcher = OdomWatcher(env)
+    done = run_nav2(env, mission, tmp_path / "out")
+    samples = watcher.samples()
+    assert done.returncode == 0, done.stderr
+    via, end = report_of(tmp_path / "out")["visits"]
+    assert via["passed_through"] and end["outcome"] == "reached"
+    # The robot stands at the start (-2, -0.5, facing +x) at the first sample and odom
+    # is not rotated against the map there: a map position is a shift of an odom one.
+    _, _, x0, y0 = samples[0]
+    near = [v for _, v, x, y in samples if math.hypot(x - x0 - 0.7, y - y0) <= radius]
+    cruise = max(v for _, v, _, _ in samples)
+    assert cruise == pytest.approx(CRUISE, abs=0.02)
+    assert near, "no odom sample near the pass-through point"
+    assert min(near) > cruise / 2, near
+
+
+def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path):
+    sim = SimNode(env, f"--start={START}", "--speed", SPEED, "--ns", "robot1")
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: -1.4, y: -0.5, yaw: 90}\n")
+    try:
+        done = run_nav2(env, mission, tmp_path / "out", "--ns", "robot1")
+    finally:
+        sim.stop()
+    assert done.returncode == 0, done.stderr
+    report = report_of(tmp_path / "out")
+    assert report["navigator"]["action"] == "/robot1/navigate_to_pose"
+    assert report["navigator"]["ns"] == "robot1"
+    # robot1/odom -> robot1/base_footprint on /tf, and /robot1/odom, were found.
+    assert report["start_source"] == "robot"
+    assert report["visits"][0]["distance_m"] == pytest.approx(0.6, abs=0.25)
+
+
+def test_without_ros2_the_nav2_navigator_says_to_source_it(tmp_path: Path):
+    """Where rclpy does not import (ROS 2 not sourced): one message, exit 2."""
+    plain = {
+        key: value
+        for key, value in os.environ.items()
+        if key not in ("PYTHONPATH", "LD_LIBRARY_PATH", "AMENT_PREFIX_PATH")
+    }
+    probe = subprocess.run([sys.executable, "-c", "import rclpy"], env=plain, capture_output=True)
+    if probe.returncode == 0:
+        pytest.skip("rclpy imports without sourcing ROS 2 here")
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: -1.5, y: -0.5, yaw: 0}\n")
+    done = subprocess.run(
+        [NAVSEQ, "run", str(mission), "--navigator", "nav2", "--out", str(tmp_path / "out")],
+        env=plain,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr
+    assert "the nav2 navigator needs ROS 2's Python packages" in done.stderr
+    assert "source ROS 2 first" in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_start_is_refused_for_a_real_robot(tmp_path: Path):
+    mission = write_mission(tmp_path / "m.yaml", "  - {x: -1.5, y: -0.5, yaw: 0}\n")
+    done = subprocess.run(
+        [NAVSEQ, "run", str(mission), "--navigator", "nav2", "--start", "0,0,0"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2
+    assert "--navigator nav2 the robot is where it is" in done.stderr
+    assert "Traceback" not in done.stderr
