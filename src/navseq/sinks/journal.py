@@ -24,8 +24,8 @@ with time: every visit's start, finish and failed attempts are kept, with the fi
 plan of each attempt (as corners, :data:`PATH_TOLERANCE`); the driven path is kept as
 a thinned polyline of ``WaypointProgress`` events (:mod:`navseq.sinks.journal_progress`:
 its corners, the pose at every arrival, every change of the stack's recovery count,
-and one at least every :data:`HEARTBEAT` seconds). Times and positions in progress and
-plans are written to 0.1 mm (0.1 ms).
+and one at least every :data:`HEARTBEAT` seconds). Positions in progress and plans are
+written to 0.1 mm.
 
 Every line ends with ``"chain"``: the first 16 hex digits of the sha256 of the previous
 line's chain and this line's record. A journal whose lines were edited, deleted or
@@ -76,8 +76,8 @@ from navseq.sinks.journal_state import (
 )
 from navseq.track import simplify_path
 
-#: Decimals of the times (s), positions (m), angles (rad) and distances written in
-#: progress and plan records: 0.1 mm, where the full float took 18 digits for nothing.
+#: Decimals of the positions (m), angles (rad) and distances written in progress and
+#: plan records: 0.1 mm, where the full float took 18 digits for nothing.
 POSITION_DECIMALS = 4
 
 
@@ -218,8 +218,8 @@ class JournalWriter:
     def _write_event(self, event: ev.MissionEvent) -> None:
         record = {"kind": "event", "type": type(event).__name__, **dataclasses.asdict(event)}
         if isinstance(event, ev.WaypointProgress):
+            # Not t: the other records' times are exact, and times must stay in order.
             for name in (
-                "t",
                 "x",
                 "y",
                 "yaw",
@@ -229,7 +229,6 @@ class JournalWriter:
             ):
                 record[name] = _rounded(record[name])
         elif isinstance(event, ev.WaypointPlan):
-            record["t"] = _rounded(record["t"])
             corners = simplify_path(event.path, PATH_TOLERANCE)
             record["path"] = [[_rounded(x), _rounded(y)] for x, y in corners]
         self._write(record)
