@@ -218,6 +218,9 @@ class JournalWriter:
     def _write_event(self, event: ev.MissionEvent) -> None:
         record = {"kind": "event", "type": type(event).__name__, **dataclasses.asdict(event)}
         if isinstance(event, ev.WaypointProgress):
+            for name in _PROGRESS_DEFAULT_NONE:  # only stacks that count them fill these
+                if record[name] is None:
+                    del record[name]
             # Not t: the other records' times are exact, and times must stay in order.
             for name in (
                 "x",
@@ -227,7 +230,8 @@ class JournalWriter:
                 "distance_driven",
                 "navigation_time",
             ):
-                record[name] = _rounded(record[name])
+                if name in record:
+                    record[name] = _rounded(record[name])
         elif isinstance(event, ev.WaypointPlan):
             corners = simplify_path(event.path, PATH_TOLERANCE)
             record["path"] = [[_rounded(x), _rounded(y)] for x, y in corners]
@@ -266,6 +270,10 @@ class JournalWriter:
         self.close()
 
 
+#: Progress fields that default to None, left out when None (the reader restores them).
+_PROGRESS_DEFAULT_NONE = tuple(
+    spec.name for spec in dataclasses.fields(ev.WaypointProgress) if spec.default is None
+)
 #: Events before which the latest pose is journaled, so the path ends where the robot was.
 _ARRIVALS = (ev.WaypointDwelling, ev.WaypointFinished, ev.MissionPaused, ev.MissionFinished)
 
