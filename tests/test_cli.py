@@ -415,7 +415,7 @@ def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkey
     )
     before = read_journal(journal)
     driven_before = [(e["x"], e["y"]) for e in journal_events(journal, "WaypointProgress")]
-    assert len(driven_before) >= 2  # the scripted robot drove 2 m, journaled once a second
+    assert len(driven_before) >= 2  # the scripted robot drove 2 m: corners and visit ends
 
     drawn: dict[str, Any] = {}
     real_draw = picture.mission_picture_png

@@ -318,13 +318,22 @@ def test_journal_header_naming_a_path_with_a_nul_is_refused(tmp_path):
         read_journal(journal(tmp_path, "mission\0.yaml"))
 
 
-def test_oversized_journal_is_refused_with_the_variable_that_raises_the_limit(
-    tmp_path, monkeypatch
-):
-    path = journal(tmp_path, "m.yaml", *['{"kind": "event"}'] * 100)
-    monkeypatch.setenv("NAVSEQ_MAX_JOURNAL_BYTES", "1000")
-    with pytest.raises(NavseqError, match="NAVSEQ_MAX_JOURNAL_BYTES"):
+def test_an_overlong_journal_line_is_refused_with_its_line_number(tmp_path):
+    # A journal has no size limit (a patrol's grows for weeks); each line has one.
+    long_line = '{"kind": "event", "type": "WaypointPlan", "path": [' + "[0, 0], " * 600_000
+    path = journal(tmp_path, "m.yaml", '{"kind": "event"}', long_line + "[0, 0]]}")
+    with pytest.raises(NavseqError, match="a line over 4 MiB") as caught:
         read_journal(path)
+    assert caught.value.source == f"{path}:3"
+
+
+def test_a_journal_claiming_a_mission_of_a_trillion_waypoints_is_refused(tmp_path):
+    started = json.dumps(
+        {"kind": "event", "type": "MissionStarted", "t": 0, "waypoint_count": 10**12, "loops": None}
+    )
+    with pytest.raises(NavseqError, match="1 to 1,000,000 waypoints") as caught:
+        read_journal(journal(tmp_path, "m.yaml", started))
+    assert caught.value.source.endswith(":2")
 
 
 # --- 5. numbers no robot can mean -----------------------------------------------------

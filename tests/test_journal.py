@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 from pathlib import Path
 
@@ -28,12 +29,14 @@ from navseq.executor.resume import ResumePoint
 from navseq.mission.model import FailureAction
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Succeed
 from navseq.sinks.journal import (
+    HEARTBEAT,
+    PATH_TOLERANCE,
     JournalWriter,
     mission_digest,
     read_journal,
     resume_point,
 )
-from navseq.sinks.recorder import RunRecorder
+from navseq.sinks.journal_reader import journal_events
 
 
 @pytest.fixture
@@ -75,27 +78,77 @@ def test_header_then_one_event_per_line(tmp_path: Path, mission_file: Path) -> N
     assert [e["outcome"] for e in events if e["type"] == "WaypointFinished"] == ["reached"] * 4
     state = read_journal(path)
     assert state.finish_reason == "completed" and state.damaged_lines == []
-    assert len(state.visits) == 4
+    assert state.visits.log is not None and state.visits.log.finished == 4
 
 
-def test_progress_is_thinned_to_one_per_second_of_mission_time(tmp_path: Path) -> None:
+def progress_event(t: float, x: float, y: float = 0.0, index: int = 0) -> WaypointProgress:
+    return WaypointProgress(
+        t=t, index=index, x=x, y=y, yaw=0.0, distance_remaining=None, distance_driven=x
+    )
+
+
+def test_a_straight_drive_is_journaled_as_its_two_ends(tmp_path: Path) -> None:
     path = tmp_path / "j"
-    journal = JournalWriter(path, "m.yaml", "0" * 64)
-    for step in range(31):
-        journal(WaypointProgress(step * 0.1, 0, 0.0, 0.0, 0.0, 1.0, 0.0))
-        journal(WaypointPlan(step * 0.1, 0, ((0.0, 0.0), (1.0, 2.0))))
-    journal.close()
-    types = [r["type"] for r in records(path)[1:]]
-    assert types.count("WaypointPlan") == 31
-    progress = [r["t"] for r in records(path)[1:] if r["type"] == "WaypointProgress"]
-    assert progress == pytest.approx([0.0, 1.0, 2.0, 3.0])
-    plans = [e for e in read_journal(path).events if isinstance(e, WaypointPlan)]
-    assert plans[0].path == ((0.0, 0.0), (1.0, 2.0))
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        journal(MissionStarted(t=0.0, waypoint_count=1, loops=1))
+        for step in range(200):  # 20 s at 10 Hz, 0.22 m/s along x
+            journal(progress_event(step * 0.1, 0.022 * step))
+        journal(WaypointFinished(19.9, 0, 0, WaypointOutcome.REACHED, 1, 19.9, 4.378))
+    kept = [r for r in records(path) if r.get("type") == "WaypointProgress"]
+    assert [(r["t"], r["x"]) for r in kept] == [(0.0, 0.0), (pytest.approx(19.9), 4.378)]
+    # ...and the path a rebuilt picture draws reaches where the robot was at the end.
+    assert read_journal(path).recorder.trajectory()[-1][1] == pytest.approx(4.378)
+
+
+def test_corners_of_the_driven_path_are_journaled_within_the_tolerance(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    poses = [(0.02 * i, 0.0) for i in range(100)] + [(2.0, 0.02 * i) for i in range(100)]
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        for step, (x, y) in enumerate(poses):
+            journal(progress_event(step * 0.1, x, y))
+        journal(MissionFinished(t=20.0, success=True, reason="completed"))
+    kept = [(r["x"], r["y"]) for r in records(path) if r.get("type") == "WaypointProgress"]
+    assert len(kept) <= 4 and kept[0] == (0.0, 0.0) and kept[-1] == pytest.approx((2.0, 1.98))
+    assert max(distance_to_polyline(pose, kept) for pose in poses) <= PATH_TOLERANCE * 1.5
+
+
+def distance_to_polyline(point: tuple[float, float], line: list[tuple[float, float]]) -> float:
+    p = np.asarray(point)
+    best = float(np.hypot(*(p - line[0])))
+    for a, b in zip(np.asarray(line[:-1]), np.asarray(line[1:]), strict=True):
+        span = b - a
+        length = float(span @ span)
+        along = 0.0 if length == 0 else float(np.clip((p - a) @ span / length, 0.0, 1.0))
+        best = min(best, float(np.hypot(*(p - a - along * span))))
+    return best
+
+
+def test_a_robot_standing_still_is_journaled_once_per_heartbeat(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        for step in range(1000):  # 100 s in place (dwelling, paused, waiting for a server)
+            journal(progress_event(step * 0.1, 1.0))
+    kept = [r["t"] for r in records(path) if r.get("type") == "WaypointProgress"]
+    assert kept == pytest.approx([0.0, HEARTBEAT, 2 * HEARTBEAT, 3 * HEARTBEAT])
+
+
+def test_one_plan_per_attempt_is_journaled_as_corners(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    staircase = tuple((0.05 * (i // 2 + i % 2), 0.05 * (i // 2)) for i in range(80))
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        for attempt in (1, 2):
+            journal(WaypointStarted(0.0, 0, 0, attempt, attempt, 2.0, 2.0, 0.0))
+            for step in range(31):  # a navigation stack that replans every tick
+                journal(WaypointPlan(step * 0.1, 0, staircase))
+    plans = [r["path"] for r in records(path) if r.get("type") == "WaypointPlan"]
+    assert len(plans) == 2  # the first of each attempt
+    assert plans[0] == [[0.0, 0.0], [2.0, 1.95]]
+    assert read_journal(path).recorder.leg_plans() == [((0.0, 0.0), (2.0, 1.95))]
 
 
 def test_events_read_back_as_they_were(tmp_path: Path, mission_file: Path) -> None:
     path = journal_of_run(tmp_path, mission_file)
-    events = read_journal(path).events
+    events = list(journal_events(path))
     finished = [e for e in events if isinstance(e, WaypointFinished)]
     assert finished[0].outcome is WaypointOutcome.REACHED
     assert finished[0].distance_driven == pytest.approx(1.0)
@@ -120,7 +173,8 @@ def test_truncated_last_line_is_tolerated_and_resume_starts_at_the_active_waypoi
     assert state.finish_reason is None
     point = resume_point(state, mission_digest=mission_digest(mission_file))
     assert (point.loop, point.index) == (0, 2)
-    assert [(v.index, v.outcome) for v in point.done] == [
+    assert point.earlier is not None
+    assert [(v.index, v.outcome) for v in point.earlier.held()] == [
         (0, WaypointOutcome.REACHED),
         (1, WaypointOutcome.REACHED),
     ]
@@ -348,13 +402,13 @@ def test_recorder_from_journal_keeps_earlier_segments_on_one_mission_clock(
             WaypointStarted(t=100.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0, yaw=0.0),
             WaypointPlan(t=100.0, index=0, path=((0.0, 0.0), (2.0, 0.0))),
             progress(100.5, 0.5),
-            progress(102.0, 1.0),
+            progress(130.5, 1.0),  # a heartbeat later: journaled although straight on
         ):
             journal(event)
     state = read_journal(path)
-    recorder = RunRecorder.from_journal(state.events)
+    recorder = state.recorder
     # ...the resumed one (appended to the same journal) on one that starts at 0.
-    with JournalWriter.resume(path, ResumePoint(loop=0, index=0)) as journal:
+    with JournalWriter.resume(path, ResumePoint(loop=0, index=0), history=state) as journal:
         for event in (
             MissionStarted(t=0.0, waypoint_count=2, loops=1, resumed_from=0),
             WaypointStarted(t=0.0, index=0, loop=0, attempt=1, goal_id=1, x=2.0, y=0.0, yaw=0.0),
@@ -364,16 +418,32 @@ def test_recorder_from_journal_keeps_earlier_segments_on_one_mission_clock(
             journal(event)
             recorder(event)
 
-    assert state.previous_duration == pytest.approx(2.0)
+    assert state.previous_duration == pytest.approx(30.5)
     assert recorder.segments == 2
     t, x, _ = zip(*recorder.trajectory(), strict=True)
     assert x[:2] == (0.5, 1.0) and np.isnan(x[2]) and x[3] == 0.7
-    assert t[:2] == (0.5, 2.0) and t[3] == pytest.approx(3.0)  # 2 s before + 1 s after
-    assert recorder.earlier_trajectory()[:2] == [(0.5, 0.5, 0.0), (2.0, 1.0, 0.0)]
-    assert recorder.mission_time(4.0) == pytest.approx(6.0)
+    assert t[:2] == (0.5, 30.5) and t[3] == pytest.approx(31.5)  # 30.5 s before + 1 s after
+    assert recorder.earlier_trajectory()[:2] == [(0.5, 0.5, 0.0), (30.5, 1.0, 0.0)]
+    assert recorder.mission_time(4.0) == pytest.approx(34.5)
     # The resumed visit shows both legs: the one planned before and the one after.
     assert recorder.leg_plans() == [((0.0, 0.0), (2.0, 0.0)), ((0.0, 0.0), (3.0, 0.0))]
     # Replaying the whole journal afterwards gives the same picture data.
-    replayed = RunRecorder.from_journal(read_journal(path).events)
+    replayed = read_journal(path).recorder
     assert replayed.leg_plans() == recorder.leg_plans()
     assert np.allclose(replayed.trajectory(), recorder.trajectory(), equal_nan=True)
+
+
+def test_every_change_of_the_stacks_recovery_count_is_journaled(tmp_path: Path) -> None:
+    path = tmp_path / "j"
+    counts = [0] * 20 + [1] * 20 + [2] * 20  # Nav2 ran two recoveries on a straight drive
+    with JournalWriter(path, "m.yaml", "0" * 64) as journal:
+        journal(MissionStarted(t=0.0, waypoint_count=1, loops=1))
+        journal(WaypointStarted(0.0, 0, 0, 1, 1, 2.0, 0.0, 0.0))
+        for step, count in enumerate(counts):
+            event = progress_event(step * 0.1, 0.02 * step)
+            journal(dataclasses.replace(event, recoveries=count, navigation_time=step * 0.1))
+        journal(WaypointFinished(6.0, 0, 0, WaypointOutcome.REACHED, 1, 6.0, 1.2))
+    kept = [r["recoveries"] for r in records(path) if r.get("type") == "WaypointProgress"]
+    assert kept == [0, 1, 2, 2]  # the first, each change, the arrival
+    [visit] = read_journal(path).visits.held()
+    assert [a.recoveries for a in visit.attempt_results] == [2]

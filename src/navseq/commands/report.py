@@ -75,14 +75,19 @@ class Rebuilt:
     exit_code: int | None
 
 
-def rebuild_outputs(journal: Path) -> Rebuilt:
-    """Write the missing or broken report / picture of the run in ``journal``."""
+def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt:
+    """Write the missing or broken report / picture of the run in ``journal``.
+
+    ``state`` is the journal already read (by a resume that found nothing to run), so
+    that a long journal is not read twice.
+    """
     from navseq.commands.run_outputs import output_error
     from navseq.files import write_atomically
     from navseq.mission.part import number_visits
     from navseq.sinks.journal import read_journal
 
-    state = read_journal(journal)
+    if state is None or state.path != journal or not state.is_current():
+        state = read_journal(journal)
     whole = journaled_mission(state)
     part = journaled_part(state, whole)
     mission = part.apply(whole) if part is not None else whole
@@ -112,37 +117,30 @@ def rebuild_outputs(journal: Path) -> Rebuilt:
 def result_from_journal(state: JournalState, mission: Mission) -> MissionResult:
     """The run's result as its journal tells it (visits not finished are not run).
 
-    Built through the same :class:`~navseq.executor.result.VisitLog` as a live run's,
-    so a rebuilt report lists and counts visits as the run's own would have.
+    Built through the same :class:`~navseq.executor.result.VisitLog` as a live run's
+    (the one reading the journal folded its visits into), so a rebuilt report lists
+    and counts visits as the run's own would have.
     """
-    from dataclasses import replace
+    from navseq.errors import NavseqError
 
-    from navseq.executor.events import WaypointOutcome
-    from navseq.executor.result import VisitLog
-
-    count = len(mission.waypoints)
     started = state.mission_started
     loops = started.loops if started is not None else mission.loops
-    log = VisitLog(mission.waypoints, loops)
-    done_per_loop: dict[int, int] = {}
-    for key in sorted(key for key in state.visits if 0 <= key[1] < count):
-        loop, index = key
-        if loops is not None and loop >= loops:
-            continue
-        known = state.visits[key]
-        if known.outcome is WaypointOutcome.NOT_RUN:
-            continue  # never finished: listed (or counted) as not run
-        waypoint = mission.waypoints[index]
-        log.add(
-            replace(known, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
-        )
-        done_per_loop[loop] = done_per_loop.get(loop, 0) + 1
+    history = state.visits
+    try:
+        log = history.log_for(mission.waypoints, loops, unfinished=True)
+    except ValueError:
+        raise NavseqError(
+            f"the journal records a mission of {history.waypoint_count} waypoint(s), but "
+            f"the mission has {len(mission.waypoints)}; the report would describe other "
+            "waypoints",
+            source=str(state.path),
+        ) from None
     success = log.finished > 0 and log.all_reached()
     return log.result(
         success=success and state.finish_reason is not None,
         reason=state.finish_reason or UNFINISHED_REASON,
         duration=state.previous_duration,
-        loops_completed=sum(done == count for done in done_per_loop.values()),
+        loops_completed=history.loops_completed(loops),
     )
 
 
@@ -238,7 +236,6 @@ def _picture(state: JournalState, mission: Mission, result: MissionResult) -> by
     from navseq.errors import NavseqError
     from navseq.sim.occupancy import load_map
     from navseq.sinks.picture import mission_picture_png
-    from navseq.sinks.recorder import RunRecorder
 
     grid = None
     map_path = state.run_options.get("map") or mission.map
@@ -247,7 +244,7 @@ def _picture(state: JournalState, mission: Mission, result: MissionResult) -> by
             grid = load_map(map_path)
         except NavseqError as error:
             print(f"navseq report: drawing without the map ({error})", file=sys.stderr)
-    recorder = RunRecorder.from_journal(state.events)
+    recorder = state.recorder
     return mission_picture_png(
         mission,
         result,

@@ -494,7 +494,7 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
 
     if setup.history is None:
         return RunRecorder()
-    return RunRecorder.from_journal(setup.history.events)
+    return setup.history.recorder  # what reading the journal replayed into it
 
 
 def _run_with_sinks(
@@ -514,7 +514,7 @@ def _run_with_sinks(
     navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
         if setup.resume is not None:
-            journal = JournalWriter.resume(journal_path, setup.resume)
+            journal = JournalWriter.resume(journal_path, setup.resume, history=setup.history)
         else:
             # The absolute path, so that --resume works from any directory.
             source = str(setup.mission_path.resolve())
@@ -749,22 +749,22 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         setup = prepare(args)
-    except NothingToResume:
+    except NothingToResume as finished:
         # A finished run: all a resume can still do is finish its outputs.
-        code = _rebuild_finished(args.resume)
+        code = _rebuild_finished(args.resume, finished.state)
         if code is None:
             raise
         return code
     return execute(setup, args)
 
 
-def _rebuild_finished(journal: Path) -> int | None:
+def _rebuild_finished(journal: Path, state: JournalState | None) -> int | None:
     """Rebuild a finished run's missing report/picture; its exit status, or None if complete."""
     from navseq.commands.report import rebuild_outputs
     from navseq.runlock import RunLock
 
     with RunLock(journal.parent):
-        rebuilt = rebuild_outputs(journal)
+        rebuilt = rebuild_outputs(journal, state)
     if not rebuilt.written:
         return None
     for role, path in rebuilt.written.items():

@@ -200,6 +200,8 @@ class MissionExecutor:
         # Finished visits: counted per waypoint, the latest kept in full (bounded memory).
         self._log = VisitLog(mission.waypoints, mission.loops)
         if resume is not None:
+            if resume.earlier is not None:  # a copy: the point may be used again
+                self._log = resume.earlier.relabelled(mission.waypoints, mission.loops)
             for done in sorted(resume.done, key=lambda v: (v.loop, v.index)):
                 self._log.add(_result_for(mission, done))
         self._visit: _Visit | None = None
@@ -966,6 +968,12 @@ def _check_resume_point(mission: Mission, resume: ResumePoint) -> None:
         raise NavseqError(
             f"the journal resumes in loop {resume.loop + 1}, "
             f"but the mission runs {mission.loops} loop(s)",
+            source=mission.source,
+        )
+    if resume.earlier is not None and resume.earlier.waypoint_count != count:
+        raise NavseqError(
+            f"the journal records a mission of {resume.earlier.waypoint_count} waypoint(s), "
+            f"but the mission has {count}",
             source=mission.source,
         )
     for done in resume.done:

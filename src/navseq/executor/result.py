@@ -161,7 +161,7 @@ KEEP_LAST_VISITS = 1000
 KEEP_NOT_REACHED_VISITS = 1000
 
 
-@dataclass
+@dataclass(slots=True)
 class WaypointTotals:
     """One waypoint's visits over every loop, counted (a patrol may make millions).
 
@@ -220,9 +220,9 @@ class VisitLog:
     ):
         self._waypoints = waypoints
         self._loops = loops
-        self._totals = [
-            WaypointTotals(i, w.name, w.x, w.y, w.yaw_rad) for i, w in enumerate(waypoints)
-        ]
+        # Made on a waypoint's first visit: a log of a journal's visits is folded before
+        # its mission is known, for as many waypoints as the journal claims.
+        self._totals: dict[int, WaypointTotals] = {}
         self._recent: deque[WaypointResult] = deque(maxlen=max(1, keep_last))
         self._not_reached: list[WaypointResult] = []
         self._keep_not_reached = keep_not_reached
@@ -233,7 +233,7 @@ class VisitLog:
 
     def add(self, visit: WaypointResult) -> None:
         """Count a finished visit and keep it in full for now."""
-        self._totals[visit.index].add(visit)
+        self._total(visit.index).add(visit)
         self.finished += 1
         if visit.outcome is WaypointOutcome.REACHED:
             self.reached += 1
@@ -250,6 +250,63 @@ class VisitLog:
                 self.omitted += 1
         recent.append(visit)
         self._keys.add((visit.loop, visit.index))
+
+    def _total(self, index: int) -> WaypointTotals:
+        total = self._totals.get(index)
+        if total is None:
+            waypoint = self._waypoints[index]
+            total = WaypointTotals(index, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw_rad)
+            self._totals[index] = total
+        return total
+
+    @property
+    def waypoint_count(self) -> int:
+        """How many waypoints the mission has (visits name one of them)."""
+        return len(self._waypoints)
+
+    def held(self) -> list[WaypointResult]:
+        """The visits kept in full, in mission order."""
+        return sorted((*self._not_reached, *self._recent), key=lambda v: (v.loop, v.index))
+
+    def relabelled(self, waypoints: Sequence[Any], loops: int | None) -> VisitLog:
+        """A copy for ``waypoints`` (as many as this log's): names and poses taken from them.
+
+        A journal's visits are counted as the journal is read, before its mission is
+        loaded; the copy describes them with the mission's waypoints, and is the log a
+        resumed run goes on adding to (this one is left as it is).
+        """
+        if len(waypoints) != len(self._waypoints):
+            raise ValueError(
+                f"a log of {len(self._waypoints)} waypoints relabelled with {len(waypoints)}"
+            )
+        copy = VisitLog(
+            waypoints,
+            loops,
+            keep_last=self._recent.maxlen or 1,
+            keep_not_reached=self._keep_not_reached,
+        )
+
+        def named(visit: WaypointResult) -> WaypointResult:
+            waypoint = waypoints[visit.index]
+            return replace(
+                visit,
+                name=waypoint.name,
+                x=waypoint.x,
+                y=waypoint.y,
+                yaw_rad=waypoint.yaw_rad,
+                attempt_results=[replace(a) for a in visit.attempt_results],
+            )
+
+        for index, total in self._totals.items():
+            waypoint = waypoints[index]
+            copy._totals[index] = replace(
+                total, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad
+            )
+        copy._recent.extend(named(v) for v in self._recent)
+        copy._not_reached = [named(v) for v in self._not_reached]
+        copy._keys = set(self._keys)
+        copy.finished, copy.reached, copy.omitted = self.finished, self.reached, self.omitted
+        return copy
 
     def __contains__(self, key: tuple[int, int]) -> bool:
         """Whether the visit (loop, index) is held in full."""
@@ -299,7 +356,10 @@ class VisitLog:
                 for index in range(len(self._waypoints))
             ]
         visits = sorted((replace(v) for v in held), key=lambda v: (v.loop, v.index))
-        totals = [replace(t) for t in self._totals]
+        totals = [
+            replace(self._totals[i]) if i in self._totals else self._no_visits(i)
+            for i in range(len(self._waypoints))
+        ]
         counted = self.finished
         if active is not None:
             totals[active.index].not_run += 1
@@ -322,6 +382,10 @@ class VisitLog:
             waypoints=totals,
             visit_count=counted,
         )
+
+    def _no_visits(self, index: int) -> WaypointTotals:
+        waypoint = self._waypoints[index]
+        return WaypointTotals(index, waypoint.name, waypoint.x, waypoint.y, waypoint.yaw_rad)
 
     def _not_run(self, loop: int, index: int) -> WaypointResult:
         waypoint = self._waypoints[index]

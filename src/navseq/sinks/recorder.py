@@ -68,7 +68,9 @@ class RunRecorder:
 
     @classmethod
     def from_journal(cls, events: Iterable[MissionEvent]) -> RunRecorder:
-        """A recorder that has seen a journal's events (e.g. ``read_journal(p).events``).
+        """A recorder that has seen these events (e.g. ``journal_events(path)``'s).
+
+        ``read_journal(path).recorder`` is one already: the journal's events replayed.
 
         Give it to the resumed run as its listener: the picture then shows the path
         driven and the legs planned before the resume as well as after it.

@@ -5,7 +5,8 @@ journal is read by :func:`navseq.sinks.journal.read_journal` (its chain checked,
 ``navseq run --resume`` checks it) and its events are folded by the live view's own
 rules (:class:`~navseq.studio.runs.LiveView`), so a replayed waypoint is in the state
 the live page showed at that moment. What the page gets is a timeline it can scrub
-with a slider: robot poses (the journal keeps about one a second of mission time), each
+with a slider: robot poses (the journal keeps the driven path's corners, the pose at
+every arrival and one at least every 30 s; the page draws the robot in between), each
 change of the waypoints' states, and each planned path, all on one clock starting at 0.
 """
 
@@ -64,6 +65,7 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
     from navseq.mission import load_mission
     from navseq.mission.robot import DEFAULT_PROFILE
     from navseq.sinks.journal import read_journal
+    from navseq.sinks.journal_reader import journal_events
     from navseq.studio.documents import document_of
     from navseq.studio.runs import LiveView, _latest_report
 
@@ -73,7 +75,7 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
     state = read_journal(journal_path)
     mission_path = _mission_file(folder, state.mission_source)
     mission = load_mission(mission_path) if mission_path is not None else None
-    events = state.events
+    events = list(journal_events(journal_path))  # read_journal keeps no event list
     start_t = events[0].t if events else 0.0
     if mission is not None:
         count = len(mission.waypoints)
