@@ -109,6 +109,8 @@ def watch(master: RosMaster, tmp_path: Path, setup: dict[str, Any], timeout: flo
     return json.loads(lines[-1])
 
 
+# Two simulated robots in real time: a recovery or a wait can exceed the budget under load.
+@pytest.mark.flaky(reruns=2)
 def test_robot1_drives_around_robot2_parked_on_its_straight_path(
     ros_master: RosMaster, tmp_path: Path
 ) -> None:

@@ -99,6 +99,9 @@ def test_with_the_settle_every_waypoint_is_truly_reached_despite_the_race(
     assert "race (~race_window)" not in nav.output()
 
 
+# A separate watcher process has to see the race's result message; on a loaded 2-core
+# machine it missed it once in five full runs (the executor's own view is tested below).
+@pytest.mark.flaky(reruns=2)
 def test_without_the_settle_navseq_runs_into_the_race(ros_master: RosMaster, tmp_path: Path):
     _robot, nav = start_sim(ros_master, nav_params=RACE)
     watcher = start_result_watcher(ros_master, tmp_path)
