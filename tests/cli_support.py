@@ -61,6 +61,30 @@ def journal_events(path: Path, kind: str) -> list[dict[str, Any]]:
     return [r for r in journal_records(path) if r.get("type") == kind]
 
 
+def printed_events(text: str, kind: str) -> list[dict[str, Any]]:
+    """The ``navseq run --json`` records of one event type in ``text`` (its stdout so far).
+
+    Wait on these, not on the journal, for "the robot is driving": ``--json`` prints
+    every progress event, the journal only the corners of the driven path (a straight
+    leg shows there when it ends).
+    """
+    records = []
+    for line in text.splitlines():
+        with contextlib.suppress(json.JSONDecodeError):  # the line being written
+            record = json.loads(line) if line.startswith("{") else None
+            if isinstance(record, dict) and record.get("event") == kind:
+                records.append(record)
+    return records
+
+
+def driven_towards(text: str, index: int, metres: float = 0.05) -> bool:
+    """Whether ``--json`` output ``text`` shows the robot ``metres`` along waypoint ``index``."""
+    return any(
+        record["index"] == index and record["distance_m"] > metres
+        for record in printed_events(text, "WaypointProgress")
+    )
+
+
 def assert_clean_error(result: subprocess.CompletedProcess[str]) -> None:
     """Bad input: exit 2, a message on stderr, never a traceback."""
     assert result.returncode == 2, result.stderr

@@ -12,7 +12,14 @@ import signal
 
 import pytest
 
-from cli_support import NAVSEQ, assert_clean_error, journal_events, navseq, wait_for, write_mission
+from cli_support import (
+    NAVSEQ,
+    assert_clean_error,
+    driven_towards,
+    navseq,
+    wait_for,
+    write_mission,
+)
 from ros_clients import MAP, start_sim
 
 pytestmark = pytest.mark.ros
@@ -72,12 +79,11 @@ def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
     _robot, nav = start_sim(ros_master)
     out = tmp_path / "out"
     process = ros_master.start(
-        [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", out],
+        [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--json", "--out", out],
         cwd=tmp_path,
         label="navseq",
     )
-    journal = out / "journal.jsonl"
-    wait_for(lambda: journal_events(journal, "WaypointProgress"), 60, "the robot moving")
+    wait_for(lambda: driven_towards(process.output(), 0), 60, "the robot moving")
     process.send_signal(signal.SIGINT)
     assert process.wait(timeout=60) == 130, process.output()
     report = json.loads((out / "report.json").read_text())

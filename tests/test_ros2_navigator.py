@@ -24,7 +24,15 @@ from typing import Any
 
 import pytest
 
-from cli_support import NAVSEQ, REPO, journal_events, wait_for, write_mission
+from cli_support import (
+    NAVSEQ,
+    REPO,
+    driven_towards,
+    journal_events,
+    printed_events,
+    wait_for,
+    write_mission,
+)
 from ros2_support import ros2_environment, ros2_prefix
 
 pytestmark = pytest.mark.ros2
@@ -148,15 +156,42 @@ def run_nav2(
     )
 
 
-def start_nav2(env: dict[str, str], mission: Path, out: Path, *extra: str) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        [NAVSEQ, "run", str(mission), "--navigator", "nav2", "--out", str(out), *extra],
-        env=env,
-        cwd=out.parent,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+class Nav2Run:
+    """``navseq run --navigator nav2 --json`` in the background; stdout goes to a file."""
+
+    def __init__(self, env: dict[str, str], mission: Path, out: Path, *extra: str) -> None:
+        self.stdout_path = out.parent / f"{out.name}.stdout.jsonl"
+        with self.stdout_path.open("w") as stdout:
+            self.process = subprocess.Popen(
+                [NAVSEQ, "run", mission, "--navigator", "nav2", "--json", "--out", out, *extra],
+                env=env,
+                cwd=out.parent,
+                stdout=stdout,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+
+    def stdout(self) -> str:
+        return self.stdout_path.read_text()
+
+    def wait_driving(self, metres: float = 0.05) -> None:
+        """Block until navseq reports the robot ``metres`` along its first waypoint."""
+
+        def driving() -> bool:
+            if self.process.poll() is not None:
+                raise AssertionError(f"navseq exited early: {self.process.communicate()[1]}")
+            return driven_towards(self.stdout(), 0, metres)
+
+        wait_for(driving, 90, "the robot driving")
+
+    def finish(self, timeout: float) -> str:
+        """Wait for navseq to exit; its stderr."""
+        try:
+            return self.process.communicate(timeout=timeout)[1]
+        finally:
+            if self.process.poll() is None:
+                self.process.kill()
+                self.process.wait()
 
 
 def report_of(out: Path) -> dict[str, Any]:
@@ -244,22 +279,14 @@ def test_sigint_mid_goal_cancels_it_the_robot_stops_and_the_report_is_written(
     mission = write_mission(tmp_path / "far.yaml", "  - {name: far, x: 1.75, y: -0.55, yaw: 0}\n")
     out = tmp_path / "out"
     watcher = OdomWatcher(env)
-    process = start_nav2(env, mission, out)
-    try:
-        wait_for(
-            lambda: len(journal_events(out / "journal.jsonl", "WaypointProgress")) >= 2,
-            90,
-            "the robot driving",
-        )
-        signalled = time.monotonic()
-        process.send_signal(signal.SIGINT)
-        _, err = process.communicate(timeout=30)
-    finally:
-        if process.poll() is None:
-            process.kill()
+    run = Nav2Run(env, mission, out)
+    run.wait_driving(0.3)
+    signalled = time.monotonic()
+    run.process.send_signal(signal.SIGINT)
+    err = run.finish(timeout=30)
     time.sleep(1.5)
     samples = watcher.samples()
-    assert process.returncode == 130, err
+    assert run.process.returncode == 130, err
     assert "Traceback" not in err
     report = report_of(out)
     assert report["interrupted"] == "SIGINT" and report["exit_code"] == 130
@@ -282,26 +309,18 @@ def test_a_goal_preempted_by_another_client_is_a_failed_attempt_then_retried(
         "defaults: {retries: 1, goal_timeout: 120, on_failure: stop}\n",
     )
     out = tmp_path / "out"
-    process = start_nav2(env, mission, out)
-    try:
-        wait_for(
-            lambda: journal_events(out / "journal.jsonl", "WaypointProgress"),
-            90,
-            "the robot driving",
-        )
-        # Another Nav2 client's goal: Nav2 preempts ours with it (ABORTED).
-        other = subprocess.run(
-            [sys.executable, str(CLIENTS), "navigate", "--", "-1.5,-0.5,0"],
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        stdout, stderr = process.communicate(timeout=240)
-    finally:
-        if process.poll() is None:
-            process.kill()
-    assert process.returncode == 0, stderr
+    run = Nav2Run(env, mission, out)
+    run.wait_driving()
+    # Another Nav2 client's goal, far from the robot: Nav2 preempts ours with it (ABORTED).
+    other = subprocess.run(
+        [sys.executable, str(CLIENTS), "navigate", "--", "-0.5,1.6,0"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    stderr = run.finish(timeout=240)
+    assert run.process.returncode == 0, stderr
     # navseq's retry preempted the other client's goal in turn.
     assert json.loads(other.stdout.strip().splitlines()[-1])["status"] == "ABORTED"
     (visit,) = report_of(out)["visits"]
@@ -309,7 +328,8 @@ def test_a_goal_preempted_by_another_client_is_a_failed_attempt_then_retried(
     first, second = visit["attempts"]
     assert first["status"] == "ABORTED" and first["text"] == "preempted by a new goal"
     assert second["status"] == "SUCCEEDED"
-    assert "attempt 1 failed (ABORTED: preempted by a new goal), will retry" in stdout
+    (failed,) = printed_events(run.stdout(), "AttemptFailed")
+    assert failed["will_retry"] and failed["text"] == "preempted by a new goal", failed
 
 
 def test_a_server_killed_mid_goal_and_restarted_is_waited_for_and_the_mission_completes(
@@ -323,14 +343,10 @@ def test_a_server_killed_mid_goal_and_restarted_is_waited_for_and_the_mission_co
         "server_timeout: 60\ndefaults: {goal_timeout: 120}\n",
     )
     out = tmp_path / "out"
-    process = start_nav2(env, mission, out)
+    run = Nav2Run(env, mission, out)
     second = None
     try:
-        wait_for(
-            lambda: journal_events(out / "journal.jsonl", "WaypointProgress"),
-            90,
-            "the robot driving",
-        )
+        run.wait_driving()
         first.process.kill()  # no goodbye: the server just vanishes
         first.process.wait()
         wait_for(
@@ -339,13 +355,11 @@ def test_a_server_killed_mid_goal_and_restarted_is_waited_for_and_the_mission_co
             "navseq noticing the server is gone",
         )
         second = SimNode(env, f"--start={START}", "--speed", SPEED)
-        _, stderr = process.communicate(timeout=180)
+        stderr = run.finish(timeout=180)
     finally:
-        if process.poll() is None:
-            process.kill()
         if second is not None:
             second.stop()
-    assert process.returncode == 0, stderr
+    assert run.process.returncode == 0, stderr
     changes = [e["available"] for e in journal_events(out / "journal.jsonl", "ServerStatusChanged")]
     assert changes == [False, True]
     (visit,) = report_of(out)["visits"]
