@@ -1,12 +1,18 @@
-"""Loading and validating huge missions: time and peak memory, fast path against slow.
+"""Loading and validating huge missions: time and peak memory of each reading path.
 
 Writes a generated navseq YAML mission of 10 000 and 100 000 waypoints (each
-``{name, x, y, yaw}``, as a recorded patrol would be) and loads it in a fresh process
-per measurement (``navseq.mission.load_mission``: read, parse, check every field),
-reporting CPU seconds, wall seconds and the process's peak resident memory. "slow"
-forces the paths every document took before the fast ones (PyYAML's composer and
-the located walker; the general waypoint reader), which remain for documents the
-fast path does not take (aliases, tags, problems); "fast" is what navseq does now.
+``{name, x, y, yaw}`` on one line, as a recorded patrol is) and loads it in a fresh
+process per measurement (``navseq.mission.load_mission``: read, parse, check every
+field), reporting CPU seconds, wall seconds and the process's peak resident memory.
+Three paths, side by side, each the one before plus one shortcut:
+
+- "composer": PyYAML's composer and the located walker, then the general waypoint
+  reader (what documents with anchors, tags or problems still take), with Python's
+  cyclic garbage collector running as it did before loading paused it;
+- "events": libyaml's parse events straight to located values, the plain-waypoint
+  reader, the collector paused while reading;
+- "lines": navseq now: runs of one-line ``- {key: value, ...}`` items read by regex
+  (``navseq.mission.yaml_flow_lines``), the rest of the document by events.
 
     .venv/bin/python benchmarks/bench_load.py [--sizes 10000 100000]
 """
@@ -26,14 +32,18 @@ from rich.table import Table
 
 # Runs in the child process: load once, print CPU, wall and peak memory as JSON.
 CHILD = """
-import json, resource, sys, time
-from navseq.mission import yaml_doc, navseq_format
+import contextlib, json, resource, sys, time
+from navseq.mission import loader, navseq_format, yaml_doc
 from navseq.mission import load_mission
-if sys.argv[2] == "slow":
+mode = sys.argv[2]
+if mode in ("composer", "events"):
+    yaml_doc.find_runs = lambda text: (text, {})
+if mode == "composer":
     def refuse(self, text):
         raise yaml_doc._SlowPath
     yaml_doc._EventBuilder.build = refuse
     navseq_format._plain_waypoint = lambda node: None
+    loader._collector_paused = contextlib.nullcontext
 cpu, wall = time.process_time(), time.perf_counter()
 mission = load_mission(sys.argv[1])
 print(json.dumps({
@@ -43,6 +53,9 @@ print(json.dumps({
     "waypoints": len(mission.waypoints),
 }))
 """
+
+
+MODES = ("composer", "events", "lines")
 
 
 def write_mission(path: Path, count: int) -> None:
@@ -77,11 +90,12 @@ def main() -> None:
         for count in args.sizes:
             path = Path(folder) / f"m{count}.yaml"
             write_mission(path, count)
-            slow, fast = measure(path, "slow"), measure(path, "fast")
-            assert slow["waypoints"] == fast["waypoints"] == count
+            rows = {mode: measure(path, mode) for mode in MODES}
+            assert all(row["waypoints"] == count for row in rows.values())
             size = f"{path.stat().st_size / 1e6:.1f}"
-            for mode, row in (("slow", slow), ("fast", fast)):
-                ratio = f"{slow['cpu'] / row['cpu']:.1f}x" if mode == "fast" else ""
+            first = rows[MODES[0]]
+            for mode, row in rows.items():
+                ratio = f"{first['cpu'] / row['cpu']:.1f}x" if mode != MODES[0] else ""
                 table.add_row(
                     f"{count:,}",
                     size,

@@ -623,3 +623,31 @@ def test_the_robot_outline_is_drawn_to_scale_at_the_start() -> None:
     # The waffle's rear-left corner (-0.205, 0.155), turned to face +y.
     assert np.allclose(corners[1], (1.0 - 0.155, 2.0 - 0.205))
     assert "turtlebot3_waffle outline" in legend_texts(fig)
+
+
+def test_tens_of_thousands_of_stacked_waypoints_get_no_more_group_rings_than_dots():
+    """A recorded patrol in a small room, positions rounded to the centimetre: thousands
+    of spots hold several waypoints. Rings are thinned as the dots are, one per
+    dot-sized cell; a ring per group drew 28 000 of them, most of a second of a stopped
+    run's picture."""
+    from matplotlib.collections import PathCollection
+
+    rng = np.random.default_rng(5)
+    xy = np.round(rng.uniform(0.5, 2.5, size=(60_000, 2)), 2)
+    mission = Mission(
+        tuple(Waypoint(float(x), float(y), yaw_rad=0.0) for x, y in xy), source="room.yaml"
+    )
+    outcomes = [REACHED] * 50 + [FAILED] + [NOT_RUN] * (len(xy) - 51)
+    fig = mission_figure(mission, visits_result(mission, outcomes))
+    marks = [c for c in fig.axes[0].collections if isinstance(c, PathCollection)]
+    rings = sum(len(c.get_offsets()) for c in marks if not len(c.get_facecolor()))
+    dots = sum(len(c.get_offsets()) for c in marks if len(c.get_facecolor()))
+    spots, counts = np.unique(xy, axis=0, return_counts=True)
+    assert np.count_nonzero(counts > 1) > dots  # the premise: more stacks than dots
+    assert 0 < rings <= dots
+    # Every waypoint still has a dot within a dot's width of it.
+    from scipy.spatial import cKDTree
+
+    centres = fig.axes[0].transData.transform(spots[::20])
+    distance, _ = cKDTree(markers_xy(fig)).query(centres)
+    assert distance.max() <= 6

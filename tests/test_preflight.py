@@ -202,3 +202,24 @@ def test_reachability_skips_over_a_bad_waypoint(pocket_map: Costmap) -> None:
     problems = check_mission(mission, pocket_map)
     assert [p.subject for p in problems] == ["waypoint 2"]
     assert "inside an obstacle" in str(problems[0])
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.7])
+def test_every_waypoint_gets_the_verdict_of_the_close_look(yaw: float) -> None:
+    """The one-pass screen of thousands of waypoints agrees with looking at each one:
+    on the map, off it, in pillars, grazing walls, on a map turned against the world."""
+    from navseq.preflight import _FreeRegions, _placement_problem
+
+    grid = load_map(REPO_MAP)
+    turned = OccupancyGrid(grid.data, grid.resolution, Pose2D(-1.0, 2.0, yaw), grid.source)
+    free = _FreeRegions(Costmap.from_grid(turned), TURTLEBOT3_BURGER)
+    rng = np.random.default_rng(7)
+    xmin, ymin, xmax, ymax = turned.bounds
+    points = rng.uniform((xmin - 0.5, ymin - 0.5), (xmax + 0.5, ymax + 0.5), size=(4000, 2))
+    waypoints = [Waypoint(float(x), float(y), yaw_rad=0.0) for x, y in points]
+    one_by_one = [
+        free.region_at(w.x, w.y) if _placement_problem(free, w.x, w.y, "", None) is None else None
+        for w in waypoints
+    ]
+    assert free.regions_of(waypoints) == one_by_one
+    assert {None} < set(one_by_one)  # both verdicts are among the points

@@ -9,7 +9,7 @@ from navseq.executor.events import WaypointOutcome
 from navseq.executor.result import MissionResult, WaypointResult
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Waypoint
-from navseq.sinks.report import SCHEMA_VERSION, build_report, write_report
+from navseq.sinks.report import SCHEMA_VERSION, build_report, report_json, write_report
 
 MISSION = Mission(
     waypoints=(
@@ -108,3 +108,14 @@ def test_report_file_is_valid_json_even_with_non_finite_numbers(tmp_path):
     assert loaded["success"] is True and loaded["exit_code"] == 0
     # Written atomically: no temporary file is left beside it.
     assert [p.name for p in path.parent.iterdir()] == ["report.json"]
+
+
+def test_report_text_is_python_json_indented_and_a_name_orjson_refuses_still_writes(tmp_path):
+    r = result(WaypointOutcome.REACHED, WaypointOutcome.SKIPPED, WaypointOutcome.REACHED)
+    report = build_report(MISSION, r, exit_code=1, navigator={"kind": "sim", "speed": 2.0})
+    assert report_json(report) == json.dumps(report, indent=2, ensure_ascii=False) + "\n"
+    # A file name holding bytes that are not UTF-8 (os.fsdecode gives lone surrogates).
+    report["files"] = {"journal": "run-\udcff/journal.jsonl"}
+    path = tmp_path / "report.json"
+    write_report(report, path)
+    assert json.loads(path.read_text())["files"]["journal"].startswith("run-")

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from navseq.errors import NavseqError
-from navseq.mission import yaml_doc
+from navseq.mission import yaml_doc, yaml_flow_lines
 from navseq.mission.located import Located
 from navseq.mission.problems import Problems
 from navseq.mission.yaml_doc import ValueBudget, parse_yaml
@@ -237,3 +237,110 @@ def test_plain_waypoints_read_as_the_general_reader_reads_them(
     fast = read()
     monkeypatch.setattr(navseq_format, "_plain_waypoint", lambda node: None)
     assert fast == read()
+
+
+# -- the line path: runs of one-line flow-mapping items, read by regex ------------------
+
+
+def _run(count: int, indent: str = "  ", item: str = "{{name: wp{i}, x: {i}.5, y: -{i}}}") -> str:
+    return "".join(f"{indent}- {item.format(i=i)}\n" for i in range(count))
+
+
+def _line_path(text: str) -> Any:
+    """The document read by the line path alone (it raises where it would give up)."""
+    shortened, runs = yaml_flow_lines.find_runs(text)
+    assert runs, "no run long enough"
+    builder = yaml_doc._EventBuilder("m.yaml", Problems(), 0, ValueBudget(None).limit)
+    root, _count = builder._build_text(shortened, runs)
+    return _plain(root)
+
+
+LINE_PATH_DOCUMENTS = [
+    "waypoints:\n" + _run(12),
+    "navseq: 1\nwaypoints:\n" + _run(10) + "defaults: {dwell: 2}\n",  # keys after the run
+    "waypoints:\n" + _run(10, "") + "loops: 2\n",  # items at column 0
+    "a:\n  b:\n" + _run(10, "    ") + "  c: 1\n",  # nested
+    "waypoints:\n" + _run(5) + "  - [1, 2]\n" + _run(9),  # two runs around another item
+    "waypoints:\n" + _run(9) + _run(9, "    "),  # an indent change ends a run (an error)
+    "w:\n" + _run(10) + "    z: 3\n",  # a deeper line after the run (an error)
+    "w:\n" + _run(10) + "  k: v\n",  # a key at the items' indent (an error)
+    "w:\n" + _run(10) + "  # a comment\n" + _run(8),
+    "w:\n\n" + _run(6) + "\n" + _run(6),  # blank lines within the list
+    "w: |\n" + _run(10),  # inside a block scalar: text, not items
+    "w: >\n" + _run(10),
+    'w: "start\n' + _run(10) + '  end"\n',  # inside a quoted text
+    "w: plain\n" + _run(10),  # after a plain scalar: an error
+    "w: [\n" + _run(10) + "]\n",  # inside a flow list: an error
+    "w:\n" + _run(10, item="{{x: {i}, x: 1}}"),  # a duplicate key: a problem
+    "w:\n" + _run(10, item="{{name: n{i}, x: 1e3, y: 0x1F, z: .inf, a: yes, b: null}}"),
+    "w:\n" + _run(10, item="{{name: north, x: -, y: +, z: ., t: 2001-12-14}}"),  # odd values
+    "w:\n" + _run(10, item="{{a: 1_000, b: 012, c: -0, d: 1., e: -.5, f: +1.5, g: 00.5}}"),
+    "w:\n" + _run(10, item="{{  a:   1 ,b: 2   }}") + "   ",  # spacing, trailing blanks
+    "w:\n" + _run(10).replace("\n", "\r\n"),  # CRLF
+    "w:\n" + _run(10) + f"  - {yaml_flow_lines.SENTINEL}\n",  # the sentinel written
+    "---\nw:\n" + _run(10) + "...\n",
+    "w:\n" + _run(10) + "---\nw: 2\n",  # a second document
+    "w: &a\n" + _run(10) + "v: *a\n",  # an anchored list, aliased
+]
+
+
+@pytest.mark.parametrize("text", LINE_PATH_DOCUMENTS)
+def test_documents_with_runs_of_one_line_items_read_the_same(text: str) -> None:
+    _same(text)
+    _same(text, first_line=40)
+
+
+def test_a_recorded_patrol_takes_the_line_path_and_reads_the_same() -> None:
+    text = "navseq: 1\nwaypoints:\n" + _run(
+        300, item="{{name: wp{i}, x: {i}.25, y: -{i}, yaw: 90}}"
+    )
+    value, problems, left = _same(text)
+    assert _line_path(text) == value
+    assert problems == [] and left == ValueBudget(None).limit - (5 + 300 * 9)
+    where, items = value[1]["waypoints"][1]
+    assert where == "m.yaml:3"  # where the list starts, as YAML readers say
+    assert items[0] == (
+        "m.yaml:3",
+        {
+            "name": ("m.yaml:3", ("m.yaml:3", "str", "'wp0'")),
+            "x": ("m.yaml:3", ("m.yaml:3", "float", "0.25")),
+            "y": ("m.yaml:3", ("m.yaml:3", "int", "0")),
+            "yaw": ("m.yaml:3", ("m.yaml:3", "int", "90")),
+        },
+    )
+    assert items[-1][0] == "m.yaml:302"
+
+
+def test_the_value_budget_is_enforced_within_a_run() -> None:
+    text = "w:\n" + _run(50, item="{{x: {i}, y: 1.5}}")
+    assert _line_path(text)
+    refused = _same(text, budget=100)
+    assert refused[0] == "error" and "more than 100 YAML values" in refused[1]
+
+
+_run_values = st.sampled_from(
+    [s for s in SCALARS if yaml_flow_lines._PAIR.fullmatch(f"k: {s}")] + ["wp7", "1.25", "-3"]
+)
+_run_keys = st.sampled_from(["x", "y", "name", "yaw", "on", "n", "_k", "k1"])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(
+        st.lists(st.tuples(_run_keys, _run_values), min_size=1, max_size=4),
+        min_size=yaml_flow_lines.MIN_RUN,
+        max_size=20,
+    ),
+    st.sampled_from(["", "  ", "    "]),
+    st.sampled_from(["", "loops: 2\n", "  x: 1\n", "  - [1, 2]\n"]),
+)
+def test_generated_runs_read_the_same(
+    lines: list[list[tuple[str, str]]], indent: str, after: str
+) -> None:
+    items = "".join(
+        f"{indent}- {{" + ", ".join(f"{k}: {v}" for k, v in pairs) + "}\n" for pairs in lines
+    )
+    text = "w:\n" + items + after
+    read = _same(text)
+    if read[0] != "error" and not read[1]:  # the line path gives up on problems
+        assert _line_path(text) == read[0]

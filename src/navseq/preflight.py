@@ -33,7 +33,7 @@ from scipy import ndimage
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
-from navseq.mission.model import Mission
+from navseq.mission.model import Mission, Waypoint
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.costmap import LETHAL, NO_INFORMATION, Costmap
 from navseq.sim.footprint import Footprint, footprint_collides
@@ -83,17 +83,14 @@ def check_mission(
     # can get to, so a waypoint after an isolated one is not blamed as well. Every
     # waypoint reached is in that one region, so the way back to the first waypoint
     # for the next loop needs no check of its own.
-    placed = [
-        _placement_problem(free, waypoint.x, waypoint.y, "", None) is None
-        for waypoint in mission.waypoints
-    ]
-    regions = [
-        free.region_at(waypoint.x, waypoint.y) if ok else None
-        for waypoint, ok in zip(mission.waypoints, placed, strict=True)
-    ]
+    regions = free.regions_of(mission.waypoints)
     reference = start_region if start_region is not None else _most_common(regions)
-    previous_label = "the start pose" if start_region is not None else None
+    # The last waypoint the robot can get to, named only when a message needs it.
+    previous: tuple[int, Waypoint] | None = None
     for index, waypoint, region in zip(numbers, mission.waypoints, regions, strict=True):
+        if region is not None and (reference is None or region == reference):
+            previous = (index, waypoint)
+            continue
         source = waypoint.where or mission.source
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
@@ -103,21 +100,23 @@ def check_mission(
             )
             problems.append(NavseqError(f"{position} {problem}", source=source, subject=subject))
             continue
-        if reference is not None and region != reference:
+        if previous is not None:
+            before, reached = previous
             where_from = (
-                f"cannot be reached from {previous_label}"
-                if previous_label is not None
-                else "is cut off from the mission's other waypoints"
+                f"cannot be reached from {reached.label(before)} "
+                f"{_format_position(reached.x, reached.y)}"
             )
-            problems.append(
-                NavseqError(
-                    f"{position} {where_from}: no free path connects them on the map",
-                    source=source,
-                    subject=subject,
-                )
+        elif start_region is not None:
+            where_from = "cannot be reached from the start pose"
+        else:
+            where_from = "is cut off from the mission's other waypoints"
+        problems.append(
+            NavseqError(
+                f"{position} {where_from}: no free path connects them on the map",
+                source=source,
+                subject=subject,
             )
-            continue
-        previous_label = f"{subject} {position}"
+        )
     return problems
 
 
@@ -192,6 +191,43 @@ class _FreeRegions:
         # Where a suggested spot may be: room to turn, with the margin to spare.
         roomy = self.costmap.params.circumscribed_radius + self.robot.clearance_margin_m
         self._roomy_cells = np.argwhere(self.free & (self.costmap.clearance >= roomy))
+
+    def regions_of(self, waypoints: Sequence[Waypoint]) -> list[int | None]:
+        """Each waypoint's free region, or None where the robot cannot stand and turn.
+
+        The same verdict as :func:`_placement_problem`, in one numpy pass for the
+        waypoints whose cell clears the robot with room to spare (most of them); only
+        those near an obstacle, unknown space or the map edge are looked at closely.
+        """
+        if not waypoints:
+            return []
+        costmap, grid = self.costmap, self.costmap.grid
+        xs = np.fromiter((w.x for w in waypoints), dtype=float, count=len(waypoints))
+        ys = np.fromiter((w.y for w in waypoints), dtype=float, count=len(waypoints))
+        rows, cols = grid.world_to_cells(xs, ys)
+        inside = (rows >= 0) & (rows < grid.height) & (cols >= 0) & (cols < grid.width)
+        rows, cols = np.where(inside, rows, 0), np.where(inside, cols, 0)
+        cost = costmap.cost[rows, cols]
+        # Beyond this cell clearance, clearance_at needs no closer look (see there).
+        roomy = costmap.params.circumscribed_radius + 2 * grid.resolution
+        clear = (
+            inside
+            & (cost != LETHAL)
+            & (cost != NO_INFORMATION)
+            & self.free[rows, cols]
+            & (costmap.clearance[rows, cols] > roomy)
+        )
+        labels = self.labels[rows, cols]
+        return [
+            int(label)
+            if ok
+            else (
+                self.region_at(w.x, w.y)
+                if _placement_problem(self, w.x, w.y, "", None) is None
+                else None
+            )
+            for w, ok, label in zip(waypoints, clear.tolist(), labels.tolist(), strict=True)
+        ]
 
     def region_at(self, x: float, y: float) -> int:
         row, col = self.costmap.world_to_cell(x, y)

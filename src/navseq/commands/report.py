@@ -85,6 +85,7 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     from navseq.files import write_atomically
     from navseq.mission.part import number_visits
     from navseq.sinks.journal import read_journal
+    from navseq.sinks.report import report_json
 
     if state is None or state.path != journal or not state.is_current():
         state = read_journal(journal)
@@ -98,7 +99,7 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     if not _complete_report(report_path):
         report = _report(state, mission, result, report_path, picture_path, journal)
         number_visits(report, part)
-        text = json.dumps(report, indent=2, ensure_ascii=False) + "\n"
+        text = report_json(report)
         try:
             write_atomically(report_path, text)
         except OSError as error:

@@ -11,6 +11,7 @@ report and the picture even when the run is interrupted.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import sys
 from collections.abc import Callable, Mapping
@@ -625,6 +626,8 @@ def _execute_locked(
     journal_path = setup.journal or reserve_file(folder, "journal.jsonl")
     for note in setup.notes:
         print(f"navseq run: {note}", file=sys.stderr)
+    if not args.no_picture:
+        _import_picture_modules()
     try:
         outcome = _run_with_sinks(setup, args, journal_path, signals)
     except BaseException:
@@ -708,6 +711,21 @@ def _report(
     # Not in a report rebuilt from the journal (navseq report): it keeps no wall time.
     report["clock"] = outcome.clock
     return report
+
+
+def _import_picture_modules() -> None:
+    """Import what the picture draws with now, before the robot moves, not after.
+
+    matplotlib takes about half a second to import; a run stopped by a signal has
+    about two seconds to write its outputs and exit, and should not spend a quarter of
+    them there. (Not in a thread alongside the run: a daemon thread still importing
+    when a refused run exits can crash the interpreter's shutdown.) A failed import is
+    left for the picture itself to report.
+    """
+    from navseq.sinks.picture import import_drawing_modules
+
+    with contextlib.suppress(ImportError):
+        import_drawing_modules()
 
 
 def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:

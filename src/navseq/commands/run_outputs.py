@@ -101,9 +101,8 @@ def write_outputs(
     written (disk full) makes the run's status 2, and the report is written again to say
     so, if it can be.
     """
-    import json
-
     from navseq.signals import StepAbandoned
+    from navseq.sinks.report import report_json
 
     if render_picture is not None:
         picture_path = free_name(folder, "mission.png")
@@ -116,7 +115,7 @@ def write_outputs(
             report["files_not_written"] = dict(files.failed)
         # Text, not bytes: write_atomically escapes what UTF-8 cannot hold (a file name's
         # undecodable bytes) so that JSON reads it back.
-        return json.dumps(report, indent=2, ensure_ascii=False) + "\n"
+        return report_json(report)
 
     try:
         report_path: Path | None = write_new_file(folder, "report.json", report_text)

@@ -12,9 +12,11 @@ its content:
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import os
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from navseq.errors import NavseqError
@@ -72,7 +74,8 @@ def _load(path: Path) -> tuple[Mission | None, Problems]:
     try:
         text = read_mission_text(path)
         reader = _reader_for(path, text)
-        mission = reader(text, source, path.resolve().parent, problems)
+        with _collector_paused():
+            mission = reader(text, source, path.resolve().parent, problems)
     except NavseqError as error:
         problems.record(error)
     except RecursionError:
@@ -81,6 +84,24 @@ def _load(path: Path) -> tuple[Mission | None, Problems]:
         problems.add("holds no mission", source=source)
     problems.errors.sort(key=_line_number)  # read like the file, top to bottom
     return (mission if not problems.errors else None), problems
+
+
+@contextlib.contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off while a mission is read.
+
+    Reading a mission builds a few small objects per value, none of them in a
+    reference cycle, so the collector finds nothing; but it walked every live one
+    again each time a few hundred more had been made: 45 % of the time 100 000
+    waypoints took to load. Reference counting still frees them.
+    """
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _line_number(error: NavseqError) -> int:

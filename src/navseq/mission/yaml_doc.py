@@ -34,6 +34,7 @@ from navseq.errors import NavseqError
 from navseq.files import limit_from_environment
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.problems import Problems
+from navseq.mission.yaml_flow_lines import SENTINEL, NotPlain, Run, find_runs
 from navseq.text import text_problem
 
 # Aliases may repeat what was written, but not blow it up: the expanded document may
@@ -320,6 +321,18 @@ class _Walker:
         return kept + explicit
 
 
+class _PlainScalar:
+    """What :meth:`_EventBuilder.scalar` reads of a plain scalar's event."""
+
+    __slots__ = ("end_mark", "start_mark", "value")
+    style = None
+    implicit = (True, False)
+
+    def __init__(self, value: str, mark: Any):
+        self.value = value
+        self.start_mark = self.end_mark = mark
+
+
 class _SlowPath(Exception):
     """The document needs the composer's full treatment (see the module docstring)."""
 
@@ -343,6 +356,9 @@ _SHORTCUTS = _standard_resolvers("-", ("float", "int")) and all(
 _PLAIN_INT = re.compile(r"-?+(?:0|[1-9][0-9]*+)")
 _PLAIN_FLOAT = re.compile(r"-?+[0-9]++\.[0-9]++")
 _PLAIN_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*+")
+# Either of the two above at once (one match per value where most are numbers): the
+# group holds the fraction of a _PLAIN_FLOAT.
+_PLAIN_NUMBER = re.compile(r"-?+[0-9]++(\.[0-9]++)?+")
 _RESOLVED_FIRST = frozenset(yaml.resolver.Resolver.yaml_implicit_resolvers)
 _SURROGATE = re.compile("[\ud800-\udfff]")
 
@@ -358,19 +374,24 @@ class _EventBuilder:
         self.places: dict[int, str] = {}
 
     def where(self, mark: Any) -> str:
-        line = mark.line
-        place = self.places.get(line)
-        if place is None:
-            place = self.places[line] = f"{self.source}:{line + 1 + self.offset}"
-        return place
+        return self._place_of_line(mark.line)
 
     def build(self, text: str) -> tuple[Located | None, int]:
         """The document's root (None when empty) and how many values it holds."""
         if _SURROGATE.search(text):
             _slow_path()  # the slow path names the value that holds one
+        shortened, runs = find_runs(text)
+        if runs:
+            try:
+                return self._build_text(shortened, dict(runs))
+            except (_SlowPath, NotPlain):
+                pass  # the events of the whole text decide
+        return self._build_text(text, {})
+
+    def _build_text(self, text: str, runs: dict[int, Run]) -> tuple[Located | None, int]:
         parser = _FAST_LOADER(text)
         try:
-            return self._build(parser.get_event)
+            return self._build(parser.get_event, runs)
         except (yaml.YAMLError, NavseqError):
             # The slow path reports it, after any problem it finds first (a syntax
             # error further on, an alias bomb), with the same message and line.
@@ -378,7 +399,48 @@ class _EventBuilder:
         finally:
             parser.dispose()
 
-    def _build(self, next_event: Any) -> tuple[Located | None, int]:
+    def _place_of_line(self, line: int) -> str:
+        place = self.places.get(line)
+        if place is None:
+            place = self.places[line] = f"{self.source}:{line + 1 + self.offset}"
+        return place
+
+    def _run_value(self, value: str, line: int) -> Any:
+        """One plain value of a run's line, read as its scalar event would be."""
+        if _SHORTCUTS:
+            number = _PLAIN_NUMBER.fullmatch(value)
+            if number is not None:
+                if number[1]:
+                    return float(value)
+                if _PLAIN_INT.fullmatch(value):
+                    return int(value)
+        if value[:1] not in _RESOLVED_FIRST and _PLAIN_WORD.fullmatch(value):
+            return value
+        mark = yaml.Mark(self.source, 0, line, 0, None, 0)
+        return self.scalar(_PlainScalar(value, mark))
+
+    def _splice_run(
+        self, event: Any, stack: list[list[Any]], runs: dict[int, Run]
+    ) -> tuple[list[Located], int]:
+        """The items (and value count) of the run ``event`` stands for, if it stands
+        where the run was written: an item of a block list, on its line and column."""
+        mark = event.start_mark
+        run = runs.get(mark.line)
+        top = stack[-1] if stack else None
+        if (
+            run is None
+            or event.value != SENTINEL  # a longer text holding it: the run's lines were text
+            or event.style
+            or mark.column != run.column
+            or top is None
+            or type(top[0]) is not list
+            or top[3]  # a flow list (see _build): the run's lines were no items of it
+        ):
+            raise NotPlain
+        del runs[mark.line]  # each run is spliced once (_build checks all were)
+        return run.items(self._place_of_line, self._run_value)
+
+    def _build(self, next_event: Any, runs: dict[int, Run]) -> tuple[Located | None, int]:
         # Each open container: [value (dict or list), where, key_where, pending key].
         stack: list[list[Any]] = []
         root: Located | None = None
@@ -401,6 +463,13 @@ class _EventBuilder:
                 count += 1
                 if event.anchor is not None or event.tag is not None:
                     _slow_path()
+                if runs and SENTINEL in event.value:
+                    items, values = self._splice_run(event, stack, runs)
+                    stack[-1][0].extend(items)
+                    count += values - 1  # the sentinel was counted
+                    if count > budget_left:
+                        _slow_path()  # the slow path refuses it with the line
+                    continue
                 place = places.get(event.start_mark.line) or where(event.start_mark)
                 top = stack[-1] if stack else None
                 if top is not None and top[3] is None and type(top[0]) is dict:
@@ -425,8 +494,8 @@ class _EventBuilder:
                     _slow_path()  # a list or mapping as a key
                 if kind is mapping_start:
                     stack.append([{}, where(event.start_mark), {}, None])
-                else:
-                    stack.append([[], where(event.start_mark), None, None])
+                else:  # a list's last slot: whether it is written in flow style
+                    stack.append([[], where(event.start_mark), None, bool(event.flow_style)])
                 continue
             elif kind in end_events:
                 value, place, key_where, _ = stack.pop()
@@ -435,6 +504,8 @@ class _EventBuilder:
                 else:
                     node = located(value, place, key_where)
             elif kind is stream_end:
+                if runs:
+                    raise NotPlain  # a run that was no list's items
                 return root, count
             elif kind is yaml.DocumentStartEvent:
                 documents += 1

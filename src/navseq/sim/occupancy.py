@@ -134,6 +134,21 @@ class OccupancyGrid:
             gx, gy = c * gx - s * gy, s * gx + c * gy
         return self.origin.x + gx, self.origin.y + gy
 
+    def world_to_cells(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the cells containing many world points; may be out of bounds.
+
+        The same arithmetic as :meth:`world_to_cell`, element by element, so each point
+        lands in the same cell.
+        """
+        dx = np.asarray(xs, dtype=float) - self.origin.x
+        dy = np.asarray(ys, dtype=float) - self.origin.y
+        if self.origin.yaw:
+            c, s = math.cos(self.origin.yaw), math.sin(self.origin.yaw)
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        rows = np.floor(dy / self.resolution).astype(np.int64)
+        cols = np.floor(dx / self.resolution).astype(np.int64)
+        return rows, cols
+
     def cells_to_world(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """World (x, y) of many cell centres at once, shape (N, 2)."""
         gx = (np.asarray(cols, dtype=float) + 0.5) * self.resolution

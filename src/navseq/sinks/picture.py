@@ -186,6 +186,28 @@ def draw_mission_picture(
     write_atomically(path, png)
 
 
+#: What drawing a picture imports (the modules above import them only when they draw).
+DRAWING_MODULES = (
+    "matplotlib.backends.backend_agg",
+    "matplotlib.collections",
+    "matplotlib.figure",
+    "matplotlib.font_manager",
+    "matplotlib.lines",
+    "matplotlib.patches",
+    "matplotlib.transforms",
+    "scipy.spatial",
+)
+
+
+def import_drawing_modules() -> None:
+    """Import :data:`DRAWING_MODULES` (about half a second), for a caller that can do it
+    ahead of time, while nothing waits for it."""
+    import importlib
+
+    for name in DRAWING_MODULES:
+        importlib.import_module(name)
+
+
 def mission_picture_png(
     mission: Mission,
     result: MissionResult,

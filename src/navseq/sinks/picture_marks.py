@@ -165,9 +165,11 @@ def draw_markers(
             linewidths=line,
             zorder=6 + 0.01 * DRAW_ORDER.index(status),
         )
-    # Groups get a thick black ring: several waypoints under one marker.
+    # Groups get a thick black ring: several waypoints under one marker (thinned as the
+    # dots are: one ring per dot-sized cell says as much as thirty thousand).
     several = inside & (markers.groups.sizes > 1)
     if several.any() and not markers.numbered:
+        several = _one_per_cell(markers, layout, several, by_status=False)
         ax.scatter(
             markers.points[several, 0],
             markers.points[several, 1],
@@ -224,19 +226,28 @@ def _thinned_dots(markers: Markers, layout: Layout) -> np.ndarray:
     Dots that would cover one another to the pixel add nothing to the picture but
     drawing time; the most alarming status of a cell is drawn last, on top.
     """
-    inside = markers.inside
-    if np.count_nonzero(inside) <= DOTS_DRAWN:
-        return inside
+    return _one_per_cell(markers, layout, markers.inside, by_status=True)
+
+
+def _one_per_cell(
+    markers: Markers, layout: Layout, candidates: np.ndarray, *, by_status: bool
+) -> np.ndarray:
+    """Of the ``candidates`` markers, the first in each dot-sized cell (of each status
+    with ``by_status``); all of them when there are no more than :data:`DOTS_DRAWN`."""
+    if np.count_nonzero(candidates) <= DOTS_DRAWN:
+        return candidates
     cell = markers.size / 72.0 * layout.dpi
     cells = np.floor(markers.pixels / cell).astype(np.int64)
     cells -= cells.min(axis=0)
     span = int(cells.max()) + 1
-    keys = (cells[:, 0] * span + cells[:, 1]) * len(STATUSES) + markers.status
-    keys = np.where(inside, keys, -1)
+    keys = cells[:, 0] * span + cells[:, 1]
+    if by_status:
+        keys = keys * len(STATUSES) + markers.status
+    keys = np.where(candidates, keys, -1)
     _, first = np.unique(keys, return_index=True)
-    drawn = np.zeros(len(inside), dtype=bool)
+    drawn = np.zeros(len(candidates), dtype=bool)
     drawn[first] = True
-    return drawn & inside
+    return drawn & candidates
 
 
 def draw_numbered_details(
