@@ -46,7 +46,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.table import Table
 
@@ -54,6 +53,8 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 THIS_SCRIPT = Path(__file__).resolve()
 # ros2_support (where ROS 2 is, the environment of a ROS 2 process) is shared with the tests.
 sys.path.insert(0, str(REPO_ROOT / "tests"))
+
+import turnaround  # noqa: E402  (benchmarks/turnaround.py: shared with bench_ros1.py)
 
 from ros2_support import ros2_available, ros2_environment, ros2_prefix  # noqa: E402
 
@@ -118,7 +119,7 @@ def role_navseq_client(goals: int, tick: float) -> None:
 
     mission = Mission(
         waypoints=tuple(Waypoint(x, y, yaw_rad=yaw) for x, y, yaw in bench_goals(goals)),
-        defaults=Policy(goal_timeout=10.0, on_failure=FailureAction.STOP),
+        defaults=Policy(goal_timeout_s=10.0, on_failure=FailureAction.STOP),
         source="<bench_nav2>",
     )
     navigator = Nav2Navigator(node_name="bench_navseq", use_sim_time=False)
@@ -211,38 +212,14 @@ def stop(process: subprocess.Popen[str]) -> None:
         process.wait()
 
 
-def last_json_line(text: str) -> dict[str, Any]:
-    for line in reversed(text.splitlines()):
-        if line.startswith("{"):
-            return dict(json.loads(line))
-    return {}
-
-
 # ---------------------------------------------------------------------------------------
 # Part 1: goal turnaround
 # ---------------------------------------------------------------------------------------
 
 
-@dataclasses.dataclass
-class Turnaround:
-    client: str
-    goals_done: int
-    gaps_ms: np.ndarray  # server clock: result n returned -> goal n+1 request arrived
-    goals_per_s: float
-    success: bool
-
-    @property
-    def median(self) -> float:
-        return float(np.median(self.gaps_ms))
-
-    @property
-    def p99(self) -> float:
-        return float(np.percentile(self.gaps_ms, 99))
-
-
 def measure_turnaround(
     env: dict[str, str], workdir: Path, name: str, client_args: list[str]
-) -> Turnaround:
+) -> turnaround.Turnaround:
     log = workdir / f"server-{name.replace(' ', '_').replace(',', '')}.jsonl"
     server = start(env, sys.executable, THIS_SCRIPT, "--role", "server", "--log", log)
     try:
@@ -254,26 +231,12 @@ def measure_turnaround(
             text=True,
             timeout=CLIENT_TIMEOUT,
         )
-        reply = last_json_line(client.stdout)
+        reply = turnaround.last_json_line(client.stdout)
         if client.returncode != 0 or not reply:
             raise RuntimeError(f"{name} failed ({client.returncode}):\n{client.stderr[-3000:]}")
     finally:
         stop(server)
-    records = sorted(
-        (json.loads(line) for line in log.read_text().splitlines()),
-        key=lambda record: record["arrived"],
-    )
-    if len(records) < 2:
-        raise RuntimeError(f"{name}: the server saw {len(records)} goal(s)")
-    arrived = np.array([r["arrived"] for r in records])
-    results = np.array([r["result"] for r in records])
-    return Turnaround(
-        client=name,
-        goals_done=len(records),
-        gaps_ms=(arrived[1:] - results[:-1]) * 1000.0,
-        goals_per_s=len(records) / (results[-1] - arrived[0]),
-        success=bool(reply.get("success")),
-    )
+    return turnaround.from_server_log(log, name, reply)
 
 
 def turnaround_table(env: dict[str, str], workdir: Path, goals: int) -> Table:
@@ -285,35 +248,12 @@ def turnaround_table(env: dict[str, str], workdir: Path, goals: int) -> Table:
         )
         for tick in (DEFAULT_TICK, DEFAULT_TICK / 10)
     ]
-    table = Table(
-        title="Goal turnaround over rclpy actions "
-        "(server clock: result n returned -> goal n+1 received)"
+    made = turnaround.table(
+        "Goal turnaround over rclpy actions (server clock: result n returned -> goal n+1 received)"
     )
-    for column in (
-        "client",
-        "goals",
-        "all ok",
-        "median ms",
-        "p99 ms",
-        "max ms",
-        "median / base",
-        "p99 / base",
-        "goals/s",
-    ):
-        table.add_column(column, justify="right")
     for row in [*rows, base]:
-        table.add_row(
-            row.client,
-            str(row.goals_done),
-            "yes" if row.success else "NO",
-            f"{row.median:.2f}",
-            f"{row.p99:.2f}",
-            f"{row.gaps_ms.max():.2f}",
-            f"{row.median / base.median:.2f}x",
-            f"{row.p99 / base.p99:.2f}x",
-            f"{row.goals_per_s:.1f}",
-        )
-    return table
+        made.add_row(*row.cells(base))
+    return made
 
 
 # ---------------------------------------------------------------------------------------

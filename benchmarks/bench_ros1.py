@@ -54,7 +54,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.table import Table
 
@@ -62,6 +61,8 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 THIS_SCRIPT = Path(__file__).resolve()
 # ros_support (rosmaster on a free port, processes stopped by PID) is shared with the tests.
 sys.path.insert(0, str(REPO_ROOT / "tests"))
+
+import turnaround  # noqa: E402  (benchmarks/turnaround.py: shared with bench_nav2.py)
 
 from navseq.mission import Mission, load_mission, write_mission  # noqa: E402
 from navseq.mission.model import FailureAction, Policy, Waypoint  # noqa: E402
@@ -225,34 +226,9 @@ def run_role(args: argparse.Namespace) -> None:
 # ---------------------------------------------------------------------------------------
 
 
-@dataclasses.dataclass
-class Turnaround:
-    server: str
-    client: str
-    goals_done: int
-    gaps_ms: np.ndarray  # server clock: result n about to be published -> goal n+1 arrived
-    goals_per_s: float
-    success: bool
-
-    @property
-    def median(self) -> float:
-        return float(np.median(self.gaps_ms))
-
-    @property
-    def p99(self) -> float:
-        return float(np.percentile(self.gaps_ms, 99))
-
-
-def last_json_line(text: str) -> dict[str, Any]:
-    for line in reversed(text.splitlines()):
-        if line.startswith("{"):
-            return dict(json.loads(line))
-    return {}
-
-
 def measure_turnaround(
     master: RosMaster, server: tuple[str, float], client: tuple[str, list[str]]
-) -> Turnaround:
+) -> turnaround.Turnaround:
     """A fresh server (name, delay_max), one run of a client (name, role arguments)."""
     (server_name, delay_max), (client_name, client_args) = server, client
     log = master.workdir / f"server-{len(master.processes)}.jsonl"
@@ -270,30 +246,15 @@ def measure_turnaround(
         master.wait_for_action_server(f"/{ACTION}", timeout=30)
         process = master.start_python(THIS_SCRIPT, *client_args, label="bench_client")
         status = process.wait(timeout=CLIENT_TIMEOUT)
-        reply = last_json_line(process.output())
+        reply = turnaround.last_json_line(process.output())
         if status != 0 or not reply:
             raise RuntimeError(f"{client_name} failed ({status}):\n{process.output()[-3000:]}")
     finally:
         server_process.stop()
-    records = sorted(
-        (json.loads(line) for line in log.read_text().splitlines()),
-        key=lambda record: record["arrived"],
-    )
-    if len(records) < 2:
-        raise RuntimeError(f"{client_name}: the server saw {len(records)} goal(s)")
-    arrived = np.array([r["arrived"] for r in records])
-    results = np.array([r["result"] for r in records])
-    return Turnaround(
-        server=server_name,
-        client=client_name,
-        goals_done=len(records),
-        gaps_ms=(arrived[1:] - results[:-1]) * 1000.0,
-        goals_per_s=len(records) / (results[-1] - arrived[0]),
-        success=bool(reply.get("success")),
-    )
+    return turnaround.from_server_log(log, client_name, reply, server_name)
 
 
-def turnaround_rows(goals: int) -> list[tuple[Turnaround, Turnaround]]:
+def turnaround_rows(goals: int) -> list[tuple[turnaround.Turnaround, turnaround.Turnaround]]:
     """Each measurement paired with the baseline measured against the same server."""
     n = ["--goals", str(goals)]
 
@@ -321,36 +282,13 @@ def turnaround_rows(goals: int) -> list[tuple[Turnaround, Turnaround]]:
 
 
 def turnaround_table(goals: int) -> Table:
-    table = Table(
-        title="Goal turnaround over actionlib (server clock: result n sent -> goal n+1 received)"
+    made = turnaround.table(
+        "Goal turnaround over actionlib (server clock: result n sent -> goal n+1 received)",
+        first=("server succeeds",),
     )
-    for column in (
-        "server succeeds",
-        "client",
-        "goals",
-        "all ok",
-        "median ms",
-        "p99 ms",
-        "max ms",
-        "median / base",
-        "p99 / base",
-        "goals/s",
-    ):
-        table.add_column(column, justify="right")
     for row, base in turnaround_rows(goals):
-        table.add_row(
-            row.server,
-            row.client,
-            str(row.goals_done),
-            "yes" if row.success else "NO",
-            f"{row.median:.2f}",
-            f"{row.p99:.2f}",
-            f"{row.gaps_ms.max():.2f}",
-            f"{row.median / base.median:.1f}x",
-            f"{row.p99 / base.p99:.1f}x",
-            f"{row.goals_per_s:.1f}",
-        )
-    return table
+        made.add_row(row.server, *row.cells(base))
+    return made
 
 
 # ---------------------------------------------------------------------------------------
@@ -401,7 +339,7 @@ def make_plan_lengths(master: RosMaster, points: list[tuple[float, float]]) -> l
         THIS_SCRIPT, "--role", "plan", "--legs", json.dumps(legs), label="make_plan"
     )
     status = caller.wait(timeout=CLIENT_TIMEOUT)
-    reply = last_json_line(caller.output())
+    reply = turnaround.last_json_line(caller.output())
     if status != 0 or "lengths" not in reply:
         raise RuntimeError(f"make_plan calls failed ({status}):\n{caller.output()[-3000:]}")
     return [float(length) for length in reply["lengths"]]
