@@ -8,23 +8,19 @@ mission. Both topics are latched: RViz shows them whenever it connects.
 
 from __future__ import annotations
 
-import json
-from typing import Any
-
 import rosgraph.names
 import rospy
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from navseq.executor.events import MissionEvent
 from navseq.mission.model import Mission
 from navseq.ros1.markers import marker_message
-from navseq.sinks.mission_status import MarkerStatus, MissionStatus
+from navseq.sinks.mission_status import MarkerStatus, StatusPublisher
 
 RUN_TOPICS_NS = "navseq"  # where `navseq run` publishes, like the node named navseq
 
 
-class MissionTopics:
+class MissionTopics(StatusPublisher):
     """A mission listener publishing ``<ns>/status`` (JSON) and ``<ns>/waypoints`` (markers).
 
     ``namespace`` is ``~`` for a node's private topics, or a name such as ``/navseq``.
@@ -33,15 +29,14 @@ class MissionTopics:
     """
 
     def __init__(self, mission: Mission, namespace: str = "~"):
+        super().__init__(mission)
         self.mission = mission
-        self.state = MissionStatus(mission)
         prefix = "~" if namespace == "~" else namespace.rstrip("/") + "/"
         self._status_pub = rospy.Publisher(f"{prefix}status", String, queue_size=10, latch=True)
         self._marker_pub = rospy.Publisher(
             f"{prefix}waypoints", MarkerArray, queue_size=2, latch=True
         )
-        self.publish_markers()
-        self.publish_status(self.state.initial_status())
+        self.publish_all()
 
     @property
     def statuses(self) -> dict[int, MarkerStatus]:
@@ -71,16 +66,8 @@ class MissionTopics:
         specs = self.state.markers()
         self._marker_pub.publish(MarkerArray(markers=[marker_message(s, stamp) for s in specs]))
 
-    def publish_status(self, fields: dict[str, Any]) -> None:
-        self._status_pub.publish(String(data=json.dumps(fields, default=str)))
-
-    def __call__(self, event: MissionEvent) -> None:
-        update = self.state.update(event)
-        if update is None:
-            return
-        if update.markers_changed:
-            self.publish_markers()
-        self.publish_status(update.status)
+    def publish_status_text(self, text: str) -> None:
+        self._status_pub.publish(String(data=text))
 
 
 def run_topics_namespace(robot_ns: str) -> str:

@@ -8,19 +8,15 @@ transient_local``, gets the last markers and status whenever it subscribes.
 
 from __future__ import annotations
 
-import json
-from typing import Any
-
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import ColorRGBA, String
 from visualization_msgs.msg import Marker, MarkerArray
 
-from navseq.executor.events import MissionEvent
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 from navseq.ros2.messages import pose_msg
-from navseq.sinks.mission_status import MarkerKind, MarkerSpec, MissionStatus
+from navseq.sinks.mission_status import MarkerKind, MarkerSpec, StatusPublisher
 
 # ROS 2's "latched": the last message is kept for subscribers that come later.
 LATCHED = QoSProfile(
@@ -51,7 +47,7 @@ def marker_message(spec: MarkerSpec) -> Marker:
     return marker
 
 
-class MissionTopics:
+class MissionTopics(StatusPublisher):
     """A mission listener publishing ``~/waypoints`` (markers) and ``~/status`` (JSON).
 
     Publishing is thread-safe in rclpy: the run's thread publishes while the node's
@@ -59,11 +55,10 @@ class MissionTopics:
     """
 
     def __init__(self, node: Node, mission: Mission, prefix: str = "~/") -> None:
-        self.state = MissionStatus(mission)
+        super().__init__(mission)
         self._marker_pub = node.create_publisher(MarkerArray, f"{prefix}waypoints", LATCHED)
         self._status_pub = node.create_publisher(String, f"{prefix}status", LATCHED)
-        self.publish_markers()
-        self.publish_status(self.state.initial_status())
+        self.publish_all()
 
     @property
     def topics(self) -> tuple[str, str]:
@@ -74,13 +69,5 @@ class MissionTopics:
         specs = self.state.markers()
         self._marker_pub.publish(MarkerArray(markers=[marker_message(s) for s in specs]))
 
-    def publish_status(self, fields: dict[str, Any]) -> None:
-        self._status_pub.publish(String(data=json.dumps(fields, default=str)))
-
-    def __call__(self, event: MissionEvent) -> None:
-        update = self.state.update(event)
-        if update is None:
-            return
-        if update.markers_changed:
-            self.publish_markers()
-        self.publish_status(update.status)
+    def publish_status_text(self, text: str) -> None:
+        self._status_pub.publish(String(data=text))

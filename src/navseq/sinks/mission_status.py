@@ -14,7 +14,9 @@ hence its lock.
 
 from __future__ import annotations
 
+import abc
 import enum
+import json
 import math
 import threading
 from collections.abc import Mapping
@@ -213,3 +215,39 @@ class MissionStatus:
             fields["state"] = status_state(event)
             fields["waypoints"] = len(self.mission)
             return StatusUpdate(markers_changed, fields)
+
+
+class StatusPublisher(abc.ABC):
+    """A mission listener putting :class:`MissionStatus`'s markers and JSON status on two
+    topics whenever an event changes them; each ROS adapter says how it publishes.
+
+    A subclass creates its publishers, then calls :meth:`publish_all` once so that a
+    latecomer to the (latched) topics sees the mission before its first event.
+    """
+
+    def __init__(self, mission: Mission) -> None:
+        self.state = MissionStatus(mission)
+
+    @abc.abstractmethod
+    def publish_markers(self) -> None:
+        """Publish ``self.state.markers()``."""
+
+    @abc.abstractmethod
+    def publish_status_text(self, text: str) -> None:
+        """Publish one status message: the fields as a JSON object."""
+
+    def publish_status(self, fields: dict[str, Any]) -> None:
+        self.publish_status_text(json.dumps(fields, default=str))
+
+    def publish_all(self) -> None:
+        """The markers and the status before any event."""
+        self.publish_markers()
+        self.publish_status(self.state.initial_status())
+
+    def __call__(self, event: MissionEvent) -> None:
+        update = self.state.update(event)
+        if update is None:
+            return
+        if update.markers_changed:
+            self.publish_markers()
+        self.publish_status(update.status)
