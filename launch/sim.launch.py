@@ -5,7 +5,9 @@
 Starts ``python3 -m navseq.ros2.sim_node`` (navseq must be importable by ``python``,
 e.g. the project's venv first on PATH, or ``pip install``ed) — the same node as
 ``navseq sim --ros2``. Arguments: map (map_server YAML; default the repository's
-TurtleBot3 world), start (x,y,yaw in degrees), ns, speed, robot, stop_on_failure.
+TurtleBot3 world), start (x,y,yaw in degrees), ns, speed, robot, stop_on_failure,
+other_robots (namespaces of the other robots of a fleet, comma-separated, e.g. robot2:
+their footprints are obstacles for this one; see multi_robot.launch.py).
 """
 
 from pathlib import Path
@@ -24,6 +26,7 @@ def generate_launch_description() -> LaunchDescription:
         "ns": ("", "namespace of the robot (robot1 -> /robot1/navigate_to_pose)"),
         "speed": ("1.0", "simulated seconds per wall second; not 1: /clock is published"),
         "robot": ("turtlebot3_burger", "robot profile name or YAML file"),
+        "other_robots": ("", "namespaces of the other robots of a fleet, e.g. robot2"),
         "stop_on_failure": ("true", "follow_waypoints stops at the first missed waypoint"),
         "python": ("python3", "the Python that can import navseq"),
     }
@@ -44,6 +47,7 @@ def generate_launch_description() -> LaunchDescription:
             LaunchConfiguration("speed"),
             "--robot",
             LaunchConfiguration("robot"),
+            ["--other-robots=", LaunchConfiguration("other_robots")],
             "--ros-args",
             "-p",
             ["stop_on_failure:=", LaunchConfiguration("stop_on_failure")],

@@ -6,6 +6,9 @@ the global frame every step; a robot whose pose is not (yet) in TF, or too old, 
 out — with a throttled warning — rather than guessed. Every other robot is taken to
 have the footprint the caller gives (the sim nodes give their own robot's, from
 ``~robot``: a fleet of one model); the burger's when none is given.
+
+The checks of the list and the warning are ROS-free and shared with the ROS 2 sim node:
+:mod:`navseq.sim.fleet`. This module only looks the poses up in TF.
 """
 
 from __future__ import annotations
@@ -16,9 +19,8 @@ import tf2_ros
 from navseq.geometry import Pose2D
 from navseq.ros1.conversions import pose2d_from_transform
 from navseq.ros1.params import param_error, str_list_param
+from navseq.sim.fleet import WARN_PERIOD, missing_warning, other_robots_problem
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
-
-WARN_PERIOD = 10.0  # s between two warnings about other robots without a pose
 
 
 def other_robots_param(own_base_frame: str) -> tuple[str, ...]:
@@ -26,14 +28,9 @@ def other_robots_param(own_base_frame: str) -> tuple[str, ...]:
     wants). This robot's own base frame among them is an error: it would bump into
     itself."""
     frames = tuple(frame.lstrip("/") for frame in str_list_param("other_robots", ()))
-    if any(not frame for frame in frames):
-        raise param_error("other_robots", f"a frame name is empty: {list(frames)!r}")
-    if own_base_frame.lstrip("/") in frames:
-        raise param_error(
-            "other_robots",
-            f"lists this robot's own base frame {own_base_frame!r}; "
-            "name only the other robots' base frames",
-        )
+    problem = other_robots_problem(frames, own_base_frame.lstrip("/"), "base frame")
+    if problem is not None:
+        raise param_error("other_robots", problem)
     return frames
 
 
@@ -75,10 +72,5 @@ class OtherRobots:
                 continue
             found.append((pose2d_from_transform(transform), self.footprint))
         if missing:
-            rospy.logwarn_throttle(
-                WARN_PERIOD,
-                "other robot(s) %s: no recent pose %s -> frame in TF; not avoided until there is",
-                ", ".join(missing),
-                self.global_frame,
-            )
+            rospy.logwarn_throttle(WARN_PERIOD, missing_warning(missing, self.global_frame))
         return found

@@ -16,6 +16,7 @@ from navseq.commands.common import parse_pose, require_file
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.sim.fleet import other_robots_problem
 
 # ROS 2 name rules for one namespace token: letters, digits, underscores, not a digit first.
 _NAMESPACE_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -64,6 +65,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "turtlebot3_waffle_pi) or a YAML file like a mission's robot: section "
         "(default turtlebot3_burger)",
     )
+    parser.add_argument(
+        "--other-robots",
+        default="",
+        metavar="NS[,NS...]",
+        help="namespaces of the other simulated robots of a fleet (e.g. robot2): their "
+        "poses are read from /tf (map -> NS/odom -> NS/base_footprint) and their "
+        "footprints (this robot's model) are obstacles to plan around and never to drive "
+        "into; needs --speed 1 (see launch/multi_robot.launch.py)",
+    )
 
 
 @dataclass(frozen=True)
@@ -75,6 +85,7 @@ class SimConfig:
     namespace: str  # "" or "robot1" (no slashes at the ends)
     speed: float
     robot: RobotProfile
+    other_robots: tuple[str, ...] = ()  # namespaces of the other robots of a fleet
     rate: float = 20.0  # simulation steps per simulated second
 
     @property
@@ -88,7 +99,7 @@ class SimConfig:
         return self.speed != 1.0
 
 
-def namespace_of(text: str) -> str:
+def namespace_of(text: str, option: str = "--ns") -> str:
     """``/robot1/`` -> ``robot1``; a clear error for a name ROS 2 would refuse."""
     stripped = text.strip().strip("/")
     if not stripped:
@@ -97,9 +108,30 @@ def namespace_of(text: str) -> str:
         raise NavseqError(
             f"{text!r} is not a ROS 2 namespace (letters, digits and underscores, "
             "separated by '/', not starting with a digit)",
-            source="--ns",
+            source=option,
         )
     return stripped
+
+
+def other_robots_of(text: str, own: str, speed: float) -> tuple[str, ...]:
+    """``robot2,robot3`` -> their namespaces, checked against this robot's own.
+
+    Several robots at another speed than 1 would each publish their own /clock, and
+    nothing makes one follow another's yet: refused rather than clocks that disagree.
+    """
+    if not text.strip():
+        return ()
+    names = tuple(namespace_of(part, "--other-robots") for part in text.split(","))
+    problem = other_robots_problem(names, own, "namespace")
+    if problem is not None:
+        raise NavseqError(problem, source="--other-robots")
+    if speed != 1.0:
+        raise NavseqError(
+            f"several robots run at wall-clock speed only (--speed 1), got --speed {speed:g}: "
+            "each would publish its own /clock",
+            source="--other-robots",
+        )
+    return names
 
 
 def config_from_args(args: argparse.Namespace) -> SimConfig:
@@ -114,10 +146,12 @@ def config_from_args(args: argparse.Namespace) -> SimConfig:
     if not (math.isfinite(speed) and 0.0 < speed <= MAX_SPEED):
         raise NavseqError(f"must be > 0 and <= {MAX_SPEED:g}, got {args.speed}", source="--speed")
     robot = robot_from_option(args.robot) if args.robot is not None else DEFAULT_PROFILE
+    namespace = namespace_of(args.ns)
     return SimConfig(
         map_yaml=map_yaml,
         start=args.start,
-        namespace=namespace_of(args.ns),
+        namespace=namespace,
         speed=speed,
         robot=robot,
+        other_robots=other_robots_of(args.other_robots, namespace, speed),
     )

@@ -27,6 +27,13 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
   ``amcl``, ...), answering *active*.
 
+Several robots that see each other: with ``--other-robots robot2`` the node also listens
+to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
+(:class:`navseq.sim.fleet.SeenRobots`) and hands their poses to the world every step,
+so their footprints are obstacles for the planner and the controller and the body
+refuses to drive into them — as the ROS 1 sim nodes do with ``~other_robots``. A robot
+not heard from for ``OTHER_POSE_TOLERANCE`` wall seconds is left out, with a warning.
+
 Goal poses may be given in the map, odom or base frame (the node knows those
 transforms); other frames are refused (this stand-in has no TF listener).
 
@@ -71,7 +78,7 @@ from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
 from navseq.errors import NavseqError
-from navseq.geometry import Pose2D, compose
+from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.ros2.messages import (
     duration_msg,
     grid_msg,
@@ -92,6 +99,7 @@ from navseq.ros2.standin import (
     Outcome,
     WaypointRun,
 )
+from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.profile import SimSettings
 from navseq.sim.world import SimWorld, default_start
@@ -101,6 +109,9 @@ MAP_FRAME = "map"
 FEEDBACK_PERIOD = 0.1  # s of wall time between two feedback messages of a goal
 AMCL_POSE_PERIOD = 0.5  # s of simulated time between two amcl_pose messages
 TELEOP_QUIET = 0.5  # s of wall time after our own cmd_vel before outside commands count
+# Wall seconds without another robot's transforms before it is left out. Its node
+# publishes /tf every step (20 Hz); a second covers a busy CPU, not a dead node.
+OTHER_POSE_TOLERANCE = 1.0
 # The Nav2 servers whose lifecycle state Nav2 clients (nav2_simple_commander, ...) ask.
 LIFECYCLE_NODES = (
     "bt_navigator",
@@ -141,6 +152,12 @@ class SimNode:
             footprint=settings.footprint,
         )
         self.standin = Nav2StandIn(world)
+        self.others = (
+            SeenRobots(config.other_robots, OTHER_POSE_TOLERANCE, settings.footprint, MAP_FRAME)
+            if config.other_robots
+            else None
+        )
+        self._last_missing_warning = -float("inf")
         self._lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
@@ -179,6 +196,8 @@ class SimNode:
             PoseStamped, "goal_pose", self._on_goal_pose, 10, callback_group=group
         )
         node.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10, callback_group=group)
+        if self.others is not None:
+            node.create_subscription(TFMessage, "/tf", self._on_tf, 100, callback_group=group)
         for service in (
             "global_costmap/clear_entirely_global_costmap",
             "local_costmap/clear_entirely_local_costmap",
@@ -246,6 +265,7 @@ class SimNode:
         next_tick = time.monotonic()
         while not self._stopping.is_set():
             with self._lock:
+                self._see_others()
                 self.standin.step()
             self._publish_state()
             next_tick += period
@@ -254,6 +274,17 @@ class SimNode:
                 self._stopping.wait(delay)
             elif delay < -0.25:
                 next_tick = time.monotonic()
+
+    def _see_others(self) -> None:
+        """Tell the world where the other robots are now (call with the lock)."""
+        if self.others is None:
+            return
+        now = time.monotonic()
+        found, missing = self.others.poses(now)
+        self.standin.world.set_other_robots(found)
+        if missing and now - self._last_missing_warning >= WARN_PERIOD:
+            self._last_missing_warning = now
+            self.log.warning(missing_warning(missing, MAP_FRAME))
 
     def _stamp(self) -> Any:
         if self.config.sim_time:
@@ -520,6 +551,19 @@ class SimNode:
         with self._lock:
             self.standin.command(float(message.linear.x), float(message.angular.z))
 
+    def _on_tf(self, message: TFMessage) -> None:
+        """The other robots' transforms (every other one, ours included, is ignored)."""
+        assert self.others is not None
+        now = time.monotonic()
+        with self._lock:
+            for transform in message.transforms:
+                self.others.heard(
+                    transform.header.frame_id,
+                    transform.child_frame_id,
+                    pose2d_from_transform(transform),
+                    now,
+                )
+
     def _on_clear_costmap(self, _request: Any, response: Any) -> Any:
         with self._lock:
             self.standin.world.server.clear_costmaps()
@@ -578,7 +622,8 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         print(
             f"navseq sim: ready: {namespace}/navigate_to_pose on {config.map_yaml}, robot at "
             f"({pose.x:.2f}, {pose.y:.2f}), speed x{config.speed:g}"
-            + (" (/clock published: use_sim_time:=true)" if config.sim_time else ""),
+            + (" (/clock published: use_sim_time:=true)" if config.sim_time else "")
+            + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else ""),
             flush=True,
         )
         while not stop.wait(0.2):
