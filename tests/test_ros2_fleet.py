@@ -268,3 +268,29 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path)
     assert "other robots robot2" in output and "other robots robot1" in output, output
     assert launch.returncode == 0, output
     assert "Traceback" not in output, output
+
+
+@pytest.mark.ros2
+def test_a_robot_whose_other_robot_is_not_running_still_navigates_and_warns():
+    """No pose from robot2: robot1 is not blocked by a guess, and says why it ignores it."""
+    from test_ros2_sim import SimProcess
+
+    prefix = ros2_prefix()
+    assert prefix is not None
+    sim = SimProcess(
+        ros2_environment(prefix),
+        "--map",
+        str(MAP),
+        "--start=-2,-0.5,0",
+        "--ns",
+        "robot1",
+        "--other-robots",
+        "robot2",
+    )
+    try:
+        seen = sim.client("navigate", "-1.6,-0.5,0", ns="robot1")
+    finally:
+        code, err = sim.stop()
+    assert seen["status"] == "SUCCEEDED", seen
+    assert "other robot(s) robot2: no recent pose in 'map'" in err, err
+    assert code == 0 and "Traceback" not in err, err
