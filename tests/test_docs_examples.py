@@ -73,6 +73,11 @@ RULES: tuple[Rule, ...] = (
         "tests/test_ros2_environment.py::test_a_ros2_process_talks_to_itself_on_a_private_domain",
     ),
     Rule(
+        r"--other-robots|^ros2 launch launch/multi_robot\.launch\.py",
+        "ros",
+        "tests/test_ros2_fleet.py::test_robot1_drives_around_robot2_parked_on_its_straight_path",
+    ),
+    Rule(
         r"navseq sim --ros2",
         "ros",
         "tests/test_ros2_cli.py::test_navseq_sim_ros2_serves_until_a_signal_and_exits_0",

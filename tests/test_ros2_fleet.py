@@ -21,6 +21,7 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from navseq.errors import NavseqError
@@ -37,7 +38,7 @@ MAP = REPO / "maps" / "turtlebot3_world.yaml"
 
 
 def test_seen_robots_composes_the_two_transforms_of_each_robot_and_ignores_the_rest():
-    square = Footprint(((0.2, 0.2), (-0.2, 0.2), (-0.2, -0.2), (0.2, -0.2)))
+    square = Footprint(np.array([[0.2, 0.2], [-0.2, 0.2], [-0.2, -0.2], [0.2, -0.2]]))
     seen = SeenRobots(("robot2",), tolerance=1.0, footprint=square)
     assert seen.poses(0.0) == ([], ["robot2"])  # nothing heard yet: not avoided
     seen.heard("map", "robot2/odom", Pose2D(1.0, 0.0, math.pi / 2), at=0.0)
