@@ -7,9 +7,10 @@ Nav2's interfaces under its namespace (``/robot1/navigate_to_pose``, frames
 ``robot1/odom``, ``robot1/base_footprint``, ...) and the other's namespace in
 ``other_robots``: each reads the other's pose from ``/tf``, plans around its footprint
 and never drives into it — what ``multi_robot.launch`` does for ROS 1. Both are the same
-model (``robot``) and run at wall-clock speed (several robots cannot share a faster
-``/clock`` yet). Arguments: map, robot, robot1_start, robot2_start (x,y,yaw in degrees),
-python (the Python that can import navseq).
+model (``robot``). At a ``speed`` other than 1 robot1 publishes ``/clock`` and robot2
+steps with it (``follow_clock``), so both live on one simulated time. Arguments: map,
+robot, speed, robot1_start, robot2_start (x,y,yaw in degrees), python (the Python that
+can import navseq).
 """
 
 from pathlib import Path
@@ -17,17 +18,19 @@ from pathlib import Path
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, GroupAction, IncludeLaunchDescription
 from launch.launch_description_sources import PythonLaunchDescriptionSource
-from launch.substitutions import LaunchConfiguration
+from launch.substitutions import LaunchConfiguration, PythonExpression
 
 HERE = Path(__file__).resolve().parent
 DEFAULT_MAP = str(HERE.parent / "maps" / "turtlebot3_world.yaml")
 ROBOTS = {"robot1": "robot2", "robot2": "robot1"}  # each robot -> the one it must avoid
+CLOCK_DRIVER = "robot1"  # the one that publishes /clock away from wall-clock speed
 
 
 def generate_launch_description() -> LaunchDescription:
     arguments = {
         "map": (DEFAULT_MAP, "map_server YAML"),
         "robot": ("turtlebot3_burger", "robot profile name or YAML file (every robot)"),
+        "speed": ("1.0", "simulated seconds per wall second; not 1: robot1 publishes /clock"),
         "robot1_start": ("-2.0,-0.5,0", "robot1's start x,y,yaw (metres, metres, degrees)"),
         "robot2_start": ("2.0,0.5,180", "robot2's start x,y,yaw (metres, metres, degrees)"),
         "python": ("python3", "the Python that can import navseq"),
@@ -36,6 +39,8 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument(name, default_value=default, description=description)
         for name, (default, description) in arguments.items()
     ]
+    speed = LaunchConfiguration("speed")
+    fast = PythonExpression(["'true' if float('", speed, "') != 1.0 else 'false'"])
     # One scoped group per robot: its include's arguments (ns, ...) stay its own.
     robots = [
         GroupAction(
@@ -49,7 +54,10 @@ def generate_launch_description() -> LaunchDescription:
                         "map": LaunchConfiguration("map"),
                         "robot": LaunchConfiguration("robot"),
                         "python": LaunchConfiguration("python"),
-                        "speed": "1.0",
+                        # Set in this order: the include sets them one by one, and
+                        # `fast` reads the launch's speed before robot2's 1.0 hides it.
+                        "follow_clock": "false" if robot == CLOCK_DRIVER else fast,
+                        "speed": speed if robot == CLOCK_DRIVER else "1.0",
                     }.items(),
                 )
             ]

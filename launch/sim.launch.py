@@ -7,7 +7,8 @@ e.g. the project's venv first on PATH, or ``pip install``ed) — the same node a
 ``navseq sim --ros2``. Arguments: map (map_server YAML; default the repository's
 TurtleBot3 world), start (x,y,yaw in degrees), ns, speed, robot, stop_on_failure,
 other_robots (namespaces of the other robots of a fleet, comma-separated, e.g. robot2:
-their footprints are obstacles for this one; see multi_robot.launch.py).
+their footprints are obstacles for this one; see multi_robot.launch.py), follow_clock
+(true: step with another node's /clock instead of a clock of its own).
 """
 
 from pathlib import Path
@@ -27,6 +28,7 @@ def generate_launch_description() -> LaunchDescription:
         "speed": ("1.0", "simulated seconds per wall second; not 1: /clock is published"),
         "robot": ("turtlebot3_burger", "robot profile name or YAML file"),
         "other_robots": ("", "namespaces of the other robots of a fleet, e.g. robot2"),
+        "follow_clock": ("false", "true: step with another simulator node's /clock"),
         "stop_on_failure": ("true", "follow_waypoints stops at the first missed waypoint"),
         "python": ("python3", "the Python that can import navseq"),
     }
@@ -48,6 +50,7 @@ def generate_launch_description() -> LaunchDescription:
             "--robot",
             LaunchConfiguration("robot"),
             ["--other-robots=", LaunchConfiguration("other_robots")],
+            ["--follow-clock=", LaunchConfiguration("follow_clock")],
             "--ros-args",
             "-p",
             ["stop_on_failure:=", LaunchConfiguration("stop_on_failure")],

@@ -92,18 +92,28 @@ def test_other_robots_option_takes_comma_separated_namespaces():
     assert config("--other-robots", "").other_robots == ()  # the launch file's default
 
 
+def test_follow_clock_is_a_flag_or_a_launch_files_true_false():
+    assert config("--follow-clock").follow_clock
+    assert config("--follow-clock=true").sim_time  # stamps with the clock it follows
+    assert not config("--follow-clock=true").publishes_clock
+    assert not config("--follow-clock=false").follow_clock
+    fast = config("--speed", "4", "--other-robots", "robot2")
+    assert fast.publishes_clock and not fast.follow_clock
+
+
 @pytest.mark.parametrize(
-    ("argv", "message"),
+    ("argv", "option", "message"),
     [
-        (("--ns", "robot1", "--other-robots", "robot1"), "own namespace"),
-        (("--other-robots", "robot2,2bad"), "not a ROS 2 namespace"),
-        (("--other-robots", "robot2", "--speed", "2"), "wall-clock speed only"),
+        (("--ns", "robot1", "--other-robots", "robot1"), "--other-robots", "own namespace"),
+        (("--other-robots", "robot2,2bad"), "--other-robots", "not a ROS 2 namespace"),
+        (("--follow-clock=yes",), "--follow-clock", "expected true or false"),
+        (("--follow-clock", "--speed", "2"), "--follow-clock", "publishes /clock sets the speed"),
     ],
 )
-def test_a_bad_other_robots_option_names_the_option(argv: tuple[str, ...], message: str):
+def test_a_bad_fleet_option_names_the_option(argv: tuple[str, ...], option: str, message: str):
     with pytest.raises(NavseqError) as caught:
         config(*argv)
-    assert "--other-robots" in str(caught.value) and message in str(caught.value)
+    assert option in str(caught.value) and message in str(caught.value)
 
 
 def test_navseq_sim_help_explains_other_robots():
@@ -121,6 +131,7 @@ WATCHER = textwrap.dedent(
     from action_msgs.msg import GoalStatus
     from nav2_msgs.action import NavigateToPose
     from nav_msgs.msg import Odometry, Path
+    from rosgraph_msgs.msg import Clock
     from rclpy.action import ActionClient
     from rclpy.node import Node
     from navseq.geometry import Pose2D, compose
@@ -131,7 +142,8 @@ WATCHER = textwrap.dedent(
     node = Node("fleet_watcher")
     latest = {}
     stats = {"samples": 0, "min_distance": math.inf, "overlaps": 0, "robot2_moved": 0.0,
-             "robot1_off_line": 0.0, "plans": 0, "plan_min_distance": math.inf}
+             "robot1_off_line": 0.0, "plans": 0, "plan_min_distance": math.inf,
+             "clock": None, "stamps": {}}
     robot2_start = Pose2D(*setup["starts"]["robot2"])
 
     def on_odom(robot):
@@ -141,6 +153,7 @@ WATCHER = textwrap.dedent(
             p, q = msg.pose.pose.position, msg.pose.pose.orientation
             pose = compose(start, Pose2D(p.x, p.y, 2.0 * math.atan2(q.z, q.w)))
             latest[robot] = pose
+            stats["stamps"][robot] = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
             if robot == "robot2":
                 moved = math.hypot(pose.x - start.x, pose.y - start.y)
                 stats["robot2_moved"] = max(stats["robot2_moved"], moved)
@@ -171,6 +184,11 @@ WATCHER = textwrap.dedent(
     for robot in ("robot1", "robot2"):
         node.create_subscription(Odometry, f"/{robot}/odom", on_odom(robot), 100)
     node.create_subscription(Path, "/robot1/plan", on_plan, 10)
+
+    def on_clock(msg):
+        stats["clock"] = msg.clock.sec + msg.clock.nanosec * 1e-9
+
+    node.create_subscription(Clock, "/clock", on_clock, 10)
     deadline = time.monotonic() + 60
     while len(latest) < 2 and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.05)
@@ -208,13 +226,14 @@ WATCHER = textwrap.dedent(
 )
 
 
-@pytest.mark.ros2
-@pytest.mark.flaky(reruns=1)  # two robots in real time: under load a goal can take long
-def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path):
-    """``ros2 launch launch/multi_robot.launch.py``, robot2 parked on robot1's way."""
-    # robot1 goes north along x = -2 to (-2, 1.2); robot2 is parked on that line at
-    # (-2, 0.3): room round it on both sides, between the west wall and the pillars.
-    robot1, robot2, goal = (-2.0, -0.5, math.pi / 2), (-2.0, 0.3, 0.0), (-2.0, 1.2, math.pi / 2)
+def while_launched(
+    speed: str,
+    robot1: tuple[float, float, float],
+    robot2: tuple[float, float, float],
+    command: list[str],
+) -> tuple[subprocess.CompletedProcess[str], str]:
+    """Run ``command`` while ``multi_robot.launch.py`` runs; its result, the launch's
+    output (the launch is stopped with SIGINT, as Ctrl-C would, and must exit 0)."""
     prefix = ros2_prefix()
     assert prefix is not None
     env = ros2_environment(prefix)
@@ -225,6 +244,7 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path)
             "launch/multi_robot.launch.py",
             f"robot1_start:={robot1[0]},{robot1[1]},{math.degrees(robot1[2]):g}",
             f"robot2_start:={robot2[0]},{robot2[1]},{math.degrees(robot2[2]):g}",
+            f"speed:={speed}",
             f"python:={sys.executable}",
         ],
         cwd=REPO,
@@ -233,17 +253,8 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path)
         stderr=subprocess.STDOUT,
         text=True,
     )
-    script = tmp_path / "fleet_watcher.py"
-    script.write_text(WATCHER)
-    setup = {"starts": {"robot1": robot1, "robot2": robot2}, "goal": goal, "timeout": 120}
     try:
-        watcher = subprocess.run(
-            [sys.executable, str(script), json.dumps(setup)],
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=200,
-        )
+        done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=200)
     finally:
         launch.send_signal(signal.SIGINT)
         try:
@@ -251,7 +262,27 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path)
         except subprocess.TimeoutExpired:
             launch.kill()
             output, _ = launch.communicate()
-    assert watcher.returncode == 0, f"{watcher.stderr}\n{output}"
+    assert done.returncode == 0, f"{done.stderr}\n{output}"
+    assert launch.returncode == 0, output
+    assert "Traceback" not in output, output
+    return done, output
+
+
+@pytest.mark.ros2
+@pytest.mark.flaky(reruns=1)  # two robots in real time: under load a goal can take long
+@pytest.mark.parametrize("speed", ["1", "4"])
+def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path, speed: str):
+    """``ros2 launch launch/multi_robot.launch.py``, robot2 parked on robot1's way; at 4x
+    robot1 publishes /clock and robot2 steps with it."""
+    # robot1 goes north along x = -2 to (-2, 1.2); robot2 is parked on that line at
+    # (-2, 0.3): room round it on both sides, between the west wall and the pillars.
+    robot1, robot2, goal = (-2.0, -0.5, math.pi / 2), (-2.0, 0.3, 0.0), (-2.0, 1.2, math.pi / 2)
+    script = tmp_path / "fleet_watcher.py"
+    script.write_text(WATCHER)
+    setup = {"starts": {"robot1": robot1, "robot2": robot2}, "goal": goal, "timeout": 120}
+    watcher, output = while_launched(
+        speed, robot1, robot2, [sys.executable, str(script), json.dumps(setup)]
+    )
     report = json.loads(watcher.stdout.strip().splitlines()[-1])
     assert report["succeeded"], (report, output[-3000:])
     assert math.dist(report["robot1"][:2], goal[:2]) < 0.1, report
@@ -267,8 +298,14 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path)
     assert report["plan_min_distance"] > 2 * TURTLEBOT3_BURGER.inscribed_radius, report
     assert report["robot1_off_line"] > 0.15, report
     assert "other robots robot2" in output and "other robots robot1" in output, output
-    assert launch.returncode == 0, output
-    assert "Traceback" not in output, output
+    if speed == "1":
+        assert report["clock"] is None, report  # wall-clock time: nobody publishes /clock
+    else:
+        # One simulated time: robot2's odometry is stamped with robot1's /clock.
+        assert report["clock"] is not None, report
+        assert abs(report["stamps"]["robot2"] - report["clock"]) < 0.5, report
+        assert abs(report["stamps"]["robot1"] - report["clock"]) < 0.5, report
+        assert "following /clock" in output, output
 
 
 @pytest.mark.ros2
@@ -295,3 +332,23 @@ def test_a_robot_whose_other_robot_is_not_running_still_navigates_and_warns():
     assert seen["status"] == "SUCCEEDED", seen
     assert "other robot(s) robot2: no recent pose in 'map'" in err, err
     assert code == 0 and "Traceback" not in err, err
+
+
+@pytest.mark.ros2
+def test_the_robot_that_follows_the_clock_navigates_too():
+    """At 4x robot2 steps only with robot1's /clock: a goal of its own still succeeds,
+    in about the simulated time the distance takes (not wall time, not stalled)."""
+    from test_ros2_sim import client_command
+
+    robot1, robot2 = (-2.0, -0.5, 0.0), (2.0, 0.5, math.pi)
+    command = client_command("navigate", ("1.5,0.5,180",), {"ns": "robot2", "timeout": 90})
+    done, output = while_launched("4", robot1, robot2, command)
+    seen = json.loads(done.stdout.strip().splitlines()[-1])
+    assert seen["status"] == "SUCCEEDED", seen
+    assert "following /clock" in output, output
+    # navigation_time is simulated time: 0.5 m at the burger's 0.22 m/s is a few
+    # simulated seconds, which at 4x is about a quarter of that in wall time.
+    sim_seconds = seen["feedback"][-1]["navigation_time"]
+    wall_seconds = seen["feedback"][-1]["t"] - seen["feedback"][0]["t"]
+    assert 1.5 < sim_seconds < 15, seen["feedback"][-1]
+    assert wall_seconds < sim_seconds / 2, (wall_seconds, sim_seconds)

@@ -72,7 +72,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="namespaces of the other simulated robots of a fleet (e.g. robot2): their "
         "poses are read from /tf (map -> NS/odom -> NS/base_footprint) and their "
         "footprints (this robot's model) are obstacles to plan around and never to drive "
-        "into; needs --speed 1 (see launch/multi_robot.launch.py)",
+        "into (see launch/multi_robot.launch.py)",
+    )
+    parser.add_argument(
+        "--follow-clock",
+        nargs="?",
+        const="true",
+        default="false",
+        metavar="true|false",
+        help="step with the /clock another simulator node publishes instead of a clock of "
+        "its own: a fleet faster than wall-clock time has one robot with --speed S and the "
+        "others with --follow-clock, all on one simulated time",
     )
 
 
@@ -86,6 +96,7 @@ class SimConfig:
     speed: float
     robot: RobotProfile
     other_robots: tuple[str, ...] = ()  # namespaces of the other robots of a fleet
+    follow_clock: bool = False  # step with another node's /clock (a fleet at speed != 1)
     rate: float = 20.0  # simulation steps per simulated second
 
     @property
@@ -95,8 +106,13 @@ class SimConfig:
 
     @property
     def sim_time(self) -> bool:
-        """Whether the node publishes /clock (at any speed but wall-clock speed)."""
-        return self.speed != 1.0
+        """Whether the node stamps with simulated time: it publishes /clock (at any
+        speed but wall-clock speed) or follows another node's."""
+        return self.speed != 1.0 or self.follow_clock
+
+    @property
+    def publishes_clock(self) -> bool:
+        return self.speed != 1.0 and not self.follow_clock
 
 
 def namespace_of(text: str, option: str = "--ns") -> str:
@@ -113,25 +129,30 @@ def namespace_of(text: str, option: str = "--ns") -> str:
     return stripped
 
 
-def other_robots_of(text: str, own: str, speed: float) -> tuple[str, ...]:
-    """``robot2,robot3`` -> their namespaces, checked against this robot's own.
-
-    Several robots at another speed than 1 would each publish their own /clock, and
-    nothing makes one follow another's yet: refused rather than clocks that disagree.
-    """
+def other_robots_of(text: str, own: str) -> tuple[str, ...]:
+    """``robot2,robot3`` -> their namespaces, checked against this robot's own."""
     if not text.strip():
         return ()
     names = tuple(namespace_of(part, "--other-robots") for part in text.split(","))
     problem = other_robots_problem(names, own, "namespace")
     if problem is not None:
         raise NavseqError(problem, source="--other-robots")
-    if speed != 1.0:
-        raise NavseqError(
-            f"several robots run at wall-clock speed only (--speed 1), got --speed {speed:g}: "
-            "each would publish its own /clock",
-            source="--other-robots",
-        )
     return names
+
+
+def follow_clock_of(text: str, speed: float) -> bool:
+    """``--follow-clock [true|false]``; the speed is then the clock publisher's, so a
+    speed of this node's own is refused rather than ignored."""
+    value = text.strip().lower()
+    if value not in ("true", "false"):
+        raise NavseqError(f"expected true or false, got {text!r}", source="--follow-clock")
+    if value == "true" and speed != 1.0:
+        raise NavseqError(
+            f"--speed {speed:g} with --follow-clock: the node that publishes /clock sets "
+            "the speed; give --speed to that one only",
+            source="--follow-clock",
+        )
+    return value == "true"
 
 
 def config_from_args(args: argparse.Namespace) -> SimConfig:
@@ -153,5 +174,6 @@ def config_from_args(args: argparse.Namespace) -> SimConfig:
         namespace=namespace,
         speed=speed,
         robot=robot,
-        other_robots=other_robots_of(args.other_robots, namespace, speed),
+        other_robots=other_robots_of(args.other_robots, namespace),
+        follow_clock=follow_clock_of(args.follow_clock, speed),
     )

@@ -21,7 +21,8 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   map_server), ``plan`` (``nav_msgs/Path``), ``cmd_vel`` (the velocity the controller
   drives with; honoured as teleop while no goal runs), ``initialpose`` (teleports),
   ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal), ``amcl_pose``
-  (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1;
+  (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1
+  (subscribed instead with ``--follow-clock``);
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``)
   and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
@@ -33,6 +34,9 @@ to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
 so their footprints are obstacles for the planner and the controller and the body
 refuses to drive into them — as the ROS 1 sim nodes do with ``~other_robots``. A robot
 not heard from for ``OTHER_POSE_TOLERANCE`` wall seconds is left out, with a warning.
+A fleet faster than wall-clock time shares one simulated time: one node publishes
+``/clock`` (``--speed S``), the others step with it (``--follow-clock``), as robot2
+follows robot1's clock in ROS 1's ``multi_robot.launch``.
 
 Goal poses may be given in the map, odom or base frame (the node knows those
 transforms); other frames are refused (this stand-in has no TF listener).
@@ -112,6 +116,9 @@ TELEOP_QUIET = 0.5  # s of wall time after our own cmd_vel before outside comman
 # Wall seconds without another robot's transforms before it is left out. Its node
 # publishes /tf every step (20 Hz); a second covers a busy CPU, not a dead node.
 OTHER_POSE_TOLERANCE = 1.0
+# Simulated seconds a clock follower may lag before it skips ahead instead of catching up
+# in a burst of steps (the clock's node was busy, or restarted and went back in time).
+CLOCK_SKIP = 1.0
 # The Nav2 servers whose lifecycle state Nav2 clients (nav2_simple_commander, ...) ask.
 LIFECYCLE_NODES = (
     "bt_navigator",
@@ -158,6 +165,12 @@ class SimNode:
             else None
         )
         self._last_missing_warning = -float("inf")
+        # --follow-clock: the latest /clock heard, and simulated time minus our own time
+        # (the clock's node started earlier; fixed at the first message heard).
+        self._clock_target = 0.0
+        self._clock_heard = threading.Event()
+        self._clock_offset = 0.0
+        self._clock_synced = False
         self._lock = threading.Lock()
         self._stopping = threading.Event()
         self._thread: threading.Thread | None = None
@@ -184,7 +197,11 @@ class SimNode:
         self._amcl_pub = node.create_publisher(
             PoseWithCovarianceStamped, "amcl_pose", TRANSIENT_LOCAL
         )
-        self._clock_pub = node.create_publisher(Clock, "/clock", 10) if config.sim_time else None
+        self._clock_pub = (
+            node.create_publisher(Clock, "/clock", 10) if config.publishes_clock else None
+        )
+        if config.follow_clock:
+            node.create_subscription(Clock, "/clock", self._on_clock, 10, callback_group=group)
         node.create_subscription(
             PoseWithCovarianceStamped,
             "initialpose",
@@ -243,7 +260,8 @@ class SimNode:
     # -- life cycle ------------------------------------------------------------------
 
     def start(self) -> None:
-        self._thread = threading.Thread(target=self._simulate, name="navseq-sim", daemon=True)
+        target = self._follow_clock if self.config.follow_clock else self._simulate
+        self._thread = threading.Thread(target=target, name="navseq-sim", daemon=True)
         self._thread.start()
 
     def stop(self) -> None:
@@ -275,6 +293,34 @@ class SimNode:
             elif delay < -0.25:
                 next_tick = time.monotonic()
 
+    def _follow_clock(self) -> None:
+        """Step whenever another node's /clock has gone a step further than ours."""
+        dt = self.standin.world.dt
+        while not self._stopping.is_set():
+            if not self._clock_heard.wait(0.1):
+                continue
+            self._clock_heard.clear()
+            stepped = False
+            with self._lock:
+                target = self._clock_target
+                now = self.standin.time + self._clock_offset
+                if not self._clock_synced or abs(target - now) > CLOCK_SKIP:
+                    self._clock_offset = target - self.standin.time
+                    self._clock_synced = True
+                    now = target
+                while now + dt / 2 <= target:
+                    self._see_others()
+                    self.standin.step()
+                    now = self.standin.time + self._clock_offset
+                    stepped = True
+            if stepped:
+                self._publish_state()
+
+    def _on_clock(self, message: Clock) -> None:
+        with self._lock:
+            self._clock_target = message.clock.sec + message.clock.nanosec * 1e-9
+        self._clock_heard.set()
+
     def _see_others(self) -> None:
         """Tell the world where the other robots are now (call with the lock)."""
         if self.others is None:
@@ -288,7 +334,7 @@ class SimNode:
 
     def _stamp(self) -> Any:
         if self.config.sim_time:
-            return time_msg(self.standin.time)
+            return time_msg(self.standin.time + self._clock_offset)
         return self.node.get_clock().now().to_msg()
 
     def _publish_state(self) -> None:
@@ -621,8 +667,9 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         namespace = f"/{config.namespace}" if config.namespace else ""
         print(
             f"navseq sim: ready: {namespace}/navigate_to_pose on {config.map_yaml}, robot at "
-            f"({pose.x:.2f}, {pose.y:.2f}), speed x{config.speed:g}"
-            + (" (/clock published: use_sim_time:=true)" if config.sim_time else "")
+            f"({pose.x:.2f}, {pose.y:.2f}), "
+            + ("following /clock" if config.follow_clock else f"speed x{config.speed:g}")
+            + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
             + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else ""),
             flush=True,
         )
