@@ -75,12 +75,12 @@ print(json.dumps(samples), flush=True)
 
 
 # Calls bt_navigator/change_state (argv[1]: activate / deactivate) as Nav2's lifecycle
-# manager does; prints {"success": ...}.
+# manager does, then get_state; prints {"success": ..., "state": the state's label}.
 LIFECYCLE_CLIENT = r"""
 import json, sys
 import rclpy
 from lifecycle_msgs.msg import Transition
-from lifecycle_msgs.srv import ChangeState
+from lifecycle_msgs.srv import ChangeState, GetState
 rclpy.init()
 node = rclpy.create_node("lifecycle_test_client")
 client = node.create_client(ChangeState, "bt_navigator/change_state")
@@ -92,7 +92,12 @@ request.transition.id = {
 }[sys.argv[1]]
 future = client.call_async(request)
 rclpy.spin_until_future_complete(node, future, timeout_sec=30)
-print(json.dumps({"success": bool(future.result() is not None and future.result().success)}))
+success = bool(future.result() is not None and future.result().success)
+get_state = node.create_client(GetState, "bt_navigator/get_state")
+get_state.wait_for_service(timeout_sec=30)
+state = get_state.call_async(GetState.Request())
+rclpy.spin_until_future_complete(node, state, timeout_sec=30)
+print(json.dumps({"success": success, "state": state.result().current_state.label}))
 """
 
 # A Nav2 whose costmap services misbehave: navigate_to_pose aborts every goal at once;
@@ -521,7 +526,8 @@ def change_navigator_state(env: dict[str, str], transition: str) -> None:
         timeout=60,
     )
     assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout.strip().splitlines()[-1]) == {"success": True}
+    state = "active" if transition == "activate" else "inactive"
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == {"success": True, "state": state}
 
 
 def test_goals_rejected_while_bt_navigator_is_inactive_spend_the_retries_then_the_policy_applies(
