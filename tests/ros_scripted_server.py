@@ -19,6 +19,10 @@ goal PREEMPTED (a pending one RECALLED). Everything observable — goals with th
 frames and stamps, cancels, results, clear_costmaps calls — is appended as JSON lines to
 ``--log`` so tests can assert what a client really sent.
 
+``--clear-costmaps`` says how its ``clear_costmaps`` service behaves: ``answer`` (at
+once), ``silent`` (takes the call, logs it, never answers: a move_base stuck in a long
+recovery) or ``absent`` (no such service).
+
 It is a real actionlib ``ActionServer`` on a real ROS master; nothing is mocked.
 """
 
@@ -72,7 +76,14 @@ class TrackedGoal:
 
 
 class ScriptedMoveBase:
-    def __init__(self, action: str, script: list[Behaviour], then: Behaviour, log: Path | None):
+    def __init__(
+        self,
+        action: str,
+        script: list[Behaviour],
+        then: Behaviour,
+        log: Path | None,
+        clear_costmaps: str = "answer",
+    ):
         self._script = list(script)
         self._then = then
         self._log_path = log
@@ -81,7 +92,9 @@ class ScriptedMoveBase:
         self._count = 0
         self._robot_xy = (0.0, 0.0)
         self._plan_pub = rospy.Publisher(f"{action}/NavfnROS/plan", PathMsg, queue_size=2)
-        rospy.Service(f"{action}/clear_costmaps", Empty, self._clear_costmaps)
+        self._clear_answers = clear_costmaps == "answer"
+        if clear_costmaps != "absent":
+            rospy.Service(f"{action}/clear_costmaps", Empty, self._clear_costmaps)
         self._server = actionlib.ActionServer(
             action, MoveBaseAction, self._on_goal, self._on_cancel, auto_start=False
         )
@@ -162,6 +175,8 @@ class ScriptedMoveBase:
 
     def _clear_costmaps(self, _request: Any) -> EmptyResponse:
         self.log("clear_costmaps")
+        while not self._clear_answers and not rospy.is_shutdown():
+            time.sleep(0.1)  # rospy serves each call on a thread of its own
         return EmptyResponse()
 
     # -- behaviour -----------------------------------------------------------------------
@@ -238,10 +253,13 @@ def main() -> None:
     parser.add_argument("--script", default="", help="space-separated KIND[:SECONDS] per goal")
     parser.add_argument("--then", type=Behaviour.parse, default=Behaviour("succeed", 0.3))
     parser.add_argument("--log", type=Path)
+    parser.add_argument(
+        "--clear-costmaps", choices=("answer", "silent", "absent"), default="answer"
+    )
     args = parser.parse_args(rospy.myargv()[1:])
     script = [Behaviour.parse(item) for item in args.script.split()]
     rospy.init_node(args.node_name)
-    server = ScriptedMoveBase(args.action, script, args.then, args.log)
+    server = ScriptedMoveBase(args.action, script, args.then, args.log, args.clear_costmaps)
     server.log("ready")
     print("scripted move_base ready", flush=True)
     while not rospy.is_shutdown():

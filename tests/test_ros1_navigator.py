@@ -174,6 +174,7 @@ if __name__ == "__main__":
 # Tests
 # ---------------------------------------------------------------------------------------
 
+from cli_support import NAVSEQ, printed_events, write_mission  # noqa: E402
 from ros_clients import server_log, start_scripted_server  # noqa: E402
 from ros_support import RosMaster, RosProcess  # noqa: E402
 
@@ -333,3 +334,95 @@ def test_spin_waits_on_the_simulation_clock(ros_master: RosMaster):
     (spun,) = [e for e in events_of(spinner) if e["type"] == "spun"]
     assert spun["ros_began"] >= 100.0  # simulation time, not wall time
     assert spun["ros_seconds"] >= 1.0
+
+
+# -- navseq run against the scripted server: the policy around rejections and clearing --
+
+
+def run_navseq(master: RosMaster, tmp_path: Path, waypoints: str, defaults: str) -> RosProcess:
+    """``navseq run --navigator ros1 --json`` to its end (a hang fails on the timeout)."""
+    mission = write_mission(tmp_path / "m.yaml", waypoints, f"defaults: {{{defaults}}}\n")
+    out = tmp_path / "out"
+    process = master.start(
+        [NAVSEQ, "run", mission, "--navigator", "ros1", "--no-preflight", "--json", "--out", out],
+        cwd=tmp_path,
+        label="navseq",
+    )
+    process.wait(timeout=90)
+    return process
+
+
+def visits_of(tmp_path: Path) -> list[dict[str, Any]]:
+    return list(json.loads((tmp_path / "out" / "report.json").read_text())["visits"])
+
+
+def test_rejected_goals_spend_the_retries_then_skip_then_stop(
+    ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "reject:0.1 reject:0.1 reject:0.1")
+    navseq = run_navseq(
+        ros_master,
+        tmp_path,
+        "  - {name: first, x: 1.0, y: 0.0, yaw: 0, retries: 1, on_failure: skip}\n"
+        "  - {name: second, x: 2.0, y: 0.0, yaw: 0}\n",
+        "retries: 0, on_failure: stop, goal_timeout: 30",
+    )
+    assert navseq.popen.returncode == 1, navseq.output()
+    assert "Traceback" not in navseq.output()
+    first, second = visits_of(tmp_path)
+    assert first["outcome"] == "skipped" and second["outcome"] == "failed"
+    attempts = first["attempts"] + second["attempts"]
+    assert [(a["status"], a["text"]) for a in attempts] == [("REJECTED", "scripted reject")] * 3
+    failed = printed_events(navseq.output(), "AttemptFailed")
+    assert [(e["index"], e["will_retry"]) for e in failed] == [(0, True), (0, False), (1, False)]
+    assert [r["event"] for r in server_log(log)].count("accepted") == 0
+
+
+@pytest.mark.parametrize("clear", [True, False])
+def test_a_retry_clears_the_costmaps_before_its_goal_only_when_asked(
+    clear: bool, ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "abort:0.2 succeed:0.2")
+    navseq = run_navseq(
+        ros_master,
+        tmp_path,
+        "  - {name: a, x: 1.0, y: 0.0, yaw: 0}\n",
+        f"retries: 1, goal_timeout: 30, clear_costmaps_on_retry: {str(clear).lower()}",
+    )
+    assert navseq.popen.returncode == 0, navseq.output()
+    (visit,) = visits_of(tmp_path)
+    assert [a["status"] for a in visit["attempts"]] == ["ABORTED", "SUCCEEDED"]
+    order = [r["event"] for r in server_log(log) if r["event"] in ("goal", "clear_costmaps")]
+    assert order == (["goal", "clear_costmaps", "goal"] if clear else ["goal", "goal"])
+
+
+@pytest.mark.parametrize(
+    ("behaviour", "warning"),
+    [
+        ("silent", "/move_base/clear_costmaps did not answer within 1 s"),
+        ("absent", "/move_base/clear_costmaps unavailable"),
+    ],
+)
+def test_a_silent_or_missing_clear_service_delays_the_retry_but_never_hangs_it(
+    behaviour: str, warning: str, ros_master: RosMaster, tmp_path: Path
+):
+    log = tmp_path / "server.jsonl"
+    start_scripted_server(
+        ros_master, "--then", "abort:0.2", "--log", str(log), "--clear-costmaps", behaviour
+    )
+    # Before the fix a silent service hung the retry for good: navseq never ended.
+    navseq = run_navseq(
+        ros_master,
+        tmp_path,
+        "  - {name: a, x: 1.0, y: 0.0, yaw: 0}\n",
+        "retries: 2, on_failure: stop, goal_timeout: 30, clear_costmaps_on_retry: true",
+    )
+    assert navseq.popen.returncode == 1, navseq.output()
+    (visit,) = visits_of(tmp_path)
+    assert [a["status"] for a in visit["attempts"]] == ["ABORTED"] * 3
+    events = [r["event"] for r in server_log(log) if r["event"] in ("goal", "clear_costmaps")]
+    calls = ["clear_costmaps"] if behaviour == "silent" else []
+    assert events == ["goal", *calls, "goal", *calls, "goal"]
+    assert navseq.output().count(warning) == 1, navseq.output()  # said once, not per retry

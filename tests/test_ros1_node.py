@@ -217,10 +217,14 @@ def test_cancel_service_ends_the_mission_and_stops_the_robot(ros_master: RosMast
     start_server(ros_master, log, then="hang")
     node = start_node(ros_master)
     wait_for(lambda: events(log, "accepted"), 20, "the first goal to be accepted")
+    status = watch_status(ros_master)
     assert ros_master.call_service("/navseq/cancel")["success"]
     assert node.wait(timeout=20) == 1, node.output()
     assert [d["status"] for d in events(log, "done")] == ["PREEMPTED"]
     assert len(events(log, "goal")) == 1
+    # The status says the operator cancelled it: not a failure, not an interruption.
+    wait_for(lambda: '\\"state\\": \\"cancelled\\"' in status.output(), 10, "status")
+    assert "mission cancelled by the operator (~cancel)" in node.output(), node.output()
 
 
 def test_bad_params_are_one_clear_error_and_exit_2(ros_master: RosMaster):

@@ -74,6 +74,75 @@ print(json.dumps(samples), flush=True)
 """
 
 
+# Calls bt_navigator/change_state (argv[1]: activate / deactivate) as Nav2's lifecycle
+# manager does, then get_state; prints {"success": ..., "state": the state's label}.
+LIFECYCLE_CLIENT = r"""
+import json, sys
+import rclpy
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState, GetState
+rclpy.init()
+node = rclpy.create_node("lifecycle_test_client")
+client = node.create_client(ChangeState, "bt_navigator/change_state")
+if not client.wait_for_service(timeout_sec=30):
+    sys.exit(3)
+request = ChangeState.Request()
+request.transition.id = {
+    "activate": Transition.TRANSITION_ACTIVATE, "deactivate": Transition.TRANSITION_DEACTIVATE
+}[sys.argv[1]]
+future = client.call_async(request)
+rclpy.spin_until_future_complete(node, future, timeout_sec=30)
+success = bool(future.result() is not None and future.result().success)
+get_state = node.create_client(GetState, "bt_navigator/get_state")
+get_state.wait_for_service(timeout_sec=30)
+state = get_state.call_async(GetState.Request())
+rclpy.spin_until_future_complete(node, state, timeout_sec=30)
+print(json.dumps({"success": success, "state": state.result().current_state.label}))
+"""
+
+# A Nav2 whose costmap services misbehave: navigate_to_pose aborts every goal at once;
+# global_costmap/clear_entirely_global_costmap takes calls but never answers; the local
+# costmap's service does not exist. Every goal and call goes to stdout as a JSON line.
+SILENT_COSTMAP_NAV2 = r"""
+import json, signal, sys, threading, time
+import rclpy
+from nav2_msgs.action import NavigateToPose
+from nav2_msgs.srv import ClearEntireCostmap
+from rclpy.action import ActionServer
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
+node = rclpy.create_node("silent_costmap_nav2")
+group = ReentrantCallbackGroup()
+stop = threading.Event()
+def say(event):
+    print(json.dumps({"event": event, "t": time.monotonic()}), flush=True)
+def execute(handle):
+    say("goal")
+    handle.abort()
+    result = NavigateToPose.Result()
+    result.error_msg = "scripted abort"
+    return result
+def clear(_request, response):
+    say("clear_global")
+    stop.wait()  # never answers while the test runs
+    return response
+ActionServer(node, NavigateToPose, "navigate_to_pose", execute, callback_group=group)
+node.create_service(
+    ClearEntireCostmap, "global_costmap/clear_entirely_global_costmap", clear,
+    callback_group=group,
+)
+executor = MultiThreadedExecutor(num_threads=8)
+executor.add_node(node)
+signal.signal(signal.SIGTERM, lambda *a: stop.set())
+signal.signal(signal.SIGINT, lambda *a: stop.set())
+threading.Thread(target=executor.spin, daemon=True).start()
+say("ready")
+stop.wait()
+executor.shutdown(timeout_sec=1)
+"""
+
+
 class SimNode:
     """A running ``python -m navseq.ros2.sim_node``; its stdout is read as it comes."""
 
@@ -446,3 +515,147 @@ def test_start_is_refused_for_a_real_robot(tmp_path: Path):
     assert done.returncode == 2
     assert "--navigator nav2 the robot is where it is" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def change_navigator_state(env: dict[str, str], transition: str) -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", LIFECYCLE_CLIENT, transition],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    state = "active" if transition == "activate" else "inactive"
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == {"success": True, "state": state}
+
+
+def test_goals_rejected_while_bt_navigator_is_inactive_spend_the_retries_then_the_policy_applies(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    # Nav2 between configure and activate: the action server is found, goals rejected.
+    change_navigator_state(env, "deactivate")
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {name: first, x: -1.5, y: -0.5, yaw: 0, retries: 1, on_failure: skip}\n"
+        "  - {name: second, x: -1.0, y: -0.5, yaw: 0}\n",
+        "defaults: {retries: 0, on_failure: stop, goal_timeout: 60}\n",
+    )
+    # A hang would run into the subprocess timeout; the three rejections take seconds.
+    done = run_nav2(env, mission, tmp_path / "out", "--json", timeout=120)
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    first, second = report_of(tmp_path / "out")["visits"]
+    assert first["outcome"] == "skipped" and second["outcome"] == "failed"
+    attempts = first["attempts"] + second["attempts"]
+    assert [a["status"] for a in attempts] == ["REJECTED"] * 3
+    assert all(a["text"] == "Nav2 rejected the goal (is bt_navigator active?)" for a in attempts)
+    failed = printed_events(done.stdout, "AttemptFailed")
+    assert [(e["index"], e["will_retry"], e["status"]) for e in failed] == [
+        (0, True, "REJECTED"),
+        (0, False, "REJECTED"),
+        (1, False, "REJECTED"),
+    ]
+    log = sim.stop()
+    assert log.count("Action server is inactive. Rejecting the goal.") == 3
+    assert "navigate_to_pose: goal to" not in log  # the robot was never sent anywhere
+
+
+def test_a_goal_rejected_before_bt_navigator_is_activated_is_retried_and_reached(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    """navseq started while Nav2 is still coming up: once activated, the retry is taken."""
+    change_navigator_state(env, "deactivate")
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {name: near, x: -1.5, y: -0.5, yaw: 0}\n",
+        "defaults: {retries: 5, on_failure: stop, goal_timeout: 60}\n",
+    )
+    out = tmp_path / "out"
+    run = Nav2Run(env, mission, out)
+    wait_for(lambda: bool(printed_events(run.stdout(), "AttemptFailed")), 60, "a rejected attempt")
+    change_navigator_state(env, "activate")
+    stderr = run.finish(timeout=120)
+    assert run.process.returncode == 0, stderr
+    (visit,) = report_of(out)["visits"]
+    assert visit["outcome"] == "reached"
+    statuses = [a["status"] for a in visit["attempts"]]
+    assert statuses[0] == "REJECTED" and statuses[-1] == "SUCCEEDED"
+    assert set(statuses[:-1]) == {"REJECTED"}
+
+
+def sim_log_sequence(log: str) -> list[str]:
+    """The sim node's goals and clear-costmap calls, in the order it logged them."""
+    kinds = {
+        "navigate_to_pose: goal to": "goal",
+        "global_costmap: cleared": "clear_global",
+        "local_costmap: cleared": "clear_local",
+    }
+    return [kind for line in log.splitlines() for text, kind in kinds.items() if text in line]
+
+
+@pytest.mark.parametrize("clear", [True, False])
+def test_a_retry_clears_both_costmaps_before_its_goal_only_when_asked(
+    clear: bool, sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    # A goal in a wall: Nav2's planner aborts it, and its retry too.
+    mission = write_mission(
+        tmp_path / "wall.yaml",
+        "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0}\n",
+        "defaults: {retries: 1, on_failure: skip, goal_timeout: 60, "
+        f"clear_costmaps_on_retry: {str(clear).lower()}}}\n",
+    )
+    done = run_nav2(env, mission, tmp_path / "out", timeout=120)
+    assert done.returncode == 1, done.stderr
+    (visit,) = report_of(tmp_path / "out")["visits"]
+    assert [a["status"] for a in visit["attempts"]] == ["ABORTED", "ABORTED"]
+    sequence = sim_log_sequence(sim.stop())
+    if clear:
+        # Both services answered before the retry's goal went out.
+        assert sequence[0] == "goal" and sequence[-1] == "goal", sequence
+        assert sorted(sequence[1:-1]) == ["clear_global", "clear_local"], sequence
+    else:
+        assert sequence == ["goal", "goal"]
+    assert "unavailable" not in done.stderr and "did not answer" not in done.stderr
+
+
+def test_a_missing_or_silent_clear_service_delays_the_retry_but_never_hangs_it(
+    env: dict[str, str], tmp_path: Path
+):
+    server = subprocess.Popen(
+        [sys.executable, "-c", SILENT_COSTMAP_NAV2],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout is not None
+        assert '"ready"' in server.stdout.readline()
+        mission = write_mission(
+            tmp_path / "m.yaml",
+            "  - {name: a, x: 1.0, y: 0.0, yaw: 0}\n",
+            "defaults: {retries: 2, on_failure: stop, goal_timeout: 30, "
+            "clear_costmaps_on_retry: true}\n",
+        )
+        # A clear call that waited for its answer would never return: the run would
+        # hit this timeout instead of ending with three attempts.
+        done = run_nav2(env, mission, tmp_path / "out", timeout=120)
+    finally:
+        server.send_signal(signal.SIGTERM)
+        try:
+            out, _ = server.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            out, _ = server.communicate()
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    (visit,) = report_of(tmp_path / "out")["visits"]
+    assert [a["status"] for a in visit["attempts"]] == ["ABORTED"] * 3
+    events = [json.loads(line)["event"] for line in out.splitlines() if line.startswith("{")]
+    assert events == ["goal", "clear_global", "goal", "clear_global", "goal"]
+    # Each misbehaving service is named once, not on every retry.
+    missing = "local_costmap/clear_entirely_local_costmap unavailable"
+    silent = "global_costmap/clear_entirely_global_costmap did not answer within 1 s"
+    assert done.stderr.count(missing) == 1, done.stderr
+    assert done.stderr.count(silent) == 1, done.stderr

@@ -34,6 +34,9 @@ pytestmark = pytest.mark.ros
 # needs to answer a result with the next goal.
 RACE_WINDOW = 0.03
 RACE = (f"_race_window:={RACE_WINDOW}", "_race_probability:=1.0")
+# Where a test needs the race to happen: on a loaded machine a client answering at once
+# can still take more than RACE_WINDOW, and then there is no race to see.
+WIDE_RACE = ("_race_window:=0.25", "_race_probability:=1.0")
 WAYPOINTS = [(-1.6, -0.5, 90), (-0.55, -1.75, 0), (-1.6, -0.5, 180)]
 # The sim's move_base succeeds within its xy tolerance; TF may lag a control step.
 REACHED_WITHIN = DEFAULT_PROFILE.goal_tolerance.xy_m + 0.03
@@ -99,11 +102,8 @@ def test_with_the_settle_every_waypoint_is_truly_reached_despite_the_race(
     assert "race (~race_window)" not in nav.output()
 
 
-# A separate watcher process has to see the race's result message; on a loaded 2-core
-# machine it missed it once in five full runs (the executor's own view is tested below).
-@pytest.mark.flaky(reruns=2)
 def test_without_the_settle_navseq_runs_into_the_race(ros_master: RosMaster, tmp_path: Path):
-    _robot, nav = start_sim(ros_master, nav_params=RACE)
+    _robot, nav = start_sim(ros_master, nav_params=WIDE_RACE)
     watcher = start_result_watcher(ros_master, tmp_path)
     process, _out = run_navseq(ros_master, tmp_path, "--settle", "0")
     assert "Traceback" not in process.output()
@@ -119,7 +119,7 @@ def test_without_the_settle_navseq_runs_into_the_race(ros_master: RosMaster, tmp
 def test_without_the_settle_the_executor_reports_a_far_succeeded(
     ros_master: RosMaster, tmp_path: Path
 ):
-    start_sim(ros_master, nav_params=RACE)
+    start_sim(ros_master, nav_params=WIDE_RACE)
     _process, out = run_navseq(ros_master, tmp_path, "--settle", "0")
     report = json.loads((out / "report.json").read_text())
     reasons = [attempt["reason"] for visit in report["visits"] for attempt in visit["attempts"]]

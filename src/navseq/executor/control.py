@@ -22,6 +22,22 @@ from dataclasses import dataclass, field
 #: What an operator can ask of a running mission.
 REQUESTS = ("skip", "pause", "resume", "cancel")
 
+#: How the reason of a mission the operator cancelled starts: the status topics and the
+#: nodes' exit logs tell a cancel from a failure or an interruption by it.
+CANCELLED = "cancelled"
+
+
+def operator_reason(kind: str, service: str) -> str:
+    """The executor's reason for an operator request made through ``service``
+    (``~cancel``, ``~/cancel``): ``"cancelled by the operator (~cancel)"``."""
+    done = {"pause": "paused", "resume": "resumed", "cancel": CANCELLED, "skip": "skipped"}
+    return f"{done[kind]} by the operator ({service})"
+
+
+def cancelled_by_operator(reason: str) -> bool:
+    """Whether a mission's reason says the operator cancelled it."""
+    return reason.startswith(CANCELLED)
+
 
 class StopRequested(Exception):
     """The process running the mission is being shut down; ``str()`` says why."""

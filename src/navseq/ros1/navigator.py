@@ -92,6 +92,7 @@ DEFAULT_SETTLE = 0.05  # s of wall time between a result and the next goal (race
 # Longest wall-time wait for the server's status array to list a finished goal as such.
 STATUS_LISTING_WAIT = 0.5
 CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
+CLEAR_WAIT = 1.0  # s of wall time clear_costmaps waits for move_base, service lookup included
 # actionlib_msgs/GoalStatus codes of a finished goal.
 _TERMINAL_CODES = frozenset({2, 3, 4, 5, 8, 9})
 
@@ -174,6 +175,7 @@ class Ros1Navigator:
         settle: float = DEFAULT_SETTLE,
         odom_frame: str = "odom",
         clock_wait: float = CLOCK_WAIT,
+        clear_wait: float = CLEAR_WAIT,
     ):
         if stamp not in ("now", "latest"):
             raise NavseqError(f"stamp must be 'now' or 'latest', not {stamp!r}", subject="stamp")
@@ -191,6 +193,7 @@ class Ros1Navigator:
         self.settle = settle
         self.odom_frame = odom_frame
         self.clock_wait = clock_wait
+        self.clear_wait = clear_wait
         # Set when the navigation stack runs on /clock but rospy came up on wall time:
         # the latest /clock time, read instead of rospy's (None: rospy's time is right).
         self._clock_time: float | None = None
@@ -209,7 +212,7 @@ class Ros1Navigator:
         self._server_up: bool | None = None  # None: not checked yet
         self._feedback_pose: Pose2D | None = None
         self._closed = False
-        self._clear_costmaps_warned = False
+        self._clear_costmaps_warned: set[str] = set()  # kinds of clear failure said
         # Created after the state its callbacks read: they may run at once.
         self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
@@ -403,14 +406,46 @@ class Ros1Navigator:
             rospy.logwarn("navseq: could not cancel the active goal: %s", error)
 
     def clear_costmaps(self) -> None:
-        service = rosgraph.names.ns_join(self.action, "clear_costmaps")
+        """Call move_base's ``clear_costmaps``, waiting at most ``clear_wait`` in all.
+
+        rospy's service calls have no timeout, and a move_base busy in a long recovery
+        (or wedged) takes the call but never answers: the call therefore runs on a
+        thread of its own, left behind (daemon) if it does not answer in time. Either
+        way the retry goes out after at most ``clear_wait``; what went wrong is said
+        once per kind (missing, silent, failed), not on every retry.
+        """
+        service = rosgraph.names.ns_join(self.resolved_action, "clear_costmaps")
+        deadline = time.monotonic() + self.clear_wait
         try:
-            rospy.wait_for_service(service, timeout=1.0)
-            rospy.ServiceProxy(service, Empty)()
-        except (rospy.ROSException, rospy.ServiceException) as error:
-            if not self._clear_costmaps_warned:
-                rospy.logwarn("navseq: %s unavailable, retrying without it (%s)", service, error)
-                self._clear_costmaps_warned = True
+            rospy.wait_for_service(service, timeout=self.clear_wait)
+        except rospy.ROSException:
+            self._warn_clear_once("unavailable", f"{service} unavailable, retrying without it")
+            return
+        answered = threading.Event()
+        errors: list[Exception] = []
+
+        def call() -> None:
+            try:
+                rospy.ServiceProxy(service, Empty)()
+            except (rospy.ROSException, rospy.ServiceException, OSError) as error:
+                errors.append(error)
+            finally:
+                answered.set()
+
+        threading.Thread(target=call, name="navseq-clear-costmaps", daemon=True).start()
+        if not answered.wait(max(deadline - time.monotonic(), 0.0)):
+            self._warn_clear_once(
+                "silent",
+                f"{service} did not answer within {self.clear_wait:g} s, "
+                "retrying without waiting for it",
+            )
+        elif errors:
+            self._warn_clear_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
+
+    def _warn_clear_once(self, kind: str, text: str) -> None:
+        if kind not in self._clear_costmaps_warned:
+            self._clear_costmaps_warned.add(kind)
+            rospy.logwarn("navseq: %s", text)
 
     def robot_pose(self) -> Pose2D | None:
         if self._tf_buffer is not None:

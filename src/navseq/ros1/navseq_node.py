@@ -62,7 +62,12 @@ import rospy
 from std_srvs.srv import Trigger, TriggerResponse
 
 from navseq.errors import NavseqError
-from navseq.executor.control import MissionControl, StopRequested
+from navseq.executor.control import (
+    MissionControl,
+    StopRequested,
+    cancelled_by_operator,
+    operator_reason,
+)
 from navseq.executor.events import MissionFinished
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
@@ -157,7 +162,7 @@ def _trigger_service(name: str, control: MissionControl, topics: MissionTopics) 
         if topics.over is not None:
             # Nobody takes requests any more: a request would only be refused.
             return TriggerResponse(success=False, message=f"nothing to {name}: {topics.over}")
-        ok, message = control.request(name, f"{name} requested by the operator (~{name})")
+        ok, message = control.request(name, operator_reason(name, f"~{name}"))
         return TriggerResponse(success=ok, message=message)
 
     rospy.Service(f"~{name}", Trigger, handle)
@@ -171,7 +176,7 @@ def _skip_service(topics: MissionTopics, control: MissionControl) -> None:
         if index is None:
             # Filed now, the request would skip whichever waypoint comes next.
             return TriggerResponse(success=False, message="no waypoint is underway")
-        control.request_skip("skipped by the operator (~skip)")
+        control.request_skip(operator_reason("skip", "~skip"))
         return TriggerResponse(
             success=True, message=f"waypoint {index + 1} skipped; going on with the next one"
         )
@@ -242,7 +247,7 @@ def run_node() -> int:
         _log_interrupted("ROS shutdown")
         return 1
     else:
-        if result.reason.startswith("cancelled"):
+        if cancelled_by_operator(result.reason):
             rospy.logwarn("navseq: mission cancelled by the operator (~cancel)")
             topics.over = "the mission was cancelled"
         elif result.success:

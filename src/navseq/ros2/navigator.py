@@ -7,8 +7,10 @@ executor's. How it maps Nav2 onto :class:`~navseq.navigators.base.Navigator`:
 - Terminal statuses: SUCCEEDED -> succeeded; ABORTED and CANCELED -> failed, with
   Nav2's status name and its ``error_msg`` / ``error_code`` as the text (a goal another
   client preempted ends ABORTED in Nav2: that is a failed attempt too, and the policy
-  decides); a rejected goal -> failed ``REJECTED``; a result ``UNKNOWN`` (a restarted
-  server that never heard of the goal) -> lost.
+  decides); a rejected goal -> failed ``REJECTED`` (Nav2 rejects while bt_navigator is
+  not active: its action server exists from configure on, so it is found, but takes
+  goals only once activated); a result ``UNKNOWN`` (a restarted server that never heard
+  of the goal) -> lost.
 - Pass-through: a new goal simply replaces the tracked one; Nav2 preempts its running
   goal with it, so the robot keeps rolling. The replaced goal's late result (ABORTED,
   "preempted") is not tracked any more and never reaches the executor.
@@ -18,7 +20,9 @@ executor's. How it maps Nav2 onto :class:`~navseq.navigators.base.Navigator`:
   process is its lease duration (Cyclone DDS: 10 s by default).
 - Costmaps are cleared through Nav2's ``global_costmap/clear_entirely_global_costmap``
   and ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``),
-  waiting (bounded) for both answers so the retry plans on the cleared maps.
+  waiting (bounded, ``clear_wait`` for both) for the answers so the retry plans on the
+  cleared maps; a missing or silent service delays the retry by at most that, and is
+  named once in the log.
 - Robot pose: ``map -> odom -> base`` composed from ``/tf`` and ``/tf_static`` with
   :class:`navseq.geometry.FrameTree` (no tf2 Python library needed), else the goal
   feedback's ``current_pose``. Odometry pose (for distance driven): the ``odom`` topic.
@@ -98,7 +102,10 @@ DEFAULT_ACTION = "navigate_to_pose"
 DEFAULT_NODE_NAME = "navseq"
 CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
 CANCEL_WAIT = 2.0  # s of wall time close() waits for Nav2's answer to a cancel
-CLEAR_WAIT = 1.0  # s of wall time for each clear-costmap service
+CLEAR_WAIT = 1.0  # s of wall time for both clear-costmap services' answers
+# Nav2's action servers reject a goal only while their lifecycle node is not active
+# (configured, not yet activated; or deactivated): name the likely cause.
+REJECTED_TEXT = "Nav2 rejected the goal (is bt_navigator active?)"
 LOST_AFTER = 0.3  # s of wall time the server must be gone from the graph to be lost
 SPIN_SLICE = 0.1  # longest wall-time wait in spin() between looks at the clock
 COSTMAP_SERVICES = (
@@ -145,6 +152,7 @@ class Nav2Navigator:
         node_name: str = DEFAULT_NODE_NAME,
         clock_wait: float = CLOCK_WAIT,
         cancel_wait: float = CANCEL_WAIT,
+        clear_wait: float = CLEAR_WAIT,
         lost_after: float = LOST_AFTER,
         session: Ros2Session | None = None,
     ) -> None:
@@ -155,6 +163,7 @@ class Nav2Navigator:
         self.base_frames = tuple(base_frames)
         self.clock_wait = clock_wait
         self.cancel_wait = cancel_wait
+        self.clear_wait = clear_wait
         self.lost_after = lost_after
         self._sim_time_asked = use_sim_time
 
@@ -174,7 +183,7 @@ class Nav2Navigator:
         self._odom_pose: Pose2D | None = None
         self._last_now = 0.0
         self._closed = False
-        self._clear_warned = False
+        self._clear_warned: set[str] = set()  # clear services already warned about
         # /tf with the frames prefixed by the namespace, and the namespace's own tf.
         self._tf = FrameTree()
         self._local_tf = FrameTree() if self.namespace else None
@@ -347,26 +356,37 @@ class Nav2Navigator:
             self._in_ros(self._send_cancel, handle)
 
     def clear_costmaps(self) -> None:
-        """Call both clear-costmap services and wait (bounded) for their answers."""
-        answered = [threading.Event() for _ in self._costmap_clients]
-        missing = [
-            COSTMAP_SERVICES[index]
-            for index, client in enumerate(self._costmap_clients)
-            if not client.service_is_ready()
-        ]
-        for client, done in zip(self._costmap_clients, answered, strict=True):
+        """Call both clear-costmap services and wait (bounded) for their answers.
+
+        Both calls go out at once and share one ``clear_wait``: a service that is
+        missing or does not answer in time costs at most that long, never a hang, and
+        the retry goes out anyway. Each such service is named once per run (a warning
+        on every retry would bury the rest of the log).
+        """
+        calls: list[tuple[str, threading.Event]] = []
+        missing: list[str] = []
+        for name, client in zip(COSTMAP_SERVICES, self._costmap_clients, strict=True):
             if client.service_is_ready():
+                done = threading.Event()
                 self._in_ros(self._call_clear, client, done)
+                calls.append((name, done))
             else:
-                done.set()
-        deadline = time.monotonic() + CLEAR_WAIT
-        for done in answered:
+                missing.append(name)
+        deadline = time.monotonic() + self.clear_wait
+        for _name, done in calls:
             done.wait(max(deadline - time.monotonic(), 0.0))
-        if missing and not self._clear_warned:
-            self._clear_warned = True
-            self._node.get_logger().warning(
-                f"{', '.join(missing)} unavailable: retrying without clearing that costmap"
-            )
+        silent = [name for name, done in calls if not done.is_set()]
+        self._warn_clear_once(missing, "unavailable: retrying without clearing that costmap")
+        self._warn_clear_once(
+            silent,
+            f"did not answer within {self.clear_wait:g} s: retrying without waiting for it",
+        )
+
+    def _warn_clear_once(self, services: Sequence[str], what: str) -> None:
+        new = [name for name in services if name not in self._clear_warned]
+        if new:
+            self._clear_warned.update(new)
+            self._node.get_logger().warning(f"{', '.join(new)} {what}")
 
     def robot_pose(self) -> Pose2D | None:
         frame = self.frame or "map"
@@ -489,7 +509,7 @@ class Nav2Navigator:
             if handle is None or not handle.accepted:
                 self._goal_id = None
                 self._cancel_answered.set()
-                text = f"the goal request failed: {error}" if error else "Nav2 rejected the goal"
+                text = f"the goal request failed: {error}" if error else REJECTED_TEXT
                 self._queue(GoalDone.failed(goal_id, "REJECTED", text))
                 return
             self._handle = handle

@@ -48,7 +48,13 @@ from rclpy.task import Future
 from std_srvs.srv import Trigger
 
 from navseq.errors import NavseqError
-from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
+from navseq.executor.control import (
+    MissionControl,
+    OperatorRequest,
+    StopRequested,
+    cancelled_by_operator,
+    operator_reason,
+)
 from navseq.executor.events import (
     AttemptFailed,
     MissionEvent,
@@ -67,13 +73,6 @@ from navseq.text import printable
 
 NODE_NAME = "navseq"
 SERVICE_ANSWER_WAIT = 5.0  # s of wall time a service waits for the mission's answer
-# The executor's reason for each request; a cancel's starts with "cancelled", which is
-# how the status topic and the exit log tell it from a failure.
-_REASONS = {
-    "pause": "paused by the operator (~/pause)",
-    "resume": "resumed by the operator (~/resume)",
-    "cancel": "cancelled by the operator (~/cancel)",
-}
 KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a signal while kept alive
 
 
@@ -139,7 +138,7 @@ class OperatorServices:
             if index is None:
                 # Filed now, the request would skip whichever waypoint comes next.
                 return False, "no waypoint is underway"
-            self.control.request_skip("skipped by the operator (~/skip)")
+            self.control.request_skip(operator_reason("skip", "~/skip"))
             return True, f"waypoint {index + 1} skipped; going on with the next one"
         answered: Future = Future(executor=self.session.executor)
 
@@ -149,7 +148,7 @@ class OperatorServices:
                 # The awaiting handler runs again when the executor looks next: now.
                 self.session.executor.wake()
 
-        request = self.control.submit(name, _REASONS[name], wake)
+        request = self.control.submit(name, operator_reason(name, f"~/{name}"), wake)
         # The run answers within one tick; the timer only guards against a stuck run.
         timer = threading.Timer(SERVICE_ANSWER_WAIT, lambda: wake(request))
         timer.daemon = True
@@ -217,7 +216,7 @@ def run_node(session: Ros2Session) -> int:
         _log_interrupted(logger, str(shutdown))
         return 1
     else:
-        if result.reason.startswith("cancelled"):
+        if cancelled_by_operator(result.reason):
             logger.warning("mission cancelled by the operator (~/cancel)")
             topics.state.over = "the mission was cancelled"
         elif result.success:

@@ -26,7 +26,13 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``)
   and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
-  ``amcl``, ...), answering *active*.
+  ``amcl``, ...), answering *active*; every clear-costmap call is logged (``global_costmap:
+  cleared``), so a client's clearing can be checked against the goals that follow;
+- ``bt_navigator/change_state`` (``lifecycle_msgs/srv/ChangeState``): *deactivate* and
+  *activate*, as Nav2's lifecycle manager does. While bt_navigator is inactive,
+  ``navigate_to_pose`` and ``navigate_through_poses`` reject new goals, as Nav2's action
+  servers do between configure and activate (they exist, so clients find them, but say
+  "Action server is inactive. Rejecting the goal."); goals already running go on.
 
 Several robots that see each other: with ``--other-robots robot2`` the node also listens
 to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
@@ -59,8 +65,8 @@ from typing import Any
 
 import rclpy
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformStamped, Twist
-from lifecycle_msgs.msg import State
-from lifecycle_msgs.srv import GetState
+from lifecycle_msgs.msg import State, Transition
+from lifecycle_msgs.srv import ChangeState, GetState
 from nav2_msgs.action import (
     ComputePathToPose,
     FollowWaypoints,
@@ -184,6 +190,7 @@ class SimNode:
         self._localized = False
         self._last_amcl = -float("inf")
         self._topic_goal: NavTask | None = None
+        self._navigator_active = True  # bt_navigator's lifecycle: inactive rejects goals
         self.log = node.get_logger()
         node.declare_parameter("stop_on_failure", True)
 
@@ -220,12 +227,24 @@ class SimNode:
             "local_costmap/clear_entirely_local_costmap",
         ):
             node.create_service(
-                ClearEntireCostmap, service, self._on_clear_costmap, callback_group=group
+                ClearEntireCostmap,
+                service,
+                self._clear_costmap_callback(service.partition("/")[0]),
+                callback_group=group,
             )
         for lifecycle_node in LIFECYCLE_NODES:
             node.create_service(
-                GetState, f"{lifecycle_node}/get_state", self._on_get_state, callback_group=group
+                GetState,
+                f"{lifecycle_node}/get_state",
+                self._get_state_callback(lifecycle_node),
+                callback_group=group,
             )
+        node.create_service(
+            ChangeState,
+            "bt_navigator/change_state",
+            self._on_change_navigator_state,
+            callback_group=group,
+        )
         self._servers = [
             self._nav_server(NavigateToPose, Navigator.TO_POSE, group),
             self._nav_server(NavigateThroughPoses, Navigator.THROUGH_POSES, group),
@@ -439,10 +458,17 @@ class SimNode:
             action,
             navigator.value,
             execute_callback=lambda handle: self._execute_navigation(handle, action, navigator),
-            goal_callback=lambda _request: GoalResponse.ACCEPT,
+            goal_callback=self._on_navigation_goal,
             cancel_callback=_accept_cancel,
             callback_group=group,
         )
+
+    def _on_navigation_goal(self, _request: Any) -> GoalResponse:
+        """Nav2's bt_navigator accepts every goal while active and none otherwise."""
+        if self._navigator_active:
+            return GoalResponse.ACCEPT
+        self.log.info("Action server is inactive. Rejecting the goal.")
+        return GoalResponse.REJECT
 
     def _execute_navigation(self, handle: Any, action: Any, navigator: Navigator) -> Any:
         request = handle.request
@@ -610,13 +636,37 @@ class SimNode:
                     now,
                 )
 
-    def _on_clear_costmap(self, _request: Any, response: Any) -> Any:
-        with self._lock:
-            self.standin.world.server.clear_costmaps()
-        return response
+    def _clear_costmap_callback(self, costmap: str) -> Any:
+        def clear(_request: Any, response: Any) -> Any:
+            with self._lock:
+                self.standin.world.server.clear_costmaps()
+            self.log.info(f"{costmap}: cleared")
+            return response
 
-    def _on_get_state(self, _request: Any, response: Any) -> Any:
-        response.current_state = State(id=State.PRIMARY_STATE_ACTIVE, label="active")
+        return clear
+
+    def _get_state_callback(self, lifecycle_node: str) -> Any:
+        def get_state(_request: Any, response: Any) -> Any:
+            active = lifecycle_node != "bt_navigator" or self._navigator_active
+            response.current_state = (
+                State(id=State.PRIMARY_STATE_ACTIVE, label="active")
+                if active
+                else State(id=State.PRIMARY_STATE_INACTIVE, label="inactive")
+            )
+            return response
+
+        return get_state
+
+    def _on_change_navigator_state(self, request: Any, response: Any) -> Any:
+        """Deactivate / activate bt_navigator; any other transition is refused."""
+        transition = request.transition.id
+        wanted = {Transition.TRANSITION_ACTIVATE: True, Transition.TRANSITION_DEACTIVATE: False}
+        if transition not in wanted or wanted[transition] == self._navigator_active:
+            response.success = False
+            return response
+        self._navigator_active = wanted[transition]
+        self.log.info(f"bt_navigator: {'active' if self._navigator_active else 'inactive'}")
+        response.success = True
         return response
 
 

@@ -23,6 +23,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from navseq.executor.control import cancelled_by_operator
 from navseq.executor.events import (
     MissionEvent,
     MissionFinished,
@@ -154,7 +155,7 @@ def status_state(event: MissionEvent) -> str:
     if event.success:
         return "succeeded"
     # The runner's reason for a run ended from outside ("interrupted: SIGINT" ...).
-    if event.reason.startswith("cancelled"):
+    if cancelled_by_operator(event.reason):
         return "cancelled"  # by the operator (~cancel)
     return "interrupted" if event.reason.startswith("interrupted") else "failed"
 
