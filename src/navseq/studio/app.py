@@ -92,6 +92,7 @@ class Studio:
         self._lock = threading.Lock()
         self._save_lock = threading.Lock()
         self._check_lock = threading.Lock()
+        self._load_lock = threading.Lock()  # one reading of a map file at a time
         self.robot: RobotProfile | None = None  # the last checked draft's robot
         self.run: StudioRun | None = None
 
@@ -114,9 +115,14 @@ class Studio:
             cached = self._maps.get(path)
             if cached is not None and cached[0] == stamp:
                 return cached[1]
-        view = MapView.load(path)
-        with self._lock:
-            self._maps[path] = (stamp, view)
+        with self._load_lock:  # a second request for it waits and finds it read
+            with self._lock:
+                cached = self._maps.get(path)
+            if cached is not None and cached[0] == stamp:
+                return cached[1]
+            view = MapView.load(path)
+            with self._lock:
+                self._maps[path] = (stamp, view)
         return view
 
     def costmap(self, map_path: Path, robot: RobotProfile) -> Costmap:
@@ -459,13 +465,17 @@ class Studio:
         return self.run
 
     def warm_up(self) -> None:
-        """Do what the page's first load asks for, ahead of it: the map image, the
-        costmap and the opened mission's planned legs. Problems are the page's to show."""
+        """Do what the page's first load asks for, ahead of it, in the order it asks:
+        the map and its image first (the first paint waits for them, so they must not
+        queue behind the rest), then the costmap and the opened mission's planned legs
+        (its first check). Problems are the page's to show."""
         try:
             opened = self.mission()
             if opened["mission"] is not None:
-                self.check(opened["mission"])
-                self.map_image(opened["mission"].get("map") or None, "map")
+                try:
+                    self.map_image(opened["mission"].get("map") or None, "map")
+                finally:
+                    self.check(opened["mission"])
         except Exception:  # the same request from the page reports it
             pass
 
