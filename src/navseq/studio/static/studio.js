@@ -9,7 +9,7 @@ const S = {
   problems: [], legs: [], route: {}, selected: null,
   undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
   layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
-  planned: false, mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
+  planned: false, painted: null, mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
 };
 const WP_FIELDS = [
   ["name", "text"], ["x", "number"], ["y", "number"], ["yaw", "number"],
@@ -412,6 +412,7 @@ async function check() {
     S.route = answer.data;
   }
   S.planned = true;
+  await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
   render();
   document.body.dataset.checked = String(seq);
@@ -705,11 +706,11 @@ async function main() {
   // The first check (pre-flight problems and every leg planned: a second or more on a
   // big map) goes out now and is worked on while the map is drawn; the page is ready
   // (map drawn, markers placed, the file's own problems listed) without waiting for it.
-  const firstCheck = check();
-  await loadMap(true);
-  render();
-  document.body.dataset.ready = "true";
-  await firstCheck;
+  S.painted = loadMap(true).then(() => {
+    render();
+    document.body.dataset.ready = "true";
+  });
+  await Promise.all([S.painted, check()]);
   loadRuns();
 }
 main();
