@@ -264,6 +264,7 @@ def exported(ref: str, into: Path) -> Path:
     archive = subprocess.run(
         ["git", "-C", str(ROOT), "archive", ref, "src"], check=True, capture_output=True
     ).stdout
+    into.mkdir(parents=True)
     subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
     for built in (ROOT / "src/navseq/sim").glob("_astar*.so"):
         shutil.copy2(built, into / "src/navseq/sim" / built.name)

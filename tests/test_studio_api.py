@@ -486,6 +486,38 @@ def test_warm_up_makes_the_map_image_before_the_first_check(
     assert studio.map_image("../maps/turtlebot3_world.yaml", "map").startswith(b"\x89PNG")
 
 
+def test_a_draft_checked_again_unchanged_gets_the_same_answer_without_a_new_check(
+    client: TestClient, workspace: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each page load's first check sends the opened mission as the warm-up checked it:
+    the answer is sent again, until the draft or its map file changes."""
+    import os
+
+    import navseq.studio.app as app
+
+    checked: list[object] = []
+    real = app.check_draft
+
+    def counting(document: object, **kwargs: object) -> object:
+        checked.append(document)
+        return real(document, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(app, "check_draft", counting)
+    document = opened(client)["mission"]
+    first = client.post("/api/check", json={"mission": document}).json()
+    assert client.post("/api/check", json={"mission": document}).json() == first
+    assert len(checked) == 1
+    document["waypoints"][2]["x"] = 0.56
+    moved = client.post("/api/check", json={"mission": document}).json()
+    assert len(checked) == 2  # a new draft: checked
+    # The map's image is touched on disk: the same draft is checked again.
+    image = workspace / "maps/turtlebot3_world.pgm"
+    stat = image.stat()
+    os.utime(image, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000_000))
+    assert client.post("/api/check", json={"mission": document}).json() == moved
+    assert len(checked) == 3
+
+
 # --- files: import, export, the robot: section ------------------------------------------
 
 
