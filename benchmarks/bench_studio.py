@@ -7,7 +7,9 @@ mission of a dozen waypoints:
 - **page ready**: from navigating to the studio's URL until the page says it is ready
   (map image drawn, markers placed), in headless Chromium (Debian's
   ``/usr/bin/chromium`` through Playwright), median of ``--repeat`` loads; the first
-  load is the one right after ``navseq studio`` started (nothing made yet);
+  load is the one right after ``navseq studio`` started (nothing made yet), the studio
+  started ``--repeat`` times for it; later loads are fresh pages on a studio that
+  served the page once already;
 - **plans shown**: from navigating until the first check's answer (pre-flight
   problems and every leg planned) is drawn; before the page had ``data-planned`` it
   was ready only then, so it is its ready time;
@@ -204,26 +206,64 @@ PLANS_SHOWN = (
 )
 
 
-def page_figures(served: Served, moves: list[tuple[float, float]], repeat: int) -> dict[str, float]:
-    """Seconds: first and median page ready, first and median plans shown, and median
-    drag -> problems drawn (absent when ``moves`` is empty).
+def load(browser: Any, url: str) -> tuple[float, float, Any]:
+    """(page ready, plans shown) in seconds from navigating to ``url`` in a fresh page
+    (its own context: nothing cached by the browser), and the page."""
+    page = browser.new_page(viewport={"width": 1400, "height": 860})
+    began = time.perf_counter()
+    page.goto(url)
+    page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
+    ready = time.perf_counter() - began
+    page.wait_for_function(PLANS_SHOWN, timeout=60_000, polling=10)
+    return ready, time.perf_counter() - began, page
 
-    The first load is the studio's first: the map's PNG is made then (later loads get it
-    from the studio's memory and the browser's cache is bypassed by a fresh page each time).
-    """
+
+def first_loads(
+    mission: Path, sources: dict[str, Path | None], repeat: int
+) -> dict[str, dict[str, float]]:
+    """Median (page ready, plans shown) of the first load right after ``navseq studio``
+    started (nothing made yet: the map's PNG, costmap and plans are made then), each
+    source's studio started ``repeat`` times, the sources in turn so that they share
+    the machine's ups and downs."""
+    from playwright.sync_api import sync_playwright
+
+    ready: dict[str, list[float]] = {label: [] for label in sources}
+    planned: dict[str, list[float]] = {label: [] for label in sources}
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        for _ in range(repeat):
+            for label, source in sources.items():
+                served = Served(mission, source)
+                try:
+                    shown, plans, page = load(browser, served.url)
+                    page.close()
+                finally:
+                    served.close()
+                ready[label].append(shown)
+                planned[label].append(plans)
+        browser.close()
+    return {
+        label: {
+            "first": statistics.median(ready[label]),
+            "first_plans": statistics.median(planned[label]),
+        }
+        for label in sources
+    }
+
+
+def page_figures(served: Served, moves: list[tuple[float, float]], repeat: int) -> dict[str, float]:
+    """Seconds: median page ready and plans shown of later loads (after a first one,
+    not counted), and median drag -> problems drawn (absent when ``moves`` is empty)."""
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        load(browser, served.url)[2].close()  # the first load: first_loads measures it
         ready, planned = [], []
         for _ in range(repeat):
-            page = browser.new_page(viewport={"width": 1400, "height": 860})
-            began = time.perf_counter()
-            page.goto(served.url)
-            page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
-            ready.append(time.perf_counter() - began)
-            page.wait_for_function(PLANS_SHOWN, timeout=60_000, polling=10)
-            planned.append(time.perf_counter() - began)
+            shown, plans, page = load(browser, served.url)
+            ready.append(shown)
+            planned.append(plans)
             if len(ready) < repeat:
                 page.close()
         drags = []
@@ -248,12 +288,7 @@ def page_figures(served: Served, moves: list[tuple[float, float]], repeat: int) 
             )
             drags.append(time.perf_counter() - began)
         browser.close()
-    figures = {
-        "first": ready[0],
-        "ready": statistics.median(ready[1:] or ready),
-        "first_plans": planned[0],
-        "plans": statistics.median(planned[1:] or planned),
-    }
+    figures = {"ready": statistics.median(ready), "plans": statistics.median(planned)}
     if drags:
         figures["drag"] = statistics.median(drags)
     return figures
@@ -355,7 +390,10 @@ def main() -> int:
         for name, (mission, _, moves) in cases.items():
             rebuilt = check_latency(mission, moves, cached=False)
             cached = check_latency(mission, moves, cached=True)
-            if before is not None:  # first, while the machine is as it was for the rest
+            sources = {"": None, "_before": before} if before is not None else {"": None}
+            for suffix, measured in first_loads(mission, sources, args.repeat).items():
+                figures[name].update({key + suffix: value for key, value in measured.items()})
+            if before is not None:
                 served = Served(mission, before)
                 try:
                     old = page_figures(served, [], args.repeat)
