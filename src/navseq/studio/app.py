@@ -96,9 +96,9 @@ class Studio:
         self._save_lock = threading.Lock()
         self._check_lock = threading.Lock()
         self._load_lock = threading.Lock()  # one reading of a map file at a time
-        self._answers: OrderedDict[tuple[str, tuple[int, ...]], tuple[Any, dict[str, Any]]] = (
-            OrderedDict()
-        )
+        self._answers: OrderedDict[
+            tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
+        ] = OrderedDict()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
         self.run: StudioRun | None = None
 
@@ -223,11 +223,10 @@ class Studio:
         """
         with self._check_lock:
             key = self._answer_key(document)
-            kept = self._answers.get(key) if key is not None else None
-            if kept is not None:
+            if key is not None and key in self._answers:
                 self._answers.move_to_end(key)
-                self.robot = kept[0]
-                return kept[1]
+                self.robot, answer = self._answers[key]
+                return answer
             answer = self._check(document)
             if key is not None:
                 self._answers[key] = (self.robot, answer)
