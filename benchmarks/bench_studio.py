@@ -5,8 +5,17 @@ Side by side on the TurtleBot3 arena (384 x 384 cells) and a generated 2000 x 20
 mission of a dozen waypoints:
 
 - **page ready**: from navigating to the studio's URL until the page says it is ready
-  (map image drawn, markers placed, first check answered), in headless Chromium
-  (Debian's ``/usr/bin/chromium`` through Playwright), median of ``--repeat`` loads;
+  (map image drawn, markers placed), in headless Chromium (Debian's
+  ``/usr/bin/chromium`` through Playwright), median of ``--repeat`` loads; the first
+  load is the one right after ``navseq studio`` started (nothing made yet), the studio
+  started ``--repeat`` times for it; later loads are fresh pages on a studio that
+  served the page once already;
+- **plans shown**: from navigating until the first check's answer (pre-flight
+  problems and every leg planned) is drawn; before the page had ``data-planned`` it
+  was ready only then, so it is its ready time;
+- **before**: with ``--before REF`` (a git commit, e.g. ``main``) the studio of that
+  commit is served too (its ``src/`` exported, the compiled A* copied in) and its page
+  figures are put beside the current ones, measured on the same maps and run;
 - **drag -> problems (page)**: a waypoint marker dragged with the mouse to another free
   spot, until the page has the server's answer (problems and planned legs) drawn;
 - **check (server)**: ``POST /api/check`` of the mission with one waypoint moved,
@@ -18,7 +27,7 @@ mission of a dozen waypoints:
 
 Targets (issue 12): ready <= 1 s / 2 s, drag -> problems <= 150 ms / 500 ms, live >= 10/s.
 
-    .venv/bin/python benchmarks/bench_studio.py [--repeat 5] [--live-seconds 6]
+    .venv/bin/python benchmarks/bench_studio.py [--repeat 5] [--live-seconds 6] [--before main]
 """
 
 from __future__ import annotations
@@ -40,6 +49,7 @@ from typing import Any
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from navseq.geometry import Pose2D
@@ -163,10 +173,14 @@ def check_latency(mission: Path, moves: list[tuple[float, float]], cached: bool)
 class Served:
     """``navseq studio MISSION --no-browser`` as a user starts it."""
 
-    def __init__(self, mission: Path) -> None:
+    def __init__(self, mission: Path, source: Path | None = None) -> None:
+        env = dict(os.environ)
+        if source is not None:  # another commit's navseq (--before)
+            env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(source), env.get("PYTHONPATH")]))
         self.process = subprocess.Popen(
             [sys.executable, "-m", "navseq", "studio", str(mission), "--no-browser"],
             cwd=mission.parent,
+            env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
@@ -184,25 +198,72 @@ class Served:
             self.process.wait()
 
 
-def page_figures(
-    served: Served, moves: list[tuple[float, float]], repeat: int
-) -> tuple[float, float, float]:
-    """(first page ready, median page ready, median drag -> problems drawn), seconds.
+# The first check's plans are drawn: data-planned, or (a page from before it had it)
+# data-ready, which that page set only once the first check was drawn.
+PLANS_SHOWN = (
+    "document.body.dataset.planned === 'true' ||"
+    " (typeof S.planned === 'undefined' && document.body.dataset.ready === 'true')"
+)
 
-    The first load is the studio's first: the map's PNG is made then (later loads get it
-    from the studio's memory and the browser's cache is bypassed by a fresh page each time).
-    """
+
+def load(browser: Any, url: str) -> tuple[float, float, Any]:
+    """(page ready, plans shown) in seconds from navigating to ``url`` in a fresh page
+    (its own context: nothing cached by the browser), and the page."""
+    page = browser.new_page(viewport={"width": 1400, "height": 860})
+    began = time.perf_counter()
+    page.goto(url)
+    page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
+    ready = time.perf_counter() - began
+    page.wait_for_function(PLANS_SHOWN, timeout=60_000, polling=10)
+    return ready, time.perf_counter() - began, page
+
+
+def first_loads(
+    mission: Path, sources: dict[str, Path | None], repeat: int
+) -> dict[str, dict[str, float]]:
+    """Median (page ready, plans shown) of the first load right after ``navseq studio``
+    started (nothing made yet: the map's PNG, costmap and plans are made then), each
+    source's studio started ``repeat`` times, the sources in turn so that they share
+    the machine's ups and downs."""
+    from playwright.sync_api import sync_playwright
+
+    ready: dict[str, list[float]] = {label: [] for label in sources}
+    planned: dict[str, list[float]] = {label: [] for label in sources}
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        for _ in range(repeat):
+            for label, source in sources.items():
+                served = Served(mission, source)
+                try:
+                    shown, plans, page = load(browser, served.url)
+                    page.close()
+                finally:
+                    served.close()
+                ready[label].append(shown)
+                planned[label].append(plans)
+        browser.close()
+    return {
+        label: {
+            "first": statistics.median(ready[label]),
+            "first_plans": statistics.median(planned[label]),
+        }
+        for label in sources
+    }
+
+
+def page_figures(served: Served, moves: list[tuple[float, float]], repeat: int) -> dict[str, float]:
+    """Seconds: median page ready and plans shown of later loads (after a first one,
+    not counted), and median drag -> problems drawn (absent when ``moves`` is empty)."""
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        ready = []
+        load(browser, served.url)[2].close()  # the first load: first_loads measures it
+        ready, planned = [], []
         for _ in range(repeat):
-            page = browser.new_page(viewport={"width": 1400, "height": 860})
-            began = time.perf_counter()
-            page.goto(served.url)
-            page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
-            ready.append(time.perf_counter() - began)
+            shown, plans, page = load(browser, served.url)
+            ready.append(shown)
+            planned.append(plans)
             if len(ready) < repeat:
                 page.close()
         drags = []
@@ -227,7 +288,22 @@ def page_figures(
             )
             drags.append(time.perf_counter() - began)
         browser.close()
-    return ready[0], statistics.median(ready[1:] or ready), statistics.median(drags)
+    figures = {"ready": statistics.median(ready), "plans": statistics.median(planned)}
+    if drags:
+        figures["drag"] = statistics.median(drags)
+    return figures
+
+
+def exported(ref: str, into: Path) -> Path:
+    """``src/`` of git commit ``ref`` under ``into``, with this tree's compiled A*."""
+    archive = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", ref, "src"], check=True, capture_output=True
+    ).stdout
+    into.mkdir(parents=True)
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    for built in (ROOT / "src/navseq/sim").glob("_astar*.so"):
+        shutil.copy2(built, into / "src/navseq/sim" / built.name)
+    return into / "src"
 
 
 def live_rate(served: Served, seconds: float) -> tuple[float, float]:
@@ -270,6 +346,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int, default=5, help="page loads and drags per map")
     parser.add_argument("--live-seconds", type=float, default=6.0)
+    parser.add_argument(
+        "--before", metavar="REF", help="also measure the page loads of git commit REF"
+    )
     args = parser.parse_args()
     if not Path(CHROMIUM).exists():
         print(f"no Chromium at {CHROMIUM}: scripts/install-browser.sh", file=sys.stderr)
@@ -306,28 +385,44 @@ def main() -> int:
             assert len(set(moves)) == len(moves), moves
             cases[name] = (mission, map_yaml, moves)
 
+        before = exported(args.before, base / "before") if args.before else None
         figures: dict[str, dict[str, float]] = {name: {} for name in cases}
         for name, (mission, _, moves) in cases.items():
             rebuilt = check_latency(mission, moves, cached=False)
             cached = check_latency(mission, moves, cached=True)
+            sources = {"": None, "_before": before} if before is not None else {"": None}
+            for suffix, measured in first_loads(mission, sources, args.repeat).items():
+                figures[name].update({key + suffix: value for key, value in measured.items()})
+            if before is not None:
+                served = Served(mission, before)
+                try:
+                    old = page_figures(served, [], args.repeat)
+                finally:
+                    served.close()
+                figures[name].update({f"{key}_before": value for key, value in old.items()})
             served = Served(mission)
             try:
-                first, ready, drag = page_figures(served, moves, args.repeat)
+                figures[name].update(page_figures(served, moves, args.repeat))
                 live, moving = live_rate(served, args.live_seconds)
             finally:
                 served.close()
-            figures[name] = {
-                "first": first,
-                "ready": ready,
-                "drag": drag,
+            figures[name] |= {
                 "rebuilt": rebuilt,
                 "cached": cached,
                 "live": live,
                 "moving": moving,
             }
+        seconds: Callable[[float], str] = lambda v: f"{v:.2f}"  # noqa: E731
+        then = f"  before ({args.before})"
         targets = {
-            "first": ("page ready, first load [s]", "<= 1 / 2", lambda v: f"{v:.2f}"),
-            "ready": ("page ready, later loads [s]", "<= 1 / 2", lambda v: f"{v:.2f}"),
+            "first": ("page ready, first load [s]", "<= 1 / 2", seconds),
+            "first_before": (then, "", seconds),
+            "ready": ("page ready, later loads [s]", "<= 1 / 2", seconds),
+            "ready_before": (then, "", seconds),
+            "first_plans": ("plans shown, first load [s]", "", seconds),
+            "first_plans_before": (then, "", seconds),
+            "plans": ("plans shown, later loads [s]", "", seconds),
+            "plans_before": (then, "", seconds),
             "drag": (
                 "drag -> problems drawn, page [ms]",
                 "<= 150 / 500",
@@ -347,8 +442,12 @@ def main() -> int:
             table.add_column(name, justify="right")
         table.add_column("target", justify="right")
         for key, (label, target, shown) in targets.items():
+            if key.endswith("_before") and before is None:
+                continue
             format_: Callable[[float], str] = shown
-            table.add_row(label, *(format_(figures[name][key]) for name in cases), target)
+            # escape: "[s]" would otherwise be taken as rich markup and vanish.
+            row = (format_(figures[name][key]) for name in cases)
+            table.add_row(escape(label), *row, escape(target))
         Console(width=120).print(table)
     finally:
         shutil.rmtree(base, ignore_errors=True)

@@ -398,6 +398,126 @@ def test_checks_inflate_the_map_once_until_its_file_changes(
     assert [problem["waypoint"] for problem in answer["problems"]] == [2]
 
 
+def test_the_images_show_the_map_greys_and_where_the_centre_may_not_be(
+    client: TestClient, workspace: Path
+) -> None:
+    from io import BytesIO
+
+    import numpy as np
+    from PIL import Image
+
+    from navseq.commands.common import costmap_for_map
+    from navseq.sim.costmap import INSCRIBED, LETHAL
+
+    query = {"map": "../maps/turtlebot3_world.yaml"}
+    shown = Image.open(BytesIO(client.get("/api/map/image", params=query).content))
+    grey = np.array(shown.convert("L"))[::-1]  # the image's top row is the map's last
+    costmap = costmap_for_map(workspace / "maps/turtlebot3_world.yaml")
+    data = costmap.grid.data
+    assert set(np.unique(grey[data == 0])) == {254}  # map_server's free
+    assert set(np.unique(grey[data == 100])) == {0}  # occupied
+    assert set(np.unique(grey[data < 0])) == {205}  # unknown
+    overlay = Image.open(
+        BytesIO(client.get("/api/map/image", params={**query, "layer": "costmap"}).content)
+    )
+    rgba = np.array(overlay.convert("RGBA"))[::-1]
+    no_centre = (costmap.planning_cost >= INSCRIBED) & (costmap.cost < LETHAL)
+    assert no_centre.any()
+    assert (rgba[no_centre] == (220, 40, 40, 150)).all()  # red: the centre may not go
+    assert (rgba[costmap.cost >= LETHAL][:, 3] == 0).all()  # obstacles: the map shows them
+    assert (rgba[costmap.cost == 0][:, 3] == 0).all()  # free of cost: clear
+
+
+def test_the_map_image_does_not_wait_for_a_costmap_being_built(
+    client: TestClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The page's first paint needs the map's PNG; the costmap and plans of the first
+    check (seconds on a big map) are made beside it, not before it."""
+    import threading
+
+    import navseq.commands.common as common
+
+    inflating, release = threading.Event(), threading.Event()
+    real = common.costmap_for_robot
+
+    def slow(grid: object, robot: object = None) -> object:
+        inflating.set()
+        assert release.wait(30)
+        return real(grid, robot)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(common, "costmap_for_robot", slow)
+    document = opened(client)["mission"]
+    answers: list[dict] = []
+    checking = threading.Thread(
+        target=lambda: answers.append(client.post("/api/check", json={"mission": document}).json())
+    )
+    checking.start()
+    try:
+        assert inflating.wait(30)
+        # Would hang until release (30 s, then fail) if the image waited for it.
+        image = client.get("/api/map/image", params={"map": "../maps/turtlebot3_world.yaml"})
+        assert image.status_code == 200 and image.content.startswith(b"\x89PNG")
+        assert answers == []  # the check is still waiting for its costmap
+    finally:
+        release.set()
+        checking.join(30)
+    assert len(answers[0]["legs"]) == 7
+
+
+def test_warm_up_makes_the_map_image_before_the_first_check(
+    workspace: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from navseq.studio import mapview
+    from navseq.studio.app import Studio
+
+    mission_path = (workspace / "examples/turtlebot3_world.yaml").resolve()
+    roots = FileRoots([mission_path.parent, workspace / "maps"], mission_path.parent)
+    studio = Studio(StudioConfig(token=TOKEN, roots=roots, mission_path=mission_path))
+    done: list[str] = []
+    real_png, real_check = mapview.map_png, studio.check
+    monkeypatch.setattr(mapview, "map_png", lambda grid: done.append("map image") or real_png(grid))
+    monkeypatch.setattr(
+        studio, "check", lambda document: done.append("check") or real_check(document)
+    )
+    studio.warm_up()
+    assert done == ["map image", "check"]
+    # What the page then asks for is made already.
+    monkeypatch.setattr(mapview, "map_png", lambda grid: pytest.fail("made twice"))
+    assert studio.map_image("../maps/turtlebot3_world.yaml", "map").startswith(b"\x89PNG")
+
+
+def test_a_draft_checked_again_unchanged_gets_the_same_answer_without_a_new_check(
+    client: TestClient, workspace: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each page load's first check sends the opened mission as the warm-up checked it:
+    the answer is sent again, until the draft or its map file changes."""
+    import os
+
+    import navseq.studio.app as app
+
+    checked: list[object] = []
+    real = app.check_draft
+
+    def counting(document: object, **kwargs: object) -> object:
+        checked.append(document)
+        return real(document, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(app, "check_draft", counting)
+    document = opened(client)["mission"]
+    first = client.post("/api/check", json={"mission": document}).json()
+    assert client.post("/api/check", json={"mission": document}).json() == first
+    assert len(checked) == 1
+    document["waypoints"][2]["x"] = 0.56
+    moved = client.post("/api/check", json={"mission": document}).json()
+    assert len(checked) == 2  # a new draft: checked
+    # The map's image is touched on disk: the same draft is checked again.
+    image = workspace / "maps/turtlebot3_world.pgm"
+    stat = image.stat()
+    os.utime(image, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000_000))
+    assert client.post("/api/check", json={"mission": document}).json() == moved
+    assert len(checked) == 3
+
+
 # --- files: import, export, the robot: section ------------------------------------------
 
 

@@ -97,6 +97,8 @@ def page(studio: tuple[str, Path, Any]) -> Iterator[Any]:
         page.on("pageerror", lambda error: page.errors.append(str(error)))
         page.goto(url)
         page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+        # The tests below start from the opened mission checked and its legs drawn.
+        page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
         try:
             yield page
         finally:
@@ -230,6 +232,37 @@ def message_of(page: Any, starts: str) -> str:
     return str(page.locator("#message").inner_text())
 
 
+def test_the_page_is_ready_before_the_first_check_and_plans_come_after(
+    studio: tuple[str, Path, Any],
+) -> None:
+    """The first paint (map drawn, markers placed, the file's problems listed) does
+    not wait for the pre-flight and the planned legs, which take seconds on a big map:
+    here the check's answer is held back until the page says it is ready."""
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        try:
+            page = browser.new_page(viewport={"width": 1400, "height": 860})
+            held: list[Any] = []
+            page.route("**/api/check", lambda route: held.append(route))
+            page.goto(studio[0])
+            page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+            assert page.get_by_test_id("map-image").count() == 1
+            assert page.get_by_test_id("waypoint-marker").count() == 7
+            assert len(held) == 1  # asked at once, not answered yet
+            assert page.evaluate("document.body.dataset.planned") is None
+            assert page.locator(".leg-label").count() == 0
+            assert "checking and planning" in page.locator("#route").inner_text()
+            held[0].continue_()
+            page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
+            assert page.locator(".leg-label").count() == 7  # every leg drawn with its length
+            route = page.locator("#route").inner_text()
+            assert "checking" not in route and " m · " in route
+        finally:
+            browser.close()
+
+
 def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:
@@ -238,7 +271,7 @@ def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     second.errors = []  # type: ignore[attr-defined]
     second.on("pageerror", lambda error: second.errors.append(str(error)))
     second.goto(url)
-    second.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+    second.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
     accept_dialogs(page)
     accept_dialogs(second)
     # Each tab adds its own waypoint; the first saves, then the second.

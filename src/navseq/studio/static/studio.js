@@ -9,7 +9,7 @@ const S = {
   problems: [], legs: [], route: {}, selected: null,
   undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
   layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
-  mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
+  planned: false, painted: null, mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
 };
 const WP_FIELDS = [
   ["name", "text"], ["x", "number"], ["y", "number"], ["yaw", "number"],
@@ -390,7 +390,7 @@ function renderProblems() {
   const r = S.route;
   $("route").textContent = r.total_length_m != null
     ? `${S.doc.waypoints.length} waypoints · ${r.total_length_m.toFixed(2)} m · ${r.estimated_duration}`
-    : `${S.doc.waypoints.length} waypoints${r.unplanned_legs ? " · some legs have no path" : ""}`;
+    : `${S.doc.waypoints.length} waypoints${!S.planned ? " · checking and planning…" : r.unplanned_legs ? " · some legs have no path" : ""}`;
 }
 
 // ---- checking (the same code as navseq validate --map) ----------------------------------
@@ -411,9 +411,12 @@ async function check() {
     S.legs = answer.data.legs;
     S.route = answer.data;
   }
+  S.planned = true;
+  await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
   render();
   document.body.dataset.checked = String(seq);
+  document.body.dataset.planned = "true";  // the first check's plans are drawn
 }
 
 // ---- files -------------------------------------------------------------------------------
@@ -700,10 +703,14 @@ async function main() {
   S.problems = answer.data.problems;
   $("mission-name").textContent = answer.data.path || S.name;
   if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
-  await loadMap(true);
-  render();
-  await check();
-  document.body.dataset.ready = "true";
+  // The first check (pre-flight problems and every leg planned: a second or more on a
+  // big map) goes out now and is worked on while the map is drawn; the page is ready
+  // (map drawn, markers placed, the file's own problems listed) without waiting for it.
+  S.painted = loadMap(true).then(() => {
+    render();
+    document.body.dataset.ready = "true";
+  });
+  await Promise.all([S.painted, check()]);
   loadRuns();
 }
 main();
