@@ -207,3 +207,16 @@ def test_the_launcher_module_imports_no_ros():
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+@pytest.mark.ros
+def test_kill_9_of_the_command_takes_its_nodes_and_master_with_it(unstarted_master):
+    sim = SimCommand(unstarted_master.env)
+    try:
+        sim.wait_ready()
+        pids = [pid_of(unstarted_master.uri)] + [
+            node_pid(unstarted_master.uri, node) for node in ("/sim_robot", "/move_base")
+        ]
+    finally:
+        sim.kill()  # SIGKILL: no chance to clean up; the kernel's parent-death signal does
+    wait_for(lambda: not any(alive(pid) for pid in pids), 20, "the children to end")
