@@ -175,6 +175,14 @@ def test_it_uses_a_running_master_and_sigterm_stops_only_its_nodes(ros_master):
         assert ros_master.get_param("/r1/sim_robot/base_frame") == "r1/base_footprint"
         ros_master.wait_for_publisher("/map")  # one world map, outside the namespace
         pids = [node_pid(ros_master.uri, node) for node in ("/r1/sim_robot", "/r1/move_base")]
+        # A second simulator in the same namespace would push these nodes off the master.
+        second = subprocess.run(
+            [NAVSEQ, "sim", "--ros1", "--ns", "r1"],
+            env=ros_master.env, capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert second.returncode == 2, second.stderr
+        assert "a node /r1/sim_robot already runs on this master" in second.stderr
+        assert all(alive(pid) for pid in pids)
         sim.popen.send_signal(signal.SIGTERM)
         assert sim.wait() == 0, sim.output()
     finally:

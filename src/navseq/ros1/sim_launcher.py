@@ -177,7 +177,8 @@ def _master(uri: str, timeout: float = 2.0) -> Any:
     return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
 
 
-def master_online(uri: str) -> bool:
+def answers(uri: str) -> bool:
+    """Whether the master or node serving XML-RPC at ``uri`` answers (both offer getPid)."""
     try:
         code, _, _ = _master(uri).getPid(CALLER_ID)
     except (OSError, xmlrpc.client.Error):
@@ -203,9 +204,10 @@ def action_server_up(uri: str, action: str) -> bool:
     return f"{action}/status" in published and f"{action}/goal" in subscribed
 
 
-def node_registered(uri: str, node: str) -> bool:
-    code, _, _ = _master(uri).lookupNode(CALLER_ID, node)
-    return bool(code == 1)
+def node_running(uri: str, node: str) -> bool:
+    """Whether ``node`` is registered and answers (a killed node's stale entry does not)."""
+    code, _, node_uri = _master(uri).lookupNode(CALLER_ID, node)
+    return code == 1 and answers(node_uri)
 
 
 # -- children -----------------------------------------------------------------------------
@@ -319,7 +321,7 @@ def _start_master(uri: str, env: dict[str, str]) -> Child:
         )
     master = Child.start("rosmaster", ["rosmaster", "--core", "-p", str(port)], env, echo=False)
     deadline = time.monotonic() + 15.0
-    while not master_online(uri):
+    while not answers(uri):
         if not master.running() or time.monotonic() > deadline:
             master.stop(signal.SIGTERM)
             raise NavseqError(
@@ -370,10 +372,10 @@ def run(config: SimConfig, start: Pose2D, robot_option: str | None) -> int:
     master: Child | None = None
     nodes: list[Child] = []
     try:
-        if master_online(uri):
+        if answers(uri):
             _say(f"using the ROS master at {uri}")
             for spec in specs:
-                if node_registered(uri, f"{namespace}/{spec.name}"):
+                if node_running(uri, f"{namespace}/{spec.name}"):
                     raise NavseqError(
                         f"a node {namespace}/{spec.name} already runs on this master "
                         "(another simulator?): stop it, or give another --ns",
