@@ -83,6 +83,12 @@ RULES: tuple[Rule, ...] = (
         "tests/test_ros2_cli.py::test_navseq_sim_ros2_serves_until_a_signal_and_exits_0",
     ),
     Rule(
+        r"navseq sim --ros1",
+        "ros",
+        "tests/test_ros1_sim_cli.py::"
+        "test_it_starts_a_master_serves_a_mission_and_leaves_nothing_behind",
+    ),
+    Rule(
         r"-m navseq\.ros2\.sim_node .*stop_on_failure",
         "ros",
         "tests/test_ros2_sim.py::test_follow_waypoints_goes_on_without_stop_on_failure",

@@ -43,12 +43,6 @@ def test_bad_options_are_one_clear_error_even_without_ros2(options, message):
     assert "Traceback" not in done.stderr
 
 
-def test_ros1_is_not_there_yet_and_says_what_to_use():
-    done = run_without_ros(CLI, "sim", "--ros1")
-    assert done.returncode == 2
-    assert "roslaunch navseq sim.launch" in done.stderr
-
-
 @pytest.mark.ros2
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_navseq_sim_ros2_serves_until_a_signal_and_exits_0(signum):

@@ -1,8 +1,10 @@
-"""``navseq sim --ros2``: the simulated robot and a Nav2 stand-in, as ROS 2 nodes.
+"""``navseq sim --ros2|--ros1``: the simulated robot and a navigation stand-in, as ROS nodes.
 
-Runs :mod:`navseq.ros2.sim_node` in this process until Ctrl-C (exit 0). ROS 2 must be
-sourced (rclpy importable); without it the command says so and exits 2. ``--ros1`` (the
-ROS 1 sim nodes) is not there yet: ``roslaunch navseq sim.launch`` starts them.
+``--ros2`` runs :mod:`navseq.ros2.sim_node` (Nav2's interfaces) in this process; ``--ros1``
+starts the ROS 1 sim nodes (move_base's interface) as child processes, and a rosmaster
+when none answers (:mod:`navseq.ros1.sim_launcher`). Either serves until Ctrl-C (exit 0).
+Both take the same options (:mod:`navseq.ros2.sim_config`), checked before any ROS is
+imported; without the chosen ROS the command says so and exits 2.
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     middleware.add_argument(
         "--ros1",
         action="store_true",
-        help="the ROS 1 sim nodes (not yet: use `roslaunch navseq sim.launch`)",
+        help="the ROS 1 sim nodes: move_base (actionlib), odom, tf, map; uses the master at "
+        "ROS_MASTER_URI or starts one",
     )
     add_arguments(parser)
 
@@ -37,13 +40,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.ros2.sim_config import config_from_args
 
+    # Bad options are reported even where the chosen ROS is missing.
+    config = config_from_args(args, ros1=args.ros1)
     if args.ros1:
-        raise NavseqError(
-            "--ros1 is not available yet: start the ROS 1 simulator with "
-            "`roslaunch navseq sim.launch` (or sim_robot.launch)",
-            source="navseq sim",
-        )
-    config = config_from_args(args)  # bad options are reported even without ROS 2
+        from navseq.ros1 import sim_launcher
+
+        start = sim_launcher.start_pose(config)  # a start in a wall is bad input, too
+        if sim_launcher.ros1_missing() is not None:
+            raise NavseqError(sim_launcher.ROS1_MISSING, source="navseq sim --ros1")
+        return sim_launcher.run(config, start, args.robot)
     from navseq.ros2 import ros2_missing
 
     if ros2_missing() is not None:

@@ -14,6 +14,8 @@
 - :mod:`navseq.ros1.params`: typed private parameters with errors naming the parameter;
 - :mod:`navseq.ros1.fleet`: the other robots of a simulated fleet, their poses from TF;
 - ``sim_robot_node`` / ``sim_nav_node``: the embedded simulator served as ROS nodes.
+- :mod:`navseq.ros1.sim_launcher`: ``navseq sim --ros1``, those two nodes (and a rosmaster
+  when none answers) started and stopped as child processes.
 
 Importing this package imports nothing from ROS; each module does so itself.
 """

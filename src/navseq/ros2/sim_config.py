@@ -1,7 +1,8 @@
-"""The ROS 2 simulator's settings: command-line options and their checks, without ROS.
+"""The simulator's settings: command-line options and their checks, without ROS.
 
-Shared by ``python -m navseq.ros2.sim_node`` and ``navseq sim --ros2`` so that both take
-the same options with the same meaning; importing this module imports no ROS 2.
+Shared by ``python -m navseq.ros2.sim_node``, ``navseq sim --ros2`` and ``navseq sim
+--ros1`` (:mod:`navseq.ros1.sim_launcher`) so that all take the same options with the
+same meaning; importing this module imports no ROS.
 """
 
 from __future__ import annotations
@@ -18,8 +19,10 @@ from navseq.geometry import Pose2D
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.fleet import other_robots_problem
 
-# ROS 2 name rules for one namespace token: letters, digits, underscores, not a digit first.
+# Name rules for one namespace token: letters, digits, underscores; ROS 2 refuses a digit
+# first, ROS 1 anything but a letter first.
 _NAMESPACE_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_ROS1_NAMESPACE_TOKEN = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 MAX_SPEED = 100.0  # beyond this the simulation cannot keep up on any machine anyway
 
 
@@ -47,8 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--ns",
         default="",
         metavar="NS",
-        help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose, frames "
-        "robot1/odom, robot1/base_footprint)",
+        help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose with --ros2, "
+        "/robot1/move_base with --ros1; frames robot1/odom, robot1/base_footprint)",
     )
     parser.add_argument(
         "--speed",
@@ -115,25 +118,27 @@ class SimConfig:
         return self.speed != 1.0 and not self.follow_clock
 
 
-def namespace_of(text: str, option: str = "--ns") -> str:
-    """``/robot1/`` -> ``robot1``; a clear error for a name ROS 2 would refuse."""
+def namespace_of(text: str, option: str = "--ns", *, ros1: bool = False) -> str:
+    """``/robot1/`` -> ``robot1``; a clear error for a name ROS 2 (or ROS 1) would refuse."""
     stripped = text.strip().strip("/")
     if not stripped:
         return ""
-    if not all(_NAMESPACE_TOKEN.fullmatch(token) for token in stripped.split("/")):
+    token = _ROS1_NAMESPACE_TOKEN if ros1 else _NAMESPACE_TOKEN
+    if not all(token.fullmatch(part) for part in stripped.split("/")):
+        rule = "each part starting with a letter" if ros1 else "not starting with a digit"
         raise NavseqError(
-            f"{text!r} is not a ROS 2 namespace (letters, digits and underscores, "
-            "separated by '/', not starting with a digit)",
+            f"{text!r} is not a ROS {1 if ros1 else 2} namespace (letters, digits and "
+            f"underscores, separated by '/', {rule})",
             source=option,
         )
     return stripped
 
 
-def other_robots_of(text: str, own: str) -> tuple[str, ...]:
+def other_robots_of(text: str, own: str, *, ros1: bool = False) -> tuple[str, ...]:
     """``robot2,robot3`` -> their namespaces, checked against this robot's own."""
     if not text.strip():
         return ()
-    names = tuple(namespace_of(part, "--other-robots") for part in text.split(","))
+    names = tuple(namespace_of(part, "--other-robots", ros1=ros1) for part in text.split(","))
     problem = other_robots_problem(names, own, "namespace")
     if problem is not None:
         raise NavseqError(problem, source="--other-robots")
@@ -155,8 +160,11 @@ def follow_clock_of(text: str, speed: float) -> bool:
     return value == "true"
 
 
-def config_from_args(args: argparse.Namespace) -> SimConfig:
-    """The checked settings; every bad value is a NavseqError naming its option."""
+def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
+    """The checked settings; every bad value is a NavseqError naming its option.
+
+    ``ros1``: for ``navseq sim --ros1``, whose nodes live under ROS 1's name rules.
+    """
     from navseq.mission.robot_format import robot_from_option
 
     map_yaml = args.map if args.map is not None else default_map()
@@ -167,13 +175,13 @@ def config_from_args(args: argparse.Namespace) -> SimConfig:
     if not (math.isfinite(speed) and 0.0 < speed <= MAX_SPEED):
         raise NavseqError(f"must be > 0 and <= {MAX_SPEED:g}, got {args.speed}", source="--speed")
     robot = robot_from_option(args.robot) if args.robot is not None else DEFAULT_PROFILE
-    namespace = namespace_of(args.ns)
+    namespace = namespace_of(args.ns, ros1=ros1)
     return SimConfig(
         map_yaml=map_yaml,
         start=args.start,
         namespace=namespace,
         speed=speed,
         robot=robot,
-        other_robots=other_robots_of(args.other_robots, namespace),
+        other_robots=other_robots_of(args.other_robots, namespace, ros1=ros1),
         follow_clock=follow_clock_of(args.follow_clock, speed),
     )
