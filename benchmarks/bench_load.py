@@ -76,7 +76,7 @@ def measure(path: Path, mode: str) -> dict[str, float]:
         capture_output=True,
         text=True,
     ).stdout
-    return json.loads(output)  # type: ignore[no-any-return]
+    return dict(json.loads(output))
 
 
 def main() -> None:

@@ -81,7 +81,7 @@ def role_server(log: Path) -> None:
     sink = open(log, "a", encoding="utf-8", buffering=1)  # noqa: SIM115 (lives with the node)
     arrivals: dict[bytes, float] = {}
 
-    class TimedServer(ActionServer):  # type: ignore[misc]
+    class TimedServer(ActionServer):
         """Stamps a goal's arrival where its request leaves the middleware (the goal
         callback does not see the goal's id)."""
 
@@ -199,7 +199,7 @@ def wait_ready(process: subprocess.Popen[str], word: str, timeout: float = 60.0)
         if word in line:
             return
     process.kill()
-    raise RuntimeError(f"not ready: {process.args}\n{process.communicate()[1][-3000:]}")
+    raise RuntimeError(f"not ready: {process.args!r}\n{process.communicate()[1][-3000:]}")
 
 
 def stop(process: subprocess.Popen[str]) -> None:

@@ -61,7 +61,7 @@ def pick_pairs(costmap: Costmap, count: int, min_separation: float, seed: int) -
     while len(pairs) < count:
         start, goal = free[rng.choice(len(free), 2)]
         if np.linalg.norm(start - goal) >= min_separation:
-            pairs.append((tuple(int(v) for v in start), tuple(int(v) for v in goal)))
+            pairs.append(((int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))))
     return pairs
 
 

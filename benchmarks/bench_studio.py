@@ -154,7 +154,7 @@ def check_latency(mission: Path, moves: list[tuple[float, float]], cached: bool)
     roots = FileRoots([mission.parent, mission.parent.parent], mission.parent)
     studio = Studio(StudioConfig(token="t", roots=roots, mission_path=mission))
     if not cached:  # the first slice: validate's function inflated the map every time
-        studio.costmap = lambda path, robot: costmap_for_map(path, robot)  # type: ignore[method-assign]
+        studio.costmap = lambda map_path, robot: costmap_for_map(map_path, robot)  # type: ignore[method-assign]
     document = studio.mission()["mission"]
     studio.check(document)  # the page's first check, on opening
     times = []
@@ -390,7 +390,9 @@ def main() -> int:
         for name, (mission, _, moves) in cases.items():
             rebuilt = check_latency(mission, moves, cached=False)
             cached = check_latency(mission, moves, cached=True)
-            sources = {"": None, "_before": before} if before is not None else {"": None}
+            sources: dict[str, Path | None] = {"": None}
+            if before is not None:
+                sources["_before"] = before
             for suffix, measured in first_loads(mission, sources, args.repeat).items():
                 figures[name].update({key + suffix: value for key, value in measured.items()})
             if before is not None:
