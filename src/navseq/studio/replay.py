@@ -75,17 +75,22 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
     state = read_journal(journal_path)
     mission_path = _mission_file(folder, state.mission_source)
     mission = load_mission(mission_path) if mission_path is not None else None
-    events = list(journal_events(journal_path))  # read_journal keeps no event list
-    start_t = events[0].t if events else 0.0
+    # Events are streamed from the file, never held: a patrol's journal may hold weeks.
     if mission is not None:
         count = len(mission.waypoints)
     else:
-        count = 1 + max((getattr(event, "index", -1) for event in events), default=-1)
+        indices = (getattr(event, "index", -1) for event in journal_events(journal_path))
+        count = 1 + max(indices, default=-1)
     fold = LiveView(count, footprint=[])
     poses: list[list[float]] = []
     states: list[dict[str, Any]] = []
     plans: list[dict[str, Any]] = []
-    for event in events:
+    start_t: float | None = None
+    last_t = 0.0
+    for event in journal_events(journal_path):
+        if start_t is None:
+            start_t = event.t
+        last_t = event.t
         before = (list(fold.waypoints), fold.current, fold.loop, fold.status)
         fold(event)
         t = round(event.t - start_t, 3)
@@ -110,7 +115,7 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
         "folder": shown,
         "mission": document_of(mission, base_dir) if mission is not None else None,
         "report": _latest_report(folder),
-        "duration_s": round(events[-1].t - start_t, 3) if events else 0.0,
+        "duration_s": round(last_t - start_t, 3) if start_t is not None else 0.0,
         "finish_reason": state.finish_reason,
         "damaged_lines": state.damaged_lines,
         "footprint_m": [[float(x), float(y)] for x, y in robot.footprint],
