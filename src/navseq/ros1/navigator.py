@@ -51,7 +51,6 @@ jumps, unlike the map pose when localisation corrects itself.
 
 from __future__ import annotations
 
-import queue
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -80,6 +79,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.inbox import EventInbox
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
 
@@ -200,10 +200,9 @@ class Ros1Navigator:
         # (wall time, actionlib goal id) of the last result of a goal we tracked.
         self._last_result: tuple[float, str] | None = None
 
-        self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
-        # Set after an event is queued (and on anything else spin() must look at); the
-        # queue itself, not this flag, says whether an event is waiting.
-        self._wake = threading.Event()
+        # Callbacks leave events here and wake spin() (also on anything else it must
+        # look at: a status, the clock).
+        self._inbox = EventInbox()
         self._lock = threading.Lock()
         self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
         self._goal_id: int | None = None
@@ -275,10 +274,7 @@ class Ros1Navigator:
             wait = SPIN_SLICE
             if self._clock_sub is None:
                 wait = min(wait, start + seconds - now)  # wall clock: ROS time is wall time
-            self._wake.wait(wait)
-            # Clear before looking at the queue again: an event queued from here on sets
-            # the flag anew, one queued before is seen by _has_news().
-            self._wake.clear()
+            self._inbox.wait(wait)
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait (wall time) for the server, then settle the clock (see the module doc).
@@ -475,14 +471,7 @@ class Ros1Navigator:
         return None
 
     def poll(self) -> list[NavEvent]:
-        events: list[NavEvent] = []
-        while True:
-            try:
-                events.append(self._events.get_nowait())
-            except queue.Empty:
-                break
-        events.extend(self._check_server())
-        return events
+        return [*self._inbox.drain(), *self._check_server()]
 
     def close(self) -> None:
         if self._closed:
@@ -493,11 +482,7 @@ class Ros1Navigator:
 
     def _has_news(self) -> bool:
         """:meth:`poll` has something to report: a queued event, or the server lost or back."""
-        return not self._events.empty() or self._server_news()
-
-    def _queue(self, event: NavEvent) -> None:
-        self._events.put(event)
-        self._wake.set()  # after the put, so that a woken spin() finds the event
+        return self._inbox.has_events() or self._server_news()
 
     # -- server liveness ---------------------------------------------------------------
 
@@ -544,7 +529,7 @@ class Ros1Navigator:
             # PENDING only means the server received it; ACTIVE means it took it on.
             if state == CommState.ACTIVE and not self._accepted:
                 self._accepted = True
-                self._queue(GoalAccepted(goal_id))
+                self._inbox.put(GoalAccepted(goal_id))
             elif state == CommState.DONE:
                 outcome, status = terminal_status_of(handle.get_goal_status()) or (
                     GoalOutcome.LOST,
@@ -554,7 +539,7 @@ class Ros1Navigator:
                     # The server forgot the goal (e.g. restarted quickly): let poll()
                     # announce ServerBack once it is ready, so the executor resends.
                     self._server_up = False
-                self._queue(GoalDone(goal_id, outcome, status, handle.get_goal_status_text()))
+                self._inbox.put(GoalDone(goal_id, outcome, status, handle.get_goal_status_text()))
                 self._last_result = (
                     time.monotonic(),
                     handle.comm_state_machine.action_goal.goal_id.id,
@@ -566,26 +551,26 @@ class Ros1Navigator:
         pose = pose2d_from_pose(feedback.base_position.pose)
         self._feedback_pose = pose
         if seq == self._send_seq and self._goal_id is not None:
-            self._queue(GoalFeedback(goal_id, pose))
+            self._inbox.put(GoalFeedback(goal_id, pose))
 
     def _on_plan(self, path: Any) -> None:
         goal_id = self._goal_id
         if goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in path.poses)
-        self._queue(GoalPlan(goal_id, points))
+        self._inbox.put(GoalPlan(goal_id, points))
 
     def _on_status(self) -> None:
         if self._server_up is False:
-            self._wake.set()  # the server may be back: let spin() check
+            self._inbox.wake()  # the server may be back: let spin() check
 
     def _on_clock(self, clock: Any) -> None:
         if self._clock_time is not None:
             self._clock_time = clock.clock.to_sec()
-        self._wake.set()  # ROS time moved: let spin() check its deadline
+        self._inbox.wake()  # ROS time moved: let spin() check its deadline
 
     def _on_rospy_shutdown(self) -> None:
-        self._wake.set()
+        self._inbox.wake()
         # Runs before rospy closes its publishers (rosnode kill, signal_shutdown), so
         # the cancel still goes out and the robot does not drive on without us.
         self.cancel_goal()

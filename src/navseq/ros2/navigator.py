@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import queue
 import threading
 import time
 from collections.abc import Sequence
@@ -89,6 +88,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.inbox import EventInbox
 from navseq.ros2.messages import (
     add_transforms,
     navigate_goal,
@@ -167,9 +167,8 @@ class Nav2Navigator:
         self.lost_after = lost_after
         self._sim_time_asked = use_sim_time
 
-        self._events: queue.SimpleQueue[NavEvent] = queue.SimpleQueue()
-        # Set after an event is queued and on every /clock message: spin() looks again.
-        self._wake = threading.Event()
+        # Callbacks leave events here and wake spin() (also on every /clock message).
+        self._inbox = EventInbox()
         self._lock = threading.Lock()
         self._send_seq = 0  # goes up with every goal sent (and when one is dropped)
         self._goal_id: int | None = None  # the executor's id of the goal tracked
@@ -269,10 +268,7 @@ class Nav2Navigator:
             wait = SPIN_SLICE
             if self._clock_sub is None:
                 wait = min(wait, max(start + seconds - now, 0.0))
-            self._wake.wait(wait)
-            # Cleared before looking again: a later event sets it anew, an earlier one
-            # is seen by _has_news().
-            self._wake.clear()
+            self._inbox.wait(wait)
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait (wall time) for the server, then settle the clock (module docstring).
@@ -313,7 +309,7 @@ class Nav2Navigator:
 
     def _watch_clock(self) -> None:
         self._clock_sub = self._node.create_subscription(
-            Clock, "/clock", lambda _msg: self._wake.set(), qos_profile_sensor_data
+            Clock, "/clock", lambda _msg: self._inbox.wake(), qos_profile_sensor_data
         )
 
     def _wait_for_valid_time(self) -> None:
@@ -399,14 +395,7 @@ class Nav2Navigator:
         return self._odom_pose
 
     def poll(self) -> list[NavEvent]:
-        events: list[NavEvent] = []
-        while True:
-            try:
-                events.append(self._events.get_nowait())
-            except queue.Empty:
-                break
-        events.extend(self._check_server())
-        return events
+        return [*self._inbox.drain(), *self._check_server()]
 
     def close(self) -> None:
         """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
@@ -442,7 +431,7 @@ class Nav2Navigator:
     # -- server liveness ---------------------------------------------------------------
 
     def _has_news(self) -> bool:
-        return not self._events.empty() or self._server_news()
+        return self._inbox.has_events() or self._server_news()
 
     def _server_news(self) -> bool:
         """:meth:`_check_server` would report ServerLost or ServerBack now."""
@@ -479,10 +468,6 @@ class Nav2Navigator:
         self._absent_since = None
         return [ServerBack()]
 
-    def _queue(self, event: NavEvent) -> None:
-        self._events.put(event)
-        self._wake.set()  # after the put, so that a woken spin() finds the event
-
     # -- on the executor's thread: rclpy calls and callbacks (record and enqueue) --------
 
     def _send(self, seq: int, goal_id: int, message: Any) -> None:
@@ -510,11 +495,11 @@ class Nav2Navigator:
                 self._goal_id = None
                 self._cancel_answered.set()
                 text = f"the goal request failed: {error}" if error else REJECTED_TEXT
-                self._queue(GoalDone.failed(goal_id, "REJECTED", text))
+                self._inbox.put(GoalDone.failed(goal_id, "REJECTED", text))
                 return
             self._handle = handle
             cancel_now = self._cancel_seq == seq
-            self._queue(GoalAccepted(goal_id))
+            self._inbox.put(GoalAccepted(goal_id))
         if cancel_now:
             self._send_cancel(handle)
         result = handle.get_result_async()
@@ -529,7 +514,7 @@ class Nav2Navigator:
             self._cancel_answered.set()  # a finished goal needs no cancel
         error = future.exception()
         if error is not None:
-            self._queue(GoalDone.lost(goal_id, f"no result: {error}"))
+            self._inbox.put(GoalDone.lost(goal_id, f"no result: {error}"))
             return
         response = future.result()
         outcome, status = terminal_status(response.status) or (GoalOutcome.LOST, "LOST")
@@ -538,7 +523,7 @@ class Nav2Navigator:
         text = result_text(getattr(result, "error_code", 0), getattr(result, "error_msg", ""))
         if outcome is GoalOutcome.LOST and not text:
             text = "the server does not know the goal (restarted?)"
-        self._queue(GoalDone(goal_id, outcome, status, text))
+        self._inbox.put(GoalDone(goal_id, outcome, status, text))
 
     def _on_feedback(self, seq: int, goal_id: int, message: Any) -> None:
         feedback = message.feedback
@@ -547,7 +532,7 @@ class Nav2Navigator:
         if seq != self._send_seq or self._goal_id != goal_id:
             return
         remaining = float(feedback.distance_remaining)
-        self._queue(
+        self._inbox.put(
             GoalFeedback(
                 goal_id,
                 pose,
@@ -569,4 +554,4 @@ class Nav2Navigator:
         if goal_id is None or not message.poses:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in message.poses)
-        self._queue(GoalPlan(goal_id, points))
+        self._inbox.put(GoalPlan(goal_id, points))
