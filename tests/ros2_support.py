@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import os
 import random
+import signal
 import subprocess
 import sys
+import threading
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -75,3 +77,45 @@ def ros2_available() -> tuple[bool, str]:
     if probe.returncode != 0:
         return False, f"rclpy does not import from {prefix}: {probe.stderr.strip()[-300:]}"
     return True, ""
+
+
+class SimNode:
+    """A running ``python -m navseq.ros2.sim_node ARGS`` (the simulated robot and Nav2's
+    interfaces); its stdout is read as it comes, and it is ready when it says so."""
+
+    def __init__(self, env: dict[str, str], *args: str) -> None:
+        self.env = env
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "navseq.ros2.sim_node", *args],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        self.stdout: list[str] = []
+        self.ready = threading.Event()
+        threading.Thread(target=self._read, daemon=True).start()
+        if not self.ready.wait(60):
+            self.process.kill()
+            _, err = self.process.communicate()
+            raise AssertionError(f"sim node not ready: {self.stdout} {err}")
+
+    def _read(self) -> None:
+        assert self.process.stdout is not None
+        for line in self.process.stdout:
+            self.stdout.append(line)
+            if "ready" in line:
+                self.ready.set()
+
+    def stop(self, signum: int = signal.SIGINT) -> str:
+        """Stop it (``signum``, then a kill after 20 s); its stderr, the node's log.
+        ``process.returncode`` is its exit status."""
+        if self.process.poll() is None:
+            self.process.send_signal(signum)
+        try:
+            self.process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        assert self.process.stderr is not None
+        return self.process.stderr.read()

@@ -16,7 +16,6 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -24,6 +23,7 @@ from typing import Any
 
 import pytest
 
+import ros2_support
 from cli_support import (
     NAVSEQ,
     REPO,
@@ -143,40 +143,11 @@ executor.shutdown(timeout_sec=1)
 """
 
 
-class SimNode:
-    """A running ``python -m navseq.ros2.sim_node``; its stdout is read as it comes."""
+class SimNode(ros2_support.SimNode):
+    """The sim node on the TurtleBot3 world (``ARGS`` add to ``--map``)."""
 
     def __init__(self, env: dict[str, str], *args: str) -> None:
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "navseq.ros2.sim_node", "--map", str(MAP), *args],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        self.ready = threading.Event()
-        threading.Thread(target=self._read, daemon=True).start()
-        if not self.ready.wait(60):
-            self.process.kill()
-            raise AssertionError(f"sim node not ready: {self.process.communicate()}")
-
-    def _read(self) -> None:
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            if "ready" in line:
-                self.ready.set()
-
-    def stop(self, signum: int = signal.SIGINT) -> str:
-        """Stop it; its stderr (the node's log)."""
-        if self.process.poll() is None:
-            self.process.send_signal(signum)
-        try:
-            self.process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait()
-        assert self.process.stderr is not None
-        return self.process.stderr.read()
+        super().__init__(env, "--map", str(MAP), *args)
 
 
 class OdomWatcher:

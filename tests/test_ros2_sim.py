@@ -13,7 +13,6 @@ import json
 import signal
 import subprocess
 import sys
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -21,7 +20,7 @@ from typing import Any
 import pytest
 
 from navseq.sim.occupancy import load_map
-from ros2_support import ros2_environment, ros2_prefix
+from ros2_support import SimNode, ros2_environment, ros2_prefix
 
 pytestmark = pytest.mark.ros2
 
@@ -32,44 +31,8 @@ START = "-2,-0.5,0"
 SPEED = "4"
 
 
-class SimProcess:
-    """A running sim node and what it printed."""
-
-    def __init__(self, env: dict[str, str], *args: str) -> None:
-        self.env = env
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "navseq.ros2.sim_node", *args],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        self.stdout: list[str] = []
-        self.ready = threading.Event()
-        self._reader = threading.Thread(target=self._read, daemon=True)
-        self._reader.start()
-        if not self.ready.wait(60):
-            self.process.kill()
-            _, err = self.process.communicate()
-            raise AssertionError(f"sim node not ready: {self.stdout} {err}")
-
-    def _read(self) -> None:
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            self.stdout.append(line)
-            if "ready" in line:
-                self.ready.set()
-
-    def stop(self, signum: int = signal.SIGINT) -> tuple[int, str]:
-        if self.process.poll() is None:
-            self.process.send_signal(signum)
-        try:
-            self.process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait()
-        assert self.process.stderr is not None
-        return self.process.returncode, self.process.stderr.read()
+class SimProcess(SimNode):
+    """A running sim node, and Nav2 clients run against it (``tests/ros2_clients.py``)."""
 
     def client(self, verb: str, *poses: str, **options: Any) -> dict[str, Any]:
         done = subprocess.run(
@@ -117,8 +80,8 @@ def env() -> dict[str, str]:
 def sim(env: dict[str, str]) -> Iterator[SimProcess]:
     node = SimProcess(env, "--map", str(MAP), f"--start={START}", "--speed", SPEED)
     yield node
-    code, err = node.stop()
-    assert code == 0, err
+    err = node.stop()
+    assert node.process.returncode == 0, err
     assert "Traceback" not in err
 
 
@@ -209,7 +172,8 @@ def test_follow_waypoints_goes_on_without_stop_on_failure(env: dict[str, str]):
     try:
         seen = sim.client("waypoints", "-1.5,-0.5,0", "-1.1,0,0", "-1.0,-0.5,0")
     finally:
-        code, err = sim.stop(signal.SIGTERM)
+        err = sim.stop(signal.SIGTERM)
+        code = sim.process.returncode
     assert seen["status"] == "SUCCEEDED"
     assert seen["missed"] == [{"index": 1, "error_code": 206}]
     assert 2 in {f["current_waypoint"] for f in seen["feedback"]}  # went on past it
@@ -234,7 +198,8 @@ def test_a_namespaced_robot_serves_under_its_namespace(env: dict[str, str]):
         ready = sim.client("ready", "-1.5,-0.5,0", ns="robot1", timeout=20)
         late = sim.client("map", ns="robot1", timeout=20)
     finally:
-        code, err = sim.stop()
+        err = sim.stop()
+        code = sim.process.returncode
     assert seen["status"] == "SUCCEEDED"
     assert ready["bt_navigator"] == "active"
     assert late["map"] == [384, 384, 0.05]
