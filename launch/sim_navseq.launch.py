@@ -4,7 +4,7 @@
     ros2 launch navseq sim_navseq.launch.py mission:=examples/turtlebot3_world.yaml speed:=4
     ros2 launch navseq sim_navseq.launch.py keep_alive:=true rviz:=true
 
-Starts ``python3 -m navseq.ros2.sim_node`` (as ``launch/sim.launch.py``) and
+Includes ``launch/sim.launch.py`` (``python3 -m navseq.ros2.sim_node``) and starts
 ``python3 -m navseq.ros2.navseq_node`` (as ``ros2 run navseq navseq_node``), so it works
 from a colcon workspace and from a source checkout whose venv is first on PATH alike.
 The node reads the tutorial's parameters from ``examples/tutorial_params_ros2.yaml``, or
@@ -21,6 +21,7 @@ from launch.actions import (
     DeclareLaunchArgument,
     EmitEvent,
     ExecuteProcess,
+    IncludeLaunchDescription,
     OpaqueFunction,
     RegisterEventHandler,
 )
@@ -28,12 +29,16 @@ from launch.conditions import IfCondition
 from launch.event_handlers import OnProcessExit
 from launch.events import Shutdown
 from launch.launch_context import LaunchContext
+from launch.launch_description_sources import PythonLaunchDescriptionSource
 from launch.substitutions import LaunchConfiguration
 
 SHARE = Path(__file__).resolve().parents[1]  # the repository, or share/navseq when installed
 DEFAULT_MAP = str(SHARE / "maps" / "turtlebot3_world.yaml")
 TUTORIAL_PARAMS = str(SHARE / "examples" / "tutorial_params_ros2.yaml")
 RVIZ_CONFIG = str(SHARE / "rviz" / "navseq_ros2.rviz")
+SIM_LAUNCH = str(SHARE / "launch" / "sim.launch.py")
+# The simulator's arguments this file passes on (sim.launch.py declares and documents them).
+SIM_ARGUMENTS = ("map", "start", "ns", "speed", "robot", "python")
 
 
 def _navseq_node(context: LaunchContext) -> list[ExecuteProcess]:
@@ -81,23 +86,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument(name, default_value=default, description=description)
         for name, (default, description) in arguments.items()
     ]
-    sim = ExecuteProcess(
-        cmd=[
-            LaunchConfiguration("python"),
-            "-m",
-            "navseq.ros2.sim_node",
-            "--map",
-            LaunchConfiguration("map"),
-            ["--start=", LaunchConfiguration("start")],
-            ["--ns=", LaunchConfiguration("ns")],
-            "--speed",
-            LaunchConfiguration("speed"),
-            "--robot",
-            LaunchConfiguration("robot"),
-        ],
-        name="navseq_sim",
-        output="screen",
-        sigterm_timeout="10",
+    sim = IncludeLaunchDescription(
+        PythonLaunchDescriptionSource(SIM_LAUNCH),
+        launch_arguments={name: LaunchConfiguration(name) for name in SIM_ARGUMENTS}.items(),
     )
     rviz = ExecuteProcess(
         cmd=["rviz2", "-d", RVIZ_CONFIG],
