@@ -639,9 +639,24 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
             response.set_cookie(COOKIE_NAME, token, httponly=True, samesite="strict")
         return response
 
-    @api
-    async def get_mission(request: Request) -> Response:
-        return JSONResponse(await run_in_threadpool(studio.mission))
+    def answer(call: Callable[[], Any]) -> Handler:
+        """A GET of the studio's ``call()``, answered as JSON (off the event loop)."""
+
+        @api
+        async def handler(request: Request) -> Response:
+            return JSONResponse(await run_in_threadpool(call))
+
+        return handler
+
+    def answer_body(call: Callable[[dict[str, Any]], Any]) -> Handler:
+        """A POST of a JSON object, given to the studio's ``call(body)``; JSON back."""
+
+        @api
+        async def handler(request: Request) -> Response:
+            body = await read_json(request)
+            return JSONResponse(await run_in_threadpool(call, body))
+
+        return handler
 
     @api
     async def get_map(request: Request) -> Response:
@@ -657,39 +672,6 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
             request.query_params.get("layer", "map"),
         )
         return Response(png, media_type="image/png")
-
-    @api
-    async def post_check(request: Request) -> Response:
-        body = await read_json(request)
-        return JSONResponse(await run_in_threadpool(studio.check, body.get("mission")))
-
-    @api
-    async def post_save(request: Request) -> Response:
-        body = await read_json(request)
-        return JSONResponse(await run_in_threadpool(studio.save, body))
-
-    @api
-    async def post_run(request: Request) -> Response:
-        body = await read_json(request)
-        return JSONResponse(await run_in_threadpool(studio.start_run, body))
-
-    @api
-    async def get_files(request: Request) -> Response:
-        return JSONResponse(await run_in_threadpool(studio.files))
-
-    @api
-    async def post_import(request: Request) -> Response:
-        body = await read_json(request)
-        return JSONResponse(await run_in_threadpool(studio.import_file, body))
-
-    @api
-    async def post_export(request: Request) -> Response:
-        body = await read_json(request)
-        return JSONResponse(await run_in_threadpool(studio.export_launch, body))
-
-    @api
-    async def get_runs(request: Request) -> Response:
-        return JSONResponse(await run_in_threadpool(studio.runs))
 
     @api
     async def get_replay(request: Request) -> Response:
@@ -731,17 +713,21 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
 
     routes = [
         Route("/", index),
-        Route("/api/mission", get_mission),
+        Route("/api/mission", answer(studio.mission)),
         Route("/api/map", get_map),
         Route("/api/map/image", get_map_image),
-        Route("/api/check", post_check, methods=["POST"]),
-        Route("/api/save", post_save, methods=["POST"]),
-        Route("/api/files", get_files),
-        Route("/api/import", post_import, methods=["POST"]),
-        Route("/api/export", post_export, methods=["POST"]),
-        Route("/api/runs", get_runs),
+        Route(
+            "/api/check",
+            answer_body(lambda body: studio.check(body.get("mission"))),
+            methods=["POST"],
+        ),
+        Route("/api/save", answer_body(studio.save), methods=["POST"]),
+        Route("/api/files", answer(studio.files)),
+        Route("/api/import", answer_body(studio.import_file), methods=["POST"]),
+        Route("/api/export", answer_body(studio.export_launch), methods=["POST"]),
+        Route("/api/runs", answer(studio.runs)),
         Route("/api/replay", get_replay),
-        Route("/api/run", post_run, methods=["POST"]),
+        Route("/api/run", answer_body(studio.start_run), methods=["POST"]),
         Route("/api/run", get_run),
         Route("/api/run/events", run_events),
         Route("/api/run/{action}", run_request, methods=["POST"]),
