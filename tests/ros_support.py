@@ -250,8 +250,41 @@ class RosMaster:
             except subprocess.TimeoutExpired:
                 self.popen.kill()
                 self.popen.wait(timeout=timeout)
+        self._stop_leftovers(timeout)
         with contextlib.suppress(TimeoutError):
             wait_for(lambda: port_is_free(self.port), timeout, f"port {self.port} to be free")
+
+    def _leftovers(self) -> list[int]:
+        """Processes still running with this master's log folder in their environment.
+
+        roslaunch starts each node in a session of its own, so a roslaunch killed before
+        its nodes were down (it gives a node 15 s after SIGINT; stop() gives roslaunch
+        10 s) leaves them running, orphaned: a simulated move_base left so kept a core
+        busy for the rest of a test run.
+        """
+        marker = f"ROS_LOG_DIR={self.workdir / 'ros_log'}".encode()
+        found = []
+        for entry in Path("/proc").iterdir():
+            if not entry.name.isdigit() or int(entry.name) == os.getpid():
+                continue
+            try:
+                environ = (entry / "environ").read_bytes()
+            except OSError:  # gone meanwhile, or not ours to read
+                continue
+            if marker in environ.split(b"\0"):
+                found.append(int(entry.name))
+        return found
+
+    def _stop_leftovers(self, timeout: float) -> None:
+        for sig in (signal.SIGTERM, signal.SIGKILL):
+            pids = self._leftovers()
+            for pid in pids:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.kill(pid, sig)
+            if not pids:
+                return
+            with contextlib.suppress(TimeoutError):
+                wait_for(lambda: not self._leftovers(), timeout / 2, "leftover ROS processes")
 
     # -- processes -------------------------------------------------------------------
 

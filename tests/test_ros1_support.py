@@ -44,3 +44,44 @@ def test_master_port_is_released_after_shutdown(tmp_path):
         assert master.master_online()
         assert not port_is_free(port)
     assert port_is_free(port)
+
+
+# A launcher that starts its "node" in a session of its own, as roslaunch does, then is
+# killed before it could stop it: the node must not outlive the test's master.
+LAUNCHER = textwrap.dedent(
+    """
+    import subprocess, sys, time
+    stubborn = "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); time.sleep(600)"
+    node = subprocess.Popen([sys.executable, "-c", stubborn], start_new_session=True)
+    print(node.pid, flush=True)
+    time.sleep(600)
+    """
+)
+
+
+def test_a_node_its_launcher_left_behind_is_stopped_with_the_master(tmp_path):
+    with running_master(tmp_path / "ros") as master:
+        script = tmp_path / "launcher.py"
+        script.write_text(LAUNCHER)
+        launcher = master.start_python(script)
+        pid = int(wait_for_first_line(launcher))
+        launcher.stop(signal.SIGKILL, timeout=5)  # roslaunch killed: its node orphaned
+        assert alive(pid)  # the premise: still running after its launcher is gone
+    assert not alive(pid)
+
+
+def alive(pid: int) -> bool:
+    """Running (not gone, not a zombie waiting to be reaped)."""
+    from pathlib import Path
+
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "\nState:\tZ" not in status
+
+
+def wait_for_first_line(process) -> str:
+    from ros_support import wait_for
+
+    return wait_for(lambda: process.output().strip().splitlines()[:1], 20, "the pid")[0]
