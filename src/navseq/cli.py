@@ -28,7 +28,7 @@ from types import FrameType
 from navseq import __version__
 from navseq.commands import SUBCOMMANDS
 from navseq.errors import NavseqError
-from navseq.signals import Terminated
+from navseq.signals import Terminated, ignore_until_exit
 from navseq.text import printable
 
 EXIT_OK = 0
@@ -141,6 +141,9 @@ def _main(argv: list[str] | None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_BAD_INPUT
     debug = getattr(args, "debug", False)
+    # The process's own command: its exit follows the command's return, so a command may
+    # leave its signal handling in place rather than reopen a window before the exit.
+    args.exits_after_command = argv is None
     _configure_logging(debug)
     previous = {signum: signal.signal(signum, _raise_terminated) for signum in _TERMINATING}
     try:
@@ -175,8 +178,11 @@ def _main(argv: list[str] | None) -> int:
         )
         return EXIT_INTERNAL_ERROR
     finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        if args.exits_after_command:
+            ignore_until_exit()
+        else:
+            for signum, handler in previous.items():
+                signal.signal(signum, handler)
 
 
 if __name__ == "__main__":

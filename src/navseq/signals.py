@@ -104,4 +104,12 @@ class SignalGuard:
             raise StepAbandoned(signal.Signals(signum).name)
 
 
-__all__ = ["SHUTDOWN_SIGNALS", "SignalGuard", "StepAbandoned", "Terminated"]
+def ignore_until_exit() -> None:
+    """Ignore shutdown signals from now on: the process's exit status is decided, and a
+    late Ctrl-C must not turn an exit 0 that the report states into a death by SIGINT."""
+    if threading.current_thread() is threading.main_thread():
+        for signum in SHUTDOWN_SIGNALS:
+            signal.signal(signum, signal.SIG_IGN)
+
+
+__all__ = ["SHUTDOWN_SIGNALS", "SignalGuard", "StepAbandoned", "Terminated", "ignore_until_exit"]

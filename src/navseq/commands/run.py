@@ -593,7 +593,10 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
         lock.release()
         if created:
             _remove_if_unused(folder)
-        signals.restore()
+        if not getattr(args, "exits_after_command", False):
+            # In the navseq process itself the guard goes on counting signals until
+            # the exit: the status the report states is the one the process returns.
+            signals.restore()
         if len(signals.received) > 1:  # the first one is the interruption itself
             print(
                 f"navseq run: {', '.join(signals.received)} received; the robot was stopped "

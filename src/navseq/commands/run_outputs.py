@@ -97,9 +97,8 @@ def write_outputs(
     ``build_report(paths, exit_code)`` makes the report given every file's path (the
     picture's name is chosen first so that the report can name it); ``render_picture()``
     the PNG, or None for no picture (``--no-picture``: the report names none). A picture
-    given up by the operator is only noted. A picture that cannot be
-    written (disk full) makes the run's status 2, and the report is written again to say
-    so, if it can be.
+    given up by the operator or that cannot be written (disk full; the run's status
+    becomes 2) is not named by the report, which is written again to say why, if it can be.
     """
     from navseq.signals import StepAbandoned
     from navseq.sinks.report import report_json
@@ -136,13 +135,16 @@ def write_outputs(
     except NavseqError as error:
         files.failed["picture"] = str(error)
         exit_code = 2
-        if report_path is not None:
-            from navseq.files import write_atomically
+    if "picture" in files.failed and report_path is not None:
+        # The report named the picture before it was drawn: it must not name a file
+        # that is not there.
+        from navseq.files import write_atomically
 
-            try:
-                write_atomically(report_path, report_text(report_path))
-            except OSError as again:
-                files.failed["report"] = str(output_error(report_path, again))
+        del files.paths["picture"]
+        try:
+            write_atomically(report_path, report_text(report_path))
+        except OSError as again:
+            files.failed["report"] = str(output_error(report_path, again))
     return exit_code
 
 
