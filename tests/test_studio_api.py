@@ -635,10 +635,18 @@ def test_a_past_run_replays_as_a_timeline(client: TestClient, workspace: Path) -
     # The journal keeps the driven path's corners and the pose at every arrival.
     assert len(replay["poses"]) >= 2 * 7
     assert max(b - a for a, b in itertools.pairwise(times)) <= HEARTBEAT
-    # Waypoints go driving -> reached in turn; at the end every one is reached.
-    assert replay["states"][-1]["waypoints"] == ["reached"] * 7
-    first_reached = next(s for s in replay["states"] if s["waypoints"][0] == "reached")
-    assert first_reached["waypoints"][1:] in (["pending"] * 6, ["driving"] + ["pending"] * 5)
+    # Waypoints go driving -> reached in turn; at the end every one is reached. Each
+    # change carries only the waypoints it changed.
+    statuses = ["pending"] * 7
+    seen: list[list[str]] = []
+    for change in replay["states"]:
+        assert len(change["changes"]) <= 1
+        for index, status in change["changes"]:
+            statuses[index] = status
+        seen.append(list(statuses))
+    assert statuses == ["reached"] * 7
+    first_reached = next(state for state in seen if state[0] == "reached")
+    assert first_reached[1:] in (["pending"] * 6, ["driving"] + ["pending"] * 5)
     assert replay["plans"] and all(len(plan["points"]) >= 2 for plan in replay["plans"])
 
 

@@ -452,7 +452,7 @@ class Studio:
         folder = roots.resolve(folder_text, "folder")
         if not folder.is_dir():
             raise ApiError(404, f"no such run folder: {printable(folder_text)}")
-        return replay_of(folder, roots.relative(folder), self.base_dir)
+        return replay_of(folder, roots.relative(folder), self.base_dir, may_read=roots.contains)
 
     def start_run(self, body: dict[str, Any]) -> dict[str, Any]:
         from navseq.studio.runs import RunRequest, StudioRun

@@ -7,13 +7,16 @@ rules (:class:`~navseq.studio.runs.LiveView`), so a replayed waypoint is in the 
 the live page showed at that moment. What the page gets is a timeline it can scrub
 with a slider: robot poses (the journal keeps the driven path's corners, the pose at
 every arrival and one at least every 30 s; the page draws the robot in between), each
-change of the waypoints' states, and each planned path, all on one clock starting at 0.
+change of the waypoints' states (only the waypoints that changed, so that the timeline
+grows with the run, not with the run times the mission's length), and each planned
+path, all on one clock starting at 0.
 """
 
 from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -54,11 +57,19 @@ def run_summary(folder: Path, shown: str) -> dict[str, Any]:
     }
 
 
-def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
+def replay_of(
+    folder: Path,
+    shown: str,
+    base_dir: Path,
+    may_read: Callable[[Path], bool] = lambda path: False,
+) -> dict[str, Any]:
     """The run in ``folder`` as a timeline (docs/studio.md, ``GET /api/replay``).
 
     ``base_dir``: the folder the mission document's ``map:`` is made relative to (the
     studio's mission folder, so the page loads the map as it loads its own).
+    ``may_read(path)``: whether the mission file the journal names may be read where it
+    is (a ``navseq run`` folder holds no copy of it); it is used only if its bytes are
+    still those that were run.
     Raises NavseqError when the folder has no readable journal.
     """
     from navseq.executor import events as ev
@@ -73,7 +84,9 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
     if not journal_path.is_file():
         raise NavseqError(f"{printable(shown)} has no {JOURNAL_NAME}: not a run folder")
     state = read_journal(journal_path)
-    mission_path = _mission_file(folder, state.mission_source)
+    mission_path = _mission_file(folder, state.mission_source) or _source_as_run(
+        folder, state.mission_source, state.mission_digest, may_read
+    )
     mission = load_mission(mission_path) if mission_path is not None else None
     # Events are streamed from the file, never held: a patrol's journal may hold weeks.
     if mission is not None:
@@ -91,7 +104,7 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
         if start_t is None:
             start_t = event.t
         last_t = event.t
-        before = (list(fold.waypoints), fold.current, fold.loop, fold.status)
+        before = (fold.current, fold.loop, fold.status)
         fold(event)
         t = round(event.t - start_t, 3)
         if isinstance(event, ev.WaypointProgress | ev.WaypointStarted):
@@ -100,11 +113,15 @@ def replay_of(folder: Path, shown: str, base_dir: Path) -> dict[str, Any]:
             )
         elif isinstance(event, ev.WaypointPlan):
             plans.append({"t": t, "index": event.index, "points": _thinned(event.path)})
-        if (list(fold.waypoints), fold.current, fold.loop, fold.status) != before:
+        reset, changes = fold.take_changes()
+        if reset or changes or (fold.current, fold.loop, fold.status) != before:
+            # Only what changed: a full list per change would grow with the square of
+            # the mission's length (5000 waypoints: hundreds of megabytes).
             states.append(
                 {
                     "t": t,
-                    "waypoints": list(fold.waypoints),
+                    "reset": reset,
+                    "changes": [list(change) for change in changes],
                     "current": fold.current,
                     "loop": fold.loop,
                     "status": fold.status,
@@ -134,6 +151,22 @@ def _mission_file(folder: Path, source: str) -> Path | None:
     for candidate in candidates:
         if candidate.is_file():
             return candidate
+    return None
+
+
+def _source_as_run(
+    folder: Path, source: str, digest: str, may_read: Callable[[Path], bool]
+) -> Path | None:
+    """The journal's mission file where it was run from, if allowed and unchanged since."""
+    from navseq.sinks.journal import mission_digest
+
+    # A relative source was relative to where navseq ran: usually the run folder's parent's.
+    for candidate in [Path(source)] if Path(source).is_absolute() else [folder.parent / source]:
+        try:
+            if may_read(candidate) and mission_digest(candidate) == digest:
+                return candidate
+        except (NavseqError, OSError):
+            continue
     return None
 
 

@@ -70,6 +70,9 @@ class LiveView:
         self.error: str | None = None
         self.navigator: Navigator | None = None
         self._start_t: float | None = None
+        # Waypoint states changed since take_changes() (a replay's timeline is made of them).
+        self._changed: set[int] = set()
+        self._reset = False
 
     # -- the run's thread --------------------------------------------------------------
 
@@ -85,18 +88,20 @@ class LiveView:
             elif isinstance(event, ev.LoopStarted):
                 self.loop = event.loop
                 self.waypoints = ["pending"] * len(self.waypoints)
+                self._reset = True
+                self._changed.clear()
             elif isinstance(event, ev.WaypointStarted):
                 self.current = event.index
-                self.waypoints[event.index] = "driving"
+                self._set(event.index, "driving")
                 self.plan = []
             elif isinstance(event, ev.WaypointProgress):
                 self._moved(event.x, event.y, event.yaw)
             elif isinstance(event, ev.WaypointPlan):
                 self.plan = [(round(x, 3), round(y, 3)) for x, y in event.path]
             elif isinstance(event, ev.WaypointDwelling):
-                self.waypoints[event.index] = "dwelling"
+                self._set(event.index, "dwelling")
             elif isinstance(event, ev.WaypointFinished):
-                self.waypoints[event.index] = event.outcome.value
+                self._set(event.index, event.outcome.value)
             elif isinstance(event, ev.MissionPaused):
                 self.status = "paused"
             elif isinstance(event, ev.MissionResumed):
@@ -106,6 +111,20 @@ class LiveView:
                 self.reason = event.reason
                 self.current = None
             self.version += 1
+
+    def _set(self, index: int, state: str) -> None:
+        if self.waypoints[index] != state:
+            self.waypoints[index] = state
+            self._changed.add(index)
+
+    def take_changes(self) -> tuple[bool, list[tuple[int, str]]]:
+        """What changed in the waypoints' states since the last call: whether every one
+        went back to pending (a new loop) first, then ``(index, state)`` in index order."""
+        with self._lock:
+            reset, self._reset = self._reset, False
+            changes = [(index, self.waypoints[index]) for index in sorted(self._changed)]
+            self._changed.clear()
+            return reset, changes
 
     def _moved(self, x: float, y: float, yaw: float) -> None:
         self.pose = (x, y, yaw)

@@ -542,6 +542,7 @@ function closeReplay() {
   $("replay").hidden = true;
   $("map").classList.remove("replaying");
   if (S.layers.replay) { S.layers.replay.remove(); S.layers.replay = null; }
+  if (S.layers.replayMarks) { S.layers.replayMarks.remove(); S.layers.replayMarks = null; }
 }
 // Index of the last item (sorted by time) at or before t, or null; key: its time field.
 function lastAt(items, t, key) {
@@ -553,6 +554,35 @@ function lastAt(items, t, key) {
   }
   return found;
 }
+// The waypoints' states after the si-th change (null: before the first). The server sends
+// only what each change changed; going forward from the last answer costs only the new ones.
+function replayStatuses(R, si) {
+  let from = R.cursor && R.cursor.si !== null && si !== null && R.cursor.si <= si ? R.cursor : { si: null, statuses: [] };
+  const statuses = from.statuses.slice();
+  for (let k = from.si === null ? 0 : from.si + 1; si !== null && k <= si; k++) {
+    const change = R.states[k];
+    if (change.reset) statuses.length = 0;
+    for (const [i, status] of change.changes) statuses[i] = status;
+  }
+  R.cursor = { si, statuses };
+  return statuses;
+}
+// The waypoint markers, redrawn only when their states change (not at every frame).
+function drawReplayMarks(R, statuses, si) {
+  if (!S.layers.replayMarks) S.layers.replayMarks = L.layerGroup().addTo(map);
+  S.layers.replayMarks.clearLayers();
+  R.markedAt = si;
+  const wps = (R.mission || {}).waypoints || [];
+  wps.forEach((w, i) => {
+    if (!okPoint(w)) return;
+    const status = statuses[i] || "pending";
+    const icon = L.divIcon({ className: `wp-icon replay ${status}`, iconSize: [26, 26], iconAnchor: [13, 13],
+      html: `<div class="arrow" style="transform: rotate(${-(w.yaw || 0)}deg)"></div><div class="dot">${i + 1}</div>` });
+    const m = L.marker(ll(w.x, w.y), { icon, interactive: false }).addTo(S.layers.replayMarks);
+    m.getElement().dataset.testid = "replay-waypoint";
+    m.getElement().dataset.status = status;
+  });
+}
 // The run at time t: waypoint states, driven path so far, plan of the current leg, robot.
 function drawReplay(t) {
   const R = S.replay;
@@ -560,17 +590,9 @@ function drawReplay(t) {
   if (!S.layers.replay) S.layers.replay = L.layerGroup().addTo(map);
   S.layers.replay.clearLayers();
   const si = lastAt(R.states, t, "t");
-  const state = si === null ? { waypoints: [], current: null, loop: 0, status: "starting" } : R.states[si];
-  const wps = (R.mission || {}).waypoints || [];
-  wps.forEach((w, i) => {
-    if (!okPoint(w)) return;
-    const status = state.waypoints[i] || "pending";
-    const icon = L.divIcon({ className: `wp-icon replay ${status}`, iconSize: [26, 26], iconAnchor: [13, 13],
-      html: `<div class="arrow" style="transform: rotate(${-(w.yaw || 0)}deg)"></div><div class="dot">${i + 1}</div>` });
-    const m = L.marker(ll(w.x, w.y), { icon, interactive: false }).addTo(S.layers.replay);
-    m.getElement().dataset.testid = "replay-waypoint";
-    m.getElement().dataset.status = status;
-  });
+  const state = si === null ? { current: null, loop: 0, status: "starting" } : R.states[si];
+  const statuses = replayStatuses(R, si);
+  if (R.markedAt !== si || !S.layers.replayMarks) drawReplayMarks(R, statuses, si);
   const pi = lastAt(R.poses, t);
   if (pi !== null) {
     const trail = R.poses.slice(0, pi + 1).map(([, px, py]) => ll(px, py));
@@ -594,7 +616,7 @@ function drawReplay(t) {
     const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.replay);
     body.getElement().dataset.testid = "replay-robot";
   }
-  const at = state.current !== null && state.current !== undefined ? ` · waypoint ${state.current + 1} ${state.waypoints[state.current]}` : "";
+  const at = state.current !== null && state.current !== undefined ? ` · waypoint ${state.current + 1} ${statuses[state.current] || "pending"}` : "";
   $("replay-clock").textContent = `${t.toFixed(1)} / ${R.duration_s.toFixed(1)} s${at}`;
 }
 

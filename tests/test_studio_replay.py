@@ -1,0 +1,69 @@
+"""A past run's timeline: the waypoints' states at any time, in a size that grows with the run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from navseq import cli
+from navseq.studio.replay import replay_of
+
+
+def states_over_time(replay: dict) -> list[list[str]]:
+    """The waypoints' states after each change, as the page rebuilds them."""
+    count = len(replay["mission"]["waypoints"])
+    statuses = ["pending"] * count
+    seen = []
+    for change in replay["states"]:
+        if change["reset"]:
+            statuses = ["pending"] * count
+        for index, status in change["changes"]:
+            statuses[index] = status
+        seen.append(list(statuses))
+    return seen
+
+
+def inside(folder: Path):
+    return lambda path: path.resolve().is_relative_to(folder.resolve())
+
+
+def run_folder(tmp_path: Path, waypoints: int, loops: int) -> Path:
+    lines = [f"loops: {loops}", "waypoints:"]
+    lines += [f"  - {{name: w{i}, x: {i * 0.5}, y: 0.0, yaw: 0}}" for i in range(waypoints)]
+    mission = tmp_path / "line.yaml"
+    mission.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    argv = ["run", str(mission), "--navigator", "scripted", "--out", str(out), "--no-picture"]
+    assert cli.main(argv) == 0
+    return out
+
+
+def test_each_loop_starts_with_every_waypoint_pending_again(tmp_path: Path) -> None:
+    replay = replay_of(run_folder(tmp_path, 3, 2), "out", tmp_path, inside(tmp_path))
+    seen = states_over_time(replay)
+    assert seen[-1] == ["reached"] * 3
+    resets = [change for change in replay["states"] if change["reset"]]
+    assert [change["loop"] for change in resets] == [0, 1]  # counted from 0, as in the journal
+    second_loop = seen[replay["states"].index(resets[1])]
+    assert second_loop == ["pending"] * 3
+
+
+def test_the_timeline_grows_with_the_run_not_with_its_square(tmp_path: Path) -> None:
+    replay = replay_of(run_folder(tmp_path, 400, 1), "out", tmp_path, inside(tmp_path))
+    changed = sum(len(change["changes"]) for change in replay["states"])
+    # driving, then reached: two changes per visit (a full list per change would be
+    # 400 entries each).
+    assert changed == 2 * 400
+    assert states_over_time(replay)[-1] == ["reached"] * 400
+
+
+def test_a_command_line_run_replays_with_its_mission_only_if_allowed_and_unchanged(
+    tmp_path: Path,
+) -> None:
+    folder = run_folder(tmp_path, 2, 1)
+    assert replay_of(folder, "out", tmp_path, inside(tmp_path))["mission"] is not None
+    # Outside the folders the studio may read: no mission, but the run still replays.
+    refused = replay_of(folder, "out", tmp_path, inside(folder))
+    assert refused["mission"] is None and refused["poses"]
+    # Edited since the run: the waypoints drawn would not be those that were run.
+    (tmp_path / "line.yaml").write_text("waypoints:\n  - {x: 9.0, y: 9.0, yaw: 0}\n")
+    assert replay_of(folder, "out", tmp_path, inside(tmp_path))["mission"] is None
