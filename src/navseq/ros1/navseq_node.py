@@ -77,6 +77,7 @@ from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros1.params import bool_param
+from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
 
 NODE_NAME = "navseq"
@@ -331,6 +332,9 @@ def main(argv: list[str] | None = None) -> None:
         print(f"navseq: {error}", file=sys.stderr)
         sys.exit(2)
     code = run_node()
+    # The status is decided: a SIGINT from roslaunch while rospy shuts down must not
+    # turn it into a traceback or a death by the signal.
+    ignore_until_exit()
     rospy.signal_shutdown(f"navseq finished with status {code}")
     sys.exit(code)
 

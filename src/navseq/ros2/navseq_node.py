@@ -68,6 +68,7 @@ from navseq.ros2.mission_topics import MissionTopics
 from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.node_params import NodeSettings, read_node_params
 from navseq.ros2.session import Ros2Session
+from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import RunView, describe
 from navseq.text import printable
 
@@ -276,6 +277,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return run_node(session)
     finally:
+        if argv is None:  # the process's own node: a signal now must not change its status
+            ignore_until_exit()
         # Let the last status reach transient-local subscribers already matched.
         time.sleep(0.05)
         session.close()
