@@ -104,6 +104,34 @@ class SignalGuard:
             raise StepAbandoned(signal.Signals(signum).name)
 
 
+class StopSignals:
+    """SIGINT and SIGTERM only noted, for a process that waits for them (a ROS node kept
+    up after its mission): :meth:`wait` returns once one came. Use as a context manager,
+    in the main thread; the previous handlers are put back on leaving."""
+
+    def __init__(self) -> None:
+        self.received: list[str] = []
+        self._came = threading.Event()
+        self._previous: dict[int, Any] = {}
+
+    def __enter__(self) -> StopSignals:
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            self._previous[signum] = signal.signal(signum, self._note)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
+
+    def wait(self, timeout: float) -> bool:
+        """True once a signal came (waits at most ``timeout`` seconds for one)."""
+        return self._came.wait(timeout)
+
+    def _note(self, signum: int, frame: FrameType | None) -> None:
+        self.received.append(signal.Signals(signum).name)
+        self._came.set()
+
+
 def ignore_until_exit() -> None:
     """Ignore shutdown signals from now on: the process's exit status is decided, and a
     late Ctrl-C must not turn an exit 0 that the report states into a death by SIGINT."""
@@ -112,4 +140,11 @@ def ignore_until_exit() -> None:
             signal.signal(signum, signal.SIG_IGN)
 
 
-__all__ = ["SHUTDOWN_SIGNALS", "SignalGuard", "StepAbandoned", "Terminated", "ignore_until_exit"]
+__all__ = [
+    "SHUTDOWN_SIGNALS",
+    "SignalGuard",
+    "StepAbandoned",
+    "StopSignals",
+    "Terminated",
+    "ignore_until_exit",
+]

@@ -52,7 +52,6 @@ once with 2, and a ``required`` node's exit then does end the launch, banner and
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
 from collections.abc import Callable
@@ -77,7 +76,7 @@ from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
 from navseq.ros1.params import bool_param
-from navseq.signals import ignore_until_exit
+from navseq.signals import StopSignals, ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
 
 NODE_NAME = "navseq"
@@ -295,26 +294,15 @@ def stay_up(
     a reason it returns means there is nothing to wait for: the node just exits.
     """
     # rospy's own signal handlers are off (see ensure_node); the node's are set here.
-    stop_signal: list[str] = []
-    stopping = threading.Event()
-
-    def on_signal(signum: int, _frame: Any) -> None:
-        stop_signal.append(signal.Signals(signum).name)
-        stopping.set()
-
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
+    with StopSignals() as stop:
         rospy.loginfo("navseq: %s", why)
         if then is not None and (why_not := then()) is not None:
             rospy.logwarn("navseq: %s; the node just exits", why_not)
             return mission_code
-        while not stopping.is_set() and not rospy.core.is_shutdown_requested():
-            stopping.wait(KEEP_ALIVE_POLL)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-    if stop_signal:
-        rospy.loginfo("navseq: %s; shutting down", stop_signal[0])
+        while not rospy.core.is_shutdown_requested() and not stop.wait(KEEP_ALIVE_POLL):
+            pass
+    if stop.received:
+        rospy.loginfo("navseq: %s; shutting down", stop.received[0])
     return mission_code
 
 

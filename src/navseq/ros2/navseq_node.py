@@ -36,7 +36,6 @@ executor thread keeps delivering ``/clock``, feedback and results meanwhile.
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
 import time
@@ -68,7 +67,7 @@ from navseq.ros2.mission_topics import MissionTopics
 from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.node_params import NodeSettings, read_node_params
 from navseq.ros2.session import Ros2Session
-from navseq.signals import ignore_until_exit
+from navseq.signals import StopSignals, ignore_until_exit
 from navseq.sinks.progress import RunView, describe
 from navseq.text import printable
 
@@ -243,22 +242,11 @@ def stay_up(session: Ros2Session, mission_code: int) -> int:
     """
     logger = session.node.get_logger()
     logger.info("mission over; staying up (keep_alive) until stopped")
-    stop_signal: list[str] = []
-    stopping = threading.Event()
-
-    def on_signal(signum: int, _frame: Any) -> None:
-        stop_signal.append(signal.Signals(signum).name)
-        stopping.set()
-
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        while not stopping.is_set() and session.ok():
-            stopping.wait(KEEP_ALIVE_POLL)
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-    if stop_signal:
-        logger.info(f"{stop_signal[0]}; shutting down")
+    with StopSignals() as stop:
+        while session.ok() and not stop.wait(KEEP_ALIVE_POLL):
+            pass
+    if stop.received:
+        logger.info(f"{stop.received[0]}; shutting down")
     return mission_code
 
 
