@@ -574,7 +574,9 @@ def real_time_text(clock: Mapping[str, float | None]) -> str:
     if factor is None:
         return f"simulated {simulated:.1f} s"
     shown = f"{factor:.0f}" if factor >= 10 else f"{factor:.2g}"
-    return f"simulated {simulated:.1f} s in {wall:.1f} s: {shown}x real time"
+    # A short mission simulates in hundredths of a second: "in 0.0 s" would say nothing.
+    wall_shown = f"{wall:.1f}" if wall >= 1 else f"{wall:.3f}"
+    return f"simulated {simulated:.1f} s in {wall_shown} s: {shown}x real time"
 
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
