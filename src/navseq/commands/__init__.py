@@ -56,7 +56,8 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
     ),
     Subcommand(
         "sim",
-        "run the simulated robot with a Nav2 stand-in as ROS 2 nodes (--ros2)",
+        "run the simulated robot and its navigation stand-in as ROS nodes "
+        "(--ros1: move_base; --ros2: Nav2)",
         "navseq.commands.sim",
     ),
     Subcommand(
