@@ -186,6 +186,8 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     )
     assert "7/7 reached" in status.inner_text()
     assert page.get_by_test_id("robot").count() == 1
+    rows = page.get_by_test_id("waypoint-row").locator(".state").all_inner_texts()
+    assert rows == ["reached"] * 7  # the list follows the run, row by row
     assert page.locator("#report-body tbody tr").count() == 8  # 7 visits + total
     runs = list((workspace / "navseq-out").iterdir())
     assert len(runs) == 1 and (runs[0] / "report.json").exists()

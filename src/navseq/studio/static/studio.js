@@ -648,13 +648,25 @@ function watchRun() {
   S.events.onmessage = (e) => {
     const run = JSON.parse(e.data);
     run.done = ["completed", "failed", "stopped", "error"].includes(run.status);
+    const before = S.run ? S.run.waypoints : null;
     S.run = run;
-    drawRun(run);
+    drawRun(run, before);
     if (run.done) { S.events.close(); S.events = null; }
   };
   S.events.onerror = () => { if (S.events && S.run && S.run.done) S.events.close(); };
 }
-function drawRun(run) {
+// Only the rows whose state changed: rebuilding the whole list at every update (20 a
+// second) would stall the page on a mission of thousands of waypoints.
+function updateRowStates(states, before) {
+  const rows = $("waypoints").children;
+  if (!before || rows.length !== S.doc.waypoints.length) { renderList(); return; }
+  states.forEach((state, i) => {
+    if (before[i] === state) return;
+    const cell = rows[i] && rows[i].querySelector(".state");
+    if (cell) cell.textContent = state || "";
+  });
+}
+function drawRun(run, before) {
   if (!S.layers.run) S.layers.run = L.layerGroup().addTo(map);
   S.layers.run.clearLayers();
   if (run.trail.length > 1) L.polyline(run.trail.map(([x, y]) => ll(x, y)), { color: "#16a34a", weight: 3, interactive: false }).addTo(S.layers.run);
@@ -677,7 +689,7 @@ function drawRun(run) {
   if (run.done && run.report) text = `${run.status} · ${run.report.totals.reached}/${run.report.totals.visits} reached · ${run.report.totals.duration_s} s`;
   if (run.error) text += ` · ${run.error}`;
   setStatus(run.status, text);
-  renderList();
+  updateRowStates(run.waypoints, before);
   if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); loadRuns(); }
 }
 function showReport(run) {
