@@ -55,6 +55,11 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
         "navseq.commands.convert",
     ),
     Subcommand(
+        "plan",
+        "plan a mission's legs on the map, and find the order that drives the least",
+        "navseq.commands.plan",
+    ),
+    Subcommand(
         "sim",
         "run the simulated robot and its navigation stand-in as ROS nodes "
         "(--ros1: move_base; --ros2: Nav2)",

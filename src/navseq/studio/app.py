@@ -28,16 +28,14 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.route.legs import LegPlanner, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     DraftRefused,
-    LegPlanner,
     check_draft,
     empty_document,
-    legs_of,
     open_document,
     problems_of,
-    route_summary,
     version_of,
 )
 from navseq.studio.mapview import MapView

@@ -5,18 +5,15 @@ syntax: the same keys, the same units (metres, degrees, seconds), so there is on
 of rules for what a mission may hold — the loader's. A draft is checked by writing it
 as navseq YAML (one line per waypoint, so a problem's line names its waypoint) and
 handing that file to :func:`navseq.commands.validate.mission_file_problems`, the code
-``navseq validate --map`` runs. Legs are planned with :func:`navseq.sim.planner.plan_path`
-on the robot's costmap, and only legs whose ends moved are planned again.
+``navseq validate --map`` runs. Legs are planned by :mod:`navseq.route.legs`, as
+``navseq plan`` plans them.
 """
 
 from __future__ import annotations
 
 import hashlib
-import itertools
 import json
 import tempfile
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,8 +26,6 @@ from navseq.text import printable
 if TYPE_CHECKING:
     from navseq.commands.validate import CostmapSource
     from navseq.mission.model import Mission
-    from navseq.mission.robot import RobotProfile
-    from navseq.sim.costmap import Costmap
     from navseq.studio.security import FileRoots
 
 #: The units of the document's numbers, sent with every mission so no client guesses.
@@ -238,109 +233,6 @@ def check_draft(
     return CheckedDraft(mission, problems, map_path)
 
 
-# --- planned legs ---------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Leg:
-    """The planned path from one place to the next (None: no path)."""
-
-    start: tuple[float, float]
-    goal: tuple[float, float]
-    points: list[tuple[float, float]] | None
-    length_m: float | None
-
-
-class LegPlanner:
-    """Plans legs on one costmap, keeping the last plans so that unchanged legs are free.
-
-    Dragging one waypoint changes the two legs touching it; the others come from the
-    cache (keyed by their exact end points).
-    """
-
-    def __init__(self, costmap: Costmap, capacity: int = 4096) -> None:
-        self.costmap = costmap
-        self._cache: OrderedDict[tuple[float, float, float, float], Leg] = OrderedDict()
-        self._capacity = capacity
-        self._lock = threading.Lock()
-        self.planned = 0  # plans computed (not taken from the cache), for benchmarks
-
-    def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg:
-        from navseq.sim.planner import plan_path
-
-        key = (start[0], start[1], goal[0], goal[1])
-        with self._lock:
-            cached = self._cache.get(key)
-            if cached is not None:
-                self._cache.move_to_end(key)
-                return cached
-        plan = plan_path(self.costmap, start, goal)
-        if plan is None:
-            leg = Leg(start, goal, None, None)
-        else:
-            leg = Leg(start, goal, corners(plan.points), round(plan.length, 3))
-        with self._lock:
-            self.planned += 1
-            self._cache[key] = leg
-            while len(self._cache) > self._capacity:
-                self._cache.popitem(last=False)
-        return leg
-
-
-def corners(points: Any) -> list[tuple[float, float]]:
-    """The plan's cells thinned to where its direction changes (what a line needs)."""
-    import numpy as np
-
-    array = np.asarray(points, dtype=float)
-    if len(array) <= 2:
-        return [(round(float(x), 3), round(float(y), 3)) for x, y in array]
-    steps = np.diff(array, axis=0)
-    turn = np.abs(steps[1:, 0] * steps[:-1, 1] - steps[1:, 1] * steps[:-1, 0]) > 1e-12
-    keep = np.concatenate(([True], turn, [True]))
-    return [(round(float(x), 3), round(float(y), 3)) for x, y in array[keep]]
-
-
-def legs_of(mission: Mission, planner: LegPlanner) -> list[dict[str, Any]]:
-    """Each leg of ``mission`` as the page draws it: from the start pose (when there is
-    one) through every waypoint, plus the way back to the first for a patrol."""
-    places: list[tuple[str, tuple[float, float]]] = []
-    if mission.start is not None:
-        places.append(("start", (mission.start.x, mission.start.y)))
-    for index, waypoint in enumerate(mission.waypoints):
-        places.append((str(index), (waypoint.x, waypoint.y)))
-    pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
-    if mission.loops != 1 and len(mission.waypoints) > 1:
-        pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
-    legs = []
-    for (from_name, start), (to_name, goal), loop in pairs:
-        leg = planner.leg(start, goal)
-        legs.append(
-            {
-                "from": from_name,
-                "to": int(to_name),
-                "points": leg.points,
-                "length_m": leg.length_m,
-                "loop": loop,
-            }
-        )
-    return legs
-
-
-def route_summary(legs: list[dict[str, Any]], robot: RobotProfile) -> dict[str, Any]:
-    """Total length of the legs and the time they take at the robot's top speed."""
-    from navseq.sinks.progress import eta_text
-
-    lengths = [leg["length_m"] for leg in legs if not leg["loop"]]
-    if any(length is None for length in lengths):
-        return {"total_length_m": None, "estimated_duration": "", "unplanned_legs": True}
-    total = float(sum(lengths))
-    return {
-        "total_length_m": round(total, 3),
-        "estimated_duration": eta_text(total, robot),
-        "unplanned_legs": False,
-    }
-
-
 def shown_path(path: Path) -> str:
     return printable(str(path))
 
@@ -349,13 +241,10 @@ __all__ = [
     "UNITS",
     "CheckedDraft",
     "DraftRefused",
-    "LegPlanner",
     "Problem",
     "check_draft",
     "document_of",
     "empty_document",
-    "legs_of",
     "open_document",
-    "route_summary",
     "version_of",
 ]

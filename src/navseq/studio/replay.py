@@ -171,7 +171,7 @@ def _source_as_run(
 
 
 def _thinned(path: Any) -> list[list[float]]:
-    from navseq.studio.documents import corners
+    from navseq.route.legs import corners
 
     return [[x, y] for x, y in corners(path)] if len(path) else []
 

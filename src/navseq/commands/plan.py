@@ -1,0 +1,259 @@
+"""``navseq plan MISSION [--map MAP] [--order shortest] [--out FILE]``: the mission's route.
+
+Every leg planned on the robot's costmap (the planner the simulator drives with; the
+studio draws the same legs), with its length beside the straight line and the time it
+takes at the robot's top speed; the route's total. With ``--order shortest`` the
+waypoints are put in the order that drives the least (:mod:`navseq.route.order`) and
+the route is shown in that order; ``--out FILE`` writes the mission so ordered (navseq
+YAML, never over an existing file unless ``--force``).
+
+Exit 0 when every leg has a path, 1 when some leg has none (``navseq validate --map``
+says why), 2 for bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from navseq.commands.common import add_robot_option
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
+    from navseq.route.legs import Legs
+
+ORDERS = ("file", "shortest")
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("mission", type=Path, metavar="MISSION", help="mission file to plan")
+    parser.add_argument(
+        "--map",
+        type=Path,
+        metavar="MAP",
+        help="map_server YAML to plan on (default: the mission's map:; without a map, "
+        "legs are straight lines)",
+    )
+    add_robot_option(parser)
+    parser.add_argument(
+        "--order",
+        choices=ORDERS,
+        default="file",
+        help="file: the waypoints as the file has them (default); shortest: the order that "
+        "drives the least (waypoint 1, or the start pose, stays first; a patrol stays a "
+        "closed tour)",
+    )
+    parser.add_argument(
+        "--keep-last",
+        action="store_true",
+        help="with --order shortest: the file's last waypoint stays last (a dock to end at)",
+    )
+    parser.add_argument(
+        "--time-limit",
+        type=float,
+        default=2.0,
+        metavar="S",
+        help="seconds the route solver may search for --order shortest (default 2)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        metavar="FILE",
+        help="write the mission in the order shown (navseq YAML)",
+    )
+    parser.add_argument("--force", action="store_true", help="replace FILE if it exists")
+    parser.add_argument("--json", action="store_true", help="print the route as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from navseq.commands.common import choose_robot, require_file
+    from navseq.errors import NavseqError
+    from navseq.mission import load_mission
+
+    if not (0.0 < args.time_limit <= 3600.0):
+        raise NavseqError("must be more than 0 and at most 3600 seconds", source="--time-limit")
+    if args.out is not None and args.out.exists() and not args.force:
+        # Refused before any work: nothing the user wrote is replaced unasked.
+        raise NavseqError(
+            "exists already; not overwriting it (use --force to replace it)",
+            source=str(args.out),
+        )
+    if args.map is not None:
+        require_file(args.map, "--map")
+    mission = load_mission(args.mission)
+    robot = choose_robot(args.robot, mission)
+    map_path = args.map if args.map is not None else mission.map
+    legs = _leg_source(map_path, robot)
+    in_file_order = _route(mission, legs)
+    order = list(range(len(mission.waypoints)))
+    ordered = mission
+    if args.order == "shortest":
+        from navseq.route.order import shortest_order
+
+        ordering = shortest_order(
+            mission, _length_of(legs), args.time_limit, keep_last=args.keep_last
+        )
+        order, ordered = list(ordering.order), ordering.apply(mission)
+    route = _route(ordered, legs) if ordered is not mission else in_file_order
+    if args.out is not None:
+        from navseq.mission import write_mission
+
+        write_mission(ordered, args.out, overwrite=args.force)
+    result = _result(mission, order, route, in_file_order, map_path, robot, args.out)
+    if args.json:
+        from navseq.sinks.report import report_json
+
+        print(report_json(result))
+    else:
+        _print(result, args)
+    return 0 if result["every_leg_has_a_path"] else 1
+
+
+def _leg_source(map_path: Path | None, robot: RobotProfile) -> Legs:
+    from navseq.route.legs import LegPlanner, StraightLegs
+
+    if map_path is None:
+        return StraightLegs()
+    from navseq.commands.common import costmap_for_map
+
+    return LegPlanner(costmap_for_map(map_path, robot))
+
+
+def _length_of(legs: Legs) -> Any:
+    return lambda start, goal: legs.leg(start, goal).length_m
+
+
+def _route(mission: Mission, legs: Legs) -> list[dict[str, Any]]:
+    from navseq.route.legs import legs_of
+
+    return legs_of(mission, legs)
+
+
+def _total(route: list[dict[str, Any]]) -> float | None:
+    """Metres once through the route: a patrol's way back to its first waypoint included,
+    for that is the leg its order changes too."""
+    lengths = [leg["length_m"] for leg in route]
+    return None if any(length is None for length in lengths) else round(sum(lengths), 3)
+
+
+def _result(
+    mission: Mission,
+    order: list[int],
+    route: list[dict[str, Any]],
+    in_file_order: list[dict[str, Any]],
+    map_path: Path | None,
+    robot: RobotProfile,
+    out: Path | None,
+) -> dict[str, Any]:
+    """The route as ``--json`` prints it (docs/cli.md#navseq-plan)."""
+    import math
+
+    waypoints = mission.waypoints
+    legs = []
+    for leg in route:
+        goal = waypoints[order[leg["to"]]]
+        start = mission.start if leg["from"] == "start" else waypoints[order[int(leg["from"])]]
+        assert start is not None
+        legs.append(
+            {
+                "from": "start" if leg["from"] == "start" else order[int(leg["from"])] + 1,
+                "to": order[leg["to"]] + 1,
+                "to_name": goal.name,
+                "length_m": leg["length_m"],
+                "straight_m": round(math.hypot(goal.x - start.x, goal.y - start.y), 3),
+                "back_to_first": leg["loop"],
+            }
+        )
+    total = _total(route)
+    return {
+        "mission": str(mission.source),
+        "map": _shown(map_path) if map_path is not None else None,
+        "robot": robot.name,
+        "order": [number + 1 for number in order],
+        "legs": legs,
+        "length_m": total,
+        "length_in_file_order_m": _total(in_file_order),
+        "max_speed_m_s": robot.max_linear_speed,
+        "duration_s": round(total / robot.max_linear_speed, 1)
+        if total is not None and robot.max_linear_speed > 0
+        else None,
+        "every_leg_has_a_path": all(leg["length_m"] is not None for leg in route),
+        "written": str(out) if out is not None else None,
+    }
+
+
+def _print(result: dict[str, Any], args: argparse.Namespace) -> None:
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    from navseq.sinks.summary import print_table
+    from navseq.text import printable
+
+    on = f"on {result['map']}" if result["map"] else "without a map: straight lines"
+    console = Console()
+
+    def say(text: str) -> None:
+        # Plain text (a name may hold [brackets]); a pipe gets whole lines.
+        console.print(text, markup=False, highlight=False, soft_wrap=True)
+
+    say(f"{printable(result['mission'])} {printable(on)}, robot {result['robot']}")
+    table = Table()
+    for header, justify in (
+        ("leg", "left"),
+        ("to", "left"),
+        ("planned [m]", "right"),
+        ("straight [m]", "right"),
+        ("time [s]", "right"),
+    ):
+        table.add_column(escape(header), justify=justify)  # type: ignore[arg-type]
+    speed = result["max_speed_m_s"]
+    for leg in result["legs"]:
+        length = leg["length_m"]
+        back = " (back to the first)" if leg["back_to_first"] else ""
+        table.add_row(
+            f"{leg['from']} → {leg['to']}{back}",
+            escape(printable(leg["to_name"] or "")),
+            "no path" if length is None else f"{length:.2f}",
+            f"{leg['straight_m']:.2f}",
+            "" if length is None or not speed else f"~{length / speed:.0f}",
+        )
+    print_table(table, console)
+    count = len(result["order"])
+    if result["length_m"] is None:
+        say(
+            f"route: {count} waypoints; some legs have no path "
+            f"(navseq validate {printable(str(args.mission))} --map ... says why)"
+        )
+    else:
+        duration = (
+            f", ~{result['duration_s']:.0f} s at {speed:.2f} m/s" if result["duration_s"] else ""
+        )
+        say(f"route: {count} waypoints, {result['length_m']:.2f} m{duration}")
+    if args.order == "shortest":
+        before, after = result["length_in_file_order_m"], result["length_m"]
+        shown = " ".join(str(number) for number in result["order"])
+        if result["order"] == sorted(result["order"]):
+            say("shortest order: the file's order already is")
+        elif before is not None and after is not None and before > 0:
+            say(
+                f"shortest order: {shown} — {after:.2f} m instead of {before:.2f} m "
+                f"({(after - before) / before:+.1%})"
+            )
+        else:
+            say(f"shortest order: {shown}")
+    if result["written"]:
+        say(f"wrote {printable(result['written'])}")
+    elif args.order == "shortest" and result["order"] != sorted(result["order"]):
+        print("navseq plan: give --out FILE to write the mission in this order", file=sys.stderr)
+
+
+def _shown(path: Path) -> str:
+    """``path`` relative to the working folder when it is below it (as the user typed it)."""
+    import os
+
+    relative = os.path.relpath(path)
+    return str(path) if relative.startswith("..") else relative

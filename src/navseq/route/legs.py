@@ -1,0 +1,134 @@
+"""The legs of a mission on a map: each one planned on the robot's costmap, with its length.
+
+A leg goes from the start pose (when the mission has one) to the first waypoint, then
+from each waypoint to the next, and for a patrol from the last back to the first. Legs
+are planned with :func:`navseq.sim.planner.plan_path`, the planner the simulator drives
+with, and kept: dragging a waypoint in the studio plans only the two legs it touches.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
+    from navseq.sim.costmap import Costmap
+
+
+@dataclass(frozen=True)
+class Leg:
+    """The planned path from one place to the next (None: no path)."""
+
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    points: list[tuple[float, float]] | None
+    length_m: float | None
+
+
+class LegPlanner:
+    """Plans legs on one costmap, keeping the last plans so that unchanged legs are free.
+
+    Dragging one waypoint changes the two legs touching it; the others come from the
+    cache (keyed by their exact end points).
+    """
+
+    def __init__(self, costmap: Costmap, capacity: int = 4096) -> None:
+        self.costmap = costmap
+        self._cache: OrderedDict[tuple[float, float, float, float], Leg] = OrderedDict()
+        self._capacity = capacity
+        self._lock = threading.Lock()
+        self.planned = 0  # plans computed (not taken from the cache), for benchmarks
+
+    def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg:
+        from navseq.sim.planner import plan_path
+
+        key = (start[0], start[1], goal[0], goal[1])
+        with self._lock:
+            cached = self._cache.get(key)
+            if cached is not None:
+                self._cache.move_to_end(key)
+                return cached
+        plan = plan_path(self.costmap, start, goal)
+        if plan is None:
+            leg = Leg(start, goal, None, None)
+        else:
+            leg = Leg(start, goal, corners(plan.points), round(plan.length, 3))
+        with self._lock:
+            self.planned += 1
+            self._cache[key] = leg
+            while len(self._cache) > self._capacity:
+                self._cache.popitem(last=False)
+        return leg
+
+
+class StraightLegs:
+    """Legs as straight lines, for a mission with no map to plan on."""
+
+    def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg:
+        return Leg(start, goal, [start, goal], round(math.dist(start, goal), 3))
+
+
+class Legs(Protocol):
+    """What plans a leg: a :class:`LegPlanner` on a costmap, or :class:`StraightLegs`."""
+
+    def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg: ...
+
+
+def corners(points: Any) -> list[tuple[float, float]]:
+    """The plan's cells thinned to where its direction changes (what a line needs)."""
+    import numpy as np
+
+    array = np.asarray(points, dtype=float)
+    if len(array) <= 2:
+        return [(round(float(x), 3), round(float(y), 3)) for x, y in array]
+    steps = np.diff(array, axis=0)
+    turn = np.abs(steps[1:, 0] * steps[:-1, 1] - steps[1:, 1] * steps[:-1, 0]) > 1e-12
+    keep = np.concatenate(([True], turn, [True]))
+    return [(round(float(x), 3), round(float(y), 3)) for x, y in array[keep]]
+
+
+def legs_of(mission: Mission, planner: Legs) -> list[dict[str, Any]]:
+    """Each leg of ``mission`` as the page draws it: from the start pose (when there is
+    one) through every waypoint, plus the way back to the first for a patrol."""
+    places: list[tuple[str, tuple[float, float]]] = []
+    if mission.start is not None:
+        places.append(("start", (mission.start.x, mission.start.y)))
+    for index, waypoint in enumerate(mission.waypoints):
+        places.append((str(index), (waypoint.x, waypoint.y)))
+    pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
+    if mission.loops != 1 and len(mission.waypoints) > 1:
+        pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
+    legs = []
+    for (from_name, start), (to_name, goal), loop in pairs:
+        leg = planner.leg(start, goal)
+        legs.append(
+            {
+                "from": from_name,
+                "to": int(to_name),
+                "points": leg.points,
+                "length_m": leg.length_m,
+                "loop": loop,
+            }
+        )
+    return legs
+
+
+def route_summary(legs: list[dict[str, Any]], robot: RobotProfile) -> dict[str, Any]:
+    """Total length of the legs and the time they take at the robot's top speed."""
+    from navseq.sinks.progress import eta_text
+
+    lengths = [leg["length_m"] for leg in legs if not leg["loop"]]
+    if any(length is None for length in lengths):
+        return {"total_length_m": None, "estimated_duration": "", "unplanned_legs": True}
+    total = float(sum(lengths))
+    return {
+        "total_length_m": round(total, 3),
+        "estimated_duration": eta_text(total, robot),
+        "unplanned_legs": False,
+    }

@@ -1,0 +1,174 @@
+"""The shortest order to visit a mission's waypoints in.
+
+A travelling-salesman problem over the lengths the robot would drive: the planned path
+between every two waypoints on the robot's costmap (the planner the simulator drives
+with), or straight lines when no map is known. OR-tools' routing solver finds the
+order (a first tour by cheapest arc, then guided local search for ``time_limit_s``).
+
+What stays where it is, so that the new order is a mission the user still recognises:
+
+- a mission with a ``start:`` pose starts there, and any waypoint may come first;
+- without one, waypoint 1 stays first (it is where the user put the robot to work);
+- a patrol (``loops`` other than 1) is a closed tour back to its first waypoint, and
+  since a cycle has no beginning, waypoint 1 stays first there too;
+- with ``keep_last``, the file's last waypoint stays last (a dock the robot ends at).
+
+Pairs with no path between them cost :data:`NO_PATH_M` each: the solver avoids them
+where it can, and the caller says which legs have no path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+
+#: Waypoints at most: the distances need a plan for every pair (n² / 2 of them).
+MAX_WAYPOINTS = 400
+#: The cost of a leg with no path, in metres: more than any route on any map.
+NO_PATH_M = 1.0e6
+#: Distances go to the solver in millimetres (it works in integers).
+_MM = 1000.0
+#: An order must be this much shorter than the file's to replace it.
+_SHORTER_BY_M = 0.01
+
+Place = tuple[float, float]
+#: The length (m) a robot drives from one place to another, None when there is no path.
+LegLength = Callable[[Place, Place], float | None]
+
+
+@dataclass(frozen=True)
+class Ordering:
+    """The order found: ``order[k]`` is the index (in the file) of the k-th waypoint."""
+
+    order: tuple[int, ...]
+
+    @property
+    def changed(self) -> bool:
+        return self.order != tuple(range(len(self.order)))
+
+    def apply(self, mission: Mission) -> Mission:
+        """The mission with its waypoints in this order, everything else as it was."""
+        return replace(mission, waypoints=tuple(mission.waypoints[i] for i in self.order))
+
+
+def straight_line(a: Place, b: Place) -> float:
+    return math.dist(a, b)
+
+
+def distance_matrix(places: Sequence[Place], length: LegLength) -> np.ndarray:
+    """Metres from every place to every other (``NO_PATH_M`` where there is no path).
+
+    Each pair is measured once and used both ways: a path planned on a costmap is as
+    long one way as the other, but for the grid's tie-breaking.
+    """
+    count = len(places)
+    matrix = np.zeros((count, count))
+    for i in range(count):
+        for j in range(i + 1, count):
+            metres = length(places[i], places[j])
+            matrix[i, j] = matrix[j, i] = NO_PATH_M if metres is None else metres
+    return matrix
+
+
+def shortest_order(
+    mission: Mission,
+    length: LegLength = straight_line,
+    time_limit_s: float = 2.0,
+    *,
+    keep_last: bool = False,
+) -> Ordering:
+    """The order of ``mission``'s waypoints that drives the least (see the module doc).
+
+    ``keep_last``: the file's last waypoint stays last (the robot ends at its dock).
+    """
+    waypoints = [(w.x, w.y) for w in mission.waypoints]
+    if len(waypoints) > MAX_WAYPOINTS:
+        raise NavseqError(
+            f"{len(waypoints)} waypoints: ordering plans a path between every two of them "
+            f"and takes at most {MAX_WAYPOINTS}; order the mission in parts "
+            "(navseq run --from/--to take parts of a file)",
+            source=mission.source,
+        )
+    closed = mission.loops != 1
+    start = None if closed else mission.start
+    from_start = start is not None
+    places = ([(start.x, start.y)] if start is not None else []) + waypoints
+    fixed = (0 if from_start else 1) + (1 if keep_last else 0)
+    if len(places) - fixed <= 1:
+        return Ordering(tuple(range(len(waypoints))))  # nothing to choose
+    matrix = distance_matrix(places, length)
+    last = len(places) - 1 if keep_last else None
+    tour = _solve(matrix, closed=closed, last=last, time_limit_s=time_limit_s)
+    as_in_file = list(range(len(places)))
+    # An order no shorter than the file's (a patrol run the other way round, a tie) is
+    # no reason to change what the user wrote.
+    if _length(matrix, tour, closed) >= _length(matrix, as_in_file, closed) - _SHORTER_BY_M:
+        tour = as_in_file
+    shift = 1 if from_start else 0
+    return Ordering(tuple(node - shift for node in tour if node >= shift))
+
+
+def _length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
+    ends = [*tour[1:], tour[0]] if closed else tour[1:]
+    return float(sum(matrix[a, b] for a, b in zip(tour, ends, strict=False)))
+
+
+def _solve(matrix: np.ndarray, *, closed: bool, last: int | None, time_limit_s: float) -> list[int]:
+    """Node 0 first; every node once; node ``last`` last if given; back to node 0 when
+    ``closed`` (a fixed last node makes the way back a constant: the route ends there)."""
+    from ortools.constraint_solver import pywrapcp, routing_enums_pb2
+
+    count = len(matrix)
+    if last is not None:
+        end, nodes = last, count
+    elif closed:
+        end, nodes = 0, count
+    else:
+        # An open route ends at a node of its own that costs nothing to reach: the last
+        # waypoint is then whichever suits the solver.
+        end, nodes = count, count + 1
+    costs = np.zeros((nodes, nodes), dtype=np.int64)
+    costs[:count, :count] = np.rint(matrix * _MM).astype(np.int64)
+    manager = pywrapcp.RoutingIndexManager(nodes, 1, [0], [end])
+    routing = pywrapcp.RoutingModel(manager)
+
+    def arc_cost(from_index: int, to_index: int) -> int:
+        return int(costs[manager.IndexToNode(from_index), manager.IndexToNode(to_index)])
+
+    routing.SetArcCostEvaluatorOfAllVehicles(routing.RegisterTransitCallback(arc_cost))
+    parameters = pywrapcp.DefaultRoutingSearchParameters()
+    parameters.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC
+    parameters.local_search_metaheuristic = (
+        routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
+    )
+    parameters.time_limit.FromMilliseconds(max(1, round(time_limit_s * 1000)))
+    solution = routing.SolveWithParameters(parameters)
+    if solution is None:  # every node may come in any order: this is a solver failure
+        raise NavseqError("the route solver found no order (OR-tools gave no solution)")
+    tour = []
+    index = routing.Start(0)
+    while not routing.IsEnd(index):
+        tour.append(manager.IndexToNode(index))
+        index = solution.Value(routing.NextVar(index))
+    if last is not None:
+        tour.append(last)  # the end node is not among the visited ones
+    return tour
+
+
+__all__ = [
+    "MAX_WAYPOINTS",
+    "NO_PATH_M",
+    "Ordering",
+    "distance_matrix",
+    "shortest_order",
+    "straight_line",
+]
