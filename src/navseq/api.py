@@ -141,6 +141,33 @@ def check_mission(
     return _problems(preflight_errors(mission, costmap, start, robot=profile))
 
 
+def order_waypoints(
+    mission: Mission,
+    *,
+    map: PathLike | None = None,
+    robot: RobotLike | None = None,
+    keep_last: bool = False,
+    time_limit_s: float = 2.0,
+) -> Mission:
+    """``mission`` with its waypoints in the order that drives the least, as ``navseq plan
+    --order shortest`` finds it; every other setting as it was.
+
+    Lengths are the paths planned on ``map`` (default: the mission's ``map:``) for
+    ``robot``, or straight lines without a map. The start pose, else waypoint 1, stays
+    first; a patrol stays a closed tour; ``keep_last`` keeps the last waypoint last. The
+    solver searches for ``time_limit_s``; an order no shorter than the mission's own
+    leaves it as it is.
+    """
+    from navseq.commands.common import choose_robot, legs_on_map
+    from navseq.route.legs import lengths
+    from navseq.route.order import shortest_order
+
+    map_path = Path(map) if map is not None else mission.map
+    legs = legs_on_map(map_path, choose_robot(robot, mission))
+    ordering = shortest_order(mission, lengths(legs), time_limit_s, keep_last=keep_last)
+    return ordering.apply(mission)
+
+
 def sim_navigator(
     mission: Mission,
     *,

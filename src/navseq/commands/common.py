@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
+    from navseq.route.legs import Legs
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
 
@@ -127,6 +128,16 @@ def costmap_for_robot(grid: OccupancyGrid, robot: RobotProfile | None = None) ->
     from navseq.sim.profile import costmap_params_of
 
     return Costmap.from_grid(grid, costmap_params_of(robot or DEFAULT_PROFILE))
+
+
+def legs_on_map(map_path: Path | None, robot: RobotProfile) -> Legs:
+    """The legs a mission's route is made of: planned on ``map_path``'s costmap for
+    ``robot``, or straight lines when there is no map."""
+    from navseq.route.legs import LegPlanner, StraightLegs
+
+    if map_path is None:
+        return StraightLegs()
+    return LegPlanner(costmap_for_map(map_path, robot))
 
 
 def add_robot_option(parser: argparse.ArgumentParser) -> None:

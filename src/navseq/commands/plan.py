@@ -69,9 +69,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.commands.common import choose_robot, require_file
+    from navseq.commands.common import choose_robot, legs_on_map, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
+    from navseq.route.legs import lengths
 
     if not (0.0 < args.time_limit <= 3600.0):
         raise NavseqError("must be more than 0 and at most 3600 seconds", source="--time-limit")
@@ -86,16 +87,14 @@ def run(args: argparse.Namespace) -> int:
     mission = load_mission(args.mission)
     robot = choose_robot(args.robot, mission)
     map_path = args.map if args.map is not None else mission.map
-    legs = _leg_source(map_path, robot)
+    legs = legs_on_map(map_path, robot)
     in_file_order = _route(mission, legs)
     order = list(range(len(mission.waypoints)))
     ordered = mission
     if args.order == "shortest":
         from navseq.route.order import shortest_order
 
-        ordering = shortest_order(
-            mission, _length_of(legs), args.time_limit, keep_last=args.keep_last
-        )
+        ordering = shortest_order(mission, lengths(legs), args.time_limit, keep_last=args.keep_last)
         order, ordered = list(ordering.order), ordering.apply(mission)
     route = _route(ordered, legs) if ordered is not mission else in_file_order
     if args.out is not None:
@@ -110,20 +109,6 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print(result, args)
     return 0 if result["every_leg_has_a_path"] else 1
-
-
-def _leg_source(map_path: Path | None, robot: RobotProfile) -> Legs:
-    from navseq.route.legs import LegPlanner, StraightLegs
-
-    if map_path is None:
-        return StraightLegs()
-    from navseq.commands.common import costmap_for_map
-
-    return LegPlanner(costmap_for_map(map_path, robot))
-
-
-def _length_of(legs: Legs) -> Any:
-    return lambda start, goal: legs.leg(start, goal).length_m
 
 
 def _route(mission: Mission, legs: Legs) -> list[dict[str, Any]]:

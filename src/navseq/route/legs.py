@@ -12,6 +12,7 @@ import itertools
 import math
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -78,6 +79,11 @@ class Legs(Protocol):
     """What plans a leg: a :class:`LegPlanner` on a costmap, or :class:`StraightLegs`."""
 
     def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg: ...
+
+
+def lengths(legs: Legs) -> Callable[[tuple[float, float], tuple[float, float]], float | None]:
+    """Metres from a place to another as ``legs`` plans them (None: no path)."""
+    return lambda start, goal: legs.leg(start, goal).length_m
 
 
 def corners(points: Any) -> list[tuple[float, float]]:
