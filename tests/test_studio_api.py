@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from starlette.testclient import TestClient
 
+from cli_support import navseq
 from navseq.mission import load_mission
 from navseq.sinks.journal import HEARTBEAT
 from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
@@ -117,6 +118,25 @@ def test_a_checked_draft_gets_validate_problems_and_planned_legs(client: TestCli
         "turtlebot3_world.yaml, waypoint 3 'inner-east': at (1.00, 0.00)"
     )
     assert "obstacle" in problem["message"]
+
+
+def test_the_shortest_order_is_that_of_navseq_plan(client: TestClient, workspace: Path) -> None:
+    document = opened(client)["mission"]
+    answer = client.post("/api/order", json={"mission": document, "keep_last": True})
+    assert answer.status_code == 200, answer.text
+    found = answer.json()
+    assert sorted(found["order"]) == list(range(7)) and found["order"][-1] == 6
+    assert found["length_m"] < found["length_before_m"]
+    mission = workspace / "examples/turtlebot3_world.yaml"
+    plan = navseq("plan", mission, "--order", "shortest", "--keep-last", "--json", cwd=workspace)
+    route = json.loads(plan.stdout)
+    assert [index + 1 for index in found["order"]] == route["order"]
+    assert found["length_m"] == route["length_m"]
+    # A draft that does not read, or a bad option: a 4xx that says why.
+    document["waypoints"][0]["x"] = "oops"
+    refused = client.post("/api/order", json={"mission": document})
+    assert refused.status_code == 422 and refused.json()["problems"]
+    assert client.post("/api/order", json={"mission": {}, "keep_last": "yes"}).status_code == 400
 
 
 def test_the_draft_problems_are_those_of_navseq_validate(

@@ -265,6 +265,23 @@ def test_the_page_is_ready_before_the_first_check_and_plans_come_after(
             browser.close()
 
 
+def test_the_shortest_order_is_one_undoable_edit(page: Any, studio: tuple[str, Path, Any]) -> None:
+    def names() -> list[str]:
+        labels = page.get_by_test_id("waypoint-row").locator(".label").all_inner_texts()
+        return [label.split(" (")[0] for label in labels]
+
+    before = names()
+    assert before[-1] == "home"
+    checked_after(page, lambda: page.get_by_test_id("order").select_option("keep-last"))
+    after = names()
+    assert after != before and sorted(after) == sorted(before) and after[-1] == "home"
+    assert "instead of" in page.locator("#message").inner_text()
+    assert page.get_by_test_id("waypoint-marker").count() == 7
+    checked_after(page, lambda: page.keyboard.press("Control+z"))
+    assert names() == before
+    assert page.errors == []
+
+
 def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:

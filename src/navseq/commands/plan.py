@@ -23,7 +23,6 @@ from navseq.commands.common import add_robot_option
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
-    from navseq.route.legs import Legs
 
 ORDERS = ("file", "shortest")
 
@@ -72,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import choose_robot, legs_on_map, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
-    from navseq.route.legs import lengths
+    from navseq.route.legs import legs_of, lengths
 
     if not (0.0 < args.time_limit <= 3600.0):
         raise NavseqError("must be more than 0 and at most 3600 seconds", source="--time-limit")
@@ -88,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     robot = choose_robot(args.robot, mission)
     map_path = args.map if args.map is not None else mission.map
     legs = legs_on_map(map_path, robot)
-    in_file_order = _route(mission, legs)
+    in_file_order = legs_of(mission, legs)
     order = list(range(len(mission.waypoints)))
     ordered = mission
     if args.order == "shortest":
@@ -96,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
 
         ordering = shortest_order(mission, lengths(legs), args.time_limit, keep_last=args.keep_last)
         order, ordered = list(ordering.order), ordering.apply(mission)
-    route = _route(ordered, legs) if ordered is not mission else in_file_order
+    route = legs_of(ordered, legs) if ordered is not mission else in_file_order
     if args.out is not None:
         from navseq.mission import write_mission
 
@@ -111,19 +110,6 @@ def run(args: argparse.Namespace) -> int:
     return 0 if result["every_leg_has_a_path"] else 1
 
 
-def _route(mission: Mission, legs: Legs) -> list[dict[str, Any]]:
-    from navseq.route.legs import legs_of
-
-    return legs_of(mission, legs)
-
-
-def _total(route: list[dict[str, Any]]) -> float | None:
-    """Metres once through the route: a patrol's way back to its first waypoint included,
-    for that is the leg its order changes too."""
-    lengths = [leg["length_m"] for leg in route]
-    return None if any(length is None for length in lengths) else round(sum(lengths), 3)
-
-
 def _result(
     mission: Mission,
     order: list[int],
@@ -135,6 +121,8 @@ def _result(
 ) -> dict[str, Any]:
     """The route as ``--json`` prints it (docs/cli.md#navseq-plan)."""
     import math
+
+    from navseq.route.legs import route_length
 
     waypoints = mission.waypoints
     legs = []
@@ -152,7 +140,7 @@ def _result(
                 "back_to_first": leg["loop"],
             }
         )
-    total = _total(route)
+    total = route_length(route)
     return {
         "mission": str(mission.source),
         "map": _shown(map_path) if map_path is not None else None,
@@ -160,7 +148,7 @@ def _result(
         "order": [number + 1 for number in order],
         "legs": legs,
         "length_m": total,
-        "length_in_file_order_m": _total(in_file_order),
+        "length_in_file_order_m": route_length(in_file_order),
         "max_speed_m_s": robot.max_linear_speed,
         "duration_s": round(total / robot.max_linear_speed, 1)
         if total is not None and robot.max_linear_speed > 0

@@ -81,6 +81,13 @@ class Legs(Protocol):
     def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg: ...
 
 
+def route_length(legs: list[dict[str, Any]]) -> float | None:
+    """Metres once through the legs :func:`legs_of` gives, a patrol's way back to its
+    first waypoint included (that leg changes with the order too); None if one has no path."""
+    metres = [leg["length_m"] for leg in legs]
+    return None if any(m is None for m in metres) else round(sum(metres), 3)
+
+
 def lengths(legs: Legs) -> Callable[[tuple[float, float], tuple[float, float]], float | None]:
     """Metres from a place to another as ``legs`` plans them (None: no path)."""
     return lambda start, goal: legs.leg(start, goal).length_m

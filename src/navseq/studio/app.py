@@ -28,7 +28,7 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from navseq.errors import NavseqError
-from navseq.route.legs import LegPlanner, legs_of, route_summary
+from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     DraftRefused,
@@ -60,6 +60,8 @@ MAX_FILES_LISTED = 500
 CHECK_ANSWERS_KEPT = 16
 #: Pace choices the page offers: None is as fast as the CPU goes.
 MAX_REALTIME = 1000.0
+#: Seconds the route solver searches for the page's "shortest order" (a click, not a batch).
+ORDER_TIME_LIMIT_S = 1.0
 
 
 @dataclass
@@ -375,6 +377,41 @@ class Studio:
                 problems=problems,
             )
         return {"path": self.roots.relative(path), "mission": document, "problems": problems}
+
+    def order(self, body: dict[str, Any]) -> dict[str, Any]:
+        """The draft's shortest visiting order (``POST /api/order``), as ``navseq plan
+        --order shortest`` finds it on the draft's map (straight lines without one)."""
+        from navseq.commands.common import choose_robot
+        from navseq.route.legs import StraightLegs, lengths, route_length
+        from navseq.route.order import shortest_order
+
+        keep_last = body.get("keep_last", False)
+        if not isinstance(keep_last, bool):
+            raise ApiError(400, "keep_last: true or false")
+        checked = check_draft(
+            body.get("mission"),
+            roots=self.roots,
+            base_dir=self.base_dir,
+            shown_as=self.shown_name,
+            costmaps=self.costmap,
+        )
+        mission = checked.mission
+        if mission is None:
+            raise ApiError(
+                422,
+                "the mission has problems that stop it being read; fix them before ordering",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        robot = choose_robot(None, mission)
+        legs: Legs = StraightLegs()
+        if checked.map_path is not None and checked.map_path.is_file():
+            legs = self.planner(checked.map_path, robot)
+        ordering = shortest_order(mission, lengths(legs), ORDER_TIME_LIMIT_S, keep_last=keep_last)
+        return {
+            "order": list(ordering.order),
+            "length_m": route_length(legs_of(ordering.apply(mission), legs)),
+            "length_before_m": route_length(legs_of(mission, legs)),
+        }
 
     def export_launch(self, body: dict[str, Any]) -> dict[str, Any]:
         """The draft as the tutorial's launch file (``p_seq`` / ``yea_seq``)."""
@@ -723,6 +760,7 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/files", answer(studio.files)),
         Route("/api/import", answer_body(studio.import_file), methods=["POST"]),
         Route("/api/export", answer_body(studio.export_launch), methods=["POST"]),
+        Route("/api/order", answer_body(studio.order), methods=["POST"]),
         Route("/api/runs", answer(studio.runs)),
         Route("/api/replay", get_replay),
         Route("/api/run", answer_body(studio.start_run), methods=["POST"]),

@@ -466,6 +466,28 @@ async function importFile() {
   edit(() => { S.doc = imported; S.selected = null; });
   say(`imported ${imported.waypoints.length} waypoints from ${answer.data.path} (undo: Ctrl+Z); save to keep them`);
 }
+// ---- shortest order ----------------------------------------------------------------------
+$("order").onchange = async (e) => {
+  const choice = e.target.value;
+  e.target.value = "";
+  if (!choice || (S.run && !S.run.done) || S.replay) return;
+  say("finding the shortest order…");
+  const answer = await api("POST", "/api/order", { mission: S.doc, keep_last: choice === "keep-last" });
+  if (!answer.ok) {
+    const first = (answer.data.problems || [])[0];
+    say(first ? `${answer.data.error}: ${first.text}` : answer.data.error, true);
+    return;
+  }
+  const { order, length_m: after, length_before_m: before } = answer.data;
+  if (order.every((index, k) => index === k)) { say("the waypoints already are in the shortest order"); return; }
+  // The page's own waypoints, moved: every field it holds stays as it is.
+  edit(() => {
+    S.doc.waypoints = order.map((index) => S.doc.waypoints[index]);
+    S.selected = null;
+  });
+  const saving = after !== null && before ? ` (${after.toFixed(2)} m instead of ${before.toFixed(2)} m)` : "";
+  say(`waypoints put in the shortest order${saving}; undo: Ctrl+Z`);
+};
 async function exportLaunch() {
   const stem = (S.name || "mission").replace(/\.[^.]*$/, "");
   const path = window.prompt("Export the tutorial's launch file (p_seq / yea_seq) as:", `${stem}.launch`);
