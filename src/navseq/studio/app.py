@@ -31,6 +31,7 @@ from navseq.errors import NavseqError
 from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
+    CheckedDraft,
     DraftRefused,
     check_draft,
     empty_document,
@@ -43,6 +44,7 @@ from navseq.studio.security import COOKIE_NAME, TOKEN_HEADER, FileRoots, token_m
 from navseq.text import printable
 
 if TYPE_CHECKING:
+    from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
     from navseq.studio.runs import StudioRun
@@ -254,16 +256,34 @@ class Studio:
             return None
         return text, stamp
 
+    def _checked(
+        self, document: Any, *, base_dir: Path | None = None, shown_as: str | None = None
+    ) -> CheckedDraft:
+        """The draft checked as ``navseq validate --map`` checks a file."""
+        return check_draft(
+            document,
+            roots=self.roots,
+            base_dir=base_dir if base_dir is not None else self.base_dir,
+            shown_as=shown_as if shown_as is not None else self.shown_name,
+            costmaps=self.costmap,
+        )
+
+    def _readable(self, document: Any, doing: str, **where: Any) -> tuple[CheckedDraft, Mission]:
+        """The draft checked and its mission; refused (422, with its problems) when it
+        cannot be read."""
+        checked = self._checked(document, **where)
+        if checked.mission is None:
+            raise ApiError(
+                422,
+                f"the mission has problems that stop it being read; fix them before {doing}",
+                problems=[problem.as_json() for problem in checked.problems],
+            )
+        return checked, checked.mission
+
     def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
-        checked = check_draft(
-            document,
-            roots=self.roots,
-            base_dir=self.base_dir,
-            shown_as=self.shown_name,
-            costmaps=self.costmap,
-        )
+        checked = self._checked(document)
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
             "readable": checked.mission is not None,
@@ -300,19 +320,9 @@ class Studio:
             target = self.roots.resolve(path_text, "path")
         if target.suffix.lower() not in (".yaml", ".yml"):
             raise ApiError(422, "path: a navseq mission is saved as .yaml or .yml")
-        checked = check_draft(
-            document,
-            roots=self.roots,
-            base_dir=target.parent,
-            shown_as=printable(target.name),
-            costmaps=self.costmap,
+        checked, mission = self._readable(
+            document, "saving", base_dir=target.parent, shown_as=printable(target.name)
         )
-        if checked.mission is None:
-            raise ApiError(
-                422,
-                "the mission has problems that stop it being read; fix them before saving",
-                problems=[problem.as_json() for problem in checked.problems],
-            )
         overwrite = body.get("overwrite") is True
         expected = body.get("version")
         with self._save_lock:
@@ -337,7 +347,7 @@ class Studio:
                         conflict="exists",
                         version=current,
                     )
-            write_mission(checked.mission, target, overwrite=exists)
+            write_mission(mission, target, overwrite=exists)
             version = version_of(target)
         return {
             "path": self.roots.relative(target),
@@ -388,20 +398,7 @@ class Studio:
         keep_last = body.get("keep_last", False)
         if not isinstance(keep_last, bool):
             raise ApiError(400, "keep_last: true or false")
-        checked = check_draft(
-            body.get("mission"),
-            roots=self.roots,
-            base_dir=self.base_dir,
-            shown_as=self.shown_name,
-            costmaps=self.costmap,
-        )
-        mission = checked.mission
-        if mission is None:
-            raise ApiError(
-                422,
-                "the mission has problems that stop it being read; fix them before ordering",
-                problems=[problem.as_json() for problem in checked.problems],
-            )
+        checked, mission = self._readable(body.get("mission"), "ordering")
         robot = choose_robot(None, mission)
         legs: Legs = StraightLegs()
         if checked.map_path is not None and checked.map_path.is_file():
@@ -423,19 +420,7 @@ class Studio:
         target = self.roots.resolve(path_text, "path")
         if target.suffix.lower() not in (".launch", ".xml"):
             raise ApiError(422, "path: the tutorial's launch file is saved as .launch or .xml")
-        checked = check_draft(
-            body.get("mission"),
-            roots=self.roots,
-            base_dir=self.base_dir,
-            shown_as=self.shown_name,
-            costmaps=self.costmap,
-        )
-        if checked.mission is None:
-            raise ApiError(
-                422,
-                "the mission has problems that stop it being read; fix them before exporting",
-                problems=[problem.as_json() for problem in checked.problems],
-            )
+        _, mission = self._readable(body.get("mission"), "exporting")
         with self._save_lock:
             exists = target.exists()
             if exists and body.get("overwrite") is not True:
@@ -444,7 +429,7 @@ class Studio:
                     f"{printable(target.name)} exists; confirm to replace it",
                     conflict="exists",
                 )
-            launch = write_tutorial_launch(checked.mission, target, overwrite=exists)
+            launch = write_tutorial_launch(mission, target, overwrite=exists)
         return {"path": self.roots.relative(target), "left_out": list(launch.left_out)}
 
     def _existing_file(self, text: Any, what: str) -> Path:
@@ -505,13 +490,7 @@ class Studio:
         with self._lock:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
-        checked = check_draft(
-            body.get("mission"),
-            roots=self.roots,
-            base_dir=self.base_dir,
-            shown_as=self.shown_name,
-            costmaps=self.costmap,
-        )
+        checked = self._checked(body.get("mission"))
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
             raise ApiError(
