@@ -107,24 +107,28 @@ def shortest_order(
         return Ordering(tuple(range(len(waypoints))))  # nothing to choose
     matrix = distance_matrix(places, length)
     last = len(places) - 1 if keep_last else None
-    tour = _solve(matrix, closed=closed, last=last, time_limit_s=time_limit_s)
+    tour = shortest_tour(matrix, closed=closed, last=last, time_limit_s=time_limit_s)
     as_in_file = list(range(len(places)))
     # An order no shorter than the file's (a patrol run the other way round, a tie) is
     # no reason to change what the user wrote.
-    if _length(matrix, tour, closed) >= _length(matrix, as_in_file, closed) - _SHORTER_BY_M:
+    if tour_length(matrix, tour, closed) >= tour_length(matrix, as_in_file, closed) - _SHORTER_BY_M:
         tour = as_in_file
     shift = 1 if from_start else 0
     return Ordering(tuple(node - shift for node in tour if node >= shift))
 
 
-def _length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
+def tour_length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
+    """Metres along ``tour`` (indices into ``matrix``), back to its first when ``closed``."""
     ends = [*tour[1:], tour[0]] if closed else tour[1:]
     return float(sum(matrix[a, b] for a, b in zip(tour, ends, strict=False)))
 
 
-def _solve(matrix: np.ndarray, *, closed: bool, last: int | None, time_limit_s: float) -> list[int]:
-    """Node 0 first; every node once; node ``last`` last if given; back to node 0 when
-    ``closed`` (a fixed last node makes the way back a constant: the route ends there)."""
+def shortest_tour(
+    matrix: np.ndarray, *, closed: bool, last: int | None = None, time_limit_s: float = 2.0
+) -> list[int]:
+    """The order of the places of ``matrix`` (metres from each to each) that drives the
+    least: node 0 first, every node once, node ``last`` last if given, and back to node 0
+    when ``closed`` (a fixed last node makes the way back a constant: the route ends there)."""
     from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
     count = len(matrix)
@@ -170,5 +174,7 @@ __all__ = [
     "Ordering",
     "distance_matrix",
     "shortest_order",
+    "shortest_tour",
     "straight_line",
+    "tour_length",
 ]

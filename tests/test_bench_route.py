@@ -1,0 +1,39 @@
+"""The shortest-order benchmark, small: navseq's route is never longer than the others."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_route.py"
+
+
+def load_bench():
+    spec = importlib.util.spec_from_file_location("bench_route", BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_navseq_s_order_is_never_longer_than_the_file_s_or_nearest_neighbour() -> None:
+    from navseq.commands.common import costmap_for_map
+
+    bench = load_bench()
+    costmap = costmap_for_map(bench.ROOT / "maps" / "turtlebot3_world.yaml")
+    row = bench.measure("turtlebot3_world", costmap, size=9, seeds=2, time_limit_s=0.3)
+    for mine, drawn, nearest in zip(row.navseq_m, row.file_m, row.nearest_m, strict=True):
+        assert mine <= drawn + 1e-6 and mine <= nearest + 1e-6
+    assert sum(row.navseq_m) < sum(row.file_m)  # random order drives further
+
+
+def test_spots_are_free_and_the_same_for_the_same_seed() -> None:
+    from navseq.commands.common import costmap_for_map
+
+    bench = load_bench()
+    costmap = costmap_for_map(bench.ROOT / "maps" / "turtlebot3_world.yaml")
+    spots = bench.free_spots(costmap, 12, seed=4)
+    assert spots == bench.free_spots(costmap, 12, seed=4)
+    assert all(costmap.is_free(x, y) for x, y in spots)
