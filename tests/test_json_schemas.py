@@ -142,3 +142,24 @@ def test_a_report_rebuilt_from_the_journal_matches_the_schema(run, tmp_path):
     assert done.returncode in (0, 1), done.stderr
     rebuilt = json.loads((copy / "report.json").read_text())
     assert problems(validator("report"), rebuilt) == []
+
+
+def test_navseq_plan_json_matches_its_schema(tmp_path: Path) -> None:
+    from navseq.commands import plan
+
+    check = validator("plan")
+    schema = json.loads((SCHEMAS / "plan.schema.json").read_text())
+    assert schema["properties"]["schema_version"]["const"] == plan.SCHEMA_VERSION
+    patrol = write_mission(tmp_path / "patrol.yaml", MISSION, f"map: {TURTLEBOT3_MAP}\nloops: 2\n")
+    no_map = write_mission(tmp_path / "line.yaml", "  - {x: 0, y: 0}\n  - {x: 2, y: 0}\n")
+    example = REPO / "examples" / "turtlebot3_world.yaml"
+    for args in [
+        (example, "--order", "shortest", "--out", tmp_path / "ordered.yaml"),
+        (patrol,),
+        (no_map, "--order", "shortest"),
+    ]:
+        done = navseq("plan", *args, "--json", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        route = json.loads(done.stdout)
+        assert problems(check, route) == [], args
+    assert problems(check, {**route, "length": 1.0})  # an unknown, unit-less name

@@ -25,6 +25,8 @@ if TYPE_CHECKING:
     from navseq.mission.robot import RobotProfile
 
 ORDERS = ("file", "shortest")
+#: The ``--json`` output's version (docs/schemas/plan.schema.json).
+SCHEMA_VERSION = 1
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -119,7 +121,7 @@ def _result(
     robot: RobotProfile,
     out: Path | None,
 ) -> dict[str, Any]:
-    """The route as ``--json`` prints it (docs/cli.md#navseq-plan)."""
+    """The route as ``--json`` prints it (docs/schemas/plan.schema.json)."""
     import math
 
     from navseq.route.legs import route_length
@@ -142,6 +144,7 @@ def _result(
         )
     total = route_length(route)
     return {
+        "schema_version": SCHEMA_VERSION,
         "mission": str(mission.source),
         "map": _shown(map_path) if map_path is not None else None,
         "robot": robot.name,
