@@ -79,6 +79,8 @@ def test_node_logs_one_line_per_waypoint_event_as_navseq_run_does_in_a_pipe(
     info = log_lines(node.output(), "INFO")
     waypoint_lines = [line for line in info if line.startswith("navseq: waypoint")]
     assert waypoint_lines[0] == "navseq: waypoint 1/3: going to (-1.00, -4.00, 90°), attempt 1"
+    # No robot in the params: the node looked for move_base's (the scripted server has none).
+    assert any("no robot parameters in /move_base parameters" in line for line in info)
     assert waypoint_lines[1].startswith("navseq: waypoint 1/3: reached after ")
     assert "navseq: waypoint 2/3: going to (1.00, -4.00, 0°), attempt 2" in waypoint_lines
     assert waypoint_lines[-1].startswith("navseq: waypoint 3/3: reached after ")

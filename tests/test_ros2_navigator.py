@@ -448,6 +448,32 @@ def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path
     assert report["visits"][0]["distance_m"] == pytest.approx(0.6, abs=0.25)
 
 
+def test_arrival_is_judged_with_the_goal_tolerance_nav2_itself_uses(
+    env: dict[str, str], tmp_path: Path
+):
+    """Nav2 ends a goal SUCCEEDED within its goal checker's tolerance (0.25 m on most
+    robots): navseq reads it from Nav2's parameters, so such an arrival is one."""
+    robot = tmp_path / "loose.yaml"
+    robot.write_text(
+        "base: turtlebot3_waffle\nname: loose\nxy_goal_tolerance: 0.3\nyaw_goal_tolerance: 40\n"
+    )
+    sim = SimNode(env, f"--start={START}", "--speed", SPEED, "--robot", str(robot))
+    mission = write_mission(
+        tmp_path / "m.yaml", "  - {x: -1.4, y: -0.5, yaw: 90}\n  - {x: -1.4, y: 0.6, yaw: 0}\n"
+    )
+    try:
+        done = run_nav2(env, mission, tmp_path / "out")
+    finally:
+        sim.stop()
+    assert done.returncode == 0, done.stderr
+    source = report_of(tmp_path / "out")["navigator"]["robot_source"]
+    assert source.startswith("robot from Nav2's parameters under /: footprint 4 points"), source
+    assert "tolerance 0.3 m / 40°" in source and source in done.stderr
+    visits = report_of(tmp_path / "out")["visits"]
+    assert [visit["outcome"] for visit in visits] == ["reached", "reached"]
+    assert all(len(visit["attempts"]) == 1 for visit in visits)  # none "far from goal"
+
+
 def test_without_ros2_the_nav2_navigator_says_to_source_it(tmp_path: Path):
     """Where rclpy does not import (ROS 2 not sourced): one message, exit 2."""
     plain = {

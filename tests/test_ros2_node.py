@@ -165,6 +165,8 @@ def test_the_tutorial_params_alone_complete_with_one_log_line_per_waypoint_event
     assert code == 0, log
     assert "Traceback" not in log
     assert "4 waypoints from param /navseq p_seq; waiting for /navigate_to_pose" in log
+    # The tutorial's params name no robot: the node judges arrival by Nav2's own.
+    assert "robot from Nav2's parameters under /: footprint 4 points" in log
     going = [line for line in node.lines if ": going to (" in line]
     reached = [line for line in node.lines if ": reached after " in line]
     assert len(going) == 4 and len(reached) == 4, log

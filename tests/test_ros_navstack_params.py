@@ -77,7 +77,7 @@ def test_robot_radius_gives_a_round_robot_and_missing_values_keep_the_base():
 def test_nothing_to_read_keeps_the_base_profile_and_says_so():
     profile, note = profile_from_navstack_params({"controller_frequency": 10.0}, "/move_base")
     assert profile == TURTLEBOT3_BURGER
-    assert "no robot parameters under /move_base" in note and "turtlebot3_burger" in note
+    assert "no robot parameters in /move_base parameters" in note and "turtlebot3_burger" in note
 
 
 @pytest.mark.parametrize(

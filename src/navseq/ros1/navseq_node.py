@@ -71,10 +71,10 @@ from navseq.executor.events import MissionFinished
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
-from navseq.mission.robot import DEFAULT_PROFILE
 from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
+from navseq.ros1.navstack_params import read_navstack_profile
 from navseq.ros1.params import bool_param
 from navseq.signals import StopSignals, ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
@@ -218,14 +218,19 @@ def run_node() -> int:
             navigator.resolved_action,
         )
         navigator.require_server(float(settings["server_wait"]))
+        robot = mission.robot
+        if robot is None:
+            # Arrival is judged with the tolerance move_base's local planner uses.
+            robot, note = read_navstack_profile(navigator.resolved_action)
+            rospy.loginfo("navseq: %s", note)
         result = run_mission(
             mission,
             navigator,
-            # The robot the executor assumes (the mission's, else the default) also
-            # gives the log's time still to go.
-            [topics, LogProgress(mission, log_line, robot=mission.robot or DEFAULT_PROFILE)],
+            # The robot also gives the log's time still to go.
+            [topics, LogProgress(mission, log_line, robot=robot)],
             tick=float(settings["tick"]),
             control=control,
+            robot=robot,
         )
     except NavseqError as error:
         rospy.logerr("navseq: %s", error)

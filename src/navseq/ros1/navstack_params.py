@@ -52,12 +52,17 @@ def read_navstack_profile(
 
 
 def profile_from_navstack_params(
-    params: Mapping[str, Any], action_ns: str, base: RobotProfile = DEFAULT_PROFILE
+    params: Mapping[str, Any],
+    action_ns: str,
+    base: RobotProfile = DEFAULT_PROFILE,
+    *,
+    where: str | None = None,
 ) -> tuple[RobotProfile, str]:
     """``base`` with what ``params`` (the tree under ``action_ns``) says; and a one-line note.
 
     The note says what was read, e.g. ``robot from /move_base parameters: footprint 4
-    points, circumscribed 0.25 m, tolerance 0.05 m / 10°``.
+    points, circumscribed 0.25 m, tolerance 0.05 m / 10°``; ``where`` names the
+    parameters otherwise (Nav2's are read into the same tree: :mod:`navseq.ros2.nav2_params`).
     """
     reader = _Reader(params, action_ns.rstrip("/") or "/")
     changes: dict[str, Any] = {}
@@ -106,10 +111,10 @@ def profile_from_navstack_params(
             w = found.get("max_angular_speed", base.max_angular_speed)
             read.append(f"max {v:g} m/s / {w:g} rad/s")
 
-    where = f"{reader.ns} parameters"
+    where = where if where is not None else f"{reader.ns} parameters"
     if not changes:
         return base, (
-            f"no robot parameters under {reader.ns} (footprint, robot_radius, local planner): "
+            f"no robot parameters in {where} (footprint, robot_radius, goal tolerance): "
             f"assuming {base.name}"
         )
     try:

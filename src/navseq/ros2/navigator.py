@@ -57,7 +57,7 @@ import contextlib
 import os
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from nav2_msgs.action import NavigateToPose
@@ -103,6 +103,7 @@ DEFAULT_NODE_NAME = "navseq"
 CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
 CANCEL_WAIT = 2.0  # s of wall time close() waits for Nav2's answer to a cancel
 CLEAR_WAIT = 1.0  # s of wall time for both clear-costmap services' answers
+PARAMS_WAIT = 2.0  # s of wall time to read the robot from Nav2's node parameters
 # Nav2's action servers reject a goal only while their lifecycle node is not active
 # (configured, not yet activated; or deactivated): name the likely cause.
 REJECTED_TEXT = "Nav2 rejected the goal (is bt_navigator active?)"
@@ -377,6 +378,74 @@ class Nav2Navigator:
             silent,
             f"did not answer within {self.clear_wait:g} s: retrying without waiting for it",
         )
+
+    def read_parameters(
+        self, nodes: Mapping[str, str], timeout: float = PARAMS_WAIT
+    ) -> dict[str, dict[str, Any]]:
+        """Every parameter of each Nav2 node in ``nodes`` (our name -> its name relative
+        to the robot's namespace), through its ``list_parameters`` / ``get_parameters``
+        services; ``timeout`` wall seconds for all. A node that is not there or does not
+        answer in time is left out of the answer."""
+        from rcl_interfaces.srv import GetParameters, ListParameters
+
+        deadline = time.monotonic() + timeout
+        clients = {
+            key: (
+                self._node.create_client(ListParameters, f"{name}/list_parameters"),
+                self._node.create_client(GetParameters, f"{name}/get_parameters"),
+            )
+            for key, name in nodes.items()
+        }
+        answers: dict[str, dict[str, Any]] = {}
+        try:
+            # Discovery takes a moment: wait until every node's services are seen, or
+            # the deadline; a node not seen by then is left out.
+            while time.monotonic() < deadline and not all(
+                lister.service_is_ready() and getter.service_is_ready()
+                for lister, getter in clients.values()
+            ):
+                time.sleep(0.05)
+            asked = {
+                key: self._ask_parameters(lister, getter)
+                for key, (lister, getter) in clients.items()
+                if lister.service_is_ready() and getter.service_is_ready()
+            }
+            for key, (done, found) in asked.items():
+                if done.wait(max(deadline - time.monotonic(), 0.0)) and found:
+                    answers[key] = found
+        finally:
+            for lister, getter in clients.values():
+                self._in_ros(self._node.destroy_client, lister)
+                self._in_ros(self._node.destroy_client, getter)
+        return answers
+
+    def _ask_parameters(self, lister: Any, getter: Any) -> tuple[threading.Event, dict[str, Any]]:
+        """List a node's parameters, then get them all (on the executor's thread)."""
+        from rcl_interfaces.srv import GetParameters, ListParameters
+        from rclpy.parameter import parameter_value_to_python
+
+        done = threading.Event()
+        found: dict[str, Any] = {}
+
+        def got(names: list[str], future: Any) -> None:
+            if future.exception() is None:
+                for name, value in zip(names, future.result().values, strict=False):
+                    found[name] = parameter_value_to_python(value)
+            done.set()
+
+        def listed(future: Any) -> None:
+            if future.exception() is not None:
+                done.set()
+                return
+            names = list(future.result().result.names)
+            call = getter.call_async(GetParameters.Request(names=names))
+            call.add_done_callback(lambda answer: got(names, answer))
+
+        def ask() -> None:
+            lister.call_async(ListParameters.Request()).add_done_callback(listed)
+
+        self._in_ros(ask)
+        return done, found
 
     def _warn_clear_once(self, services: Sequence[str], what: str) -> None:
         new = [name for name in services if name not in self._clear_warned]

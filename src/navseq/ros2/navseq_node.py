@@ -64,6 +64,7 @@ from navseq.executor.events import (
 )
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.ros2.mission_topics import MissionTopics
+from navseq.ros2.nav2_params import NODES, profile_from_nav2_params
 from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.node_params import NodeSettings, read_node_params
 from navseq.ros2.session import Ros2Session
@@ -193,12 +194,19 @@ def run_node(session: Ros2Session) -> int:
             f"waiting for {navigator.resolved_action}"
         )
         navigator.require_server(settings.server_wait)
+        robot = mission.robot
+        if robot is None:
+            # Arrival is judged with the tolerance of Nav2's own goal checker.
+            params = navigator.read_parameters(NODES)
+            robot, note = profile_from_nav2_params(params, navigator.namespace)
+            logger.info(note)
         result = run_mission(
             mission,
             navigator,
             [topics, WaypointLog(mission, logger)],
             tick=settings.tick,
             control=control,
+            robot=robot,
         )
     except NavseqError as error:
         logger.error(f"{error}")

@@ -4,9 +4,10 @@ Everything that needs the running stack is done here, before the robot moves and
 any file is written, so a problem is one clear :class:`NavseqError` (exit 2): the
 ``navigate_to_pose`` server must answer within ``--server-timeout`` wall seconds and,
 under ``use_sim_time``, its clock must run (:meth:`Nav2Navigator.wait_for_server`).
-The robot profile is ``--robot``, else the mission's ``robot:``, else the default
-(``draft.robot`` already says which); pre-flight runs on ``--map`` / the mission's
-``map:`` when there is one.
+The robot profile is ``--robot``, else the mission's ``robot:``, else the one Nav2's own
+node parameters describe (:mod:`navseq.ros2.nav2_params`: outline, inflation, goal
+tolerance, speeds; what it does not say keeps the default's value); pre-flight runs on
+``--map`` / the mission's ``map:`` when there is one.
 
 This module imports rclpy (through the navigator): the registry imports it only when
 ``nav2`` is chosen, and turns an ImportError into one message saying to source ROS 2.
@@ -18,6 +19,7 @@ import argparse
 
 from navseq.errors import NavseqError
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.ros2.nav2_params import NODES, profile_from_nav2_params
 from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.sim_config import namespace_of
 
@@ -51,8 +53,16 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
     if not action or any(c.isspace() for c in action):
         raise NavseqError(f"{action!r} is not an action name", source="--action")
     navigator = Nav2Navigator(action, frame, namespace=namespace, use_sim_time=use_sim_time)
+    notes = []
+    robot_source = None
     try:
         navigator.require_server(server_timeout)
+        if getattr(args, "robot", None) is None and mission.robot is None:
+            # The robot Nav2 drives, as its own parameters say, unless the user named one:
+            # its goal checker's tolerance is the one arrival is judged by.
+            params = navigator.read_parameters(NODES)
+            draft.robot, robot_source = profile_from_nav2_params(params, namespace, draft.robot)
+            notes.append(robot_source)
         grid = draft.optional_map()
     except BaseException:
         navigator.close()
@@ -65,7 +75,8 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
         "use_sim_time": navigator.uses_sim_time,
         "robot": draft.robot.name,
     }
-    notes = []
+    if robot_source is not None:
+        info["robot_source"] = robot_source
     if use_sim_time is None and navigator.uses_sim_time:
         notes.append("/clock is published: navseq runs on simulation time (use_sim_time)")
     return NavigatorSetup(

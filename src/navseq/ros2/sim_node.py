@@ -28,6 +28,13 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
   ``amcl``, ...), answering *active*; every clear-costmap call is logged (``global_costmap:
   cleared``), so a client's clearing can be checked against the goals that follow;
+- the robot's parameters where Nav2 keeps them, on nodes of Nav2's names
+  (``controller_server``: ``general_goal_checker.xy_goal_tolerance`` and
+  ``yaw_goal_tolerance``, ``FollowPath.desired_linear_vel`` and
+  ``rotate_to_heading_angular_vel``; ``global_costmap/global_costmap`` and
+  ``local_costmap/local_costmap``: ``footprint``, ``inflation_layer.inflation_radius``
+  and ``cost_scaling_factor``), so that a client reading the robot from Nav2 finds the
+  simulated one (:func:`nav2_parameter_nodes`);
 - ``bt_navigator/change_state`` (``lifecycle_msgs/srv/ChangeState``): *deactivate* and
   *activate*, as Nav2's lifecycle manager does. While bt_navigator is inactive,
   ``navigate_to_pose`` and ``navigate_through_poses`` reject new goals, as Nav2's action
@@ -89,6 +96,7 @@ from tf2_msgs.msg import TFMessage
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
+from navseq.mission.robot import RobotProfile
 from navseq.ros2.messages import (
     duration_msg,
     grid_msg,
@@ -699,6 +707,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         previous[signum] = signal.signal(signum, request_stop)
     sim: SimNode | None = None
     node: Node | None = None
+    helpers: list[Node] = []
     spinner: threading.Thread | None = None
     executor = MultiThreadedExecutor(num_threads=8)
     try:
@@ -710,6 +719,9 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             print(f"navseq sim: {error}", file=sys.stderr)
             return 2
         executor.add_node(node)
+        helpers = nav2_parameter_nodes(config.robot, config.namespace)
+        for helper in helpers:
+            executor.add_node(helper)
         spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2")
         spinner.start()
         sim.start()
@@ -732,11 +744,48 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         executor.shutdown(timeout_sec=5.0)
         if spinner is not None:
             spinner.join(timeout=5.0)
+        for helper in helpers:
+            helper.destroy_node()
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
         for number, handler in previous.items():
             signal.signal(number, handler)
+
+
+def nav2_parameter_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
+    """Nodes named as Nav2's that hold the robot's parameters where Nav2 keeps them
+    (``controller_server``, ``global_costmap/global_costmap``, ``local_costmap/local_costmap``;
+    see :mod:`navseq.ros2.nav2_params`), so a client that reads the robot from Nav2 finds
+    the simulated one: its goal checker's tolerance, its controller's speeds, its outline
+    and inflation. rclpy serves every node's parameters by itself."""
+    ns = f"/{namespace.strip('/')}" if namespace and namespace.strip("/") else ""
+    tolerance = robot.goal_tolerance
+    controller = [
+        Parameter("goal_checker_plugins", value=["general_goal_checker"]),
+        Parameter("general_goal_checker.xy_goal_tolerance", value=tolerance.xy_m),
+        Parameter("general_goal_checker.yaw_goal_tolerance", value=tolerance.yaw_rad),
+        Parameter("controller_plugins", value=["FollowPath"]),
+        Parameter("FollowPath.desired_linear_vel", value=robot.max_linear_speed),
+        Parameter("FollowPath.rotate_to_heading_angular_vel", value=robot.max_angular_speed),
+    ]
+    outline = "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in robot.footprint) + "]"
+    costmap = [
+        Parameter("footprint", value=outline),
+        Parameter("inflation_layer.inflation_radius", value=robot.inflation_radius),
+        Parameter("inflation_layer.cost_scaling_factor", value=robot.cost_scaling_factor),
+    ]
+    made = [("controller_server", ns or None, controller)]
+    made += [(name, f"{ns}/{name}", costmap) for name in ("global_costmap", "local_costmap")]
+    return [
+        Node(
+            name,
+            namespace=where,
+            parameter_overrides=overrides,
+            automatically_declare_parameters_from_overrides=True,
+        )
+        for name, where, overrides in made
+    ]
 
 
 def _spin(executor: MultiThreadedExecutor) -> None:
