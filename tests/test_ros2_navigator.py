@@ -443,6 +443,8 @@ def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path
     report = report_of(tmp_path / "out")
     assert report["navigator"]["action"] == "/robot1/navigate_to_pose"
     assert report["navigator"]["ns"] == "robot1"
+    # The robot came from the namespace's own Nav2 nodes.
+    assert "Nav2's parameters under /robot1: footprint" in report["navigator"]["robot_source"]
     # robot1/odom -> robot1/base_footprint on /tf, and /robot1/odom, were found.
     assert report["start_source"] == "robot"
     assert report["visits"][0]["distance_m"] == pytest.approx(0.6, abs=0.25)
