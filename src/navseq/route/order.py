@@ -20,6 +20,7 @@ where it can, and the caller says which legs have no path.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -64,17 +65,24 @@ def straight_line(a: Place, b: Place) -> float:
     return math.dist(a, b)
 
 
-def distance_matrix(places: Sequence[Place], length: LegLength) -> np.ndarray:
+def distance_matrix(
+    places: Sequence[Place], length: LegLength, *, workers: int | None = None
+) -> np.ndarray:
     """Metres from every place to every other (``NO_PATH_M`` where there is no path).
 
     Each pair is measured once and used both ways: a path planned on a costmap is as
-    long one way as the other, but for the grid's tie-breaking.
+    long one way as the other, but for the grid's tie-breaking. The pairs are measured
+    on ``workers`` threads (default: one per core): the compiled A* search lets go of
+    the GIL, so plans run side by side.
     """
+    from concurrent.futures import ThreadPoolExecutor
+
     count = len(places)
+    pairs = [(i, j) for i in range(count) for j in range(i + 1, count)]
     matrix = np.zeros((count, count))
-    for i in range(count):
-        for j in range(i + 1, count):
-            metres = length(places[i], places[j])
+    with ThreadPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
+        measured = pool.map(lambda pair: length(places[pair[0]], places[pair[1]]), pairs)
+        for (i, j), metres in zip(pairs, measured, strict=True):
             matrix[i, j] = matrix[j, i] = NO_PATH_M if metres is None else metres
     return matrix
 
