@@ -98,6 +98,7 @@ def test_bad_options_are_one_clear_message(tmp_path: Path) -> None:
     for args, named in [
         (("--time-limit", "0"), "--time-limit"),
         (("--map", tmp_path / "none.yaml"), "--map"),
+        (("--keep-last",), "--order shortest"),
     ]:
         done = navseq("plan", EXAMPLE, *args, cwd=tmp_path)
         assert_clean_error(done)

@@ -75,6 +75,10 @@ def run(args: argparse.Namespace) -> int:
     from navseq.mission import load_mission
     from navseq.route.legs import legs_of, lengths
 
+    if args.keep_last and args.order != "shortest":
+        raise NavseqError(
+            "keeps a waypoint last in a new order: give --order shortest too", source="--keep-last"
+        )
     if not (0.0 < args.time_limit <= 3600.0):
         raise NavseqError("must be more than 0 and at most 3600 seconds", source="--time-limit")
     if args.out is not None and args.out.exists() and not args.force:
