@@ -4,24 +4,11 @@ waypoint reached."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_missions.py"
-
-
-def load_bench():
-    spec = importlib.util.spec_from_file_location("bench_missions", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+from bench_support import load_benchmark
 
 
 def test_small_seeded_benchmark_reaches_every_accepted_waypoint() -> None:
-    bench = load_bench()
+    bench = load_benchmark("bench_missions")
     policies = {"no stall limit": bench.POLICIES["no stall limit"]}
     rows = bench.run_benchmark(6, seed=11, waypoints=(3, 4), policies=policies)
     assert {row.kind for row in rows} == {"office", "warehouse"}

@@ -2,26 +2,13 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_route.py"
-
-
-def load_bench():
-    spec = importlib.util.spec_from_file_location("bench_route", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+from bench_support import load_benchmark
 
 
 def test_navseq_s_order_is_never_longer_than_the_file_s_or_nearest_neighbour() -> None:
     from navseq.commands.common import costmap_for_map
 
-    bench = load_bench()
+    bench = load_benchmark("bench_route")
     costmap = costmap_for_map(bench.ROOT / "maps" / "turtlebot3_world.yaml")
     row = bench.measure("turtlebot3_world", costmap, size=9, seeds=2, time_limit_s=0.3)
     for mine, drawn, nearest in zip(row.navseq_m, row.file_m, row.nearest_m, strict=True):
@@ -32,7 +19,7 @@ def test_navseq_s_order_is_never_longer_than_the_file_s_or_nearest_neighbour() -
 def test_spots_are_free_and_the_same_for_the_same_seed() -> None:
     from navseq.commands.common import costmap_for_map
 
-    bench = load_bench()
+    bench = load_benchmark("bench_route")
     costmap = costmap_for_map(bench.ROOT / "maps" / "turtlebot3_world.yaml")
     spots = bench.free_spots(costmap, 12, seed=4)
     assert spots == bench.free_spots(costmap, 12, seed=4)
