@@ -157,12 +157,41 @@ def test_the_yaw_limit_is_the_tolerance_plus_slack() -> None:
         assert outcome is (expected or WaypointOutcome.SKIPPED)
 
 
-def test_a_pass_through_visit_is_not_checked() -> None:
+def test_a_pass_through_success_far_from_its_point_is_a_failed_attempt() -> None:
+    # Nav2 ends a goal that preempted another SUCCEEDED with the robot where the old
+    # one ended (issue 16: 1.84 m away): passing through is no excuse.
+    h = Harness(line_mission(2, pass_through_m=0.3, retries=1))
+    h.start(0.0)
+    h.succeed(0.1, pose=Pose2D(0.0, 0.0, 0.0))  # 1 m from p1 (1, 0), radius 0.3
+    [failure] = h.of_type(AttemptFailed)
+    assert failure.reason == "succeeded far from goal (1.00 m)" and failure.will_retry
+    assert not h.of_type(WaypointFinished)
+    h.tick(1.2)
+    assert h.goals()[-1].goal.pose == GOAL  # p1 again, not p2
+
+
+def test_a_pass_through_success_within_radius_plus_slack_is_reached_whatever_the_yaw() -> None:
     h = Harness(line_mission(2, pass_through_m=0.3))
     h.start(0.0)
-    h.succeed(0.1, pose=Pose2D(0.0, 0.0, 0.0))  # first visit passes through: not a stop
+    # 0.38 m off (radius 0.3 + slack 0.1) and facing backwards: passing through.
+    h.succeed(0.1, pose=Pose2D(1.0, 0.38, math.pi))
     assert h.executor.result.visits[0].outcome is WaypointOutcome.REACHED
     assert isinstance(h.commands[-1], SendGoal) and h.goals()[-1].goal.pose.x == 2.0
+
+
+def test_a_pass_through_radius_smaller_than_the_stacks_tolerance_allows_the_tolerance() -> None:
+    # The stack may end the goal within its own tolerance before the robot is ever
+    # within a small radius: that is a true success.
+    tolerance = DEFAULT_PROFILE.goal_tolerance.xy_m
+    h = Harness(line_mission(2, pass_through_m=0.01, xy_tolerance_m=0.25))
+    h.start(0.0)
+    h.succeed(0.1, pose=Pose2D(1.0 - 0.3, 0.0, 0.0))
+    assert h.executor.result.visits[0].outcome is WaypointOutcome.REACHED
+    assert tolerance < 0.25  # the waypoint's own tolerance was the one applied
+    h2 = Harness(line_mission(2, pass_through_m=0.01, xy_tolerance_m=0.25))
+    h2.start(0.0)
+    h2.succeed(0.1, pose=Pose2D(1.0 - 0.4, 0.0, 0.0))
+    assert h2.executor.result.visits[0].outcome is not WaypointOutcome.REACHED
 
 
 def test_runner_with_the_plan_race_retries_and_reaches() -> None:

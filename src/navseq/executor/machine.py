@@ -34,12 +34,13 @@ the active goal without counting it as a failed attempt.
 
 The executor believes the robot, not only the navigation stack:
 
-* **Arrival.** A SUCCEEDED of a visit where the robot stops is checked against the
-  robot's pose (move_base can end a fresh goal SUCCEEDED with the robot metres away,
-  ros-planning/navigation #949). Farther than the goal tolerance plus
-  :data:`ARRIVAL_SLACK_M` (or turned more than the yaw tolerance plus
-  :data:`ARRIVAL_SLACK_RAD`), the attempt fails with a reason like ``succeeded far
-  from goal (2.38 m)`` and the waypoint's policy decides what follows.
+* **Arrival.** Every SUCCEEDED is checked against the robot's pose (move_base can end
+  a fresh goal SUCCEEDED with the robot metres away, ros-planning/navigation #949; Nav2
+  can end a goal that preempted another SUCCEEDED where the old one ended). Farther
+  than the goal tolerance (a pass-through visit: its radius) plus
+  :data:`ARRIVAL_SLACK_M` (or, where the robot stops, turned more than the yaw
+  tolerance plus :data:`ARRIVAL_SLACK_RAD`), the attempt fails with a reason like
+  ``succeeded far from goal (2.38 m)`` and the waypoint's policy decides what follows.
 * **Progress** (the stall timeout) is judged on one measure per attempt, the best
   one available: the navigator's distance remaining along its plan, else the
   distance along the latest ``GoalPlan`` from the robot's projection onto it, else
@@ -731,20 +732,31 @@ class MissionExecutor:
     def _arrival_miss(self) -> str | None:
         """Why a SUCCEEDED is not believed (the robot is not there), or None.
 
-        Only visits where the robot stops are checked: a pass-through visit is
-        reached by coming near, and its SUCCEEDED is as good as that. Without any
-        robot pose the SUCCEEDED is believed.
+        Every SUCCEEDED is checked. A visit where the robot stops allows the goal
+        tolerance plus :data:`ARRIVAL_SLACK_M`, and the yaw tolerance plus
+        :data:`ARRIVAL_SLACK_RAD`. A pass-through visit allows its radius (or the goal
+        tolerance, if larger: the stack may legitimately end the goal there before the
+        robot comes within the radius) plus the same slack, and no yaw: passing through
+        does not turn to the goal's heading. Nav2 can end a goal that preempted another
+        SUCCEEDED with the robot still at the preempted goal (its tree keeps following
+        the old path until the next re-plan), so pass-through visits need the check as
+        much as stops. Without any robot pose the SUCCEEDED is believed.
         """
         visit = self._current
         attempt = self._attempt
         pose = self._latest_pose
-        if pose is None or attempt is None or self._passes_through(visit):
+        if pose is None or attempt is None:
             return None
         tolerance = self.goal_tolerance(visit.policy)
         goal = attempt.goal.pose
         off = pose.distance_to(goal)
-        if off > tolerance.xy_m + ARRIVAL_SLACK_M:
+        passes = self._passes_through(visit)
+        radius = visit.policy.pass_through_m if passes else None
+        allowed = tolerance.xy_m if radius is None else max(radius, tolerance.xy_m)
+        if off > allowed + ARRIVAL_SLACK_M:
             return f"succeeded far from goal ({off:.2f} m)"
+        if passes:
+            return None
         yaw_off = abs(normalize_angle(goal.yaw - pose.yaw))
         if yaw_off > tolerance.yaw_rad + ARRIVAL_SLACK_RAD:
             return f"succeeded {math.degrees(yaw_off):.0f}° off the goal yaw"

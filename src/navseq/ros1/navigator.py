@@ -74,12 +74,12 @@ from navseq.navigators.base import (
     GoalDone,
     GoalFeedback,
     GoalOutcome,
-    GoalPlan,
     NavEvent,
     ServerBack,
     ServerLost,
 )
 from navseq.navigators.inbox import EventInbox
+from navseq.navigators.plans import PlanMatcher
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
 
@@ -203,6 +203,7 @@ class Ros1Navigator:
         # Callbacks leave events here and wake spin() (also on anything else it must
         # look at: a status, the clock).
         self._inbox = EventInbox()
+        self._plans = PlanMatcher()  # a plan is the goal's it ends at (a stale one is not)
         self._lock = threading.Lock()
         self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
         self._goal_id: int | None = None
@@ -350,6 +351,7 @@ class Ros1Navigator:
             self._goal_id = goal.goal_id
             self._accepted = False
             self._handle = None
+            self._plans.track(goal.goal_id, goal.pose, frame)
         # Not under self._lock: actionlib holds its own locks while calling our callbacks,
         # which take self._lock; holding ours while it takes its own would deadlock.
         handle = self._client.send_goal(
@@ -554,11 +556,12 @@ class Ros1Navigator:
             self._inbox.put(GoalFeedback(goal_id, pose))
 
     def _on_plan(self, path: Any) -> None:
-        goal_id = self._goal_id
-        if goal_id is None:
+        if self._goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in path.poses)
-        self._inbox.put(GoalPlan(goal_id, points))
+        plan = self._plans.plan_for(points, path.header.frame_id)
+        if plan is not None:
+            self._inbox.put(plan)
 
     def _on_status(self) -> None:
         if self._server_up is False:

@@ -83,12 +83,12 @@ from navseq.navigators.base import (
     GoalDone,
     GoalFeedback,
     GoalOutcome,
-    GoalPlan,
     NavEvent,
     ServerBack,
     ServerLost,
 )
 from navseq.navigators.inbox import EventInbox
+from navseq.navigators.plans import PlanMatcher
 from navseq.ros2.messages import (
     add_transforms,
     navigate_goal,
@@ -170,6 +170,7 @@ class Nav2Navigator:
 
         # Callbacks leave events here and wake spin() (also on every /clock message).
         self._inbox = EventInbox()
+        self._plans = PlanMatcher()  # a plan (and distance remaining) is the goal it ends at
         self._lock = threading.Lock()
         self._send_seq = 0  # goes up with every goal sent (and when one is dropped)
         self._goal_id: int | None = None  # the executor's id of the goal tracked
@@ -336,6 +337,7 @@ class Nav2Navigator:
             seq = self._send_seq
             self._goal_id = goal.goal_id
             self._handle = None
+            self._plans.track(goal.goal_id, goal.pose, frame)
         self._in_ros(self._send, seq, goal.goal_id, message)
 
     def cancel_goal(self) -> None:
@@ -601,6 +603,9 @@ class Nav2Navigator:
         if seq != self._send_seq or self._goal_id != goal_id:
             return
         remaining = float(feedback.distance_remaining)
+        if not self._plans.distance_is_this_goals():
+            # Measured along the preempted goal's path, which Nav2 follows until it re-plans.
+            remaining = 0.0
         self._inbox.put(
             GoalFeedback(
                 goal_id,
@@ -619,8 +624,9 @@ class Nav2Navigator:
         self._odom_pose = pose2d_from_pose(message.pose.pose)
 
     def _on_plan(self, message: Any) -> None:
-        goal_id = self._goal_id
-        if goal_id is None or not message.poses:
+        if self._goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in message.poses)
-        self._inbox.put(GoalPlan(goal_id, points))
+        plan = self._plans.plan_for(points, message.header.frame_id)
+        if plan is not None:
+            self._inbox.put(plan)
