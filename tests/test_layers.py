@@ -41,6 +41,7 @@ CORE_MODULES = [
     "navseq.commands.sim",
     "navseq.ros2",
     "navseq.ros2.standin",
+    "navseq.ros2.error_codes",
     "navseq.ros2.sim_config",
     "navseq.mission",
     "navseq.executor.machine",

@@ -296,7 +296,9 @@ def test_a_goal_in_a_wall_is_aborted_and_the_policy_skips_it(
     assert pillar["outcome"] == "skipped"
     attempt = pillar["attempts"][0]
     assert attempt["status"] == "ABORTED"
-    assert "(error_code 206)" in attempt["text"]  # Nav2's planner GOAL_OCCUPIED
+    # Nav2's error_msg first, then the planner's code by its nav2_msgs name.
+    assert attempt["text"].endswith("(ComputePathToPose GOAL_OCCUPIED, error_code 206)")
+    assert "in an obstacle" in attempt["text"]
     assert free["outcome"] == "reached"
 
 

@@ -27,6 +27,7 @@ from navseq.geometry import (
     yaw_to_quaternion,
 )
 from navseq.navigators.base import GoalOutcome
+from navseq.ros2.error_codes import describe_result
 from navseq.ros2.standin import plan_poses
 from navseq.sim.occupancy import OccupancyGrid
 from navseq.sim.planner import Plan
@@ -139,15 +140,13 @@ def terminal_status(code: int) -> tuple[GoalOutcome, str] | None:
 
 
 def result_text(error_code: int, error_msg: str) -> str:
-    """Nav2's own words about a result: ``error_msg``, and ``error_code`` when set.
+    """Nav2's own words about a result: ``error_msg``, and ``error_code`` by name when set.
 
     Nav2 (Iron and later) fills both on a failure (``error_code`` 206: the planner's
-    GOAL_OCCUPIED, ...); Humble's results have neither, so both may be empty.
+    GOAL_OCCUPIED, ...); Humble's results have neither, so both may be empty. The names
+    come from the installed nav2_msgs (:mod:`navseq.ros2.error_codes`).
     """
-    message = error_msg.strip()
-    if error_code:
-        return f"{message} (error_code {error_code})" if message else f"error_code {error_code}"
-    return message
+    return describe_result(int(error_code), error_msg)
 
 
 def navigate_goal(pose: Pose2D, frame: str, stamp: Time, z: float = 0.0) -> Any:

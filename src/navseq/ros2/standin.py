@@ -65,14 +65,16 @@ class ErrorCode(enum.IntEnum):
 
     Nav2's navigators pass on the code of the server that failed: the planner's
     ``ComputePathToPose`` codes (2xx) when there is no plan, the controller's
-    ``FollowPath`` codes (1xx) when the robot cannot follow it.
+    ``FollowPath`` codes (1xx) when the robot cannot follow it. Each value is the
+    nav2_msgs constant of the same name (``tests/test_ros2_error_codes.py`` compares
+    them with the installed nav2_msgs), so navseq's ``nav2`` navigator names them.
     """
 
     NONE = 0
-    CONTROLLER_UNKNOWN = 100
+    CONTROLLER_UNKNOWN = 100  # FollowPath UNKNOWN
     FAILED_TO_MAKE_PROGRESS = 105
     NO_VALID_CONTROL = 106
-    PLANNER_UNKNOWN = 200
+    PLANNER_UNKNOWN = 200  # ComputePathToPose UNKNOWN
     START_OUTSIDE_MAP = 203
     GOAL_OUTSIDE_MAP = 204
     START_OCCUPIED = 205
