@@ -26,6 +26,9 @@ fi
 
 packages=(zstd libpython3.11 libyaml-0-2 python3-numpy python3-yaml python3-lark
   python3-psutil python3-packaging)
+# A larger tree (the real Nav2, scripts/install-nav2.sh) names the libraries it needs too.
+read -r -a extra <<< "${NAVSEQ_ROS2_EXTRA_PACKAGES:-}"
+packages+=("${extra[@]}")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
