@@ -199,3 +199,54 @@ def test_a_goal_in_an_unknown_frame_fails_with_nav2s_words(
     [visit] = report["visits"]
     assert visit["outcome"] == "skipped"
     assert visit["attempts"][0]["status"] in ("ABORTED", "REJECTED"), visit
+
+
+def test_a_patrol_loops_on_nav2(placed: RealNav2, tmp_path: Path) -> None:
+    mission = write_mission(
+        tmp_path / "patrol.yaml",
+        "  - {name: south, x: -1.75, y: -1.0, yaw: 0}\n"
+        "  - {name: west, x: -2.0, y: -0.5, yaw: 0}\n",
+        header="loops: 2\ndefaults: {retries: 2, on_failure: stop}\n",
+    )
+    result = run(placed, mission, tmp_path / "out")
+    assert result.returncode == 0, result.stdout + result.stderr
+    events = journal(tmp_path / "out")
+    finished = [
+        (e["loop"], e["index"], e["outcome"]) for e in events if e["type"] == "WaypointFinished"
+    ]
+    assert finished == [(0, 0, "reached"), (0, 1, "reached"), (1, 0, "reached"), (1, 1, "reached")]
+
+
+def manage_nodes(nav2: RealNav2, command: int) -> None:
+    """Nav2's lifecycle manager: PAUSE (1) deactivates the navigation servers, RESUME (2)."""
+    service = "/lifecycle_manager_navigation/manage_nodes"
+    request = f"{{command: {command}}}"
+    result = subprocess.run(
+        ["ros2", "service", "call", service, "nav2_msgs/srv/ManageLifecycleNodes", request],
+        env=nav2.env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert "success=True" in result.stdout, result.stdout + result.stderr
+
+
+def test_goals_an_inactive_nav2_rejects_are_failed_attempts_saying_so(
+    placed: RealNav2, tmp_path: Path
+) -> None:
+    mission = write_mission(
+        tmp_path / "paused.yaml",
+        "  - {name: a, x: -1.75, y: -1.0, yaw: 0}\n",
+        header="defaults: {retries: 1, on_failure: skip}\n",
+    )
+    manage_nodes(placed, 1)
+    try:
+        result = run(placed, mission, tmp_path / "out", "--server-timeout", 10)
+    finally:
+        manage_nodes(placed, 2)
+    assert result.returncode == 1, result.stdout + result.stderr
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    [visit] = report["visits"]
+    assert visit["outcome"] == "skipped"
+    assert [a["status"] for a in visit["attempts"]] == ["REJECTED", "REJECTED"]
+    assert "is bt_navigator active?" in visit["attempts"][0]["text"]
