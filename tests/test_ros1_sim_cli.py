@@ -40,6 +40,7 @@ def test_without_rospy_it_says_to_source_ros1_and_exits_2():
         (["--start", "1,2,3,4"], "expected x,y,yaw"),
         (["--start", "0,0,0"], "--start: (0.00, 0.00) puts the robot on an obstacle"),
         (["--robot", "roomba"], "neither a built-in robot"),
+        (["--replan-period", "1"], "--replan-period: Nav2's re-plan on preemption"),
     ],
 )
 def test_bad_options_are_one_clear_error_even_without_rospy(options, message):

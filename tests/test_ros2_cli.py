@@ -34,6 +34,7 @@ def test_without_ros2_navseq_sim_says_to_source_it_and_exits_2():
         (["--ns", "1robot"], "is not a ROS 2 namespace"),
         (["--map", "no/such/map.yaml"], "no such file"),
         (["--robot", "roomba"], "neither a built-in robot"),
+        (["--replan-period", "-1"], "--replan-period: must be >= 0 s, got -1"),
     ],
 )
 def test_bad_options_are_one_clear_error_even_without_ros2(options, message):

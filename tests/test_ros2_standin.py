@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 import pytest
 
+from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
 from navseq.ros2.standin import (
     ErrorCode,
     Nav2StandIn,
@@ -184,3 +187,120 @@ def test_teleop_drives_only_while_no_goal_runs(standin: Nav2StandIn):
 def test_plan_poses_face_the_next_point_and_end_with_the_goal_yaw():
     poses = plan_poses([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], Pose2D(1.0, 1.0, 3.0))
     assert [round(p.yaw, 3) for p in poses] == [0.0, 1.571, 3.0]
+
+
+# -- Nav2's re-plan period on preemption (replan_period) ---------------------------------
+
+OLD_GOAL, NEW_GOAL = Pose2D(-1.0, -0.5, 0.0), Pose2D(-0.5, -1.7, 0.0)
+
+
+def preempt_near_the_old_goal(standin: Nav2StandIn, within: float = 0.4) -> tuple[NavTask, NavTask]:
+    """A goal to OLD_GOAL, then, once the robot is ``within`` of it, one to NEW_GOAL (what
+    navseq's pass-through does): the two tasks."""
+    old = standin.navigate(Navigator.TO_POSE, [OLD_GOAL])
+    while standin.world.robot.pose.distance_to(OLD_GOAL) > within:
+        standin.step()
+        assert standin.time < 30
+    return old, standin.navigate(Navigator.TO_POSE, [NEW_GOAL])
+
+
+def test_with_a_replan_period_a_goal_preempting_near_the_old_goals_end_succeeds_there(grid):
+    # A period longer than the drive: the tick comes after the robot has reached OLD_GOAL.
+    standin = Nav2StandIn(SimWorld(grid, START), replan_period=10.0)
+    old, new = preempt_near_the_old_goal(standin)
+    assert old.ending is not None
+    assert (old.ending.outcome, old.ending.error_code) == (Outcome.ABORTED, ErrorCode.NONE)
+    sent = standin.time
+    assert standin.world.server.goal == OLD_GOAL  # the old path is still followed
+    # Until the re-plan, Nav2's feedback measures the old path, not the way to NEW_GOAL.
+    feedback = standin.feedback(new)
+    assert feedback.distance_remaining < 0.45
+    assert standin.world.robot.pose.distance_to(NEW_GOAL) > 1.2
+    ending = run_until_done(standin, new)
+    assert (ending.outcome, ending.error_code, ending.error_msg) == (
+        Outcome.SUCCEEDED,
+        ErrorCode.NONE,
+        "",
+    )
+    assert new.succeeded_on_old_path
+    assert standin.time - sent < 3.0  # well before the tick
+    robot = standin.world.robot.pose
+    assert robot.distance_to(OLD_GOAL) < 0.1 and robot.distance_to(NEW_GOAL) > 1.2
+    for _ in range(10):
+        standin.step()
+    assert standin.active is None and standin.world.robot.v == 0.0
+
+
+def test_without_a_replan_period_the_preempting_goal_is_driven_to_its_own_pose(
+    standin: Nav2StandIn,
+):
+    old, new = preempt_near_the_old_goal(standin)
+    assert old.ending is not None and old.ending.outcome is Outcome.ABORTED
+    assert standin.world.server.goal == NEW_GOAL
+    assert run_until_done(standin, new).outcome is Outcome.SUCCEEDED
+    assert not new.succeeded_on_old_path
+    assert standin.world.robot.pose.distance_to(NEW_GOAL) < 0.1
+
+
+def test_the_re_plan_tick_comes_a_whole_period_after_the_trees_last_plan(grid):
+    # Nav2's 1 Hz: the goal that started the tree planned at 0 s; a preemption at 2.5 s
+    # is planned at the 3 s tick, with the old path driven until then.
+    standin = Nav2StandIn(SimWorld(grid, START), replan_period=1.0)
+    standin.navigate(Navigator.TO_POSE, [Pose2D(2.0, 0.5)])
+    while standin.time < 2.5 - 1e-9:
+        standin.step()
+    new = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.5, -0.5, 0.0)])
+    seen = []
+    while standin.time < 3.2:
+        seen.append((round(standin.time, 2), standin.world.server.goal))
+        standin.step()
+    switched = next(t for t, goal in seen if goal == Pose2D(-1.5, -0.5, 0.0))
+    assert switched == pytest.approx(3.05)  # planned in the step from 3.0 s on
+    # A tick far enough from the old goal's end: the new goal is reached, truly.
+    assert run_until_done(standin, new).outcome is Outcome.SUCCEEDED
+    assert not new.succeeded_on_old_path
+    assert standin.world.robot.pose.distance_to(Pose2D(-1.5, -0.5)) < 0.1
+
+
+def test_a_goal_that_starts_the_tree_is_planned_at_once_even_with_a_replan_period(grid):
+    standin = Nav2StandIn(SimWorld(grid, START), replan_period=10.0)
+    task = standin.navigate(Navigator.TO_POSE, [OLD_GOAL])
+    assert standin.world.server.goal == OLD_GOAL
+    assert run_until_done(standin, task).outcome is Outcome.SUCCEEDED
+    standin.step()
+    # The tree ended with it: the next goal starts a new one, planned at once too.
+    again = standin.navigate(Navigator.TO_POSE, [Pose2D(-1.5, -0.5, 0.0)])
+    assert standin.world.server.goal == Pose2D(-1.5, -0.5, 0.0)
+    assert run_until_done(standin, again).outcome is Outcome.SUCCEEDED
+    assert not again.succeeded_on_old_path
+
+
+def test_a_cancel_before_the_re_plan_tick_stops_the_robot_and_ends_canceled(grid):
+    standin = Nav2StandIn(SimWorld(grid, START), replan_period=10.0)
+    _old, new = preempt_near_the_old_goal(standin, within=0.6)
+    standin.cancel(new)
+    assert new.ending is not None and new.ending.outcome is Outcome.CANCELED
+    for _ in range(10):
+        standin.step()
+    assert standin.world.robot.v == 0.0 and standin.active is None
+    assert standin.world.robot.pose.distance_to(OLD_GOAL) > 0.3  # it did not drive on
+
+
+def sim_config(*argv: str, ros1: bool = False) -> SimConfig:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return config_from_args(parser.parse_args(["--map", str(MAP), *argv]), ros1=ros1)
+
+
+def test_the_replan_period_option_is_off_by_default_and_checked():
+    assert sim_config().replan_period == 0.0
+    assert sim_config("--replan-period", "1").replan_period == 1.0
+    assert sim_config("--replan-period", "0", ros1=True).replan_period == 0.0
+    for argv, ros1, message in (
+        (("--replan-period", "-1"), False, "must be >= 0 s, got -1"),
+        (("--replan-period", "nan"), False, "must be >= 0 s"),
+        (("--replan-period", "1"), True, "use it with --ros2"),
+    ):
+        with pytest.raises(NavseqError) as caught:
+            sim_config(*argv, ros1=ros1)
+        assert "--replan-period" in str(caught.value) and message in str(caught.value)

@@ -87,6 +87,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "its own: a fleet faster than wall-clock time has one robot with --speed S and the "
         "others with --follow-clock, all on one simulated time",
     )
+    parser.add_argument(
+        "--replan-period",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="(--ros2, for tests) simulated seconds between the re-plans of Nav2's default "
+        'tree (its RateController hz="1.0" is 1 s): a navigate_to_pose goal that preempts '
+        "another keeps the old path until the next re-plan, and ends SUCCEEDED if the robot "
+        "reaches the old goal first, as on Nav2. 0 (default): planned at once",
+    )
 
 
 @dataclass(frozen=True)
@@ -100,6 +110,7 @@ class SimConfig:
     robot: RobotProfile
     other_robots: tuple[str, ...] = ()  # namespaces of the other robots of a fleet
     follow_clock: bool = False  # step with another node's /clock (a fleet at speed != 1)
+    replan_period: float = 0.0  # s: Nav2's re-plan tick on preemption; 0 = plan at once
     rate: float = 20.0  # simulation steps per simulated second
 
     @property
@@ -160,6 +171,19 @@ def follow_clock_of(text: str, speed: float) -> bool:
     return value == "true"
 
 
+def replan_period_of(value: float, *, ros1: bool = False) -> float:
+    """``--replan-period``: seconds >= 0; Nav2's rule, so ROS 1's move_base has none."""
+    if not (math.isfinite(value) and value >= 0.0):
+        raise NavseqError(f"must be >= 0 s, got {value:g}", source="--replan-period")
+    if ros1 and value > 0.0:
+        raise NavseqError(
+            "Nav2's re-plan on preemption has no move_base twin: use it with --ros2 (the "
+            "ROS 1 move_base stand-in has ~race_window for move_base's SUCCEEDED race)",
+            source="--replan-period",
+        )
+    return value
+
+
 def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
     """The checked settings; every bad value is a NavseqError naming its option.
 
@@ -184,4 +208,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         robot=robot,
         other_robots=other_robots_of(args.other_robots, namespace, ros1=ros1),
         follow_clock=follow_clock_of(args.follow_clock, speed),
+        replan_period=replan_period_of(float(args.replan_period), ros1=ros1),
     )

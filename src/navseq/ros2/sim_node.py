@@ -54,6 +54,12 @@ follows robot1's clock in ROS 1's ``multi_robot.launch``.
 Goal poses may be given in the map, odom or base frame (the node knows those
 transforms); other frames are refused (this stand-in has no TF listener).
 
+For tests, ``--replan-period S`` (simulated seconds, default 0 = off) reproduces Nav2's
+re-plan race on preemption: a ``navigate_to_pose`` goal that preempts another keeps the
+old path until the next re-plan tick, and ends SUCCEEDED at the old goal if the robot
+gets there first (see :mod:`navseq.ros2.standin`); each such goal is logged as a
+warning.
+
 Run it with ``python -m navseq.ros2.sim_node --map MAP`` or ``navseq sim --ros2``;
 SIGINT / SIGTERM end every goal (ABORTED), stop the robot and exit 0.
 """
@@ -172,7 +178,7 @@ class SimNode:
             nav_params=settings.nav_params,
             footprint=settings.footprint,
         )
-        self.standin = Nav2StandIn(world)
+        self.standin = Nav2StandIn(world, replan_period=config.replan_period)
         self.others = (
             SeenRobots(config.other_robots, OTHER_POSE_TOLERANCE, settings.footprint, MAP_FRAME)
             if config.other_robots
@@ -500,7 +506,20 @@ class SimNode:
         _finish(handle, ending)
         if ending.outcome is not Outcome.SUCCEEDED:
             self.log.info(f"{navigator.value}: {ending.outcome.value} {ending.error_msg}")
+        elif task is not None and task.succeeded_on_old_path:
+            self._warn_old_path_success(navigator, task)
         return result
+
+    def _warn_old_path_success(self, navigator: Navigator, task: NavTask) -> None:
+        """Say when --replan-period made a goal succeed at the goal it preempted."""
+        with self._lock:
+            robot = self.standin.world.robot.pose
+        goal = task.poses[-1]
+        self.log.warning(
+            f"{navigator.value}: goal ({goal.x:.2f}, {goal.y:.2f}) SUCCEEDED on the preempted "
+            f"goal's path before the re-plan (--replan-period), robot "
+            f"{robot.distance_to(goal):.2f} m away"
+        )
 
     def _follow_task(self, handle: Any, task: NavTask, action: Any, navigator: Navigator) -> Ending:
         """Feedback until ``task`` ends; a cancel request cancels it."""
@@ -732,7 +751,12 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             f"({pose.x:.2f}, {pose.y:.2f}), "
             + ("following /clock" if config.follow_clock else f"speed x{config.speed:g}")
             + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
-            + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else ""),
+            + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else "")
+            + (
+                f", re-plan period {config.replan_period:g} s on preemption"
+                if config.replan_period > 0
+                else ""
+            ),
             flush=True,
         )
         while not stop.wait(0.2):

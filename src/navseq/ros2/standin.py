@@ -21,6 +21,21 @@ stand-in uses) and plays three Nav2 servers on it:
   ``stop_on_failure`` (Nav2's default) the whole goal then ends ABORTED, otherwise the
   follower goes on and SUCCEEDS at the end with the missed ones listed.
 
+Re-planning on preemption (``replan_period``, off by default): Nav2's default tree
+(``navigate_to_pose_w_replanning_and_recovery.xml``) computes the path inside a
+``RateController hz="1.0"``, and a preempting ``navigate_to_pose`` goal only updates
+the tree's goal: the tree goes on, and ``FollowPath`` keeps following the *old* path
+until the next tick of that rate controller (ticks ``replan_period`` apart from the
+plan that started the tree). If the robot reaches the old path's end within the goal
+checker's tolerances before that tick, ``FollowPath`` succeeds and so does the tree:
+the *new* goal ends SUCCEEDED with the robot at the old goal (measured on Nav2 Jazzy:
+a pass-through radius of 0.4 m, SUCCEEDED 0.7 s after the goal was sent, 1.79 m from
+it, in 2 of 6 runs). Meanwhile its feedback's ``distance_remaining`` is along the old
+path. With ``replan_period`` > 0 the stand-in does the same; with 0 a preempting goal
+is planned at once. The stand-in models this tick only for a preempting goal: otherwise
+it re-plans by its own rules (a new goal, a robot that strays from the plan), which
+give the same paths on a static map.
+
 Times are simulated seconds (:attr:`Nav2StandIn.time`); the node steps this object from
 one thread and calls everything else under the same lock.
 """
@@ -99,6 +114,9 @@ class NavTask:
     index: int = 0  # the pose being driven to
     recoveries_before: int = 0  # recovery behaviours run for poses already passed
     ending: Ending | None = None
+    # SUCCEEDED while the server still followed a preempted goal's path (replan_period):
+    # the robot stands at that goal's end, not at this one's.
+    succeeded_on_old_path: bool = False
     done: threading.Event = field(default_factory=threading.Event, repr=False)
 
     @property
@@ -153,12 +171,19 @@ class Feedback:
 class Nav2StandIn:
     """bt_navigator and waypoint_follower on one simulated robot; see the module doc."""
 
-    def __init__(self, world: SimWorld, *, pass_radius: float = PASS_RADIUS) -> None:
+    def __init__(
+        self, world: SimWorld, *, pass_radius: float = PASS_RADIUS, replan_period: float = 0.0
+    ) -> None:
         self.world = world
         self.pass_radius = pass_radius
+        self.replan_period = replan_period  # s; 0: a preempting goal is planned at once
         self.time = 0.0
         self.active: NavTask | None = None
         self.waypoints: WaypointRun | None = None
+        # The tree's rate controller: when it last planned, and when it plans the goal
+        # that preempted another (None: the server pursues the active goal's own pose).
+        self._planned_at = 0.0
+        self._replan_due: float | None = None
         # A robot driven from outside (teleop on cmd_vel) follows its commands for longer
         # than the world's two steps; while a goal runs a command comes every step.
         world.body.cmd_vel_timeout = max(world.body.cmd_vel_timeout, 0.5)
@@ -182,10 +207,25 @@ class Nav2StandIn:
                 )
             )
             return task
+        running = active is not None and active.ending is None
         if active is not None:
             active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by a new goal"))
         self.active = task
-        self.world.server.set_goal(task.target)
+        server = self.world.server
+        if (
+            running
+            and self.replan_period > 0
+            and navigator is Navigator.TO_POSE
+            and server.state is NavState.ACTIVE
+        ):
+            # Nav2's tree goes on with the old path until its rate controller ticks.
+            if self._replan_due is None:
+                self._replan_due = self._next_replan_tick()
+            task.recoveries_before = -server.recoveries_run  # Nav2 counts from the preemption
+            return task
+        self._replan_due = None
+        self._planned_at = self.time
+        server.set_goal(task.target)
         return task
 
     def cancel(self, task: NavTask) -> None:
@@ -243,6 +283,7 @@ class Nav2StandIn:
         world = self.world
         task = self.active
         if task is not None and task.ending is None:
+            self._replan_if_due(task)
             self._pass_through(task)
         if world.server.state is NavState.ACTIVE:
             world.step()
@@ -276,8 +317,9 @@ class Nav2StandIn:
     def feedback(self, task: NavTask) -> Feedback:
         """What Nav2 reports for ``task`` now.
 
-        The distance is along the current plan to the current pose, plus the straight
-        lines between the poses still ahead; the time remaining is that distance at the
+        The distance is along the current plan to the current pose (until the re-plan
+        tick of a preempting goal, the preempted goal's plan, as in Nav2), plus the
+        straight lines between the poses still ahead; the time remaining is that distance at the
         robot's present speed, zero when it stands or is within 0.1 m (Nav2's rule).
         """
         world = self.world
@@ -304,8 +346,27 @@ class Nav2StandIn:
     # -- internals -------------------------------------------------------------------
 
     def _stop(self) -> None:
+        self._replan_due = None
         self.world.server.cancel()
         self.world.body.command(0.0, 0.0)
+
+    def _next_replan_tick(self) -> float:
+        """The rate controller's first tick after now: ``replan_period`` apart, counted
+        from its last plan (the goal that started the tree, or the last preemption's)."""
+        period = self.replan_period
+        periods = math.floor((self.time - self._planned_at) / period + 1e-9) + 1
+        return self._planned_at + periods * period
+
+    def _replan_if_due(self, task: NavTask) -> None:
+        """The rate controller ticks: the goal that preempted another gets its own path."""
+        due = self._replan_due
+        if due is None or self.time + 1e-9 < due:
+            return
+        self._replan_due = None
+        self._planned_at = due
+        server = self.world.server
+        task.recoveries_before += server.recoveries_run
+        server.set_goal(task.target)  # plans from where the robot is; it keeps rolling
 
     def _pass_through(self, task: NavTask) -> None:
         """Through poses: the next pose becomes the target once this one is near."""
@@ -325,6 +386,7 @@ class Nav2StandIn:
                 task.index += 1
                 server.set_goal(task.target)
             else:
+                task.succeeded_on_old_path = self._replan_due is not None
                 task.end(Ending(Outcome.SUCCEEDED))
         elif server.state is NavState.ABORTED:
             task.end(Ending(Outcome.ABORTED, self._error_code(task), server.status_text))
@@ -333,8 +395,11 @@ class Nav2StandIn:
 
     def _error_code(self, task: NavTask) -> int:
         """The Nav2 code for the server's failure (see :class:`ErrorCode`)."""
-        text = self.world.server.status_text
-        code, _ = self.no_plan_reason(self.world.robot.pose, task.target)
+        server = self.world.server
+        text = server.status_text
+        # The pose the server pursued: a preempted goal's until the re-plan tick.
+        goal = server.goal if server.goal is not None else task.target
+        code, _ = self.no_plan_reason(self.world.robot.pose, goal)
         if code in (ErrorCode.GOAL_OUTSIDE_MAP, ErrorCode.GOAL_OCCUPIED):
             return code
         if "another robot" in text:
