@@ -50,6 +50,8 @@ class RealNav2:
         self.env = ros2_environment(prefix)
         self.env["RCUTILS_COLORIZED_OUTPUT"] = "0"
         log_dir.mkdir(parents=True, exist_ok=True)
+        # ros2 launch writes every node's parameters to a temporary file it never removes.
+        self.env["TMPDIR"] = str(log_dir)
         self.log_path = log_dir / "nav2-launch.log"
         self._log = self.log_path.open("w")
         self.process = subprocess.Popen(
