@@ -75,6 +75,42 @@ def test_ros1_run_completes_and_reports(ros_master, tmp_path):
     assert (out / "mission.png").exists()
 
 
+def test_without_a_map_file_pre_flight_runs_on_the_map_the_stack_latches(ros_master, tmp_path):
+    _robot, nav = start_sim(ros_master)
+    # (1.0, 0.0): the edge of the east pillar (navseq validate --map: inside an obstacle).
+    pillar = write_mission(
+        tmp_path / "pillar.yaml",
+        "  - {name: west, x: -1.6, y: -0.5, yaw: 90}\n  - {name: pillar, x: 1.0, y: 0.0, yaw: 0}\n",
+    )
+    refused = ros_master.start(
+        [NAVSEQ, "run", pillar, "--navigator", "ros1", "--out", tmp_path / "refused"],
+        cwd=tmp_path,
+        label="navseq-refused",
+    )
+    assert refused.wait(timeout=120) == 2, refused.output()
+    text = refused.output()
+    assert "pre-flight on the map on /map: 384 x 384 cells at 0.050 m" in text, text
+    assert "waypoint 2 'pillar'" in text and "inside an obstacle" in text, text
+    assert "Traceback" not in text
+    assert not (tmp_path / "refused").exists()
+    assert "new goal" not in nav.output()  # nothing was sent: the robot never moved
+
+    out = tmp_path / "out"
+    done = ros_master.start(
+        [NAVSEQ, "run", mission(tmp_path), "--navigator", "ros1", "--out", out],
+        cwd=tmp_path,
+        label="navseq",
+    )
+    assert done.wait(timeout=120) == 0, done.output()
+    assert "navseq run: pre-flight on the map on /map: 384 x 384 cells at 0.050 m" in (
+        done.output()
+    )
+    report = json.loads((out / "report.json").read_text())
+    assert report["navigator"]["map_source"] == "the map on /map: 384 x 384 cells at 0.050 m"
+    assert [v["outcome"] for v in report["visits"]] == ["reached", "reached"]
+    assert (out / "mission.png").exists()
+
+
 def test_ros1_sigint_cancels_the_goal(ros_master, tmp_path):
     _robot, nav = start_sim(ros_master)
     out = tmp_path / "out"

@@ -51,6 +51,7 @@ CORE_MODULES = [
     "navseq.navigators.registry",
     "navseq.navigators.sim",
     "navseq.navigators.scripted",
+    "navseq.navigators.stack_map",
     "navseq.preflight",
     "navseq.sim.world",
     "navseq.sim.base",

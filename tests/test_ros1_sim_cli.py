@@ -196,6 +196,30 @@ def test_it_uses_a_running_master_and_sigterm_stops_only_its_nodes(ros_master):
 
 
 @pytest.mark.ros
+def test_a_namespaced_robot_without_its_own_map_is_checked_on_the_global_map(ros_master, tmp_path):
+    """A ROS 1 fleet shares one map_server on /map (nothing publishes /r1/map): pre-flight
+    of ``navseq run --ns r1`` without --map falls back to it."""
+    sim = SimCommand(ros_master.env, "--ns", "r1", "--start", "-2,-0.5,90")
+    mission = tmp_path / "pillar.yaml"
+    mission.write_text("waypoints:\n  - {name: pillar, x: 1.0, y: 0.0, yaw: 0}\n")
+    try:
+        sim.wait_ready()
+        run = subprocess.run(
+            [NAVSEQ, "run", str(mission), "--navigator", "ros1", "--ns", "r1",
+             "--out", str(tmp_path / "out")],
+            env=ros_master.env, cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        sim.popen.send_signal(signal.SIGTERM)
+        assert sim.wait() == 0, sim.output()
+    finally:
+        sim.kill()
+    assert run.returncode == 2, run.stderr
+    assert "(pre-flight on the map on /map: 384 x 384 cells at 0.050 m)" in run.stderr
+    assert "waypoint 1 'pillar'" in run.stderr and "inside an obstacle" in run.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.ros
 def test_a_node_that_dies_is_named_and_the_command_fails(ros_master):
     sim = SimCommand(ros_master.env)
     try:

@@ -284,15 +284,17 @@ def test_the_example_mission_completes_with_the_same_visits_as_on_the_simulator(
 def test_a_goal_in_a_wall_is_aborted_and_the_policy_skips_it(
     sim: SimNode, env: dict[str, str], tmp_path: Path
 ):
-    # No map: pre-flight cannot catch the wall, Nav2's planner must.
+    # Pre-flight off: it would refuse the pillar on the map Nav2 publishes; its planner
+    # must catch it instead.
     mission = write_mission(
         tmp_path / "wall.yaml",
         "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0, on_failure: skip}\n"
         "  - {name: free, x: -1.5, y: -0.5, yaw: 0}\n",
         "defaults: {retries: 0, goal_timeout: 60}\n",
     )
-    done = run_nav2(env, mission, tmp_path / "out")
+    done = run_nav2(env, mission, tmp_path / "out", "--no-preflight")
     assert done.returncode == 1, done.stderr  # not every waypoint reached
+    assert "the map on /map: 384 x 384 cells at 0.050 m (no pre-flight" in done.stderr
     pillar, free = report_of(tmp_path / "out")["visits"]
     assert pillar["outcome"] == "skipped"
     attempt = pillar["attempts"][0]
@@ -301,6 +303,33 @@ def test_a_goal_in_a_wall_is_aborted_and_the_policy_skips_it(
     assert attempt["text"].endswith("(ComputePathToPose GOAL_OCCUPIED, error_code 206)")
     assert "in an obstacle" in attempt["text"]
     assert free["outcome"] == "reached"
+
+
+def test_without_a_map_file_pre_flight_runs_on_the_map_nav2_publishes(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    # (1.0, 0.0): the edge of the east pillar (navseq validate --map: inside an obstacle).
+    pillar = write_mission(
+        tmp_path / "pillar.yaml",
+        "  - {name: west, x: -1.4, y: -0.5, yaw: 90}\n  - {name: pillar, x: 1.0, y: 0.0, yaw: 0}\n",
+    )
+    refused = run_nav2(env, pillar, tmp_path / "refused", timeout=120)
+    assert refused.returncode == 2, refused.stderr
+    assert "(pre-flight on the map on /map: 384 x 384 cells at 0.050 m)" in refused.stderr
+    assert "waypoint 2 'pillar'" in refused.stderr
+    assert "inside an obstacle" in refused.stderr
+    assert "Traceback" not in refused.stderr
+    assert not (tmp_path / "refused").exists()
+
+    good = write_mission(tmp_path / "good.yaml", "  - {name: west, x: -1.4, y: -0.5, yaw: 90}\n")
+    done = run_nav2(env, good, tmp_path / "out")
+    assert done.returncode == 0, done.stderr
+    assert "navseq run: pre-flight on the map on /map: 384 x 384 cells at 0.050 m" in done.stderr
+    report = report_of(tmp_path / "out")
+    assert report["navigator"]["map_source"] == "the map on /map: 384 x 384 cells at 0.050 m"
+    assert report["visits"][0]["outcome"] == "reached"
+    # The refused mission sent no goal: the only one is the good mission's.
+    assert sim_log_sequence(sim.stop()) == ["goal"]
 
 
 def test_no_server_is_a_clear_error_within_the_server_timeout(env: dict[str, str], tmp_path: Path):
@@ -507,8 +536,11 @@ def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path
     report = report_of(tmp_path / "out")
     assert report["navigator"]["action"] == "/robot1/navigate_to_pose"
     assert report["navigator"]["ns"] == "robot1"
-    # The robot came from the namespace's own Nav2 nodes.
+    # The robot came from the namespace's own Nav2 nodes, and the map from its map_server.
     assert "Nav2's parameters under /robot1: footprint" in report["navigator"]["robot_source"]
+    assert report["navigator"]["map_source"] == (
+        "the map on /robot1/map: 384 x 384 cells at 0.050 m"
+    )
     # robot1/odom -> robot1/base_footprint on /tf, and /robot1/odom, were found.
     assert report["start_source"] == "robot"
     assert report["visits"][0]["distance_m"] == pytest.approx(0.6, abs=0.25)
@@ -661,14 +693,14 @@ def sim_log_sequence(log: str) -> list[str]:
 def test_a_retry_clears_both_costmaps_before_its_goal_only_when_asked(
     clear: bool, sim: SimNode, env: dict[str, str], tmp_path: Path
 ):
-    # A goal in a wall: Nav2's planner aborts it, and its retry too.
+    # A goal in a wall (pre-flight off): Nav2's planner aborts it, and its retry too.
     mission = write_mission(
         tmp_path / "wall.yaml",
         "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0}\n",
         "defaults: {retries: 1, on_failure: skip, goal_timeout: 60, "
         f"clear_costmaps_on_retry: {str(clear).lower()}}}\n",
     )
-    done = run_nav2(env, mission, tmp_path / "out", timeout=120)
+    done = run_nav2(env, mission, tmp_path / "out", "--no-preflight", timeout=120)
     assert done.returncode == 1, done.stderr
     (visit,) = report_of(tmp_path / "out")["visits"]
     assert [a["status"] for a in visit["attempts"]] == ["ABORTED", "ABORTED"]

@@ -305,7 +305,7 @@ def test_the_same_mission_gives_the_same_visits_on_sim_ros1_and_nav2(
 ):
     from ros_clients import start_sim
 
-    # No map: the pillar is found by each stack's planner, not by pre-flight.
+    # Pre-flight off: the pillar is found by each stack's planner.
     mission = write_mission(
         tmp_path / "same.yaml",
         "  - {name: west, x: -1.6, y: -0.5, yaw: 90}\n"
@@ -316,10 +316,11 @@ def test_the_same_mission_gives_the_same_visits_on_sim_ros1_and_nav2(
 
     def run(navigator: str, run_env: dict[str, str] | None) -> list[tuple[str, str, int]]:
         out = tmp_path / navigator
-        # The in-process simulator needs the map as its world; pre-flight, which would
-        # refuse the pillar before the robot moves, is off so its planner meets it too.
+        # The in-process simulator needs the map as its world. Pre-flight, which would
+        # refuse the pillar before the robot moves (on the stacks' own map for ros1 and
+        # nav2), is off so that each planner meets it.
         world = ["--map", str(REPO / "maps" / "turtlebot3_world.yaml"), "--start=-2,-0.5,0"]
-        extra = [*world, "--no-preflight"] if navigator == "sim" else []
+        extra = [*world, "--no-preflight"] if navigator == "sim" else ["--no-preflight"]
         done = subprocess.run(
             [NAVSEQ, "run", str(mission), "--navigator", navigator, "--out", str(out), *extra],
             env=run_env,

@@ -23,12 +23,18 @@ class NavseqError(Exception):
 
 
 class MissionErrors(NavseqError):
-    """Several problems found at once (``navseq validate`` lists them all)."""
+    """Several problems found at once (``navseq validate`` lists them all).
 
-    def __init__(self, errors: list[NavseqError]):
+    ``context`` says what found them where the user could not tell otherwise
+    (``pre-flight on the map on /map``: a map the user did not name).
+    """
+
+    def __init__(self, errors: list[NavseqError], context: str = ""):
         self.errors = list(errors)
         lines = [str(e) for e in self.errors]
         summary = f"{len(lines)} problem{'s' if len(lines) != 1 else ''} found"
+        if context:
+            summary += f" ({context})"
         super().__init__(summary + ":\n" + "\n".join(f"  - {line}" for line in lines))
 
     def __str__(self) -> str:

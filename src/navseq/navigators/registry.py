@@ -25,6 +25,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
 
+from navseq.navigators.stack_map import MAP_WAIT
+
 if TYPE_CHECKING:
     from navseq.executor.machine import MissionListener
     from navseq.geometry import Pose2D
@@ -74,8 +76,9 @@ class NavigatorDraft:
     # so that pre-flight names them as the user numbers them.
     numbers: Sequence[int] | None = None
 
-    def check_against(self, costmap: Costmap) -> None:
-        """Pre-flight on this costmap: every problem of the mission, raised together."""
+    def check_against(self, costmap: Costmap, context: str = "") -> None:
+        """Pre-flight on this costmap: every problem of the mission, raised together
+        (``context`` heads the list, see :class:`~navseq.errors.MissionErrors`)."""
         if not self.preflight:
             return
         from navseq.commands.common import preflight_errors
@@ -85,18 +88,25 @@ class NavigatorDraft:
             self.mission, costmap, self.start, self.numbers, robot=self.robot
         )
         if problems:
-            raise MissionErrors(problems)
+            raise MissionErrors(problems, context)
+
+    def check_map(self, grid: OccupancyGrid, context: str = "") -> None:
+        """Pre-flight on ``grid`` inflated for the draft's robot, as it stands now (a kind
+        settles the robot first); nothing at all with ``--no-preflight``."""
+        if not self.preflight:
+            return
+        from navseq.commands.common import costmap_for_robot
+
+        self.check_against(costmap_for_robot(grid, self.robot), context)
 
     def optional_map(self) -> OccupancyGrid | None:
         """The map, if one is known, with the mission checked against it."""
         if self.map_path is None:
             return None
-        from navseq.commands.common import costmap_for_robot
         from navseq.sim.occupancy import load_map
 
         grid = load_map(self.map_path)
-        if self.preflight:
-            self.check_against(costmap_for_robot(grid, self.robot))
+        self.check_map(grid)
         return grid
 
 
@@ -178,6 +188,17 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
                 type=float,
                 metavar="S",
             ),
+            NavigatorOption(
+                "--map-wait",
+                "without --map (or the mission's map:), pre-flight checks the waypoints on "
+                "the stack's own map (NS/map, else /map) and the picture is drawn on it: "
+                "wall seconds to wait for it; none by then: pre-flight is skipped, said on "
+                f"stderr. 0: do not read it (default {MAP_WAIT:g}; also nav2)",
+                MAP_WAIT,
+                type=float,
+                metavar="S",
+                journaled=False,
+            ),
         ),
         requires="ROS 1's Python packages (rospy, actionlib, move_base_msgs)",
         places_robot=False,
@@ -207,6 +228,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
                 "auto",
                 metavar="auto|true|false",
             ),
+            NavigatorOption("--map-wait", "", MAP_WAIT, type=float, journaled=False),
         ),
         requires="ROS 2's Python packages (rclpy, nav2_msgs): source ROS 2 first "
         "(e.g. source /opt/ros/jazzy/setup.bash), then start navseq from that shell",

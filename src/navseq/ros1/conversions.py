@@ -14,7 +14,6 @@ from geometry_msgs.msg import Pose, PoseStamped, Quaternion, TransformStamped
 from move_base_msgs.msg import MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 
-from navseq.errors import NavseqError
 from navseq.geometry import (  # the message-free readers, re-exported for the nodes
     Pose2D,
     pose2d_from_pose,
@@ -23,7 +22,7 @@ from navseq.geometry import (  # the message-free readers, re-exported for the n
     yaw_to_quaternion,
 )
 from navseq.navigators.base import GoalOutcome
-from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.occupancy import OccupancyGrid, grid_from_map_message
 
 # actionlib_msgs/GoalStatus values that end a goal: the executor's outcome and the name
 # the report gives the status.
@@ -101,19 +100,7 @@ def grid_to_msg(grid: OccupancyGrid, frame_id: str, stamp: rospy.Time) -> Occupa
 
 def grid_from_msg(msg: OccupancyGridMsg, source: str) -> OccupancyGrid:
     """navseq's grid from a ``nav_msgs/OccupancyGrid``; ``source`` names it in messages."""
-    width, height = int(msg.info.width), int(msg.info.height)
-    if width <= 0 or height <= 0 or len(msg.data) != width * height:
-        raise NavseqError(
-            f"map message is {width} x {height} cells but carries {len(msg.data)} values",
-            source=source,
-        )
-    data = np.asarray(msg.data, dtype=np.int8).reshape(height, width)
-    return OccupancyGrid(
-        data=data,
-        resolution=float(msg.info.resolution),
-        origin=pose2d_from_pose(msg.info.origin),
-        source=source,
-    )
+    return grid_from_map_message(msg, source)
 
 
 __all__ = [

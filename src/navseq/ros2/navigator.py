@@ -89,6 +89,7 @@ from navseq.navigators.base import (
 )
 from navseq.navigators.inbox import EventInbox
 from navseq.navigators.plans import PlanMatcher
+from navseq.navigators.stack_map import MAP_WAIT, MapCatch, StackMap, stack_map_from_message
 from navseq.ros2.messages import (
     add_transforms,
     navigate_goal,
@@ -420,6 +421,39 @@ class Nav2Navigator:
                 self._in_ros(self._node.destroy_client, lister)
                 self._in_ros(self._node.destroy_client, getter)
         return answers
+
+    def read_map(self, topics: Sequence[str], timeout: float = MAP_WAIT) -> StackMap | None:
+        """The stack's map (``nav_msgs/OccupancyGrid``) from the best of ``topics``
+        (absolute names, best first) heard within ``timeout`` wall seconds, or None.
+
+        Subscribed as Nav2's map_server publishes (reliable, transient local, depth 1),
+        so its last map reaches this late subscriber at once; a publisher that offers
+        only volatile durability is not matched by DDS and not heard. Which topic wins
+        is :class:`~navseq.navigators.stack_map.MapCatch`'s rule; NavseqError when the
+        message's fields do not make a map.
+        """
+        from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
+
+        qos = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        catch = MapCatch(topics)
+
+        def offer(topic: str) -> Any:
+            return lambda message: catch.offer(topic, message)
+
+        subscriptions = [
+            self._node.create_subscription(OccupancyGridMsg, topic, offer(topic), qos)
+            for topic in catch.topics
+        ]
+        try:
+            heard = catch.wait(timeout, lambda topic: self._node.count_publishers(topic) > 0)
+        finally:
+            for subscription in subscriptions:
+                self._in_ros(self._node.destroy_subscription, subscription)
+        return None if heard is None else stack_map_from_message(heard[1], heard[0])
 
     def _ask_parameters(self, lister: Any, getter: Any) -> tuple[threading.Event, dict[str, Any]]:
         """List a node's parameters, then get them all (on the executor's thread)."""

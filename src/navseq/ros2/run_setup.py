@@ -7,7 +7,9 @@ under ``use_sim_time``, its clock must run (:meth:`Nav2Navigator.wait_for_server
 The robot profile is ``--robot``, else the mission's ``robot:``, else the one Nav2's own
 node parameters describe (:mod:`navseq.ros2.nav2_params`: outline, inflation, goal
 tolerance, speeds; what it does not say keeps the default's value); pre-flight runs on
-``--map`` / the mission's ``map:`` when there is one.
+``--map`` / the mission's ``map:`` when there is one, else on the map Nav2's map_server
+publishes (``map`` in the namespace, else ``/map``: :mod:`navseq.navigators.stack_map`),
+waited for ``--map-wait`` wall seconds.
 
 This module imports rclpy (through the navigator): the registry imports it only when
 ``nav2`` is chosen, and turns an ImportError into one message saying to source ROS 2.
@@ -19,8 +21,14 @@ import argparse
 
 from navseq.errors import NavseqError
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.navigators.stack_map import (
+    MAP_TOPIC,
+    map_topics,
+    map_wait_setting,
+    preflight_on_stack_map,
+)
 from navseq.ros2.nav2_params import NODES, profile_from_nav2_params
-from navseq.ros2.navigator import Nav2Navigator
+from navseq.ros2.navigator import Nav2Navigator, join_name
 from navseq.ros2.sim_config import namespace_of
 
 SERVER_WAIT = 30.0  # s of wall time for the action server by default (ROS 1 waits as long)
@@ -52,9 +60,11 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
     action = args.action
     if not action or any(c.isspace() for c in action):
         raise NavseqError(f"{action!r} is not an action name", source="--action")
+    map_wait = map_wait_setting(args.map_wait)
     navigator = Nav2Navigator(action, frame, namespace=namespace, use_sim_time=use_sim_time)
     notes = []
     robot_source = None
+    map_source = None
     try:
         navigator.require_server(server_timeout)
         if getattr(args, "robot", None) is None and mission.robot is None:
@@ -64,6 +74,14 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
             draft.robot, robot_source = profile_from_nav2_params(params, namespace, draft.robot)
             notes.append(robot_source)
         grid = draft.optional_map()
+        if draft.map_path is None:
+            # No map file: the one Nav2 publishes, checked for the robot Nav2 drives.
+            topics = map_topics(join_name(namespace, MAP_TOPIC))
+            used = preflight_on_stack_map(
+                draft, navigator.read_map, topics, frame or "map", map_wait
+            )
+            grid, map_source = used.grid, used.source
+            notes.append(used.note)
     except BaseException:
         navigator.close()
         raise
@@ -77,6 +95,8 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
     }
     if robot_source is not None:
         info["robot_source"] = robot_source
+    if map_source is not None:
+        info["map_source"] = map_source
     if use_sim_time is None and navigator.uses_sim_time:
         notes.append("/clock is published: navseq runs on simulation time (use_sim_time)")
     return NavigatorSetup(

@@ -35,6 +35,11 @@ mission files' reader (YAML 1.2 numbers such as ``5e-2``, alias bombs and Python
 refused, every message with its line), both files must be regular files of bounded
 size, and an image may hold at most ``NAVSEQ_MAX_MAP_PIXELS`` pixels, checked from its
 header before a byte of it is decoded.
+
+The map a running stack publishes (``nav_msgs/OccupancyGrid`` on ``/map``) becomes a
+grid through :func:`grid_from_cells` (its fields as plain numbers) or
+:func:`grid_from_map_message` (the message itself, ROS 1 or ROS 2): the one conversion
+both ROS packages use, with the same bounds as a map file.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ from __future__ import annotations
 import contextlib
 import math
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,7 +57,7 @@ from PIL import Image, UnidentifiedImageError
 
 from navseq.errors import NavseqError
 from navseq.files import limit_from_environment, open_input_file
-from navseq.geometry import Pose2D, normalize_angle
+from navseq.geometry import Pose2D, normalize_angle, pose2d_from_pose
 from navseq.mission.located import Located, describe
 from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
@@ -259,6 +264,74 @@ def pixels_to_occupancy(
     values[occupancy < free_thresh] = FREE
     values[occupancy > occupied_thresh] = OCCUPIED
     return np.ascontiguousarray(np.flipud(values))
+
+
+def grid_from_cells(
+    width: int,
+    height: int,
+    resolution: float,
+    origin: Pose2D,
+    data: Sequence[int] | np.ndarray,
+    *,
+    source: str,
+) -> OccupancyGrid:
+    """A grid from the fields of a ``nav_msgs/OccupancyGrid`` (ROS 1 or ROS 2).
+
+    ``data`` is row-major from the origin's cell: its first ``width`` values are the
+    bottom row, which is the grid's row 0 too, so nothing is flipped (an image is, see
+    :func:`pixels_to_occupancy`: its top row is the map's last). The values are kept as
+    they are (-1 unknown, 0..100). The message comes from a running stack, not from the
+    user's files, but it is checked with a map file's bounds all the same, and any
+    problem is a :class:`NavseqError` naming ``source`` (``topic /map``).
+    """
+
+    def fail(message: str) -> NavseqError:
+        return NavseqError(message, source=source)
+
+    width, height = int(width), int(height)
+    if width <= 0 or height <= 0:
+        raise fail(f"the map is {width} x {height} cells: empty")
+    limit = max_map_pixels()
+    if width * height > limit:
+        raise fail(
+            f"the map is {width} x {height} = {width * height:,} cells; navseq checks at most "
+            f"{limit:,} (the environment variable {MAX_PIXELS_VARIABLE} raises the limit)"
+        )
+    if len(data) != width * height:
+        raise fail(f"the map is {width} x {height} cells but carries {len(data)} values")
+    resolution = float(resolution)
+    if not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
+        raise fail(
+            f"the resolution must be from {MIN_RESOLUTION:g} to {MAX_RESOLUTION:g} m per "
+            f"cell, not {resolution:g}"
+        )
+    if not (abs(origin.x) <= MAX_ORIGIN and abs(origin.y) <= MAX_ORIGIN):
+        raise fail(f"the origin must be within ±{MAX_ORIGIN:g} m, not ({origin.x:g}, {origin.y:g})")
+    if not math.isfinite(origin.yaw):
+        raise fail(f"the origin's yaw is {origin.yaw}")
+    values = np.asarray(data)
+    # ROS 1 gives a tuple of ints, ROS 2 an array('b'): int8 values either way, unless forged.
+    if values.dtype != np.int8 and (
+        values.dtype.kind not in "iu" or values.min() < -128 or values.max() > 127
+    ):
+        raise fail("the occupancy values must be integers from -128 to 127 (int8)")
+    cells = np.array(values, dtype=np.int8).reshape(height, width)
+    origin = Pose2D(float(origin.x), float(origin.y), normalize_angle(float(origin.yaw)))
+    return OccupancyGrid(data=cells, resolution=resolution, origin=origin, source=source)
+
+
+def grid_from_map_message(message: Any, source: str) -> OccupancyGrid:
+    """A grid from a ``nav_msgs/OccupancyGrid``-like object: ROS 1 and ROS 2 name its
+    fields alike, so both read their messages here (see :func:`grid_from_cells`)."""
+    info = message.info
+    return grid_from_cells(
+        info.width,
+        info.height,
+        info.resolution,
+        pose2d_from_pose(info.origin),
+        message.data,
+        source=source,
+    )
 
 
 @dataclass(frozen=True)
