@@ -250,3 +250,18 @@ def test_goals_an_inactive_nav2_rejects_are_failed_attempts_saying_so(
     assert visit["outcome"] == "skipped"
     assert [a["status"] for a in visit["attempts"]] == ["REJECTED", "REJECTED"]
     assert "is bt_navigator active?" in visit["attempts"][0]["text"]
+
+
+def test_preflight_checks_the_map_nav2_publishes_before_anything_moves(
+    placed: RealNav2, tmp_path: Path
+) -> None:
+    mission = write_mission(
+        tmp_path / "pillar.yaml",
+        "  - {name: fine, x: -1.75, y: -1.0, yaw: 0}\n  - {name: pillar, x: 1.1, y: 0.0, yaw: 0}\n",
+    )
+    result = run(placed, mission, tmp_path / "out")
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "pre-flight on the map on /map: 384 x 384 cells" in result.stderr
+    # The arena's pillars are unknown inside (as the map file says): not a place to drive to.
+    assert "1 problem found" in result.stderr and "waypoint 2 'pillar'" in result.stderr
+    assert not (tmp_path / "out").exists()  # nothing written, nothing moved
