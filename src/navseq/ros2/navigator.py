@@ -87,6 +87,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.navigators.catchup import ResultHold
 from navseq.navigators.inbox import EventInbox
 from navseq.navigators.plans import PlanMatcher
 from navseq.navigators.stack_map import MAP_WAIT, MapCatch, StackMap, stack_map_from_message
@@ -172,6 +173,7 @@ class Nav2Navigator:
         # Callbacks leave events here and wake spin() (also on every /clock message).
         self._inbox = EventInbox()
         self._plans = PlanMatcher()  # a plan (and distance remaining) is the goal it ends at
+        self._result_hold = ResultHold()  # a SUCCEEDED waits for /tf to catch up with it
         self._lock = threading.Lock()
         self._send_seq = 0  # goes up with every goal sent (and when one is dropped)
         self._goal_id: int | None = None  # the executor's id of the goal tracked
@@ -220,10 +222,12 @@ class Nav2Navigator:
         self._costmap_clients = [
             node.create_client(ClearEntireCostmap, name) for name in COSTMAP_SERVICES
         ]
-        node.create_subscription(TFMessage, "/tf", self._on_tf(self._tf), TF_QOS)
+        node.create_subscription(TFMessage, "/tf", self._on_tf(self._tf, dynamic=True), TF_QOS)
         node.create_subscription(TFMessage, "/tf_static", self._on_tf(self._tf), TF_STATIC_QOS)
         if self._local_tf is not None:
-            node.create_subscription(TFMessage, "tf", self._on_tf(self._local_tf), TF_QOS)
+            node.create_subscription(
+                TFMessage, "tf", self._on_tf(self._local_tf, dynamic=True), TF_QOS
+            )
             node.create_subscription(
                 TFMessage, "tf_static", self._on_tf(self._local_tf), TF_STATIC_QOS
             )
@@ -339,6 +343,7 @@ class Nav2Navigator:
             self._goal_id = goal.goal_id
             self._handle = None
             self._plans.track(goal.goal_id, goal.pose, frame)
+            self._result_hold.drop()  # a held result of the replaced goal is void
         self._in_ros(self._send, seq, goal.goal_id, message)
 
     def cancel_goal(self) -> None:
@@ -500,7 +505,8 @@ class Nav2Navigator:
         return self._odom_pose
 
     def poll(self) -> list[NavEvent]:
-        return [*self._inbox.drain(), *self._check_server()]
+        released = self._result_hold.release(time.monotonic())
+        return [*self._inbox.drain(), *released, *self._check_server()]
 
     def close(self) -> None:
         """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
@@ -536,7 +542,11 @@ class Nav2Navigator:
     # -- server liveness ---------------------------------------------------------------
 
     def _has_news(self) -> bool:
-        return self._inbox.has_events() or self._server_news()
+        return (
+            self._inbox.has_events()
+            or self._result_hold.ready(time.monotonic())
+            or self._server_news()
+        )
 
     def _server_news(self) -> bool:
         """:meth:`_check_server` would report ServerLost or ServerBack now."""
@@ -564,6 +574,7 @@ class Nav2Navigator:
             self._server_up = False
             with self._lock:
                 # The goal died with the server: stop tracking it; the executor resends.
+                self._result_hold.drop()
                 self._send_seq += 1
                 self._goal_id = None
                 self._handle = None
@@ -628,7 +639,14 @@ class Nav2Navigator:
         text = result_text(getattr(result, "error_code", 0), getattr(result, "error_msg", ""))
         if outcome is GoalOutcome.LOST and not text:
             text = "the server does not know the goal (restarted?)"
-        self._inbox.put(GoalDone(goal_id, outcome, status, text))
+        done = GoalDone(goal_id, outcome, status, text)
+        stamp = self._node.get_clock().now().nanoseconds * 1e-9
+        if self._result_hold.should_hold(done, stamp):
+            # Judged on the robot's pose: wait (bounded) until /tf is as recent as this.
+            self._result_hold.hold(done, stamp, time.monotonic())
+            self._inbox.wake()
+            return
+        self._inbox.put(done)
 
     def _on_feedback(self, seq: int, goal_id: int, message: Any) -> None:
         feedback = message.feedback
@@ -651,8 +669,14 @@ class Nav2Navigator:
             )
         )
 
-    def _on_tf(self, tree: FrameTree) -> Any:
-        return lambda message: add_transforms(tree, message)
+    def _on_tf(self, tree: FrameTree, *, dynamic: bool = False) -> Any:
+        def on_tf(message: Any) -> None:
+            add_transforms(tree, message)
+            if dynamic and message.transforms:
+                stamps = (seconds_of(t.header.stamp) for t in message.transforms)
+                self._result_hold.saw_pose(max(stamps))
+
+        return on_tf
 
     def _on_odom(self, message: Any) -> None:
         self._odom_pose = pose2d_from_pose(message.pose.pose)
