@@ -33,6 +33,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -180,20 +181,23 @@ def preempt(nav2: RealNav2, workdir: Path, number: int) -> Outcome:
 
 def table(outcomes: list[Outcome]) -> Table:
     result = Table(title="Passing through 4 waypoints to a 5th on the real Nav2")
-    for column in ("mode", "completed", "mean s", "min s", "max s", "false successes", "notes"):
+    columns = ("mode", "completed", "mean s", "min s", "max s", "poses passed", "false successes")
+    for column in (*columns, "failures"):
         result.add_column(column)
     for mode in dict.fromkeys(o.mode for o in outcomes):
         runs = [o for o in outcomes if o.mode == mode]
         times = [o.seconds for o in runs if o.completed and o.seconds is not None]
-        notes = sorted({o.detail for o in runs if not o.completed or o.false_successes})
+        failures = Counter(o.detail for o in runs if not o.completed)
+        passed = [len(o.passed_at) for o in runs]
         result.add_row(
             mode,
             f"{sum(o.completed for o in runs)}/{len(runs)}",
             f"{statistics.mean(times):.1f}" if times else "-",
             f"{min(times):.1f}" if times else "-",
             f"{max(times):.1f}" if times else "-",
+            f"{min(passed)}-{max(passed)}" if passed else "-",
             str(sum(o.false_successes for o in runs)),
-            "; ".join(notes)[:120],
+            ", ".join(f"{count}x {detail}" for detail, count in failures.items()) or "-",
         )
     return result
 
@@ -205,7 +209,7 @@ def main() -> int:
     args = parser.parse_args()
     if args.role:
         return role_through(args.role == "closed")
-    console = Console()
+    console = Console(width=160)
     missing = nav2_missing_reason()
     if missing is not None:
         console.print(f"bench_nav2_pass_modes: {missing}; nothing to measure")
