@@ -281,23 +281,29 @@ def test_the_example_mission_completes_with_the_same_visits_as_on_the_simulator(
     assert (tmp_path / "nav2" / "mission.png").exists()
 
 
-def test_a_goal_in_a_wall_is_aborted_and_the_policy_skips_it(
+def test_goals_in_a_pillar_and_deep_in_a_wall_are_judged_truthfully_and_skipped(
     sim: SimNode, env: dict[str, str], tmp_path: Path
 ):
-    # Pre-flight off: it would refuse the pillar on the map Nav2 publishes; its planner
-    # must catch it instead.
+    # Pre-flight off: it would refuse both on the map Nav2 publishes; the stack must
+    # answer instead. As Nav2's NavFn (tolerance 0.5 m), the stand-in drives to a free
+    # cell near the pillar's centre and says SUCCEEDED there: navseq's arrival check
+    # makes that a failed attempt. The wall's corner is beyond the tolerance: ABORTED.
     mission = write_mission(
         tmp_path / "wall.yaml",
         "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0, on_failure: skip}\n"
+        "  - {name: wall, x: -2.3, y: -2.3, yaw: 0, on_failure: skip}\n"
         "  - {name: free, x: -1.5, y: -0.5, yaw: 0}\n",
         "defaults: {retries: 0, goal_timeout: 60}\n",
     )
     done = run_nav2(env, mission, tmp_path / "out", "--no-preflight")
     assert done.returncode == 1, done.stderr  # not every waypoint reached
     assert "the map on /map: 384 x 384 cells at 0.050 m (no pre-flight" in done.stderr
-    pillar, free = report_of(tmp_path / "out")["visits"]
-    assert pillar["outcome"] == "skipped"
-    attempt = pillar["attempts"][0]
+    pillar, wall, free = report_of(tmp_path / "out")["visits"]
+    assert pillar["outcome"] == wall["outcome"] == "skipped"
+    near = pillar["attempts"][0]
+    assert near["status"] == "SUCCEEDED"
+    assert re.fullmatch(r"succeeded far from goal \(0\.[2-6]\d m\)", near["reason"]), near
+    attempt = wall["attempts"][0]
     assert attempt["status"] == "ABORTED"
     # Nav2's error_msg first, then the planner's code by its nav2_msgs name.
     assert attempt["text"].endswith("(ComputePathToPose GOAL_OCCUPIED, error_code 206)")

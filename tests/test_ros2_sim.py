@@ -100,11 +100,31 @@ def test_navigate_to_pose_reaches_the_goal_with_feedback_getting_closer(sim: Sim
     assert {f["frame"] for f in seen["feedback"]} == {"map"}
 
 
-def test_a_goal_in_a_wall_is_aborted_with_nav2s_planner_code(sim: SimProcess):
-    seen = sim.client("navigate", "-1.1,0,0")
+def test_a_goal_deep_in_a_wall_is_aborted_with_nav2s_planner_code(sim: SimProcess):
+    # Farther than the planner's tolerance (0.5 m) from any free cell.
+    seen = sim.client("navigate", "-2.3,-2.3,0")
     assert seen["status"] == "ABORTED"
     assert seen["error_code"] == 206  # ComputePathToPose GOAL_OCCUPIED
     assert "obstacle" in seen["error_msg"]
+
+
+def test_a_goal_in_a_pillar_succeeds_at_the_nearest_free_cell_as_nav2s_does(sim: SimProcess):
+    # Nav2 Jazzy (NavFn, tolerance 0.5 m) plans to a free cell near it and SUCCEEDS there.
+    seen = sim.client("navigate", "-1.1,0,0")
+    assert (seen["status"], seen["error_code"], seen["error_msg"]) == ("SUCCEEDED", 0, "")
+    assert -1.7 < seen["feedback"][-1]["x"] < -1.3  # short of the pillar (-1.1), west of it
+
+
+def test_a_goal_in_an_unknown_frame_ends_aborted_without_code_or_message_as_in_nav2(
+    env: dict[str, str],
+):
+    node = SimProcess(env, "--map", str(MAP), f"--start={START}", "--speed", SPEED)
+    try:
+        seen = node.client("navigate", "-0.8,-0.5,0", frame="nowhere")
+    finally:
+        err = node.stop()
+    assert (seen["status"], seen["error_code"], seen["error_msg"]) == ("ABORTED", 0, "")
+    assert "frame 'nowhere' is not 'map'" in err  # the reason is in the node's log
 
 
 def test_a_client_cancel_ends_canceled_and_the_robot_stops(sim: SimProcess):
@@ -151,7 +171,7 @@ def test_navigate_through_poses_passes_the_first_pose_and_stops_at_the_last(sim:
 
 def test_follow_waypoints_lists_a_missed_waypoint(sim: SimProcess, env: dict[str, str]):
     # Nav2's default stop_on_failure: the mission ends at the waypoint in the wall.
-    seen = sim.client("waypoints", "-1.5,-0.5,0", "-1.1,0,0", "-1.0,-0.5,0")
+    seen = sim.client("waypoints", "-1.5,-0.5,0", "-2.3,-2.3,0", "-1.0,-0.5,0")
     assert seen["status"] == "ABORTED"
     assert seen["missed"] == [{"index": 1, "error_code": 206}]
     assert {f["current_waypoint"] for f in seen["feedback"]} <= {0, 1}  # never on to 2
@@ -170,7 +190,7 @@ def test_follow_waypoints_goes_on_without_stop_on_failure(env: dict[str, str]):
         "stop_on_failure:=false",
     )
     try:
-        seen = sim.client("waypoints", "-1.5,-0.5,0", "-1.1,0,0", "-1.0,-0.5,0")
+        seen = sim.client("waypoints", "-1.5,-0.5,0", "-2.3,-2.3,0", "-1.0,-0.5,0")
     finally:
         err = sim.stop(signal.SIGTERM)
         code = sim.process.returncode
@@ -186,9 +206,12 @@ def test_compute_path_to_pose_plans_from_the_robot(sim: SimProcess):
     assert seen["frame"] == "map"
     assert seen["points"] > 10
     assert seen["last"] == pytest.approx([-0.5, -1.7], abs=1e-6)
-    blocked = sim.client("path", "-1.1,0,0")
+    blocked = sim.client("path", "-2.3,-2.3,0")
     assert blocked["status"] == "ABORTED"
     assert blocked["error_code"] == 206
+    near = sim.client("path", "-1.1,0,0")  # in the pillar: to a free cell within 0.5 m
+    assert near["status"] == "SUCCEEDED"
+    assert 0.0 < abs(near["last"][0] - -1.1) + abs(near["last"][1]) <= 0.75
 
 
 def test_a_namespaced_robot_serves_under_its_namespace(env: dict[str, str]):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 import pytest
@@ -11,6 +12,7 @@ from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
 from navseq.ros2.standin import (
+    NAV2_PLANNER_TOLERANCE,
     ErrorCode,
     Nav2StandIn,
     Navigator,
@@ -24,7 +26,9 @@ from navseq.sim.world import SimWorld
 
 MAP = Path(__file__).resolve().parents[1] / "maps" / "turtlebot3_world.yaml"
 START = Pose2D(-2.0, -0.5, 0.0)
-IN_A_PILLAR = Pose2D(-1.1, 0.0)
+IN_A_PILLAR = Pose2D(-1.1, 0.0)  # the west pillar's centre: free cells within 0.5 m
+# Beyond the arena's south-west wall, farther than the planner's 0.5 m from free space.
+DEEP_IN_A_WALL = Pose2D(-2.3, -2.3)
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +77,38 @@ def test_the_other_navigator_is_refused_while_one_runs(standin: Nav2StandIn):
     assert running.ending is None and standin.active is running
 
 
-def test_a_goal_in_a_pillar_aborts_with_goal_occupied(standin: Nav2StandIn):
+@pytest.mark.parametrize("goal", [IN_A_PILLAR, Pose2D(-1.1, 0.1, 0.0)], ids=["centre", "wall"])
+def test_a_goal_in_a_pillar_is_driven_to_the_nearest_free_cell_and_succeeds(
+    standin: Nav2StandIn, goal: Pose2D
+):
+    # Nav2 Jazzy (NavFn, tolerance 0.5 m): SUCCEEDED 0.52 m and 0.44 m from such goals.
+    server = standin.world.server
+    assert server.params.planner_tolerance == NAV2_PLANNER_TOLERANCE == 0.5
+    assert not server.costmap.is_free(goal.x, goal.y)
+    end = server.goal_point(goal)
+    assert end is not None and math.dist(end, (goal.x, goal.y)) <= 0.5
+    task = standin.navigate(Navigator.TO_POSE, [goal])
+    ending = run_until_done(standin, task)
+    assert (ending.outcome, ending.error_code, ending.error_msg) == (Outcome.SUCCEEDED, 0, "")
+    robot = standin.world.robot.pose
+    # The goal checker is satisfied at the plan's end, not at the goal.
+    assert math.dist((robot.x, robot.y), end) <= server.params.xy_tolerance + 0.01
+    assert 0.1 < robot.distance_to(goal) <= 0.5 + server.params.xy_tolerance
+
+
+def test_a_goal_deep_in_a_wall_aborts_with_goal_occupied_at_once(standin: Nav2StandIn):
+    assert standin.world.server.goal_point(DEEP_IN_A_WALL) is None
+    task = standin.navigate(Navigator.TO_POSE, [DEEP_IN_A_WALL])
+    ending = run_until_done(standin, task)
+    assert (ending.outcome, ending.error_code) == (Outcome.ABORTED, ErrorCode.GOAL_OCCUPIED)
+    assert "no free cell within 0.5 m" in ending.error_msg
+    assert standin.time < 0.2
+    code, _ = standin.no_plan_reason(standin.world.robot.pose, DEEP_IN_A_WALL)
+    assert code == ErrorCode.GOAL_OCCUPIED
+
+
+def test_without_a_planner_tolerance_a_goal_in_a_pillar_aborts_as_before(grid):
+    standin = Nav2StandIn(SimWorld(grid, START), planner_tolerance=0.0)
     task = standin.navigate(Navigator.TO_POSE, [IN_A_PILLAR])
     ending = run_until_done(standin, task)
     assert (ending.outcome, ending.error_code) == (Outcome.ABORTED, ErrorCode.GOAL_OCCUPIED)
@@ -126,7 +161,7 @@ def test_feedback_counts_time_and_distance_like_nav2(standin: Nav2StandIn):
 
 
 def test_follow_waypoints_stops_at_a_missed_one_by_default(standin: Nav2StandIn):
-    run = standin.follow([Pose2D(-1.5, -0.5), IN_A_PILLAR, Pose2D(-1.0, -0.5)])
+    run = standin.follow([Pose2D(-1.5, -0.5), DEEP_IN_A_WALL, Pose2D(-1.0, -0.5)])
     ending = run_until_done(standin, run)
     assert ending.outcome is Outcome.ABORTED
     assert [(m.index, m.error_code) for m in run.missed] == [(1, ErrorCode.GOAL_OCCUPIED)]
@@ -135,7 +170,7 @@ def test_follow_waypoints_stops_at_a_missed_one_by_default(standin: Nav2StandIn)
 
 def test_follow_waypoints_goes_on_without_stop_on_failure(standin: Nav2StandIn):
     run = standin.follow(
-        [Pose2D(-1.5, -0.5), IN_A_PILLAR, Pose2D(-1.0, -0.5)], stop_on_failure=False
+        [Pose2D(-1.5, -0.5), DEEP_IN_A_WALL, Pose2D(-1.0, -0.5)], stop_on_failure=False
     )
     assert run_until_done(standin, run).outcome is Outcome.SUCCEEDED
     assert [m.index for m in run.missed] == [1]

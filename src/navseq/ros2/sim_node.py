@@ -29,7 +29,8 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   ``amcl``, ...), answering *active*; every clear-costmap call is logged (``global_costmap:
   cleared``), so a client's clearing can be checked against the goals that follow;
 - the robot's parameters where Nav2 keeps them, on nodes of Nav2's names
-  (``controller_server``: ``general_goal_checker.xy_goal_tolerance`` and
+  (``planner_server``: ``GridBased.tolerance``;
+  ``controller_server``: ``general_goal_checker.xy_goal_tolerance`` and
   ``yaw_goal_tolerance``, ``FollowPath.desired_linear_vel`` and
   ``rotate_to_heading_angular_vel``; ``global_costmap/global_costmap`` and
   ``local_costmap/local_costmap``: ``footprint``, ``inflation_layer.inflation_radius``
@@ -52,7 +53,11 @@ A fleet faster than wall-clock time shares one simulated time: one node publishe
 follows robot1's clock in ROS 1's ``multi_robot.launch``.
 
 Goal poses may be given in the map, odom or base frame (the node knows those
-transforms); other frames are refused (this stand-in has no TF listener).
+transforms); a ``navigate_*`` goal in another frame ends ABORTED with error_code 0 and
+an empty error_msg, the frame named in the node's log, as Nav2's bt_navigator does (this
+stand-in has no TF listener). A goal in an obstacle or unknown space is planned to the
+nearest free cell within the planner's tolerance (``planner_server``'s
+``GridBased.tolerance``, 0.5 m as nav2_bringup's) and SUCCEEDS there, as NavFn plans.
 
 For tests, ``--replan-period S`` (simulated seconds, default 0 = off) reproduces Nav2's
 re-plan race on preemption: a ``navigate_to_pose`` goal that preempts another keeps the
@@ -115,8 +120,8 @@ from navseq.ros2.messages import (
 )
 from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
 from navseq.ros2.standin import (
+    NAV2_PLANNER_TOLERANCE,
     Ending,
-    ErrorCode,
     Nav2StandIn,
     Navigator,
     NavTask,
@@ -490,8 +495,11 @@ class SimNode:
         with self._lock:
             poses = self._poses_in_map(raw)
             if isinstance(poses, str):
+                # Nav2's bt_navigator logs a goal it cannot transform and ends it ABORTED
+                # with neither code nor message (measured on Nav2 Jazzy).
                 task = None
-                ending = Ending(Outcome.ABORTED, ErrorCode.PLANNER_UNKNOWN, poses)
+                ending = Ending(Outcome.ABORTED)
+                self.log.warning(f"{navigator.value}: goal ABORTED: {poses}")
             else:
                 task = self.standin.navigate(navigator, poses)
         if task is not None:
@@ -779,7 +787,8 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
 
 def nav2_parameter_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
     """Nodes named as Nav2's that hold the robot's parameters where Nav2 keeps them
-    (``controller_server``, ``global_costmap/global_costmap``, ``local_costmap/local_costmap``;
+    (``controller_server``, ``planner_server``, ``global_costmap/global_costmap``,
+    ``local_costmap/local_costmap``;
     see :mod:`navseq.ros2.nav2_params`), so a client that reads the robot from Nav2 finds
     the simulated one: its goal checker's tolerance, its controller's speeds, its outline
     and inflation. rclpy serves every node's parameters by itself."""
@@ -799,7 +808,11 @@ def nav2_parameter_nodes(robot: RobotProfile, namespace: str | None) -> list[Nod
         Parameter("inflation_layer.inflation_radius", value=robot.inflation_radius),
         Parameter("inflation_layer.cost_scaling_factor", value=robot.cost_scaling_factor),
     ]
-    made = [("controller_server", ns or None, controller)]
+    planner = [
+        Parameter("planner_plugins", value=["GridBased"]),
+        Parameter("GridBased.tolerance", value=NAV2_PLANNER_TOLERANCE),
+    ]
+    made = [("controller_server", ns or None, controller), ("planner_server", ns or None, planner)]
     made += [(name, f"{ns}/{name}", costmap) for name in ("global_costmap", "local_costmap")]
     return [
         Node(

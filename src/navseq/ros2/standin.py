@@ -42,6 +42,7 @@ one thread and calls everything else under the same lock.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import itertools
 import math
@@ -58,6 +59,10 @@ from navseq.sim.navserver import CONTROL_FAILED, NavState
 from navseq.sim.world import SimWorld
 
 PASS_RADIUS = 0.5  # m: Nav2's RemovePassedGoals default radius
+# m: nav2_bringup's planner_server GridBased.tolerance. A goal in an obstacle or unknown
+# space is planned to the nearest free cell within it and SUCCEEDS there (measured on
+# Nav2 Jazzy: 0.44 m and 0.52 m from goals on and inside a pillar).
+NAV2_PLANNER_TOLERANCE = 0.5
 
 
 class Navigator(enum.Enum):
@@ -172,9 +177,18 @@ class Nav2StandIn:
     """bt_navigator and waypoint_follower on one simulated robot; see the module doc."""
 
     def __init__(
-        self, world: SimWorld, *, pass_radius: float = PASS_RADIUS, replan_period: float = 0.0
+        self,
+        world: SimWorld,
+        *,
+        pass_radius: float = PASS_RADIUS,
+        replan_period: float = 0.0,
+        planner_tolerance: float = NAV2_PLANNER_TOLERANCE,
     ) -> None:
         self.world = world
+        # Nav2's planner plans to a free cell near a goal that is not free (NavFn's
+        # tolerance); the world's server, shared with ROS 1, does so only when told.
+        server = world.server
+        server.params = dataclasses.replace(server.params, planner_tolerance=planner_tolerance)
         self.pass_radius = pass_radius
         self.replan_period = replan_period  # s; 0: a preempting goal is planned at once
         self.time = 0.0
@@ -417,9 +431,11 @@ class Nav2StandIn:
                 ErrorCode.GOAL_OUTSIDE_MAP,
                 f"goal ({goal.x:.2f}, {goal.y:.2f}) is outside the map",
             )
-        if not costmap.is_free(goal.x, goal.y):
+        if self.world.server.goal_point(goal) is None:
+            tolerance = self.world.server.params.planner_tolerance
             return ErrorCode.GOAL_OCCUPIED, (
                 f"goal ({goal.x:.2f}, {goal.y:.2f}) is in an obstacle or too close to one"
+                + (f", no free cell within {tolerance:g} m" if tolerance > 0.0 else "")
             )
         if not grid.contains(start.x, start.y):
             return (

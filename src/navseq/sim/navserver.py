@@ -8,7 +8,9 @@ Life of a goal (``state``): :meth:`set_goal` makes it ACTIVE (replacing any othe
 the first control step plans on the costmap. It ends
 
 - SUCCEEDED when the controller has the robot within the xy and yaw tolerances;
-- ABORTED at once when the goal is off the map or not free, or no way on the map leads
+- ABORTED at once when the goal is off the map or not free (and, with
+  ``planner_tolerance``, no free cell is that near it: else the plan ends at the nearest
+  one and the goal SUCCEEDS there, as Nav2's NavFn plans), or no way on the map leads
   there from a robot that stands where it can turn (nothing the robot does changes that);
 - otherwise, when no plan exists from where the robot is (it stopped where it cannot
   turn, and no free cell is near), or the next step could not
@@ -99,11 +101,18 @@ class NavParams(ControllerParams):
     ``start_search_radius``: when the robot centre sits in a cell the planner may not
     start from (it stopped close to a wall), plan from the nearest free cell within
     this radius, as move_base's planners clear the robot's own cell.
+
+    ``planner_tolerance``: when the goal's cell is not free (an obstacle, too close to
+    one, unknown), plan to the nearest free cell within this distance and drive there
+    (the goal then succeeds at the plan's end), as NavFn does with its ``tolerance``.
+    move_base's ``default_tolerance`` is 0 (the ROS 1 default here); nav2_bringup's
+    ``GridBased.tolerance`` is 0.5 m (the ROS 2 stand-in's, see ``NAV2_PLANNER_TOLERANCE``).
     """
 
     stray_distance: float = 0.3
     replan_period: float | None = None  # the simulated world is static: off by default
     start_search_radius: float = 0.25
+    planner_tolerance: float = 0.0  # m; 0: a goal that is not free is not planned to
     escape_speed: float = 0.05  # m/s, forward or back, when the controller's move is unsafe
     escape_distance: float = 0.1  # m crept before the controller gets another try
     blocked_patience: float = 10.0  # s blocked without 0.2 m of progress before ABORT
@@ -409,16 +418,34 @@ class NavigationServer:
         self.plan_version += 1
         self._plan_others = self._costmap_others
         self._waiting = False
-        self.controller.set_path(plan.points, goal)
+        # The plan may end short of a goal that is not free (planner_tolerance): the
+        # goal checker is satisfied at the plan's end, as Nav2's controller is.
+        end_x, end_y = (float(value) for value in plan.points[-1])
+        self.controller.set_path(plan.points, Pose2D(end_x, end_y, goal.yaw))
         return True
 
     # -- recovery behaviours (move_base's, in small) -------------------------------------
 
     def _goal_is_hopeless(self, goal: Pose2D) -> bool:
         """True if no move of the robot can make a plan exist: the goal is off the map or
-        not free there."""
+        neither it nor a free cell within ``planner_tolerance`` is free there."""
         costmap = self.costmap
-        return not (costmap.grid.contains(goal.x, goal.y) and costmap.is_free(goal.x, goal.y))
+        return not costmap.grid.contains(goal.x, goal.y) or self.goal_point(goal) is None
+
+    def goal_point(
+        self, goal: Pose2D, costmap: Costmap | None = None
+    ) -> tuple[float, float] | None:
+        """Where a plan to ``goal`` ends: the goal if it is free, else the centre of the
+        nearest free cell within ``planner_tolerance`` (NavFn's tolerance), else None."""
+        costmap = costmap if costmap is not None else self.costmap
+        if not costmap.grid.contains(goal.x, goal.y):
+            return None  # Nav2 and move_base refuse a goal off the map, tolerance or not
+        if costmap.is_free(goal.x, goal.y):
+            return goal.x, goal.y
+        tolerance = self.params.planner_tolerance
+        if tolerance <= 0.0:
+            return None
+        return _nearest_free(costmap, goal.x, goal.y, tolerance)
 
     def _stuck(self, failure: str, why: str) -> None:
         """Start the next recovery behaviour, or ABORT with move_base's text if none is left."""
@@ -512,25 +539,33 @@ class NavigationServer:
         return None
 
     def _plan_on(self, costmap: Costmap, start: Pose2D, goal: Pose2D) -> Plan | None:
+        end = self.goal_point(goal, costmap)
+        if end is None:
+            return None
         from_x, from_y = self._planning_start(costmap, start)
-        plan = plan_path(costmap, (from_x, from_y), (goal.x, goal.y))
+        plan = plan_path(costmap, (from_x, from_y), end)
         if plan is None:
             return None
-        return _with_exact_ends(plan, (start.x, start.y), (goal.x, goal.y))
+        return _with_exact_ends(plan, (start.x, start.y), end)
 
     def _why_no_plan(self, start: Pose2D, goal: Pose2D) -> str:
         costmap = self.costmap
         if not costmap.grid.contains(goal.x, goal.y):
             return f"no plan: goal ({goal.x:.2f}, {goal.y:.2f}) is outside the map"
-        if not costmap.is_free(goal.x, goal.y):
+        if self.goal_point(goal) is None:
             return (
                 f"no plan: goal ({goal.x:.2f}, {goal.y:.2f}) is in an obstacle "
-                "or too close to one for the robot"
+                "or too close to one for the robot" + self._tolerance_note()
             )
         from_x, from_y = self._planning_start(costmap, start)
         if not costmap.is_free(from_x, from_y):
             return f"no plan: the robot at ({start.x:.2f}, {start.y:.2f}) is in an obstacle"
         return f"no plan: goal ({goal.x:.2f}, {goal.y:.2f}) is unreachable"
+
+    def _tolerance_note(self) -> str:
+        """Text for a goal with no free cell near: how near was searched, if at all."""
+        tolerance = self.params.planner_tolerance
+        return f", no free cell within {tolerance:g} m" if tolerance > 0.0 else ""
 
     def _planning_start(self, costmap: Costmap, start: Pose2D) -> tuple[float, float]:
         """Where to plan from: the robot, or the nearest free point if it is not free."""
@@ -662,6 +697,34 @@ class _Recovery:
     left: float
     elapsed: float = 0.0
     command: tuple[float, float] | None = None
+
+
+def _nearest_free(
+    costmap: Costmap, x: float, y: float, radius: float
+) -> tuple[float, float] | None:
+    """The centre of the free cell nearest (x, y) within ``radius`` (m), or None.
+
+    NavFn searches its tolerance square for the reachable point of least potential;
+    the nearest free cell is that point wherever it is reachable (a goal beside a thin
+    wall whose near side is unreachable may differ: the plan then fails as before).
+    """
+    grid = costmap.grid
+    row, col = grid.world_to_cell(x, y)
+    reach = math.ceil(radius / grid.resolution)
+    top, left = max(row - reach, 0), max(col - reach, 0)
+    window = costmap.free_mask()[top : row + reach + 1, left : col + reach + 1]
+    rows, cols = np.nonzero(window)
+    if rows.size == 0:
+        return None
+    centres = [
+        grid.cell_to_world(int(r + top), int(c + left)) for r, c in zip(rows, cols, strict=True)
+    ]
+    points = np.array(centres, dtype=float)
+    squared = (points[:, 0] - x) ** 2 + (points[:, 1] - y) ** 2
+    nearest = int(np.argmin(squared))
+    if squared[nearest] > radius * radius:
+        return None
+    return float(points[nearest, 0]), float(points[nearest, 1])
 
 
 def _with_exact_ends(plan: Plan, start: tuple[float, float], goal: tuple[float, float]) -> Plan:
