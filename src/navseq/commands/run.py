@@ -48,7 +48,7 @@ if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
-    from navseq.sinks.journal import JournalState
+    from navseq.sinks.journal import JournalState, JournalWriter
     from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
@@ -498,10 +498,27 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
     return setup.history.recorder  # what reading the journal replayed into it
 
 
+def _new_journal(setup: RunSetup, journal_path: Path) -> JournalWriter:
+    """A new run's journal, its header written."""
+    from navseq.sinks.journal import JournalWriter
+
+    # The absolute path, so that --resume works from any directory.
+    source = str(setup.mission_path.resolve())
+    return JournalWriter(journal_path, source, setup.digest, run_options=setup.run_options)
+
+
 def _run_with_sinks(
-    setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
+    setup: RunSetup,
+    args: argparse.Namespace,
+    journal_path: Path,
+    signals: SignalGuard,
+    fresh: JournalWriter | None,
 ) -> RunOutcome:
-    """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    """Run the mission; from the moment it ends, shutdown signals are only counted.
+
+    ``fresh`` is a new run's journal (None when resuming: the journal at
+    ``journal_path`` is continued once the navigator is there).
+    """
     import time
 
     from navseq.commands.run_outputs import StdoutGuard
@@ -514,14 +531,11 @@ def _run_with_sinks(
     error: NavseqError | None = None
     navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
-        if setup.resume is not None:
-            journal = JournalWriter.resume(journal_path, setup.resume, history=setup.history)
+        if fresh is not None:
+            journal = fresh
         else:
-            # The absolute path, so that --resume works from any directory.
-            source = str(setup.mission_path.resolve())
-            journal = JournalWriter(
-                journal_path, source, setup.digest, run_options=setup.run_options
-            )
+            assert setup.resume is not None
+            journal = JournalWriter.resume(journal_path, setup.resume, history=setup.history)
         recorder = new_recorder(setup)
         progress = make_progress(
             setup.mission,
@@ -629,14 +643,23 @@ def _execute_locked(
         )
     # Resuming appends to the run's own journal; a new run starts a new one.
     journal_path = setup.journal or reserve_file(folder, "journal.jsonl")
-    for note in setup.notes:
-        print(f"navseq run: {note}", file=sys.stderr)
-    if not args.no_picture:
-        _import_picture_modules()
+    fresh: JournalWriter | None = None
     try:
-        outcome = _run_with_sinks(setup, args, journal_path, signals)
+        # A new journal gets its header at once, before the slow steps (the picture's
+        # imports, the navigator's connection): a run killed during them used to
+        # leave an empty journal, which neither --resume nor navseq report can read.
+        if setup.journal is None:
+            fresh = _new_journal(setup, journal_path)
+        for note in setup.notes:
+            print(f"navseq run: {note}", file=sys.stderr)
+        if not args.no_picture:
+            _import_picture_modules()
+        outcome = _run_with_sinks(setup, args, journal_path, signals, fresh)
     except BaseException:
-        # No result to report (e.g. no navigation server): leave no empty files behind.
+        # No result to report (e.g. no navigation server, or a signal before the run
+        # began): leave no journal of nothing behind.
+        if fresh is not None:
+            fresh.close()
         if setup.journal is None:
             _discard_unused(journal_path)
         raise
