@@ -284,3 +284,69 @@ def test_a_picture_that_cannot_be_written_exits_2_and_the_report_says_so(
     assert "picture" in report["files_not_written"]
     assert "picture" not in report["files"]  # it names no file that is not there
     assert not (out / "mission.png").exists()
+
+
+def test_a_disk_that_fills_after_the_report_says_exactly_what_is_on_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The report is written, then the disk is full: no picture, and the report cannot
+    be updated to say so. The run used to claim the report "could not be written"."""
+    import errno
+
+    from navseq import cli, files
+
+    real = files.write_atomically
+    room = {"files": 1}  # the first report fits, nothing after it
+
+    def filling_up(path: Path, data: Any, **kwargs: Any) -> None:
+        if room["files"] == 0:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        room["files"] -= 1
+        real(path, data, **kwargs)
+
+    monkeypatch.setattr(files, "write_atomically", filling_up)
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    report_path = out / "report.json"
+    report = json.loads(report_path.read_text())  # complete and valid, as said
+    assert report["exit_code"] == 0 and report["files"]["picture"] == str(out / "mission.png")
+    assert not (out / "mission.png").exists()
+    assert "the report could not be written" not in stderr
+    assert (
+        f"the picture could not be written ({out / 'mission.png'}: cannot write it: the disk "
+        f"is full); the report {report_path} is complete, but could not be updated after the "
+        "picture failed (the disk is full): it still names the picture mission.png, which was "
+        "not written, and states exit status 0, not 2" in stderr
+    )
+    assert f"`navseq report {out}` draws the picture" in stderr
+    assert stderr.count("the disk is full") == 2  # one message: picture and report, once
+    assert not list(out.glob(".*.tmp"))
+    monkeypatch.undo()
+    assert cli.main(["report", str(out)]) == 0  # once there is room: the picture only
+    assert (out / "mission.png").exists() and json.loads(report_path.read_text()) == report
+
+
+def test_a_report_that_cannot_be_written_at_all_says_so_and_how_to_rebuild_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import errno
+
+    from navseq import cli, files
+
+    def full(path: Path, data: Any, **kwargs: Any) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(files, "write_atomically", full)
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    assert f"the report could not be written ({out / 'report.json'}: cannot write it" in stderr
+    assert f", nor the picture ({out / 'mission.png'}: cannot write it" in stderr
+    assert f"`navseq report {out}` rebuilds what is missing" in stderr
+    assert stderr.count("the disk is full") == 2  # one message: report and picture, once
+    assert sorted(p.name for p in out.iterdir()) == ["journal.jsonl"]

@@ -631,6 +631,7 @@ def _execute_locked(
     from navseq.commands.output import reserve_file
     from navseq.commands.run_outputs import (
         RunFiles,
+        outputs_error,
         print_summary,
         report_failures,
         silence_stdout,
@@ -698,20 +699,15 @@ def _execute_locked(
             part=setup.part.describe() if setup.part is not None else None,
             notes=notes,
         )
-    report_failures(files)
+    failure = outputs_error(files, folder, journal_path, exit_code)
+    if failure is None or outcome.error is not None:
+        report_failures(files)  # else the closing message says it all, once
     if outcome.error is not None:
         raise outcome.error
-    if "report" in files.failed:
+    if failure is not None:
         from navseq.errors import NavseqError
 
-        raise NavseqError(
-            f"the report could not be written ({files.failed['report']}); the journal "
-            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it"
-        )
-    if exit_code == 2:
-        from navseq.errors import NavseqError
-
-        raise NavseqError(f"the picture could not be written: {files.failed['picture']}")
+        raise NavseqError(failure)
     return exit_code
 
 

@@ -31,10 +31,12 @@ MAX_NAME_ATTEMPTS = 1000
 
 @dataclass
 class RunFiles:
-    """The files of one run: role -> path, and the roles that could not be written."""
+    """The files of one run: role -> path, the roles that could not be written, and
+    those written complete but out of date (a later update failed)."""
 
     paths: dict[str, str] = field(default_factory=dict)
     failed: dict[str, str] = field(default_factory=dict)  # role -> why
+    outdated: dict[str, str] = field(default_factory=dict)  # role -> what it says wrongly
 
 
 def free_name(folder: Path, name: str, start: int = 1) -> Path:
@@ -123,6 +125,7 @@ def write_outputs(
         files.failed["report"] = str(error)
     if render_picture is None:
         return exit_code
+    stated_exit_code = exit_code  # what the report just written says
     try:
         if signals is not None:
             with signals.abortable():
@@ -144,7 +147,15 @@ def write_outputs(
         try:
             write_atomically(report_path, report_text(report_path))
         except OSError as again:
-            files.failed["report"] = str(output_error(report_path, again))
+            # The report on disk is whole and valid, only out of date: say that, not
+            # that there is none (a user would rebuild or distrust a good file).
+            why = output_error(report_path, again).message.removeprefix("cannot write it: ")
+            wrong = f"it still names the picture {picture_path.name}, which was not written"
+            if exit_code != stated_exit_code:
+                wrong += f", and states exit status {stated_exit_code}, not {exit_code}"
+            files.outdated["report"] = (
+                f"complete, but could not be updated after the picture failed ({why}): {wrong}"
+            )
     return exit_code
 
 
@@ -178,8 +189,44 @@ def print_summary(
 
 
 def report_failures(files: RunFiles) -> None:
+    """On stderr: each file not written and why, each written one that is out of date."""
     for role, why in files.failed.items():
         print(f"navseq run: {role}: {why}", file=sys.stderr)
+    for role, wrong in files.outdated.items():
+        print(f"navseq run: {role}: {files.paths[role]}: {wrong}", file=sys.stderr)
+
+
+def outputs_error(files: RunFiles, folder: Path, journal: Path, exit_code: int) -> str | None:
+    """The closing message of a run whose outputs failed (exit 2), or None.
+
+    It says exactly what is on disk: a report not written at all (and the picture's
+    fate), or a picture not written beside a report that was (up to date or not), and
+    how to finish them. It says all :func:`report_failures` would.
+    """
+    rebuild = f"`navseq report {folder}`"
+    if "report" in files.failed:
+        if "picture" in files.failed:
+            picture = f", nor the picture ({files.failed['picture']})"
+        elif "picture" in files.paths:
+            picture = f" (the picture {files.paths['picture']} was)"
+        else:
+            picture = ""
+        return (
+            f"the report could not be written ({files.failed['report']}){picture}; the "
+            f"journal {journal} holds the run: {rebuild} rebuilds what is missing once "
+            "there is room"
+        )
+    if exit_code != 2 or "picture" not in files.failed:
+        return None
+    report = files.paths["report"]
+    if "report" in files.outdated:
+        said = f"the report {report} is {files.outdated['report']}"
+    else:
+        said = f"the report {report} was written, and says so"
+    return (
+        f"the picture could not be written ({files.failed['picture']}); {said}. "
+        f"{rebuild} draws the picture once the cause is fixed"
+    )
 
 
 def silence_stdout() -> None:
@@ -226,6 +273,7 @@ __all__ = [
     "StdoutGuard",
     "free_name",
     "output_error",
+    "outputs_error",
     "print_summary",
     "report_failures",
     "silence_stdout",
