@@ -350,3 +350,107 @@ def test_a_report_that_cannot_be_written_at_all_says_so_and_how_to_rebuild_it(
     assert f"`navseq report {out}` rebuilds what is missing" in stderr
     assert stderr.count("the disk is full") == 2  # one message: report and picture, once
     assert sorted(p.name for p in out.iterdir()) == ["journal.jsonl"]
+
+
+# A run killed with -9 in the middle of writing its report: the temporary stays behind.
+KILLED_WHILE_WRITING = """
+import os, signal, sys
+from navseq import cli, files
+def killed(temporary, target):
+    os.kill(os.getpid(), signal.SIGKILL)
+files._publish_without_replacing = killed
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def killed_while_writing_the_report(tmp_path: Path) -> Path:
+    import sys
+
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    args = ["run", str(mission), "--navigator", "scripted", "--out", str(out)]
+    killed = subprocess.run(
+        [sys.executable, "-c", KILLED_WHILE_WRITING, *args], cwd=tmp_path, capture_output=True
+    )
+    assert killed.returncode == -signal.SIGKILL
+    assert [p.name.startswith(".report.json.") for p in out.glob(".*.tmp")] == [True]
+    assert not (out / "report.json").exists()
+    return out
+
+
+@pytest.mark.parametrize("command", ["resume", "report", "new run"])
+def test_a_temporary_a_killed_run_left_is_removed_by_the_next_command_in_its_folder(
+    tmp_path: Path, command: str
+) -> None:
+    out = killed_while_writing_the_report(tmp_path)
+    args = {
+        "resume": ("run", "--resume", out / "journal.jsonl"),
+        "report": ("report", out),
+        "new run": ("run", tmp_path / "square.yaml", "--navigator", "scripted", "--out", out),
+    }[command]
+    result = navseq(*args, cwd=tmp_path)
+    assert result.returncode in (0, 1), result.stderr
+    assert not list(out.glob(".*.tmp"))
+    assert json.loads((out / "report.json").read_text())["visits"]
+
+
+def test_only_stale_temporaries_of_our_own_outputs_are_removed(tmp_path: Path) -> None:
+    import fcntl
+    import os
+
+    from navseq.commands.run_outputs import remove_stale_temporaries
+
+    stale = [
+        ".report.json.0123abcd.tmp",
+        ".mission-2.png.deadbeef.tmp",
+        ".report-3.json.00ff00ff.tmp",
+    ]
+    others = [
+        ".notes.txt.deadbeef.tmp",  # our pattern, not our output
+        ".report.json.tmp",
+        "report.json.deadbeef.tmp",
+        ".report.json.DEADBEEF.tmp",
+        ".report.json.deadbeef.tmp.bak",
+        "mission.png",
+    ]
+    for name in stale + others:
+        (tmp_path / name).write_text("x")
+    live = tmp_path / ".report.json.1111aaaa.tmp"  # another process is writing it
+    live.write_text("being written")
+    user_file = tmp_path / "mine.png"
+    user_file.write_text("the user's")
+    (tmp_path / ".mission.png.2222bbbb.tmp").symlink_to(user_file)
+    (tmp_path / ".mission.png.3333cccc.tmp").mkdir()
+    with open(live, "rb") as holder:
+        fcntl.flock(holder.fileno(), fcntl.LOCK_EX)
+        removed = remove_stale_temporaries(tmp_path)
+    assert sorted(p.name for p in removed) == sorted(stale)
+    left = set(os.listdir(tmp_path))
+    assert left >= {*others, live.name, user_file.name, ".mission.png.2222bbbb.tmp"}
+    assert user_file.read_text() == "the user's"
+
+
+def test_a_temporary_being_written_is_locked_until_it_is_gone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import fcntl
+
+    from navseq import files
+
+    seen = []
+    real_publish = files._publish_without_replacing
+
+    def publish(temporary: Path, target: Path) -> None:
+        with open(temporary, "rb") as other:  # what a cleaner in another process sees
+            try:
+                fcntl.flock(other.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+                seen.append("unlocked")
+            except OSError:
+                seen.append("locked")
+        real_publish(temporary, target)
+
+    monkeypatch.setattr(files, "_publish_without_replacing", publish)
+    files.write_atomically(tmp_path / "report.json", "{}", replace=False)
+    assert seen == ["locked"]
+    assert (tmp_path / "report.json").read_text() == "{}"
+    assert not list(tmp_path.glob(".*.tmp"))

@@ -79,9 +79,10 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     """Write the missing or broken report / picture of the run in ``journal``.
 
     ``state`` is the journal already read (by a resume that found nothing to run), so
-    that a long journal is not read twice.
+    that a long journal is not read twice. The caller holds the folder's run lock;
+    temporaries a killed run left there are removed.
     """
-    from navseq.commands.run_outputs import output_error
+    from navseq.commands.run_outputs import output_error, remove_stale_temporaries
     from navseq.files import write_atomically
     from navseq.mission.part import number_visits
     from navseq.sinks.journal import read_journal
@@ -89,6 +90,7 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
 
     if state is None or state.path != journal or not state.is_current():
         state = read_journal(journal)
+    remove_stale_temporaries(journal.parent)
     whole = journaled_mission(state)
     part = journaled_part(state, whole)
     mission = part.apply(whole) if part is not None else whole

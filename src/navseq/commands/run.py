@@ -595,6 +595,7 @@ def real_time_text(clock: Mapping[str, float | None]) -> str:
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
+    from navseq.commands.run_outputs import remove_stale_temporaries
     from navseq.runlock import RunLock
     from navseq.signals import SignalGuard
 
@@ -602,6 +603,7 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     # One live run per folder: a second --resume of the same journal is refused here,
     # before it writes anything or moves the robot.
     lock = RunLock(folder).acquire()
+    remove_stale_temporaries(folder)  # of a run killed while it wrote its outputs
     signals = SignalGuard()
     try:
         return _execute_locked(setup, args, folder, lock, signals)

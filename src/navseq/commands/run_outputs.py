@@ -12,6 +12,7 @@ signals twice more while the picture is drawn gives the picture up.
 from __future__ import annotations
 
 import errno
+import re
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -27,6 +28,8 @@ if TYPE_CHECKING:
 
 #: Attempts at a free name (``report-2.json`` ...) before giving up.
 MAX_NAME_ATTEMPTS = 1000
+#: The files a run (or ``navseq report``) writes atomically into its folder.
+OUTPUT_NAMES = re.compile(r"report(?:-[0-9]+)?\.json|mission(?:-[0-9]+)?\.png")
 
 
 @dataclass
@@ -49,6 +52,22 @@ def free_name(folder: Path, name: str, start: int = 1) -> Path:
         if not candidate.exists() and not candidate.is_symlink():
             return candidate
     raise NavseqError(f"no free name for {name} in {MAX_NAME_ATTEMPTS} tries", source=str(folder))
+
+
+def remove_stale_temporaries(folder: Path) -> list[Path]:
+    """Remove the report's and picture's temporaries a killed run left in its ``folder``.
+
+    ``kill -9`` while a report or picture was being written leaves its temporary
+    (``.report.json.1a2b3c4d.tmp``) beside the outputs, where every later run or
+    rebuild in the folder would leave it too. Call this holding the folder's run lock
+    (:mod:`navseq.runlock`): no other run writes there then, and a temporary that a
+    live process still holds locked is left alone anyway
+    (:func:`navseq.files.remove_stale_temporaries`). Only our outputs' temporaries
+    are touched, never another file of the folder.
+    """
+    from navseq.files import remove_stale_temporaries as remove
+
+    return remove(folder, OUTPUT_NAMES)
 
 
 def write_new_file(folder: Path, name: str, render: Callable[[Path], str | bytes]) -> Path:
@@ -275,6 +294,7 @@ __all__ = [
     "output_error",
     "outputs_error",
     "print_summary",
+    "remove_stale_temporaries",
     "report_failures",
     "silence_stdout",
     "write_new_file",
