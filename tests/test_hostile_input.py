@@ -631,3 +631,66 @@ def test_nesting_is_refused_before_the_parser_goes_deeper():
     with pytest.raises(NavseqError, match="nested more than 64") as caught:
         refuse_deep_nesting("a: 1\nx: " + "[" * 1_000_000, "m.yaml", first_line=10)
     assert caught.value.source == "m.yaml:11"
+
+
+# --- 9. a newline in a file's name -----------------------------------------------------
+
+
+def no_raw_line_break_from(name: str, *outputs: str) -> None:
+    """The name is shown escaped (``to\\nur``), never split over two lines."""
+    escaped = printable(name)
+    tail = name.split("\n")[-1]
+    for output in outputs:
+        assert not any(line.startswith(tail) for line in output.splitlines()), output
+    assert any(escaped in output for output in outputs)
+
+
+def test_a_newline_in_a_mission_files_name_is_printed_escaped(tmp_path):
+    good = mission_file(tmp_path, "waypoints:\n  - [0.5, 0.5]\n  - [1.0, 0.5]\n", "to\nur.yaml")
+    bad = mission_file(tmp_path, "waypoints:\n  - {x: 0, y: 0, bogus: 1}\n", "ba\nd.yaml")
+    out = tmp_path / "o\nut"
+
+    ok = navseq("validate", good, cwd=tmp_path, timeout=GENEROUS)
+    assert ok.returncode == 0, ok.stderr
+    no_raw_line_break_from("to\nur.yaml", ok.stdout)
+
+    refused = navseq("validate", bad, cwd=tmp_path, timeout=GENEROUS)
+    message = one_message(refused)
+    assert message.count("\n") == 2  # the summary line and one problem
+    no_raw_line_break_from("ba\nd.yaml", message)
+
+    ran = navseq("run", good, "--navigator", "scripted", "--out", out, cwd=tmp_path, timeout=60)
+    assert ran.returncode == 0, ran.stderr
+    no_raw_line_break_from("o\nut", ran.stdout)
+    no_raw_line_break_from("to\nur.yaml", ran.stdout)
+
+    (out / "report.json").unlink()
+    for args in (("report", out), ("run", "--resume", out / "journal.jsonl")):
+        result = navseq(*args, cwd=tmp_path, timeout=60)
+        no_raw_line_break_from("o\nut", result.stdout + result.stderr)
+
+    converted = navseq("convert", good, tmp_path / "c\nv.yaml", cwd=tmp_path, timeout=GENEROUS)
+    assert converted.returncode == 0, converted.stderr
+    no_raw_line_break_from("c\nv.yaml", converted.stdout)
+    no_raw_line_break_from("to\nur.yaml", converted.stdout)
+
+
+def test_error_text_keeps_only_the_line_breaks_between_listed_problems():
+    from navseq.errors import MissionErrors, error_text
+
+    errors = [
+        NavseqError("unknown key", source="a\nb.yaml:3", subject="field \x1b[2Jx"),
+        NavseqError("the journal x\ny holds the run", source="run"),
+    ]
+    shown = error_text(MissionErrors(errors, context="map m\nap.yaml"))
+    assert shown.splitlines() == [
+        "2 problems found (map m\\nap.yaml):",
+        "  - a\\nb.yaml:3, field \\x1b[2Jx: unknown key",
+        "  - run: the journal x\\ny holds the run",
+    ]
+    rosmaster = NavseqError("could not start rosmaster", source="ROS", details="  one\n  two\x1b")
+    assert error_text(rosmaster).splitlines() == [
+        "ROS: could not start rosmaster:",
+        "  one",
+        "  two\\x1b",
+    ]

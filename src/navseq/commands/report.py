@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from navseq.text import printable
+
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
     from navseq.mission.model import Mission
@@ -43,7 +45,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
     from navseq.runlock import RunLock
-    from navseq.text import printable
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
     if args.run.is_dir() and not journal.exists():
@@ -59,10 +60,13 @@ def run(args: argparse.Namespace) -> int:
     with RunLock(journal.parent):  # not while a live run writes them
         rebuilt = rebuild_outputs(journal)
     if not rebuilt.written:
-        print(f"navseq report: the report in {journal.parent} is complete; nothing to rebuild")
+        print(
+            f"navseq report: the report in {printable(str(journal.parent))} is complete; "
+            "nothing to rebuild"
+        )
         return 0
     for role, path in rebuilt.written.items():
-        print(f"{role:>8}: {path}")
+        print(f"{role:>8}: {printable(path)}")
     return 0
 
 
@@ -246,7 +250,10 @@ def _picture(state: JournalState, mission: Mission, result: MissionResult) -> by
         try:
             grid = load_map(map_path)
         except NavseqError as error:
-            print(f"navseq report: drawing without the map ({error})", file=sys.stderr)
+            print(
+                f"navseq report: drawing without the map ({printable(str(error))})",
+                file=sys.stderr,
+            )
     recorder = state.recorder
     return mission_picture_png(
         mission,

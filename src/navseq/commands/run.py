@@ -34,6 +34,7 @@ from navseq.navigators.registry import (
     journaled_options,
     navigator_kind,
 )
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -654,7 +655,7 @@ def _execute_locked(
         if setup.journal is None:
             fresh = _new_journal(setup, journal_path)
         for note in setup.notes:
-            print(f"navseq run: {note}", file=sys.stderr)
+            print(f"navseq run: {printable(note)}", file=sys.stderr)
         if not args.no_picture:
             _import_picture_modules()
         outcome = _run_with_sinks(setup, args, journal_path, signals, fresh)
@@ -691,7 +692,7 @@ def _execute_locked(
         except BrokenPipeError:
             silence_stdout()
         for note in notes:  # stdout is for programs here
-            print(f"navseq run: {note}", file=sys.stderr)
+            print(f"navseq run: {printable(note)}", file=sys.stderr)
     else:
         print_summary(
             setup.mission,
@@ -812,5 +813,8 @@ def _rebuild_finished(journal: Path, state: JournalState | None) -> int | None:
     if not rebuilt.written:
         return None
     for role, path in rebuilt.written.items():
-        print(f"navseq run: nothing left to run; rebuilt the {role}: {path}", file=sys.stderr)
+        print(
+            f"navseq run: nothing left to run; rebuilt the {role}: {printable(path)}",
+            file=sys.stderr,
+        )
     return 1 if rebuilt.exit_code is None else rebuilt.exit_code

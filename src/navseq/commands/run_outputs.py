@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
@@ -198,11 +199,11 @@ def print_summary(
     try:
         console = Console()
         print_table(summary_table(mission, result, numbers=numbers, part=part), console)
-        for note in notes:
-            console.print(note, highlight=False)
+        for note in notes:  # plain text: a path may hold [brackets], or a newline
+            console.print(printable(note), highlight=False, markup=False)
         for role, path in files.paths.items():
             if role not in files.failed:
-                console.print(f"{role:>8}: {path}", highlight=False)
+                console.print(f"{role:>8}: {printable(path)}", highlight=False, markup=False)
     except BrokenPipeError:
         silence_stdout()
 
@@ -210,9 +211,9 @@ def print_summary(
 def report_failures(files: RunFiles) -> None:
     """On stderr: each file not written and why, each written one that is out of date."""
     for role, why in files.failed.items():
-        print(f"navseq run: {role}: {why}", file=sys.stderr)
+        print(f"navseq run: {role}: {printable(why)}", file=sys.stderr)
     for role, wrong in files.outdated.items():
-        print(f"navseq run: {role}: {files.paths[role]}: {wrong}", file=sys.stderr)
+        print(f"navseq run: {role}: {printable(f'{files.paths[role]}: {wrong}')}", file=sys.stderr)
 
 
 def outputs_error(files: RunFiles, folder: Path, journal: Path, exit_code: int) -> str | None:
