@@ -513,3 +513,184 @@ def test_megabyte_names_and_keys_give_short_messages(tmp_path):
     message = one_message(navseq("validate", path, cwd=tmp_path, timeout=GENEROUS))
     assert "at most 256" in message
     assert len(message) < 2000
+
+
+# --- 7. whole numbers longer than Python converts --------------------------------------
+
+LONG = "9" * 5000
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "where"),
+    [
+        (
+            "mission.yaml",
+            f"navseq: 1\nwaypoints:\n  - {{x: {LONG}, y: 0}}\n",
+            "mission.yaml:3, key x",
+        ),
+        (
+            "mission.yaml",
+            f"navseq: 1\nwaypoints:\n  - x: 0\n    y: -{LONG}\n",
+            "mission.yaml:4, key y",
+        ),
+        ("mission.yaml", f"navseq: 1\nwaypoints:\n  - {{x: 0, y: 0, name: {LONG}}}\n", "key name"),
+        ("mission.yaml", f"navseq: 1\nwaypoints:\n  - {{x: 0x{'f' * 5000}, y: 0}}\n", "key x"),
+        (
+            "params.yaml",
+            f"p_seq: [0, 0, 0, {LONG}, 0, 0]\nyea_seq: [0, 0]\n",
+            "params.yaml:1, key p_seq",
+        ),
+        (
+            "mission.yaml",  # the line path: a run of one-line items
+            "navseq: 1\nwaypoints:\n"
+            + "".join(f"  - {{x: {i}, y: 0}}\n" for i in range(20))
+            + f"  - {{x: {LONG}, y: 0}}\n",
+            "mission.yaml:23, key x",
+        ),
+    ],
+)
+def test_a_whole_number_of_thousands_of_digits_is_refused_naming_line_and_key(
+    tmp_path, name, text, where
+):
+    path = tmp_path / name
+    path.write_text(text)
+    message = one_message(navseq("validate", path, cwd=tmp_path, timeout=GENEROUS))
+    assert where in message and "5,000 digits" in message
+    assert len(message) < 2000
+
+
+def test_a_long_whole_number_in_a_launch_param_names_the_param(tmp_path):
+    path = tmp_path / "tour.launch"
+    path.write_text(
+        '<launch>\n  <node pkg="p" type="t" name="n">\n'
+        f'    <param name="goal_timeout" value="{LONG}"/>\n'
+        '    <rosparam param="p_seq">[0, 0, 0]</rosparam>\n'
+        '    <rosparam param="yea_seq">[0]</rosparam>\n  </node>\n</launch>\n'
+    )
+    with pytest.raises(NavseqError, match="5,000 digits") as caught:
+        load_mission(path)
+    assert caught.value.source == f"{path}:3" and caught.value.subject == "param goal_timeout"
+
+
+def test_ros2_waypoints_string_is_read_by_the_mission_files_reader():
+    from navseq.ros2.node_params import read_node_params
+
+    for text, expected in [
+        (f"[{{x: {LONG}, y: 0}}]", "5,000 digits"),
+        ("[" * 100_000 + "]" * 100_000, "nested more than 64 levels deep"),
+    ]:
+        with pytest.raises(NavseqError, match=expected):
+            read_node_params({"waypoints": text}, "/navseq")
+    mission, _ = read_node_params({"waypoints": "[{x: 1, y: 2, yaw: 90}]"}, "/navseq")
+    assert mission.waypoints[0].x == 1.0
+
+
+# --- 8. nesting deep enough to crash PyYAML's composer ---------------------------------
+
+
+def nested(kind: str, levels: int) -> str:
+    if kind == "flow list":
+        return "[" * levels + "]" * levels
+    if kind == "flow mapping":
+        return "{a: " * levels + "1" + "}" * levels
+    if kind == "unclosed":
+        return "[" * levels
+    return "\n" + "- " * levels + "1"  # block lists, one level per "- "
+
+
+@pytest.mark.parametrize("kind", ["flow list", "flow mapping", "unclosed", "block"])
+def test_a_mission_nested_100000_levels_deep_is_refused_at_its_line(tmp_path, kind):
+    # Before: 30-67 s in the parser, then SIGSEGV in libyaml's composer.
+    path = mission_file(tmp_path, f"waypoints:\n  - [0, 0]\nx: {nested(kind, 100_000)}\n")
+    message = one_message(navseq("validate", path, cwd=tmp_path, timeout=GENEROUS))
+    assert f"{path.name}:4" in message or f"{path.name}:5" in message
+    assert "nested more than 64 levels deep" in message
+
+
+def test_maps_robots_and_rosparam_files_refuse_deep_nesting_too(tmp_path):
+    deep = nested("flow mapping", 50_000)
+    map_yaml = map_files(tmp_path, MAP_YAML + f"extra: {deep}\n", tiny_pgm())
+    robot = tmp_path / "robot.yaml"
+    robot.write_text(f"name: r\nfootprint: {deep}\n")
+    params = tmp_path / "params.yaml"
+    params.write_text(f"p_seq: {deep}\nyea_seq: [0]\n")
+    mission = mission_file(tmp_path, "waypoints:\n  - [0.1, 0.1]\n")
+    for args, where in [
+        (("validate", mission, "--map", map_yaml), "map.yaml:4"),
+        (("validate", mission, "--robot", robot), "robot.yaml:2"),
+        (("validate", params), "params.yaml:1"),
+    ]:
+        message = one_message(navseq(*args, cwd=tmp_path, timeout=GENEROUS))
+        assert where in message and "nested more than 64 levels deep" in message
+
+
+def test_nesting_is_refused_before_the_parser_goes_deeper():
+    from navseq.mission.yaml_doc import MAX_DEPTH, refuse_deep_nesting
+
+    refuse_deep_nesting("x: " + "[" * (MAX_DEPTH - 1) + "]" * (MAX_DEPTH - 1), "m.yaml")
+    with pytest.raises(NavseqError, match="nested more than 64") as caught:
+        refuse_deep_nesting("a: 1\nx: " + "[" * 1_000_000, "m.yaml", first_line=10)
+    assert caught.value.source == "m.yaml:11"
+
+
+# --- 9. a newline in a file's name -----------------------------------------------------
+
+
+def no_raw_line_break_from(name: str, *outputs: str) -> None:
+    """The name is shown escaped (``to\\nur``), never split over two lines."""
+    escaped = printable(name)
+    tail = name.split("\n")[-1]
+    for output in outputs:
+        assert not any(line.startswith(tail) for line in output.splitlines()), output
+    assert any(escaped in output for output in outputs)
+
+
+def test_a_newline_in_a_mission_files_name_is_printed_escaped(tmp_path):
+    good = mission_file(tmp_path, "waypoints:\n  - [0.5, 0.5]\n  - [1.0, 0.5]\n", "to\nur.yaml")
+    bad = mission_file(tmp_path, "waypoints:\n  - {x: 0, y: 0, bogus: 1}\n", "ba\nd.yaml")
+    out = tmp_path / "o\nut"
+
+    ok = navseq("validate", good, cwd=tmp_path, timeout=GENEROUS)
+    assert ok.returncode == 0, ok.stderr
+    no_raw_line_break_from("to\nur.yaml", ok.stdout)
+
+    refused = navseq("validate", bad, cwd=tmp_path, timeout=GENEROUS)
+    message = one_message(refused)
+    assert message.count("\n") == 2  # the summary line and one problem
+    no_raw_line_break_from("ba\nd.yaml", message)
+
+    ran = navseq("run", good, "--navigator", "scripted", "--out", out, cwd=tmp_path, timeout=60)
+    assert ran.returncode == 0, ran.stderr
+    no_raw_line_break_from("o\nut", ran.stdout)
+    no_raw_line_break_from("to\nur.yaml", ran.stdout)
+
+    (out / "report.json").unlink()
+    for args in (("report", out), ("run", "--resume", out / "journal.jsonl")):
+        result = navseq(*args, cwd=tmp_path, timeout=60)
+        no_raw_line_break_from("o\nut", result.stdout + result.stderr)
+
+    converted = navseq("convert", good, tmp_path / "c\nv.yaml", cwd=tmp_path, timeout=GENEROUS)
+    assert converted.returncode == 0, converted.stderr
+    no_raw_line_break_from("c\nv.yaml", converted.stdout)
+    no_raw_line_break_from("to\nur.yaml", converted.stdout)
+
+
+def test_error_text_keeps_only_the_line_breaks_between_listed_problems():
+    from navseq.errors import MissionErrors, error_text
+
+    errors = [
+        NavseqError("unknown key", source="a\nb.yaml:3", subject="field \x1b[2Jx"),
+        NavseqError("the journal x\ny holds the run", source="run"),
+    ]
+    shown = error_text(MissionErrors(errors, context="map m\nap.yaml"))
+    assert shown.splitlines() == [
+        "2 problems found (map m\\nap.yaml):",
+        "  - a\\nb.yaml:3, field \\x1b[2Jx: unknown key",
+        "  - run: the journal x\\ny holds the run",
+    ]
+    rosmaster = NavseqError("could not start rosmaster", source="ROS", details="  one\n  two\x1b")
+    assert error_text(rosmaster).splitlines() == [
+        "ROS: could not start rosmaster:",
+        "  one",
+        "  two\\x1b",
+    ]

@@ -271,3 +271,64 @@ def test_turtlebot3_world_map() -> None:
     assert grid.data[grid.world_to_cell(0.2, 0.0)] == 100
     assert grid.data[grid.world_to_cell(0.55, 0.55)] == 0
     assert grid.data[grid.world_to_cell(-9.9, -9.9)] == -1
+
+
+REQUIRED = ("image", "resolution", "origin")
+WRONG_TYPES = {
+    "image": ["null", "5", "[map.pgm]", "{file: map.pgm}", "''", "true"],
+    "resolution": ["null", "fine", "[0.05]", "{m: 0.05}", "true", ".nan", ".inf", "0"],
+    "origin": [
+        *("null", "0", "[0, 0]", "[0, 0, 0, 0]", "'[0, 0, 0]'", "{x: 0, y: 0, yaw: 0}"),
+        *("[a, 0, 0]", "[true, 0, 0]", "[[0], 0, 0]", "[.nan, 0, 0]"),
+    ],
+    "negate": ["null", "2", "0.5", "[0]", "{a: 0}", "off please"],
+    "occupied_thresh": ["null", "high", "[0.65]", "true", "2"],
+    "free_thresh": ["null", "low", "{a: 1}", "false", "-1"],
+    "mode": ["null", "5", "[trinary]", "{a: 1}", "fuzzy"],
+}
+
+
+def _map_yaml_with(tmp_path: Path, key: str, value: str | None) -> Path:
+    """A valid map's YAML with ``key`` set to ``value`` (written as is), or left out."""
+    yaml_path = write_map(tmp_path, [GREYS])
+    lines = [line for line in yaml_path.read_text().splitlines() if not line.startswith(key)]
+    if value is not None:
+        lines.append(f"{key}: {value}")
+    yaml_path.write_text("\n".join(lines) + "\n")
+    return yaml_path
+
+
+@pytest.mark.parametrize("key", REQUIRED)
+def test_every_required_map_setting_missing_is_refused_naming_the_file_and_key(
+    tmp_path: Path, key: str
+) -> None:
+    yaml_path = _map_yaml_with(tmp_path, key, None)
+    with pytest.raises(NavseqError, match=f"the map YAML has no '{key}'") as caught:
+        load_map(yaml_path)
+    assert caught.value.subject == f"key {key}"
+    assert str(caught.value).startswith(str(yaml_path))
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [(key, value) for key, values in WRONG_TYPES.items() for value in values]
+)
+def test_every_map_setting_of_the_wrong_type_is_refused_naming_its_line_and_key(
+    tmp_path: Path, key: str, value: str
+) -> None:
+    yaml_path = _map_yaml_with(tmp_path, key, value)
+    line = yaml_path.read_text().splitlines().index(f"{key}: {value}") + 1
+    with pytest.raises(NavseqError) as caught:
+        load_map(yaml_path)
+    assert caught.value.subject == f"key {key}"
+    assert caught.value.source == f"{yaml_path}:{line}"
+
+
+def test_a_map_without_origin_is_refused_by_the_cli_with_exit_2(tmp_path: Path) -> None:
+    from cli_support import assert_clean_error, navseq, write_mission
+
+    yaml_path = _map_yaml_with(tmp_path, "origin", None)
+    mission = write_mission(tmp_path / "m.yaml", "  - [0.05, 0.05]\n")
+    for command in ("validate", "run"):
+        result = navseq(command, mission, "--map", yaml_path, cwd=tmp_path, timeout=60)
+        assert_clean_error(result)
+        assert f"{yaml_path}:1, key origin: the map YAML has no 'origin'" in result.stderr

@@ -181,3 +181,72 @@ def test_lock_refusal_names_the_holder(tmp_path):
     lock = RunLock(tmp_path).acquire()  # the kernel dropped the dead holder's lock
     assert lock.took_over == holder.pid
     lock.release()
+
+
+# --- a run stopped in its first moments ------------------------------------------------
+
+
+def test_the_journal_has_its_header_before_the_slow_first_steps(tmp_path, monkeypatch):
+    """A kill -9 while the picture's modules load (or the navigator connects) left a 0-byte
+    journal that --resume and navseq report refused; now the header is there already."""
+    import shutil
+
+    from navseq import cli
+    from navseq.commands import run as run_command
+
+    mission = write_mission(tmp_path / "patrol.yaml", PATROL)
+    out, killed, connecting = tmp_path / "out", tmp_path / "killed", tmp_path / "connecting"
+    real_prepare = run_command.prepare
+
+    def snapshot_as_if_killed_here() -> None:
+        shutil.copytree(out, killed)  # what a kill -9 at this moment would leave
+
+    def prepare(args: Any) -> Any:
+        setup = real_prepare(args)
+        make = setup.make_navigator
+        setup.make_navigator = lambda: (shutil.copytree(out, connecting), make())[1]
+        return setup
+
+    monkeypatch.setattr(run_command, "_import_picture_modules", snapshot_as_if_killed_here)
+    monkeypatch.setattr(run_command, "prepare", prepare)
+    assert cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)]) == 0
+    monkeypatch.undo()
+    for folder in (killed, connecting):
+        (folder / ".navseq.lock").unlink(missing_ok=True)
+        assert journal_records(folder / "journal.jsonl")[0]["kind"] == "header"
+        resumed = navseq(
+            "run", "--resume", folder / "journal.jsonl", "--navigator", "scripted", cwd=tmp_path
+        )
+        assert resumed.returncode == 0, resumed.stderr
+        assert len(journal_events(folder / "journal.jsonl", "WaypointFinished")) == 3
+
+
+def test_a_signal_before_the_run_began_leaves_no_journal_behind(tmp_path, monkeypatch, capsys):
+    from navseq import cli
+    from navseq.commands import run as run_command
+    from navseq.signals import Terminated
+
+    def terminated() -> None:
+        raise Terminated("SIGTERM")
+
+    monkeypatch.setattr(run_command, "_import_picture_modules", terminated)
+    mission = write_mission(tmp_path / "patrol.yaml", PATROL)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)]) == 143
+    assert "terminated (SIGTERM)" in capsys.readouterr().err
+    assert not out.exists()  # the folder this run created, with nothing in it, is gone
+
+
+def test_an_empty_journal_is_said_to_be_a_run_that_never_began(tmp_path):
+    write_mission(tmp_path / "patrol.yaml", PATROL)
+    journal = tmp_path / "out" / "journal.jsonl"
+    journal.parent.mkdir()
+    journal.write_bytes(b"")
+    for args in (("run", "--resume", journal), ("report", journal.parent)):
+        result = navseq(*args, cwd=tmp_path)
+        assert_clean_error(result)
+        assert f"{journal}:1: the journal is empty: its run was stopped before it began" in (
+            result.stderr
+        )
+        assert "navseq run MISSION" in result.stderr
+    assert journal.read_bytes() == b""  # left as it was

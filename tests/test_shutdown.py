@@ -284,3 +284,173 @@ def test_a_picture_that_cannot_be_written_exits_2_and_the_report_says_so(
     assert "picture" in report["files_not_written"]
     assert "picture" not in report["files"]  # it names no file that is not there
     assert not (out / "mission.png").exists()
+
+
+def test_a_disk_that_fills_after_the_report_says_exactly_what_is_on_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The report is written, then the disk is full: no picture, and the report cannot
+    be updated to say so. The run used to claim the report "could not be written"."""
+    import errno
+
+    from navseq import cli, files
+
+    real = files.write_atomically
+    room = {"files": 1}  # the first report fits, nothing after it
+
+    def filling_up(path: Path, data: Any, **kwargs: Any) -> None:
+        if room["files"] == 0:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        room["files"] -= 1
+        real(path, data, **kwargs)
+
+    monkeypatch.setattr(files, "write_atomically", filling_up)
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    report_path = out / "report.json"
+    report = json.loads(report_path.read_text())  # complete and valid, as said
+    assert report["exit_code"] == 0 and report["files"]["picture"] == str(out / "mission.png")
+    assert not (out / "mission.png").exists()
+    assert "the report could not be written" not in stderr
+    assert (
+        f"the picture could not be written ({out / 'mission.png'}: cannot write it: the disk "
+        f"is full); the report {report_path} is complete, but could not be updated after the "
+        "picture failed (the disk is full): it still names the picture mission.png, which was "
+        "not written, and states exit status 0, not 2" in stderr
+    )
+    assert f"`navseq report {out}` draws the picture" in stderr
+    assert stderr.count("the disk is full") == 2  # one message: picture and report, once
+    assert not list(out.glob(".*.tmp"))
+    monkeypatch.undo()
+    assert cli.main(["report", str(out)]) == 0  # once there is room: the picture only
+    assert (out / "mission.png").exists() and json.loads(report_path.read_text()) == report
+
+
+def test_a_report_that_cannot_be_written_at_all_says_so_and_how_to_rebuild_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import errno
+
+    from navseq import cli, files
+
+    def full(path: Path, data: Any, **kwargs: Any) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(files, "write_atomically", full)
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 2
+    assert f"the report could not be written ({out / 'report.json'}: cannot write it" in stderr
+    assert f", nor the picture ({out / 'mission.png'}: cannot write it" in stderr
+    assert f"`navseq report {out}` rebuilds what is missing" in stderr
+    assert stderr.count("the disk is full") == 2  # one message: report and picture, once
+    assert sorted(p.name for p in out.iterdir()) == ["journal.jsonl"]
+
+
+# A run killed with -9 in the middle of writing its report: the temporary stays behind.
+KILLED_WHILE_WRITING = """
+import os, signal, sys
+from navseq import cli, files
+def killed(temporary, target):
+    os.kill(os.getpid(), signal.SIGKILL)
+files._publish_without_replacing = killed
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def killed_while_writing_the_report(tmp_path: Path) -> Path:
+    import sys
+
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+    out = tmp_path / "out"
+    args = ["run", str(mission), "--navigator", "scripted", "--out", str(out)]
+    killed = subprocess.run(
+        [sys.executable, "-c", KILLED_WHILE_WRITING, *args], cwd=tmp_path, capture_output=True
+    )
+    assert killed.returncode == -signal.SIGKILL
+    assert [p.name.startswith(".report.json.") for p in out.glob(".*.tmp")] == [True]
+    assert not (out / "report.json").exists()
+    return out
+
+
+@pytest.mark.parametrize("command", ["resume", "report", "new run"])
+def test_a_temporary_a_killed_run_left_is_removed_by_the_next_command_in_its_folder(
+    tmp_path: Path, command: str
+) -> None:
+    out = killed_while_writing_the_report(tmp_path)
+    args = {
+        "resume": ("run", "--resume", out / "journal.jsonl"),
+        "report": ("report", out),
+        "new run": ("run", tmp_path / "square.yaml", "--navigator", "scripted", "--out", out),
+    }[command]
+    result = navseq(*args, cwd=tmp_path)
+    assert result.returncode in (0, 1), result.stderr
+    assert not list(out.glob(".*.tmp"))
+    assert json.loads((out / "report.json").read_text())["visits"]
+
+
+def test_only_stale_temporaries_of_our_own_outputs_are_removed(tmp_path: Path) -> None:
+    import fcntl
+    import os
+
+    from navseq.commands.run_outputs import remove_stale_temporaries
+
+    stale = [
+        ".report.json.0123abcd.tmp",
+        ".mission-2.png.deadbeef.tmp",
+        ".report-3.json.00ff00ff.tmp",
+    ]
+    others = [
+        ".notes.txt.deadbeef.tmp",  # our pattern, not our output
+        ".report.json.tmp",
+        "report.json.deadbeef.tmp",
+        ".report.json.DEADBEEF.tmp",
+        ".report.json.deadbeef.tmp.bak",
+        "mission.png",
+    ]
+    for name in stale + others:
+        (tmp_path / name).write_text("x")
+    live = tmp_path / ".report.json.1111aaaa.tmp"  # another process is writing it
+    live.write_text("being written")
+    user_file = tmp_path / "mine.png"
+    user_file.write_text("the user's")
+    (tmp_path / ".mission.png.2222bbbb.tmp").symlink_to(user_file)
+    (tmp_path / ".mission.png.3333cccc.tmp").mkdir()
+    with open(live, "rb") as holder:
+        fcntl.flock(holder.fileno(), fcntl.LOCK_EX)
+        removed = remove_stale_temporaries(tmp_path)
+    assert sorted(p.name for p in removed) == sorted(stale)
+    left = set(os.listdir(tmp_path))
+    assert left >= {*others, live.name, user_file.name, ".mission.png.2222bbbb.tmp"}
+    assert user_file.read_text() == "the user's"
+
+
+def test_a_temporary_being_written_is_locked_until_it_is_gone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import fcntl
+
+    from navseq import files
+
+    seen = []
+    real_publish = files._publish_without_replacing
+
+    def publish(temporary: Path, target: Path) -> None:
+        with open(temporary, "rb") as other:  # what a cleaner in another process sees
+            try:
+                fcntl.flock(other.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+                seen.append("unlocked")
+            except OSError:
+                seen.append("locked")
+        real_publish(temporary, target)
+
+    monkeypatch.setattr(files, "_publish_without_replacing", publish)
+    files.write_atomically(tmp_path / "report.json", "{}", replace=False)
+    assert seen == ["locked"]
+    assert (tmp_path / "report.json").read_text() == "{}"
+    assert not list(tmp_path.glob(".*.tmp"))

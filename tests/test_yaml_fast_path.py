@@ -158,6 +158,9 @@ DOCUMENTS = [
     "x: " + "[" * 70 + "]" * 70 + "\n",  # deeper than MAX_DEPTH
     "a:\n  b:\n    c: [1, {d: 2.5, e: [x, 'y']}]\n",
     "- &w {x: 1}\n- *w\n- *w\n",
+    "x: " + "9" * 5000 + "\n",  # more digits than Python converts
+    "a: {b: [1, -0x" + "f" * 2000 + "]}\n",
+    "a: [[" * 40 + "]]" * 40 + "\n",  # deeper than MAX_DEPTH, opened two at a time
 ]
 
 

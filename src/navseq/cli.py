@@ -27,7 +27,7 @@ from types import FrameType
 
 from navseq import __version__
 from navseq.commands import SUBCOMMANDS
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.signals import Terminated, ignore_until_exit
 from navseq.text import printable
 
@@ -149,11 +149,7 @@ def _main(argv: list[str] | None) -> int:
     try:
         return args.command_module.run(args)
     except NavseqError as error:
-        # MissionErrors is a NavseqError whose text lists every problem.
-        # Messages quote what the user wrote: escaped, so it cannot drive the terminal.
-        print(
-            f"navseq {args.command}: {printable(str(error), keep_newlines=True)}", file=sys.stderr
-        )
+        print(f"navseq {args.command}: {error_text(error)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"navseq {args.command}: interrupted", file=sys.stderr)

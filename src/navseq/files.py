@@ -5,7 +5,9 @@ file is refused before it can hang navseq or fill the memory.
 
 from __future__ import annotations
 
+import fcntl
 import os
+import re
 import secrets
 import stat
 from collections.abc import Callable
@@ -15,6 +17,9 @@ from typing import BinaryIO
 from navseq.errors import NavseqError
 from navseq.text import printable
 
+#: The temporary :func:`write_atomically` writes ``name`` through: ``.name.<8 hex>.tmp``.
+TEMPORARY_NAME = re.compile(r"\.(?P<name>.+)\.[0-9a-f]{8}\.tmp")
+
 
 def write_atomically(path: Path, data: str | bytes, *, replace: bool = True) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder.
@@ -23,24 +28,93 @@ def write_atomically(path: Path, data: str | bytes, *, replace: bool = True) -> 
     an existing ``path`` is never replaced — even one that appears while writing —
     and :class:`FileExistsError` is raised instead. The new file gets ordinary
     permissions under the umask. Other failures raise :class:`OSError`.
+
+    The temporary (:data:`TEMPORARY_NAME`) is locked (``flock``) from its creation
+    until it is gone, so :func:`remove_stale_temporaries` can tell one a live process
+    is writing from one a killed process left (the kernel drops the lock of a dead
+    process, even after ``kill -9``).
     """
     # A file name with bytes that are not UTF-8 reaches Python as lone surrogates;
     # written as "\udcff" it stays readable (and JSON reads the escape back).
     payload = data.encode("utf-8", "backslashreplace") if isinstance(data, str) else data
-    temporary = path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
+    temporary, descriptor = _locked_temporary(path)
     try:
-        # O_EXCL: never follow or reuse someone else's file; 0o666 honours the umask.
-        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
         with os.fdopen(descriptor, "wb") as stream:
             stream.write(payload)
             stream.flush()
             os.fsync(stream.fileno())
-        if replace:
-            os.replace(temporary, path)
-        else:
-            _publish_without_replacing(temporary, path)
+            # Published while still open and locked: never seen unlocked and unnamed.
+            if replace:
+                os.replace(temporary, path)
+            else:
+                _publish_without_replacing(temporary, path)
+            temporary.unlink(missing_ok=True)
     finally:
         temporary.unlink(missing_ok=True)
+
+
+def _locked_temporary(path: Path) -> tuple[Path, int]:
+    """A new temporary beside ``path``, opened and locked; retried if a cleaner removed
+    it between its creation and the lock."""
+    while True:
+        temporary = path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp"
+        # O_EXCL: never follow or reuse someone else's file; 0o666 honours the umask.
+        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX)
+            if _still_named(descriptor, temporary):
+                return temporary, descriptor
+        except BaseException:
+            os.close(descriptor)
+            raise
+        os.close(descriptor)
+
+
+def remove_stale_temporaries(folder: Path, names: re.Pattern[str]) -> list[Path]:
+    """Remove the temporaries of :func:`write_atomically` that killed processes left in
+    ``folder``, for the files whose names match ``names``; returns those removed.
+
+    Only regular files named as this module names its temporaries, and only those no
+    live process holds locked: one being written now is left alone. Whatever else the
+    folder holds is not touched. Failures are ignored (tidying up only).
+    """
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = TEMPORARY_NAME.fullmatch(entry.name)
+        if match is None or not names.fullmatch(match["name"]):
+            continue
+        path = Path(entry.path)
+        try:
+            descriptor = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+        except OSError:
+            continue  # gone meanwhile, a symlink, unreadable
+        try:
+            if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+                continue
+            try:
+                fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                continue  # a live process is writing it
+            if _still_named(descriptor, path):
+                path.unlink()
+                removed.append(path)
+        except OSError:
+            continue
+        finally:
+            os.close(descriptor)
+    return removed
+
+
+def _still_named(descriptor: int, path: Path) -> bool:
+    """The open file is still the one at ``path`` (not removed or replaced meanwhile)."""
+    try:
+        return os.path.samestat(os.fstat(descriptor), os.lstat(path))
+    except OSError:
+        return False
 
 
 def _publish_without_replacing(temporary: Path, target: Path) -> None:

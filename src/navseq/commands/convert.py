@@ -30,6 +30,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.errors import NavseqError
     from navseq.mission import load_mission, write_mission
+    from navseq.text import printable
 
     mission = load_mission(args.input)
     if args.output.exists() and not args.force:
@@ -46,11 +47,14 @@ def run(args: argparse.Namespace) -> int:
         if launch.left_out:
             print(
                 f"navseq convert: the tutorial's format has no place for: "
-                f"{'; '.join(launch.left_out)}",
+                f"{printable('; '.join(launch.left_out))}",
                 file=sys.stderr,
             )
     else:
         write_mission(mission, args.output, overwrite=args.force)
     count = len(mission.waypoints)
-    print(f"wrote {args.output} ({count} waypoint{'s' if count != 1 else ''} from {args.input})")
+    print(
+        f"wrote {printable(str(args.output))} ({count} waypoint{'s' if count != 1 else ''} "
+        f"from {printable(str(args.input))})"
+    )
     return 0

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from navseq.text import printable
+
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
     from navseq.mission.model import Mission
@@ -43,7 +45,6 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
     from navseq.runlock import RunLock
-    from navseq.text import printable
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
     if args.run.is_dir() and not journal.exists():
@@ -59,10 +60,13 @@ def run(args: argparse.Namespace) -> int:
     with RunLock(journal.parent):  # not while a live run writes them
         rebuilt = rebuild_outputs(journal)
     if not rebuilt.written:
-        print(f"navseq report: the report in {journal.parent} is complete; nothing to rebuild")
+        print(
+            f"navseq report: the report in {printable(str(journal.parent))} is complete; "
+            "nothing to rebuild"
+        )
         return 0
     for role, path in rebuilt.written.items():
-        print(f"{role:>8}: {path}")
+        print(f"{role:>8}: {printable(path)}")
     return 0
 
 
@@ -79,9 +83,10 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     """Write the missing or broken report / picture of the run in ``journal``.
 
     ``state`` is the journal already read (by a resume that found nothing to run), so
-    that a long journal is not read twice.
+    that a long journal is not read twice. The caller holds the folder's run lock;
+    temporaries a killed run left there are removed.
     """
-    from navseq.commands.run_outputs import output_error
+    from navseq.commands.run_outputs import output_error, remove_stale_temporaries
     from navseq.files import write_atomically
     from navseq.mission.part import number_visits
     from navseq.sinks.journal import read_journal
@@ -89,6 +94,7 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
 
     if state is None or state.path != journal or not state.is_current():
         state = read_journal(journal)
+    remove_stale_temporaries(journal.parent)
     whole = journaled_mission(state)
     part = journaled_part(state, whole)
     mission = part.apply(whole) if part is not None else whole
@@ -244,7 +250,10 @@ def _picture(state: JournalState, mission: Mission, result: MissionResult) -> by
         try:
             grid = load_map(map_path)
         except NavseqError as error:
-            print(f"navseq report: drawing without the map ({error})", file=sys.stderr)
+            print(
+                f"navseq report: drawing without the map ({printable(str(error))})",
+                file=sys.stderr,
+            )
     recorder = state.recorder
     return mission_picture_png(
         mission,

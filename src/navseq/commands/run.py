@@ -34,6 +34,7 @@ from navseq.navigators.registry import (
     journaled_options,
     navigator_kind,
 )
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.errors import NavseqError
@@ -48,7 +49,7 @@ if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
-    from navseq.sinks.journal import JournalState
+    from navseq.sinks.journal import JournalState, JournalWriter
     from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
@@ -498,10 +499,27 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
     return setup.history.recorder  # what reading the journal replayed into it
 
 
+def _new_journal(setup: RunSetup, journal_path: Path) -> JournalWriter:
+    """A new run's journal, its header written."""
+    from navseq.sinks.journal import JournalWriter
+
+    # The absolute path, so that --resume works from any directory.
+    source = str(setup.mission_path.resolve())
+    return JournalWriter(journal_path, source, setup.digest, run_options=setup.run_options)
+
+
 def _run_with_sinks(
-    setup: RunSetup, args: argparse.Namespace, journal_path: Path, signals: SignalGuard
+    setup: RunSetup,
+    args: argparse.Namespace,
+    journal_path: Path,
+    signals: SignalGuard,
+    fresh: JournalWriter | None,
 ) -> RunOutcome:
-    """Run the mission; from the moment it ends, shutdown signals are only counted."""
+    """Run the mission; from the moment it ends, shutdown signals are only counted.
+
+    ``fresh`` is a new run's journal (None when resuming: the journal at
+    ``journal_path`` is continued once the navigator is there).
+    """
     import time
 
     from navseq.commands.run_outputs import StdoutGuard
@@ -514,14 +532,11 @@ def _run_with_sinks(
     error: NavseqError | None = None
     navigator_start, wall_start = navigator.now(), time.monotonic()
     try:
-        if setup.resume is not None:
-            journal = JournalWriter.resume(journal_path, setup.resume, history=setup.history)
+        if fresh is not None:
+            journal = fresh
         else:
-            # The absolute path, so that --resume works from any directory.
-            source = str(setup.mission_path.resolve())
-            journal = JournalWriter(
-                journal_path, source, setup.digest, run_options=setup.run_options
-            )
+            assert setup.resume is not None
+            journal = JournalWriter.resume(journal_path, setup.resume, history=setup.history)
         recorder = new_recorder(setup)
         progress = make_progress(
             setup.mission,
@@ -581,6 +596,7 @@ def real_time_text(clock: Mapping[str, float | None]) -> str:
 
 def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     """Run the mission with every sink attached; write report and picture; exit status."""
+    from navseq.commands.run_outputs import remove_stale_temporaries
     from navseq.runlock import RunLock
     from navseq.signals import SignalGuard
 
@@ -588,6 +604,7 @@ def execute(setup: RunSetup, args: argparse.Namespace) -> int:
     # One live run per folder: a second --resume of the same journal is refused here,
     # before it writes anything or moves the robot.
     lock = RunLock(folder).acquire()
+    remove_stale_temporaries(folder)  # of a run killed while it wrote its outputs
     signals = SignalGuard()
     try:
         return _execute_locked(setup, args, folder, lock, signals)
@@ -617,6 +634,7 @@ def _execute_locked(
     from navseq.commands.output import reserve_file
     from navseq.commands.run_outputs import (
         RunFiles,
+        outputs_error,
         print_summary,
         report_failures,
         silence_stdout,
@@ -629,14 +647,23 @@ def _execute_locked(
         )
     # Resuming appends to the run's own journal; a new run starts a new one.
     journal_path = setup.journal or reserve_file(folder, "journal.jsonl")
-    for note in setup.notes:
-        print(f"navseq run: {note}", file=sys.stderr)
-    if not args.no_picture:
-        _import_picture_modules()
+    fresh: JournalWriter | None = None
     try:
-        outcome = _run_with_sinks(setup, args, journal_path, signals)
+        # A new journal gets its header at once, before the slow steps (the picture's
+        # imports, the navigator's connection): a run killed during them used to
+        # leave an empty journal, which neither --resume nor navseq report can read.
+        if setup.journal is None:
+            fresh = _new_journal(setup, journal_path)
+        for note in setup.notes:
+            print(f"navseq run: {printable(note)}", file=sys.stderr)
+        if not args.no_picture:
+            _import_picture_modules()
+        outcome = _run_with_sinks(setup, args, journal_path, signals, fresh)
     except BaseException:
-        # No result to report (e.g. no navigation server): leave no empty files behind.
+        # No result to report (e.g. no navigation server, or a signal before the run
+        # began): leave no journal of nothing behind.
+        if fresh is not None:
+            fresh.close()
         if setup.journal is None:
             _discard_unused(journal_path)
         raise
@@ -665,7 +692,7 @@ def _execute_locked(
         except BrokenPipeError:
             silence_stdout()
         for note in notes:  # stdout is for programs here
-            print(f"navseq run: {note}", file=sys.stderr)
+            print(f"navseq run: {printable(note)}", file=sys.stderr)
     else:
         print_summary(
             setup.mission,
@@ -675,20 +702,15 @@ def _execute_locked(
             part=setup.part.describe() if setup.part is not None else None,
             notes=notes,
         )
-    report_failures(files)
+    failure = outputs_error(files, folder, journal_path, exit_code)
+    if failure is None or outcome.error is not None:
+        report_failures(files)  # else the closing message says it all, once
     if outcome.error is not None:
         raise outcome.error
-    if "report" in files.failed:
+    if failure is not None:
         from navseq.errors import NavseqError
 
-        raise NavseqError(
-            f"the report could not be written ({files.failed['report']}); the journal "
-            f"{journal_path} holds the run: `navseq report {folder}` rebuilds it"
-        )
-    if exit_code == 2:
-        from navseq.errors import NavseqError
-
-        raise NavseqError(f"the picture could not be written: {files.failed['picture']}")
+        raise NavseqError(failure)
     return exit_code
 
 
@@ -791,5 +813,8 @@ def _rebuild_finished(journal: Path, state: JournalState | None) -> int | None:
     if not rebuilt.written:
         return None
     for role, path in rebuilt.written.items():
-        print(f"navseq run: nothing left to run; rebuilt the {role}: {path}", file=sys.stderr)
+        print(
+            f"navseq run: nothing left to run; rebuilt the {role}: {printable(path)}",
+            file=sys.stderr,
+        )
     return 1 if rebuilt.exit_code is None else rebuilt.exit_code

@@ -12,6 +12,7 @@ signals twice more while the picture is drawn gives the picture up.
 from __future__ import annotations
 
 import errno
+import re
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
@@ -27,14 +29,18 @@ if TYPE_CHECKING:
 
 #: Attempts at a free name (``report-2.json`` ...) before giving up.
 MAX_NAME_ATTEMPTS = 1000
+#: The files a run (or ``navseq report``) writes atomically into its folder.
+OUTPUT_NAMES = re.compile(r"report(?:-[0-9]+)?\.json|mission(?:-[0-9]+)?\.png")
 
 
 @dataclass
 class RunFiles:
-    """The files of one run: role -> path, and the roles that could not be written."""
+    """The files of one run: role -> path, the roles that could not be written, and
+    those written complete but out of date (a later update failed)."""
 
     paths: dict[str, str] = field(default_factory=dict)
     failed: dict[str, str] = field(default_factory=dict)  # role -> why
+    outdated: dict[str, str] = field(default_factory=dict)  # role -> what it says wrongly
 
 
 def free_name(folder: Path, name: str, start: int = 1) -> Path:
@@ -47,6 +53,22 @@ def free_name(folder: Path, name: str, start: int = 1) -> Path:
         if not candidate.exists() and not candidate.is_symlink():
             return candidate
     raise NavseqError(f"no free name for {name} in {MAX_NAME_ATTEMPTS} tries", source=str(folder))
+
+
+def remove_stale_temporaries(folder: Path) -> list[Path]:
+    """Remove the report's and picture's temporaries a killed run left in its ``folder``.
+
+    ``kill -9`` while a report or picture was being written leaves its temporary
+    (``.report.json.1a2b3c4d.tmp``) beside the outputs, where every later run or
+    rebuild in the folder would leave it too. Call this holding the folder's run lock
+    (:mod:`navseq.runlock`): no other run writes there then, and a temporary that a
+    live process still holds locked is left alone anyway
+    (:func:`navseq.files.remove_stale_temporaries`). Only our outputs' temporaries
+    are touched, never another file of the folder.
+    """
+    from navseq.files import remove_stale_temporaries as remove
+
+    return remove(folder, OUTPUT_NAMES)
 
 
 def write_new_file(folder: Path, name: str, render: Callable[[Path], str | bytes]) -> Path:
@@ -123,6 +145,7 @@ def write_outputs(
         files.failed["report"] = str(error)
     if render_picture is None:
         return exit_code
+    stated_exit_code = exit_code  # what the report just written says
     try:
         if signals is not None:
             with signals.abortable():
@@ -144,7 +167,15 @@ def write_outputs(
         try:
             write_atomically(report_path, report_text(report_path))
         except OSError as again:
-            files.failed["report"] = str(output_error(report_path, again))
+            # The report on disk is whole and valid, only out of date: say that, not
+            # that there is none (a user would rebuild or distrust a good file).
+            why = output_error(report_path, again).message.removeprefix("cannot write it: ")
+            wrong = f"it still names the picture {picture_path.name}, which was not written"
+            if exit_code != stated_exit_code:
+                wrong += f", and states exit status {stated_exit_code}, not {exit_code}"
+            files.outdated["report"] = (
+                f"complete, but could not be updated after the picture failed ({why}): {wrong}"
+            )
     return exit_code
 
 
@@ -168,18 +199,54 @@ def print_summary(
     try:
         console = Console()
         print_table(summary_table(mission, result, numbers=numbers, part=part), console)
-        for note in notes:
-            console.print(note, highlight=False)
+        for note in notes:  # plain text: a path may hold [brackets], or a newline
+            console.print(printable(note), highlight=False, markup=False)
         for role, path in files.paths.items():
             if role not in files.failed:
-                console.print(f"{role:>8}: {path}", highlight=False)
+                console.print(f"{role:>8}: {printable(path)}", highlight=False, markup=False)
     except BrokenPipeError:
         silence_stdout()
 
 
 def report_failures(files: RunFiles) -> None:
+    """On stderr: each file not written and why, each written one that is out of date."""
     for role, why in files.failed.items():
-        print(f"navseq run: {role}: {why}", file=sys.stderr)
+        print(f"navseq run: {role}: {printable(why)}", file=sys.stderr)
+    for role, wrong in files.outdated.items():
+        print(f"navseq run: {role}: {printable(f'{files.paths[role]}: {wrong}')}", file=sys.stderr)
+
+
+def outputs_error(files: RunFiles, folder: Path, journal: Path, exit_code: int) -> str | None:
+    """The closing message of a run whose outputs failed (exit 2), or None.
+
+    It says exactly what is on disk: a report not written at all (and the picture's
+    fate), or a picture not written beside a report that was (up to date or not), and
+    how to finish them. It says all :func:`report_failures` would.
+    """
+    rebuild = f"`navseq report {folder}`"
+    if "report" in files.failed:
+        if "picture" in files.failed:
+            picture = f", nor the picture ({files.failed['picture']})"
+        elif "picture" in files.paths:
+            picture = f" (the picture {files.paths['picture']} was)"
+        else:
+            picture = ""
+        return (
+            f"the report could not be written ({files.failed['report']}){picture}; the "
+            f"journal {journal} holds the run: {rebuild} rebuilds what is missing once "
+            "there is room"
+        )
+    if exit_code != 2 or "picture" not in files.failed:
+        return None
+    report = files.paths["report"]
+    if "report" in files.outdated:
+        said = f"the report {report} is {files.outdated['report']}"
+    else:
+        said = f"the report {report} was written, and says so"
+    return (
+        f"the picture could not be written ({files.failed['picture']}); {said}. "
+        f"{rebuild} draws the picture once the cause is fixed"
+    )
 
 
 def silence_stdout() -> None:
@@ -226,7 +293,9 @@ __all__ = [
     "StdoutGuard",
     "free_name",
     "output_error",
+    "outputs_error",
     "print_summary",
+    "remove_stale_temporaries",
     "report_failures",
     "silence_stdout",
     "write_new_file",

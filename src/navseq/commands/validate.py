@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from navseq.commands.common import add_robot_option, parse_pose
 from navseq.errors import NavseqError
+from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.geometry import Pose2D
@@ -80,11 +81,15 @@ def run(args: argparse.Namespace) -> int:
     count = len(mission.waypoints)
     loops = "forever" if mission.loops is None else str(mission.loops)
     map_path = args.map if args.map is not None else mission.map
-    checked = f"checked against map {map_path}" if map_path is not None else "no map to check"
+    checked = (
+        f"checked against map {printable(str(map_path))}"
+        if map_path is not None
+        else "no map to check"
+    )
     if map_path is not None:
         checked += f" for robot {choose_robot(args.robot, mission).name}"
     print(
-        f"{args.mission}: OK — {count} waypoint{'s' if count != 1 else ''}, "
+        f"{printable(str(args.mission))}: OK — {count} waypoint{'s' if count != 1 else ''}, "
         f"loops {loops}, {checked}",
         file=sys.stdout,
     )

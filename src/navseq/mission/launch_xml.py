@@ -44,11 +44,13 @@ from navseq.mission.reading import MAX_MISSION_BYTES, read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
 from navseq.mission.xml_tree import XmlElement, parse_xml
 from navseq.mission.yaml_doc import (
+    NumberTooLongError,
     TooManyValuesError,
     ValueBudget,
     parse_yaml,
     parse_yaml_value,
 )
+from navseq.text import printable
 
 # Real launch trees are a few includes deep; these bound a file that includes others
 # many times over (each of which includes more), not just cycles.
@@ -233,6 +235,10 @@ class _LaunchReader:
                 )
             except TooManyValuesError:
                 raise
+            except NumberTooLongError as error:  # meant as a number: not kept as text
+                raise NumberTooLongError(
+                    error.message, source=error.source, subject=f"param {printable(name)}"
+                ) from None
             except NavseqError:
                 parsed = None  # plain text, as roslaunch would keep it
             if parsed is not None:

@@ -82,6 +82,18 @@ def from_plain(data: Any, where: str, _depth: int = 0) -> Located:
     return Located(data, where)
 
 
+def to_plain(node: Located | None) -> Any:
+    """The plain data a Located tree holds (dicts, lists, scalars), places dropped."""
+    if node is None:
+        return None
+    value = node.value
+    if isinstance(value, dict):
+        return {key: to_plain(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [to_plain(item) for item in value]
+    return value
+
+
 def describe(value: Any) -> str:
     """How a wrong value is shown in a message: ``text 'abc'``, ``a list``, ``null``."""
     if value is None:

@@ -25,6 +25,8 @@ and messages are the same either way (``tests/test_yaml_fast_path.py`` compares)
 from __future__ import annotations
 
 import re
+import sys
+from collections.abc import Iterator
 from typing import Any, NoReturn
 
 import yaml
@@ -35,7 +37,7 @@ from navseq.files import limit_from_environment
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.problems import Problems
 from navseq.mission.yaml_flow_lines import SENTINEL, NotPlain, Run, find_runs
-from navseq.text import text_problem
+from navseq.text import printable, text_problem
 
 # Aliases may repeat what was written, but not blow it up: the expanded document may
 # hold at most this many values more than were written.
@@ -46,6 +48,8 @@ MAX_ALIAS_EXPANSION = 100_000
 MAX_VALUES = 1_000_000
 MAX_VALUES_VARIABLE = "NAVSEQ_MAX_YAML_VALUES"
 _VALUE_EVENTS = (yaml.ScalarEvent, yaml.SequenceStartEvent, yaml.MappingStartEvent, yaml.AliasEvent)
+_COLLECTION_STARTS = (yaml.SequenceStartEvent, yaml.MappingStartEvent)
+_COLLECTION_ENDS = (yaml.SequenceEndEvent, yaml.MappingEndEvent)
 _FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 _TAG = "tag:yaml.org,2002:"
@@ -55,6 +59,15 @@ _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 # the match is linear in the scalar's length (a backtracking "\d+\.?\d*" was quadratic:
 # 38 s on 100 000 digits).
 EXPONENT_FLOAT = re.compile(r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)[eE][-+]?+\d++")
+
+# No value navseq reads needs a long whole number, and Python refuses to convert one of
+# more than 4300 decimal digits (``sys.set_int_max_str_digits``; the environment may
+# lower it to 640) either way, from text or to text: a ValueError deep in the reader,
+# or in a message that prints the value. Hexadecimal, octal and binary are not limited
+# when read, only when printed, so the bound is on the digits as written, with room
+# for hexadecimal's 1.2 decimal digits per digit.
+MAX_INTEGER_DIGITS = min(1000, int(0.8 * sys.get_int_max_str_digits()) or 1000)
+_INT_TAG = "tag:yaml.org,2002:int"
 
 
 def parse_yaml(
@@ -135,31 +148,69 @@ class ValueBudget:
 
 
 def _spend_values(text: str, source: str, offset: int, budget: ValueBudget) -> None:
-    """Count the document's values against ``budget`` before composing it; refuse excess.
+    """Count the document's values against ``budget`` and check how deep it nests,
+    before composing it; refuse excess.
 
     Composing and checking cost some 20 µs a value; the 10 MiB a file may hold can
     write millions (minutes and gigabytes). Counting the parser's events (with libyaml's C
     parser where installed) is linear and quick, and stops at the limit. Syntax
-    errors are left to the composer, which reports them with their lines.
+    errors are left to the composer, which reports them with their lines. For the
+    depth, see :func:`refuse_deep_nesting`.
     """
     count = 0
+    for event in _shallow_events(text, source, offset):
+        if isinstance(event, _VALUE_EVENTS):
+            count += 1
+            if count > budget.left:
+                raise TooManyValuesError(
+                    f"holds more than {budget.limit:,} YAML values (with the documents "
+                    "read before it); navseq refuses missions this large (write long "
+                    "recorded paths as CSV, or set the environment variable "
+                    f"{MAX_VALUES_VARIABLE} to raise the limit)",
+                    source=f"{source}:{_line_of(event, offset)}",
+                )
+    budget.left -= count
+
+
+def refuse_deep_nesting(text: str, source: str, *, first_line: int = 1) -> None:
+    """Raise :class:`NavseqError` (with the line) if ``text`` nests more than
+    :data:`MAX_DEPTH` lists and mappings; for readers that then hand it to PyYAML.
+
+    PyYAML's composer recurses once per level (libyaml's in C, where nothing stops
+    it: ``[[[[...`` 50 000 levels deep crashed the process with SIGSEGV), and the
+    parser's own work per event grows with the depth of the open flow collections
+    (the same text took 30 s to parse before the crash). The parser's events come one
+    level at a time, so the depth is known before the parser goes any deeper: a
+    document opening more than :data:`MAX_DEPTH` collections is refused there, after
+    a few hundred events at most. Syntax errors are left to the reader.
+    """
+    for _ in _shallow_events(text, source, first_line - 1):
+        pass
+
+
+def _shallow_events(text: str, source: str, offset: int) -> Iterator[yaml.Event]:
+    """The document's parse events, until a syntax error ends them; NavseqError where a
+    collection opens deeper than :data:`MAX_DEPTH` (see :func:`refuse_deep_nesting`)."""
+    depth = 0
     try:
         for event in yaml.parse(text, Loader=_FAST_LOADER):
-            if isinstance(event, _VALUE_EVENTS):
-                count += 1
-                if count > budget.left:
-                    mark = event.start_mark
-                    line = (mark.line if mark is not None else 0) + 1 + offset
-                    raise TooManyValuesError(
-                        f"holds more than {budget.limit:,} YAML values (with the documents "
-                        "read before it); navseq refuses missions this large (write long "
-                        "recorded paths as CSV, or set the environment variable "
-                        f"{MAX_VALUES_VARIABLE} to raise the limit)",
-                        source=f"{source}:{line}",
+            if isinstance(event, _COLLECTION_STARTS):
+                depth += 1
+                if depth > MAX_DEPTH:
+                    raise NavseqError(
+                        f"is nested more than {MAX_DEPTH} levels deep",
+                        source=f"{source}:{_line_of(event, offset)}",
                     )
+            elif isinstance(event, _COLLECTION_ENDS):
+                depth -= 1
+            yield event
     except yaml.YAMLError:
-        pass
-    budget.left -= count
+        return
+
+
+def _line_of(event: yaml.Event, offset: int) -> int:
+    mark = event.start_mark
+    return (mark.line if mark is not None else 0) + 1 + offset
 
 
 def parse_yaml_value(
@@ -170,6 +221,40 @@ def parse_yaml_value(
     result = parse_yaml(text, source, problems, first_line=first_line, budget=budget)
     problems.raise_if_any()
     return result
+
+
+class NumberTooLongError(NavseqError):
+    """A whole number with more digits than any value can need (:data:`MAX_INTEGER_DIGITS`).
+
+    Raised where the number is read, without a subject; the mapping that holds it
+    names its key (:meth:`under_key`), so the message says which field it is.
+    """
+
+    def under_key(self, key: str) -> NumberTooLongError:
+        """This error naming ``key`` (the nearest key around the number wins)."""
+        if self.subject is not None:
+            return self
+        shown = printable(key if len(key) <= 60 else key[:57] + "...")
+        return NumberTooLongError(self.message, source=self.source, subject=f"key {shown}")
+
+
+def _refuse_long_integer(literal: str, where: str) -> None:
+    """Raise :class:`NumberTooLongError` for an integer literal too long to be a value.
+
+    Counts the digits as written (sign, ``_``, ``:`` and a ``0x``/``0o``/``0b`` prefix
+    left out), before Python is asked to convert them: linear, whatever the length.
+    """
+    body = literal.lstrip("+-")
+    if body[:2].lower() in ("0x", "0o", "0b"):
+        body = body[2:]
+    digits = len(body) - body.count("_") - body.count(":")
+    if digits > MAX_INTEGER_DIGITS:
+        raise NumberTooLongError(
+            f"the whole number {literal[:20]}... has {digits:,} digits; navseq reads whole "
+            f"numbers of at most {MAX_INTEGER_DIGITS:,} digits (no coordinate, angle, time "
+            "or count needs more: a typo or a damaged file?)",
+            source=where,
+        )
 
 
 class _Walker:
@@ -255,6 +340,8 @@ class _Walker:
                 "navseq does not accept (quote it if it is text)",
                 source=self.where(node),
             )
+        if node.tag == _INT_TAG:  # digits only: checked before a slower look at the text
+            _refuse_long_integer(node.value, self.where(node))
         problem = text_problem(node.value, single_line=False)
         if problem is not None:  # also in keys: messages print them
             raise NavseqError(f"the text {node.value[:40]!r} {problem}", source=self.where(node))
@@ -292,7 +379,10 @@ class _Walker:
                     source=self.where(key_node),
                 )
                 continue
-            values[key] = self.walk(value_node, depth + 1)
+            try:
+                values[key] = self.walk(value_node, depth + 1)
+            except NumberTooLongError as error:
+                raise error.under_key(key) from None
             key_where[key] = self.where(key_node)
         return Located(values, self.where(node), key_where)
 
@@ -412,7 +502,7 @@ class _EventBuilder:
             if number is not None:
                 if number[1]:
                     return float(value)
-                if _PLAIN_INT.fullmatch(value):
+                if len(value) <= MAX_INTEGER_DIGITS and _PLAIN_INT.fullmatch(value):
                     return int(value)
         if value[:1] not in _RESOLVED_FIRST and _PLAIN_WORD.fullmatch(value):
             return value
@@ -534,7 +624,7 @@ class _EventBuilder:
             if _SHORTCUTS:
                 if _PLAIN_FLOAT.fullmatch(value):
                     return float(value)
-                if _PLAIN_INT.fullmatch(value):
+                if len(value) <= MAX_INTEGER_DIGITS and _PLAIN_INT.fullmatch(value):
                     return int(value)
             if value[:1] not in _RESOLVED_FIRST and _PLAIN_WORD.fullmatch(value):
                 return value

@@ -60,7 +60,7 @@ from typing import Any
 import rospy
 from std_srvs.srv import Trigger, TriggerResponse
 
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.executor.control import (
     MissionControl,
     StopRequested,
@@ -78,6 +78,7 @@ from navseq.ros1.navstack_params import read_navstack_profile
 from navseq.ros1.params import bool_param
 from navseq.signals import StopSignals, ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
+from navseq.text import printable
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -189,7 +190,7 @@ def run_node() -> int:
     try:
         mission, settings = read_params()
     except NavseqError as error:
-        rospy.logerr("navseq: %s", error)
+        rospy.logerr("navseq: %s", error_text(error))
         return 2
     try:
         navigator = Ros1Navigator(
@@ -203,7 +204,7 @@ def run_node() -> int:
             odom_frame=str(settings["odom_frame"]),
         )
     except (NavseqError, TypeError, ValueError) as error:
-        rospy.logerr("navseq: bad node parameter (param ~): %s", error)
+        rospy.logerr("navseq: bad node parameter (param ~): %s", error_text(error))
         return 2
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
@@ -214,7 +215,7 @@ def run_node() -> int:
         rospy.loginfo(
             "navseq: %d waypoints from %s; waiting for %s",
             len(mission),
-            mission.source,
+            printable(mission.source),
             navigator.resolved_action,
         )
         navigator.require_server(float(settings["server_wait"]))
@@ -233,7 +234,7 @@ def run_node() -> int:
             robot=robot,
         )
     except NavseqError as error:
-        rospy.logerr("navseq: %s", error)
+        rospy.logerr("navseq: %s", error_text(error))
         topics.publish_status({"state": "error", "reason": str(error)})
         return 2
     except MissionInterrupted as interrupted:
@@ -322,7 +323,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         ensure_node(NODE_NAME, anonymous=False)
     except NavseqError as error:
-        print(f"navseq: {error}", file=sys.stderr)
+        print(f"navseq: {error_text(error)}", file=sys.stderr)
         sys.exit(2)
     code = run_node()
     # The status is decided: a SIGINT from roslaunch while rospy shuts down must not

@@ -27,8 +27,9 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D
+from navseq.text import printable
 
 DEFAULT_TOPIC = "/move_base_simple/goal"
 NODE_NAME = "navseq_record"
@@ -110,7 +111,7 @@ def record_main(
     try:
         recorder = WaypointRecorder(Path(out), overwrite=overwrite)
     except NavseqError as error:
-        print(f"navseq record: {error}", file=sys.stderr)
+        print(f"navseq record: {error_text(error)}", file=sys.stderr)
         return 2
 
     import rospy
@@ -123,7 +124,7 @@ def record_main(
     try:
         ensure_node(NODE_NAME)
     except NavseqError as error:
-        print(f"navseq record: {error}", file=sys.stderr)
+        print(f"navseq record: {error_text(error)}", file=sys.stderr)
         return 2
 
     def record(pose: Pose2D, pose_frame: str, z: float, origin: str) -> str:
@@ -189,7 +190,7 @@ def record_main(
     count = len(recorder)
     print(
         f"navseq record: {count} waypoint{'s' if count != 1 else ''} "
-        + (f"saved in {recorder.out}" if count else "recorded; no file written"),
+        + (f"saved in {printable(str(recorder.out))}" if count else "recorded; no file written"),
         flush=True,
     )
     rospy.signal_shutdown("recording finished")
@@ -251,7 +252,7 @@ def main() -> None:
         overwrite = bool_param("overwrite", False)
         from_tf = bool_param("from_tf", False)
     except NavseqError as error:
-        print(f"navseq record: {error}", file=sys.stderr)
+        print(f"navseq record: {error_text(error)}", file=sys.stderr)
         sys.exit(2)
     sys.exit(
         record_main(

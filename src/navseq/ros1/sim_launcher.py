@@ -327,9 +327,9 @@ def _start_master(uri: str, env: dict[str, str]) -> Child:
         if not master.running() or time.monotonic() > deadline:
             master.stop(signal.SIGTERM)
             raise NavseqError(
-                f"could not start rosmaster on port {port} (exit {master.popen.returncode}):\n"
-                + master.last_output(),
+                f"could not start rosmaster on port {port} (exit {master.popen.returncode})",
                 source="ROS_MASTER_URI",
+                details=master.last_output(),
             )
         time.sleep(0.1)
     return master

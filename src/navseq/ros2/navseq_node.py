@@ -46,7 +46,7 @@ from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.task import Future
 from std_srvs.srv import Trigger
 
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.executor.control import (
     MissionControl,
     OperatorRequest,
@@ -182,7 +182,7 @@ def run_node(session: Ros2Session) -> int:
         mission, settings = read_node_params(given, node.get_fully_qualified_name())
         navigator = make_navigator(session, settings)
     except NavseqError as error:
-        logger.error(f"{error}")
+        logger.error(error_text(error))
         return 2
     topics = MissionTopics(node, mission)
     control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
@@ -209,7 +209,7 @@ def run_node(session: Ros2Session) -> int:
             robot=robot,
         )
     except NavseqError as error:
-        logger.error(f"{error}")
+        logger.error(error_text(error))
         topics.publish_status({"state": "error", "reason": str(error)})
         topics.state.over = "the mission could not run"
         return 2
@@ -268,7 +268,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         session = Ros2Session(NODE_NAME, args=args, any_parameter=True)
     except Exception as error:  # rclpy's own: bad --ros-args, a params file it cannot read
-        print(f"navseq: cannot start the ROS 2 node: {error}", file=sys.stderr)
+        print(f"navseq: cannot start the ROS 2 node: {error_text(error)}", file=sys.stderr)
         return 2
     try:
         return run_node(session)

@@ -20,11 +20,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import yaml
-
 from navseq.errors import NavseqError
+from navseq.mission.located import to_plain
 from navseq.mission.model import Mission
 from navseq.mission.params import mission_from_params
+from navseq.mission.yaml_doc import parse_yaml_value
 
 # The node's own parameters and their defaults. use_sim_time is rclpy's own.
 NODE_PARAMS: dict[str, Any] = {
@@ -85,16 +85,17 @@ def read_node_params(given: Mapping[str, Any], node: str) -> tuple[Mission, Node
 
 
 def _yaml_list(text: str, source: str) -> Any:
+    """The waypoints string read by the mission files' YAML reader (its limits on
+    nesting, size and numbers included), as plain data."""
     try:
-        value = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" at column {mark.column + 1}" if mark is not None else ""
-        raise NavseqError(
-            f"is not YAML{where}: {getattr(error, 'problem', None) or error}; give a YAML "
-            'list of waypoints, e.g. "[{x: 1.0, y: 2.0, yaw: 90}]"',
-            source=source,
-        ) from None
+        value = to_plain(parse_yaml_value(text, source))
+    except NavseqError as error:
+        hint = (
+            '; give a YAML list of waypoints, e.g. "[{x: 1.0, y: 2.0, yaw: 90}]"'
+            if error.message.startswith("is not valid YAML")
+            else ""
+        )
+        raise NavseqError(error.message + hint, source=source, subject=error.subject) from None
     if not isinstance(value, list):
         raise NavseqError(
             "expected a YAML list of waypoints in a string, e.g. "

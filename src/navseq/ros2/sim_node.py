@@ -105,7 +105,7 @@ from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.messages import (
@@ -132,6 +132,7 @@ from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.profile import SimSettings
 from navseq.sim.world import SimWorld, default_start
+from navseq.text import printable
 
 NODE_NAME = "navseq_sim"
 MAP_FRAME = "map"
@@ -743,7 +744,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         try:
             sim = SimNode(node, config)
         except NavseqError as error:
-            print(f"navseq sim: {error}", file=sys.stderr)
+            print(f"navseq sim: {error_text(error)}", file=sys.stderr)
             return 2
         executor.add_node(node)
         helpers = nav2_parameter_nodes(config.robot, config.namespace)
@@ -755,7 +756,8 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         pose = sim.standin.world.robot.pose
         namespace = f"/{config.namespace}" if config.namespace else ""
         print(
-            f"navseq sim: ready: {namespace}/navigate_to_pose on {config.map_yaml}, robot at "
+            f"navseq sim: ready: {namespace}/navigate_to_pose on "
+            f"{printable(str(config.map_yaml))}, robot at "
             f"({pose.x:.2f}, {pose.y:.2f}), "
             + ("following /clock" if config.follow_clock else f"speed x{config.speed:g}")
             + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
@@ -846,7 +848,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         config = config_from_args(args)
     except NavseqError as error:
-        print(f"navseq sim: {error}", file=sys.stderr)
+        print(f"navseq sim: {error_text(error)}", file=sys.stderr)
         return 2
     return run(config, everything)
 

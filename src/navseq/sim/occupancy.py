@@ -27,8 +27,11 @@ means the same thing here as on a robot:
 - the image's top row is the map's last row: row 0 of ``OccupancyGrid.data`` is the
   bottom of the picture (``nav_msgs/OccupancyGrid`` order).
 
+``image``, ``resolution`` and ``origin`` are required, as map_server requires them (a map
+without an origin would put every waypoint somewhere else than the robot's map does).
 Where map_server insists on ``occupied_thresh`` and ``free_thresh``, navseq falls back
-on the values ``map_saver`` writes (0.65 and 0.196).
+on the values ``map_saver`` writes (0.65 and 0.196). A setting missing or of the wrong
+type is refused naming the map file's line and the key.
 
 A map is input like a mission file and gets the same care: the YAML is read by the
 mission files' reader (YAML 1.2 numbers such as ``5e-2``, alias bombs and Python tags
@@ -369,7 +372,13 @@ class _MapSettings:
                 f"{MAX_RESOLUTION:g}, got {_shown(description, 'resolution')}",
             )
 
-        origin_value = doc.get("origin", [0.0, 0.0, 0.0])
+        if "origin" not in doc:  # map_server refuses such a map too
+            raise fail(
+                "origin",
+                "the map YAML has no 'origin' ([x, y, yaw]: the pose of the image's "
+                "lower-left pixel, in metres and radians)",
+            )
+        origin_value = doc["origin"]
         origin_numbers = (
             [_number(v.value) for v in origin_value] if isinstance(origin_value, list) else []
         )

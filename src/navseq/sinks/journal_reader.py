@@ -12,6 +12,7 @@ whole file: a legitimate journal of a week-long patrol is read whatever its size
 Damage a crash can leave is tolerated: a line cut short (``kill -9`` while writing) as
 the last line of the journal or of a run segment (when a resumed run appended after
 it: the ``resumed`` record follows). Any other damage is refused with its line number.
+An empty journal (:class:`EmptyJournal`) is said to be one: its run never began.
 """
 
 from __future__ import annotations
@@ -80,6 +81,15 @@ class Event:
 Entry = Event | Resumed | Damaged
 
 
+class EmptyJournal(NavseqError):
+    """A journal file with nothing in it, not even the header.
+
+    The run writes the header before anything else it does, so only a run killed in
+    the moment between creating the file and writing that line leaves one (and runs
+    of navseq before it did, which got as far as a second in): nothing had happened.
+    """
+
+
 class JournalReader:
     """A journal opened for reading: ``header`` checked, ``entries()`` to go through.
 
@@ -119,7 +129,12 @@ class JournalReader:
             # Check the header before reading on, so a huge wrong file fails fast.
             first = self._read_line(MAX_HEADER_BYTES, 1)
             if first is None:
-                raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
+                raise EmptyJournal(
+                    "the journal is empty: its run was stopped before it began (nothing "
+                    "was driven, nothing journaled), so there is nothing to resume or "
+                    "report. Start the mission again (navseq run MISSION)",
+                    source=f"{path}:1",
+                )
             header = _parse_line(first, f"{path}:1")
             if header is None or header.get("kind") != "header":
                 raise NavseqError("not a navseq journal (no header line)", source=f"{path}:1")
@@ -288,6 +303,7 @@ def _parse_line(line: bytes, where: str) -> dict[str, Any] | None:
 __all__ = [
     "MAX_LINE_BYTES",
     "Damaged",
+    "EmptyJournal",
     "Entry",
     "Event",
     "JournalHeader",

@@ -545,7 +545,11 @@ def map_stamp(path: Path) -> tuple[int, ...]:
     try:
         import yaml
 
-        image = yaml.safe_load(path.read_text(encoding="utf-8")).get("image")
+        from navseq.mission.yaml_doc import refuse_deep_nesting
+
+        text = path.read_text(encoding="utf-8")
+        refuse_deep_nesting(text, str(path))  # before PyYAML's composer recurses
+        image = yaml.safe_load(text).get("image")
         image_path = path.parent / str(image)
         stamp.append(image_path.stat().st_mtime_ns)
     except Exception:  # the loader says what is wrong with a bad map; the YAML's stamp will do

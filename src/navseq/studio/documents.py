@@ -77,14 +77,18 @@ def open_document(path: Path, base_dir: Path) -> tuple[dict[str, Any] | None, li
     that the user can fix it on the map; other formats with problems give None.
     """
     from navseq.mission import inspect_mission_file
+    from navseq.mission.yaml_doc import refuse_deep_nesting
 
     mission, problems = inspect_mission_file(path)
     if mission is not None:
         return document_of(mission, base_dir), []
     if path.suffix.lower() in (".yaml", ".yml"):
         try:
-            raw = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except (yaml.YAMLError, OSError, UnicodeDecodeError, RecursionError):
+            text = path.read_text(encoding="utf-8")
+            refuse_deep_nesting(text, str(path))  # before PyYAML's composer recurses
+            raw = yaml.safe_load(text)
+        # ValueError: an integer longer than Python converts (the loader said so).
+        except (yaml.YAMLError, NavseqError, OSError, ValueError, RecursionError):
             raw = None
         if isinstance(raw, dict) and "navseq" in raw:
             return json.loads(json.dumps(raw, default=str)), list(problems.errors)

@@ -14,6 +14,7 @@ from typing import TextIO
 
 from navseq.errors import NavseqError
 from navseq.studio.app import Studio, StudioConfig, create_app
+from navseq.text import printable
 
 #: Seconds uvicorn gives open connections (the live view's stream) to close on Ctrl-C.
 GRACEFUL_SHUTDOWN_S = 2
@@ -85,7 +86,7 @@ def serve(
         print(
             "navseq studio: warning: listening on every network interface; anyone who can "
             "reach this machine and learns the token can read and write missions under "
-            f"{config.roots.describe()}",
+            f"{printable(config.roots.describe())}",
             file=err,
             flush=True,
         )
