@@ -699,10 +699,11 @@ def sim_log_sequence(log: str) -> list[str]:
 def test_a_retry_clears_both_costmaps_before_its_goal_only_when_asked(
     clear: bool, sim: SimNode, env: dict[str, str], tmp_path: Path
 ):
-    # A goal in a wall (pre-flight off): Nav2's planner aborts it, and its retry too.
+    # A goal deep beyond the arena's wall, farther than the planner's 0.5 m tolerance
+    # from free space (pre-flight off): Nav2's planner aborts it, and its retry too.
     mission = write_mission(
         tmp_path / "wall.yaml",
-        "  - {name: pillar, x: -1.1, y: 0.0, yaw: 0}\n",
+        "  - {name: wall, x: -2.3, y: -2.3, yaw: 0}\n",
         "defaults: {retries: 1, on_failure: skip, goal_timeout: 60, "
         f"clear_costmaps_on_retry: {str(clear).lower()}}}\n",
     )
