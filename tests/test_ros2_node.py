@@ -272,7 +272,7 @@ def test_sigint_cancels_the_goal_and_the_robot_stops(
         ),
         (["-p", "yea_seq:=[0.0]"], "'yea_seq' is set but 'p_seq' (the flat list"),
         ([], "give the waypoints exactly one way"),
-        (["-p", "waypoints:='[{x: 1'"], "param /navseq waypoints: is not YAML"),
+        (["-p", "waypoints:='[{x: 1'"], "param /navseq waypoints: is not valid YAML"),
         (
             ["-p", "p_seq:=[1.0, 2.0, 0.0]", "-p", "yea_seq:=[0.0]", "-p", "tick:=-1.0"],
             "param /navseq tick: expected a number of seconds > 0",
