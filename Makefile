@@ -3,7 +3,7 @@
 VENV := .venv
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint bench fuzz venv clean
+.PHONY: demo test test-pythons lint bench fuzz venv clean
 
 venv: $(STAMP)
 
@@ -20,6 +20,13 @@ test: $(STAMP)
 	$(VENV)/bin/mypy
 	$(VENV)/bin/python -m pytest
 
+# The non-ROS tests on the other Python versions navseq supports (3.10: ROS 2 Humble,
+# 3.12: Jazzy), from the interpreters the test machine carries (../shared/python):
+# unpacked into /opt/navseq-python, one venv each (.venv310, .venv312). `make test` is
+# Debian's 3.11 with ROS.
+test-pythons:
+	scripts/python-versions.sh
+
 # The loaders' fuzz tests at scale: FUZZ_SCALE x 2000 cases per loader (6 loaders;
 # the default 10 runs 120 000 cases). The normal test run does 2000 per loader.
 FUZZ_SCALE ?= 10
@@ -31,4 +38,4 @@ bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(VENV)/bin/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) navseq-out
+	rm -rf $(VENV) .venv310 .venv312 navseq-out

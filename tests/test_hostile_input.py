@@ -13,6 +13,8 @@ import math
 import os
 import re
 import struct
+import subprocess
+import sys
 import zlib
 from pathlib import Path
 
@@ -108,6 +110,63 @@ def test_a_one_mib_number_like_scalar_is_read_or_refused_promptly(tmp_path, scal
     if result.returncode != 0:
         assert f"{path.name}:3" in one_message(result)
         assert len(result.stderr) < 2000  # the value is quoted short, not in full
+
+
+MANY_PAIRS = ", ".join(f"k{i}: 1" for i in range(100_000))  # about a megabyte
+FIND_RUNS = """
+import json, sys
+from pathlib import Path
+from navseq.mission.yaml_flow_lines import find_runs
+text, runs = find_runs(Path(sys.argv[1]).read_text())
+print(json.dumps(sorted([first, len(run.bodies)] for first, run in runs.items())))
+"""
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        "- {" + MANY_PAIRS + " x",  # flow pairs up to the end of the line, then not
+        "- {" + MANY_PAIRS + ", x",
+        "- {" + MANY_PAIRS + ", x: 'q'}",
+        "- {x: 0, y: 0" + " " * 2**20 + "x}",
+        "- {" + "x: " * 2**18 + "}",
+        " " * 2**20 + "- {x",
+    ],
+    ids=["a-word", "a-lone-key", "a-quoted-value", "spaces", "keys", "indent"],
+)
+def test_a_megabyte_line_that_almost_is_a_one_line_flow_item_is_passed_over_promptly(
+    tmp_path, line
+):
+    # The YAML fast path (navseq.mission.yaml_flow_lines) reads "- {key: value, ...}"
+    # lines with a regular expression, without possessive quantifiers (Python 3.10): it
+    # must stay linear on a line that fails at its very end. Run in a subprocess, where
+    # the timeout can stop a blow-up; the loader's later steps are not what is tested.
+    items = "".join(f"- {{x: {i}, y: 0}}\n" for i in range(10))
+    path = tmp_path / "items.yaml"
+    path.write_text(items + line + "\n" + items)
+    result = subprocess.run(
+        [sys.executable, "-c", FIND_RUNS, path],
+        capture_output=True,
+        text=True,
+        timeout=GENEROUS,
+        check=True,
+    )
+    assert json.loads(result.stdout) == [[0, 10], [11, 10]]  # the line is in no run
+
+
+def test_a_megabyte_one_line_flow_item_is_one_item_of_its_run(tmp_path):
+    # ... and a line that is one, however long, is read on the fast path.
+    items = "".join(f"- {{x: {i}, y: 0}}\n" for i in range(10))
+    path = tmp_path / "items.yaml"
+    path.write_text(items + "- {" + MANY_PAIRS + "}\n" + items)
+    result = subprocess.run(
+        [sys.executable, "-c", FIND_RUNS, path],
+        capture_output=True,
+        text=True,
+        timeout=GENEROUS,
+        check=True,
+    )
+    assert json.loads(result.stdout) == [[0, 21]]
 
 
 def test_a_csv_like_line_with_a_megabyte_of_spaces_is_sniffed_promptly(tmp_path):

@@ -32,8 +32,10 @@ from navseq.mission.yaml_doc import parse_yaml
 
 Reader = Callable[[str, str, Path, Problems], "Mission | None"]
 
-# Possessive quantifiers: the match never backtracks, so it is linear in the line.
-_CSV_LINE = re.compile(r"\s*+[-+0-9.eE]++(?:\s*+,\s*+[-+0-9.eE]++)++\s*+")
+# Linear in the line: each repeat is followed by a character it cannot match (numbers
+# by spaces or ",", spaces by what is not a space), so backtracking gives back one
+# character at a time and fails at once (no possessive quantifiers: Python 3.10).
+_CSV_LINE = re.compile(r"\s*[-+0-9.eE]+(?:\s*,\s*[-+0-9.eE]+)+\s*")
 _NAVSEQ_KEYS = ("waypoints", "navseq")
 SUPPORTED = (
     "navseq YAML or rosparam YAML (.yaml, .yml), roslaunch XML (.launch, .xml), "

@@ -55,10 +55,11 @@ _FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + name for name in ("null", "bool", "int", "float", "str")}
 # PyYAML follows YAML 1.1, where "1e3" (no dot) is text; YAML 1.2 and every user
-# reads it as a number. Possessive quantifiers never give back what they matched, so
-# the match is linear in the scalar's length (a backtracking "\d+\.?\d*" was quadratic:
-# 38 s on 100 000 digits).
-EXPONENT_FLOAT = re.compile(r"[-+]?+(?:\d++(?:\.\d*+)?+|\.\d++)[eE][-+]?+\d++")
+# reads it as a number. The match is linear in the scalar's length: the fraction's
+# digits come only after a ".", so no digit can be read by two repeats (a backtracking
+# "\d+\.?\d*" was quadratic: 38 s on 100 000 digits), and no possessive quantifier is
+# needed (Python 3.10 has none).
+EXPONENT_FLOAT = re.compile(r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)[eE][-+]?\d+")
 
 # No value navseq reads needs a long whole number, and Python refuses to convert one of
 # more than 4300 decimal digits (``sys.set_int_max_str_digits``; the environment may
@@ -443,12 +444,12 @@ _SHORTCUTS = _standard_resolvers("-", ("float", "int")) and all(
 # Plain scalars whose YAML 1.1 reading is certain and cheap: a decimal int without
 # leading zeros or "_" (PyYAML: int(value)); digits '.' digits (PyYAML: float(value));
 # a word starting with a character no implicit resolver is registered for (text).
-_PLAIN_INT = re.compile(r"-?+(?:0|[1-9][0-9]*+)")
-_PLAIN_FLOAT = re.compile(r"-?+[0-9]++\.[0-9]++")
-_PLAIN_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*+")
+_PLAIN_INT = re.compile(r"-?(?:0|[1-9][0-9]*)")
+_PLAIN_FLOAT = re.compile(r"-?[0-9]+\.[0-9]+")
+_PLAIN_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 # Either of the two above at once (one match per value where most are numbers): the
 # group holds the fraction of a _PLAIN_FLOAT.
-_PLAIN_NUMBER = re.compile(r"-?+[0-9]++(\.[0-9]++)?+")
+_PLAIN_NUMBER = re.compile(r"-?[0-9]+(\.[0-9]+)?")
 _RESOLVED_FIRST = frozenset(yaml.resolver.Resolver.yaml_implicit_resolvers)
 _SURROGATE = re.compile("[\ud800-\udfff]")
 

@@ -40,13 +40,16 @@ SENTINEL = "__navseq_flow_run__"
 #: than it saves, and short documents are quick anyway.
 MIN_RUN = 8
 
-_KEY = r"[A-Za-z_][A-Za-z0-9_]*+"
-_VALUE = r"[A-Za-z0-9_.+-]++"
-_PAIR = re.compile(rf"({_KEY}): ++({_VALUE})")
-# Linear in the line's length whatever it holds: possessive quantifiers give nothing
-# back, and the pairs' repetition (greedy: Python 3.11.2 never matches a possessive
-# group repeat) can only give back whole pairs, each ending at a comma, one at a time.
-_ITEM = re.compile(rf"( *+)- \{{ *+((?:{_KEY}: ++{_VALUE} *+, *+)*{_KEY}: ++{_VALUE}) *+\}} *+")
+_KEY = r"[A-Za-z_][A-Za-z0-9_]*"
+_VALUE = r"[A-Za-z0-9_.+-]+"
+_PAIR = re.compile(rf"({_KEY}): +({_VALUE})")
+# Linear in the line's length whatever it holds, without possessive quantifiers (Python
+# 3.10 has none): every repeat is followed by a character it cannot match (a key by
+# ":", a value by " ", "," or "}", spaces by what is not a space), so a character given
+# back fails at once, and a pair is repeated only after a comma (not "pairs, each ending
+# at a comma" then a last one: the last pair would be read twice, and given back pair by
+# pair when the line fails). tests/test_hostile_input.py runs megabyte lines.
+_ITEM = re.compile(rf"( *)- \{{ *({_KEY}: +{_VALUE}(?: *, *{_KEY}: +{_VALUE})*) *\}} *")
 
 
 class NotPlain(Exception):
