@@ -129,7 +129,9 @@ def _dump(doc: dict[str, Any]) -> str:
 _WIDTH = 4096
 # Text PyYAML writes plain in a flow mapping, if no implicit resolver claims it (see
 # _plain_text): words of letters, digits and "_", joined by single " ", "." or "-".
-_PLAIN_TEXT = re.compile(r"\w++(?:[ .-]\w++)*+")
+# Linear without possessive quantifiers (Python 3.10 has none): a separator is never a
+# word character, so no two repeats can match the same text.
+_PLAIN_TEXT = re.compile(r"\w+(?:[ .-]\w+)*")
 _STR_TAG = "tag:yaml.org,2002:str"
 
 
