@@ -44,11 +44,11 @@ from rich.table import Table
 
 from navseq.executor import events as ev
 from navseq.executor.runner import MissionInterrupted, run_mission
+from navseq.journal.format import json_default, sealed
+from navseq.journal.writer import JournalWriter, mission_digest
 from navseq.mission import load_mission
 from navseq.navigators.sim import SimNavigator
-from navseq.sinks.journal import JournalWriter, mission_digest
-from navseq.sinks.journal_format import json_default, sealed
-from navseq.sinks.picture import mission_picture_png
+from navseq.sinks.picture.draw import mission_picture_png
 from navseq.sinks.recorder import RunRecorder
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -35,7 +35,7 @@ from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Waypoint
 from navseq.sim.mapgen import warehouse_map
 from navseq.sim.occupancy import OccupancyGrid
-from navseq.sinks import picture
+from navseq.sinks.picture import draw as picture
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -90,13 +90,18 @@ def scenario(size: int, points_per_leg: int, seed: int = 7) -> dict[str, Any]:
 
 
 def module_at(ref: str) -> ModuleType:
-    """``navseq.sinks.picture`` as it is at git ``ref`` (for a before/after table)."""
-    source = subprocess.run(
-        ["git", "-C", str(ROOT), "show", f"{ref}:src/navseq/sinks/picture.py"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
+    """``navseq.sinks.picture.draw`` as it is at git ``ref`` (for a before/after table)."""
+    # The module moved into a package (sinks/picture.py -> sinks/picture/draw.py).
+    for path_at_ref in ("src/navseq/sinks/picture/draw.py", "src/navseq/sinks/picture.py"):
+        shown = subprocess.run(
+            ["git", "-C", str(ROOT), "show", f"{ref}:{path_at_ref}"],
+            capture_output=True,
+            text=True,
+        )
+        if shown.returncode == 0:
+            break
+    shown.check_returncode()
+    source = shown.stdout
     folder = Path(tempfile.mkdtemp())
     path = folder / "picture_before.py"
     path.write_text(source, encoding="utf-8")

@@ -21,8 +21,8 @@ from pathlib import Path
 from helpers_executor import line_mission
 from navseq.errors import NavseqError
 from navseq.executor import MissionInterrupted, MissionResult, run_mission
+from navseq.journal.writer import JournalWriter, mission_digest, read_journal, resume_point
 from navseq.navigators.scripted import ScriptedNavigator
-from navseq.sinks.journal import JournalWriter, mission_digest, read_journal, resume_point
 
 
 def main() -> int:

@@ -400,8 +400,8 @@ def test_resume_after_kill_runs_only_what_is_left(tmp_path):
 
 def test_resumed_picture_shows_the_path_driven_before_the_crash(tmp_path, monkeypatch):
     from navseq import cli
-    from navseq.sinks import picture
-    from navseq.sinks.journal import read_journal
+    from navseq.journal.writer import read_journal
+    from navseq.sinks.picture import draw as picture
 
     mission = write_mission(tmp_path / "m.yaml", SQUARE)
     out = tmp_path / "out"

@@ -19,10 +19,10 @@ from navseq.executor.events import AttemptFailed, MissionEvent, WaypointOutcome
 from navseq.executor.result import AttemptResult
 from navseq.executor.runner import run_mission
 from navseq.geometry import Pose2D
+from navseq.journal.reader import journal_events
+from navseq.journal.writer import JournalWriter, read_journal, resume_point
 from navseq.mission.model import FailureAction
 from navseq.navigators.scripted import Finish, ScriptedNavigator, Stall, Succeed
-from navseq.sinks.journal import JournalWriter, read_journal, resume_point
-from navseq.sinks.journal_reader import journal_events
 from navseq.sinks.json_events import JsonProgress
 from navseq.sinks.progress import LogProgress
 from navseq.sinks.report import build_report

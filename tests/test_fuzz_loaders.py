@@ -26,11 +26,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from navseq.errors import NavseqError
+from navseq.journal.writer import read_journal, resume_point
 from navseq.mission import inspect_mission_file
 from navseq.mission.fields import MAX_COORDINATE
 from navseq.mission.model import Mission
 from navseq.sim.occupancy import MAX_RESOLUTION, MIN_RESOLUTION, load_map, max_map_pixels
-from navseq.sinks.journal import read_journal, resume_point
 from navseq.text import text_problem
 
 CASES = max(1, round(2000 * float(os.environ.get("NAVSEQ_FUZZ_SCALE", "1"))))

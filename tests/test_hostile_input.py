@@ -34,10 +34,10 @@ from navseq.executor.events import (
     WaypointStarted,
 )
 from navseq.executor.result import MissionResult, WaypointResult
+from navseq.journal.writer import read_journal
 from navseq.mission import load_mission
 from navseq.mission.model import Mission, Waypoint
 from navseq.sim.occupancy import load_map
-from navseq.sinks.journal import read_journal
 from navseq.sinks.progress import LogProgress
 from navseq.sinks.summary import summary_table
 from navseq.text import printable, text_problem

@@ -26,9 +26,8 @@ from navseq.executor.events import (
     WaypointStarted,
 )
 from navseq.executor.resume import ResumePoint
-from navseq.mission.model import FailureAction
-from navseq.navigators.scripted import Finish, ScriptedNavigator, Succeed
-from navseq.sinks.journal import (
+from navseq.journal.reader import journal_events
+from navseq.journal.writer import (
     HEARTBEAT,
     PATH_TOLERANCE,
     JournalWriter,
@@ -36,7 +35,8 @@ from navseq.sinks.journal import (
     read_journal,
     resume_point,
 )
-from navseq.sinks.journal_reader import journal_events
+from navseq.mission.model import FailureAction
+from navseq.navigators.scripted import Finish, ScriptedNavigator, Succeed
 
 
 @pytest.fixture

@@ -20,8 +20,8 @@ from navseq.executor.events import (
     WaypointProgress,
 )
 from navseq.executor.result import KEEP_LAST_VISITS
+from navseq.journal.writer import JournalWriter, read_journal, resume_point
 from navseq.navigators.scripted import ScriptedNavigator
-from navseq.sinks.journal import JournalWriter, read_journal, resume_point
 
 LOOPS = 300  # 1200 visits: more than a result lists in full
 WAYPOINTS = 4

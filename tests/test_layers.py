@@ -56,9 +56,9 @@ CORE_MODULES = [
     "navseq.sim.world",
     "navseq.sim.base",
     "navseq.sinks.progress",
-    "navseq.sinks.journal",
+    "navseq.journal.writer",
     "navseq.sinks.report",
-    "navseq.sinks.picture",
+    "navseq.sinks.picture.draw",
 ]
 
 
@@ -163,3 +163,52 @@ def test_only_navseq_ros1_imports_rospy_and_only_navseq_ros2_rclpy():
 def test_the_old_ros_package_is_gone():
     """``navseq.ros`` became ``navseq.ros1``; nothing external needed an alias."""
     assert not (SRC / "ros").exists()
+
+
+def _runtime_imports(path: Path, modules: set[str]) -> set[str]:
+    """The navseq modules a module imports when it runs (``if TYPE_CHECKING:`` blocks
+    aside); ``from package import submodule`` counts as the submodule alone."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    typing_only = {
+        id(inner)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+        for statement in node.body
+        for inner in ast.walk(statement)
+    }
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if id(node) in typing_only:
+            continue
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            submodules = {f"{node.module}.{alias.name}" for alias in node.names} & modules
+            found |= submodules
+            if len(submodules) < len(node.names):
+                found.add(node.module)
+        elif isinstance(node, ast.Import):
+            found |= {alias.name for alias in node.names}
+    return found & modules
+
+
+def test_no_module_imports_itself_through_others():
+    """No import circles (e.g. loader -> launch_xml -> rosparam_format -> params -> loader):
+    every module can be read, and tested, from its dependencies up."""
+    paths = {}
+    for path in SRC.rglob("*.py"):
+        parts = path.relative_to(SRC.parent).with_suffix("").parts
+        paths[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    graph = {name: _runtime_imports(path, set(paths)) - {name} for name, path in paths.items()}
+    circles = []
+    for start in sorted(graph):
+        # A path back to `start` through modules after it in sorted order (each circle once).
+        stack = [(start, (start,))]
+        seen = set()
+        while stack:
+            name, trail = stack.pop()
+            for nxt in sorted(graph[name]):
+                if nxt == start:
+                    circles.append(" -> ".join((*trail, start)))
+                elif nxt > start and nxt not in seen:
+                    seen.add(nxt)
+                    stack.append((nxt, (*trail, nxt)))
+    assert circles == []

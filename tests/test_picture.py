@@ -23,14 +23,14 @@ from navseq.geometry import Pose2D
 from navseq.mission.model import Mission, Policy, Waypoint
 from navseq.sim.mapgen import office_map, warehouse_map
 from navseq.sim.occupancy import OccupancyGrid
-from navseq.sinks.picture import (
+from navseq.sinks.picture.draw import (
     STATUS_COLOURS,
     Status,
     draw_mission_picture,
     mission_figure,
     waypoint_outcomes,
 )
-from navseq.sinks.picture_thin import coincident_groups, map_image, thin_segments
+from navseq.sinks.picture.thin import coincident_groups, map_image, thin_segments
 
 RES = 0.05
 ORIGIN = Pose2D(-1.0, -2.0, 0.0)

@@ -222,7 +222,7 @@ def test_a_full_disk_under_the_journal_stops_the_robot_and_exits_2(
     import os
 
     from navseq import cli
-    from navseq.sinks import journal as journal_module
+    from navseq.journal import writer as journal_module
 
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
     log = tmp_path / "nav.log"

@@ -12,8 +12,8 @@ import pytest
 from starlette.testclient import TestClient
 
 from cli_support import navseq
+from navseq.journal.writer import HEARTBEAT
 from navseq.mission import load_mission
-from navseq.sinks.journal import HEARTBEAT
 from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
 from navseq.studio.security import FileRoots
 
@@ -285,7 +285,7 @@ def test_a_run_writes_the_usual_output_folder(client: TestClient, workspace: Pat
     assert report["totals"]["reached"] == 7 and report == state["report"]
     assert len(state["trail"]) > 50 and state["pose"] is not None
     # The folder is navseq run's own: navseq report rebuilds from its journal.
-    from navseq.sinks.journal import read_journal
+    from navseq.journal.writer import read_journal
 
     assert read_journal(folder / "journal.jsonl").mission_started is not None
 

@@ -3,7 +3,7 @@
 A run killed with ``kill -9`` (or on a full disk) after its last journal line but
 before its report leaves no report; the journal still holds everything the report
 says. This command reads the journal (refusing one that was altered, see
-:mod:`navseq.sinks.journal`), checks the mission file is the one the run used, and
+:mod:`navseq.journal.writer`), checks the mission file is the one the run used, and
 writes whatever of ``report.json`` / ``mission.png`` is missing, empty or unreadable.
 A complete report is left as it is. ``navseq run --resume`` of a journal with nothing
 left to run does the same.
@@ -22,9 +22,9 @@ from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
+    from navseq.journal.writer import JournalState
     from navseq.mission.model import Mission
     from navseq.mission.part import MissionPart
-    from navseq.sinks.journal import JournalState
 
 JOURNAL_NAME = "journal.jsonl"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -88,8 +88,8 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     """
     from navseq.commands.run_outputs import output_error, remove_stale_temporaries
     from navseq.files import write_atomically
+    from navseq.journal.writer import read_journal
     from navseq.mission.part import number_visits
-    from navseq.sinks.journal import read_journal
     from navseq.sinks.report import report_json
 
     if state is None or state.path != journal or not state.is_current():
@@ -166,8 +166,8 @@ def journaled_mission(state: JournalState) -> Mission:
 
     from navseq.commands.common import require_file
     from navseq.errors import NavseqError
+    from navseq.journal.writer import mission_digest
     from navseq.mission import load_mission
-    from navseq.sinks.journal import mission_digest
 
     source = Path(state.mission_source)
     require_file(source, f"the journal's mission file ({state.path})")
@@ -242,7 +242,7 @@ def _start_of(options: dict[str, Any]) -> Any:
 def _picture(state: JournalState, mission: Mission, result: MissionResult) -> bytes:
     from navseq.errors import NavseqError
     from navseq.sim.occupancy import load_map
-    from navseq.sinks.picture import mission_picture_png
+    from navseq.sinks.picture.draw import mission_picture_png
 
     grid = None
     map_path = state.run_options.get("map") or mission.map

@@ -43,13 +43,13 @@ if TYPE_CHECKING:
     from navseq.executor.result import MissionResult
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
+    from navseq.journal.writer import JournalState, JournalWriter
     from navseq.mission.model import Mission
     from navseq.mission.part import MissionPart
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
-    from navseq.sinks.journal import JournalState, JournalWriter
     from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.recorder import RunRecorder
 
@@ -171,7 +171,7 @@ def _read_resume(journal: Path, mission_arg: Path | None) -> tuple[Path, ResumeP
     """The mission file, resume point and contents of a journal (mission unchanged)."""
     from navseq.commands.common import require_file
     from navseq.errors import NavseqError
-    from navseq.sinks.journal import mission_digest, read_journal, resume_point
+    from navseq.journal.writer import mission_digest, read_journal, resume_point
 
     require_file(journal, "--resume")
     state = read_journal(journal)
@@ -197,9 +197,9 @@ def prepare(args: argparse.Namespace) -> RunSetup:
     """Load and check the user's input; raise NavseqError on any problem."""
     from navseq.commands.common import choose_robot, require_file
     from navseq.errors import NavseqError
+    from navseq.journal.writer import mission_digest
     from navseq.mission import load_mission
     from navseq.mission.part import PartSpec
-    from navseq.sinks.journal import mission_digest
 
     resume = history = None
     notes: list[str] = []
@@ -501,7 +501,7 @@ def new_recorder(setup: RunSetup) -> RunRecorder:
 
 def _new_journal(setup: RunSetup, journal_path: Path) -> JournalWriter:
     """A new run's journal, its header written."""
-    from navseq.sinks.journal import JournalWriter
+    from navseq.journal.writer import JournalWriter
 
     # The absolute path, so that --resume works from any directory.
     source = str(setup.mission_path.resolve())
@@ -524,7 +524,7 @@ def _run_with_sinks(
 
     from navseq.commands.run_outputs import StdoutGuard
     from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
-    from navseq.sinks.journal import JournalWriter
+    from navseq.journal.writer import JournalWriter
     from navseq.sinks.json_events import JsonProgress
     from navseq.sinks.progress import make_progress
 
@@ -749,14 +749,14 @@ def _import_picture_modules() -> None:
     when a refused run exits can crash the interpreter's shutdown.) A failed import is
     left for the picture itself to report.
     """
-    from navseq.sinks.picture import import_drawing_modules
+    from navseq.sinks.picture.draw import import_drawing_modules
 
     with contextlib.suppress(ImportError):
         import_drawing_modules()
 
 
 def _picture_png(setup: RunSetup, outcome: RunOutcome) -> bytes:
-    from navseq.sinks.picture import mission_picture_png
+    from navseq.sinks.picture.draw import mission_picture_png
 
     return mission_picture_png(
         setup.mission,
@@ -790,7 +790,7 @@ def picture_trajectory(outcome: RunOutcome) -> list[tuple[float, float, float]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.sinks.journal import NothingToResume
+    from navseq.journal.writer import NothingToResume
 
     try:
         setup = prepare(args)

@@ -79,7 +79,7 @@ def run_mission(
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
     ``listeners`` receive every mission event (progress display, journal, report).
-    ``resume`` continues an earlier run (see :mod:`navseq.sinks.journal`). ``tick`` is
+    ``resume`` continues an earlier run (see :mod:`navseq.journal.writer`). ``tick`` is
     how much navigator time passes between two looks at the mission (seconds);
     ``server_wait`` how long to wait (wall time) for the navigation server at start.
     ``control`` lets other threads file operator requests (skip, pause, resume,

@@ -7,9 +7,14 @@
 - :func:`dump_mission_yaml` / :func:`write_mission` write navseq YAML.
 """
 
-from navseq.mission.loader import inspect_mission_file, load_mission, validate_mission_file
+from navseq.mission.loader import (
+    inspect_mission_file,
+    load_mission,
+    mission_from_params,
+    validate_mission_file,
+)
 from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
-from navseq.mission.params import MISSION_PARAM_KEYS, mission_from_params
+from navseq.mission.params import MISSION_PARAM_KEYS
 from navseq.mission.writer import dump_mission_yaml, write_mission
 
 __all__ = [

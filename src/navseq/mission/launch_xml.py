@@ -39,6 +39,7 @@ from navseq.mission.launch_subst import (
 )
 from navseq.mission.located import MAX_DEPTH, Located
 from navseq.mission.model import Mission
+from navseq.mission.params import OpenMission
 from navseq.mission.problems import Problems
 from navseq.mission.reading import MAX_MISSION_BYTES, read_mission_text
 from navseq.mission.rosparam_format import mission_from_tree
@@ -61,8 +62,15 @@ MAX_LAUNCH_TREE_BYTES = 2 * MAX_MISSION_BYTES
 
 
 def mission_from_launch(
-    text: str, source: str, base_dir: Path | None, problems: Problems
+    text: str,
+    source: str,
+    base_dir: Path | None,
+    problems: Problems,
+    *,
+    open_mission: OpenMission,
 ) -> Mission | None:
+    """The mission a launch file sets; ``open_mission`` reads a file a ``mission``
+    parameter names."""
     root = parse_xml(text, source)
     if root.tag != "launch":
         problems.add(
@@ -77,7 +85,12 @@ def mission_from_launch(
     if len(problems) > before:  # e.g. a broken <rosparam> body: what it set is unknown
         return None
     return mission_from_tree(
-        reader.tree.located(), source, base_dir, problems, not_followed=reader.not_followed
+        reader.tree.located(),
+        source,
+        base_dir,
+        problems,
+        open_mission=open_mission,
+        not_followed=reader.not_followed,
     )
 
 

@@ -16,15 +16,17 @@ import contextlib
 import gc
 import os
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator, Mapping
 from pathlib import Path
+from typing import Any
 
 from navseq.errors import NavseqError
 from navseq.mission.csv_format import mission_from_csv
 from navseq.mission.launch_xml import mission_from_launch
-from navseq.mission.located import Located
+from navseq.mission.located import Located, from_plain
 from navseq.mission.model import Mission
 from navseq.mission.navseq_format import mission_from_document
+from navseq.mission.params import mission_from_namespace
 from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
 from navseq.mission.rosparam_format import find_mission_namespaces, mission_from_tree
@@ -52,6 +54,34 @@ def load_mission(path: str | os.PathLike[str]) -> Mission:
     mission, problems = _load(Path(path))
     problems.raise_if_any()
     assert mission is not None, "a loader returned no mission without saying why"
+    return mission
+
+
+def mission_from_params(
+    params: Mapping[str, Any], source: str = "param ~", *, ignore: Collection[str] = ()
+) -> Mission:
+    """The mission a ROS node's private parameters describe.
+
+    ``params`` is the node's private namespace as a dict (``rospy.get_param("~")``);
+    ``source`` prefixes parameter names in messages (``param ~p_seq``). Keys in
+    ``ignore`` belong to the node itself (``action_name``...) and are not checked;
+    any other unknown key is an error naming the closest known one. Raises
+    NavseqError, or MissionErrors when there are several problems.
+    """
+    values = {
+        str(key): from_plain(value, f"{source}{key}")
+        for key, value in params.items()
+        if str(key) not in ignore
+    }
+    namespace = Located(
+        values, source.rstrip() or "params", {key: node.where for key, node in values.items()}
+    )
+    problems = Problems()
+    mission = mission_from_namespace(
+        namespace, problems, base_dir=None, strict=True, open_mission=load_mission
+    )
+    problems.raise_if_any()
+    assert mission is not None
     return mission
 
 
@@ -146,7 +176,7 @@ def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mi
     doc = parse_yaml(text, source, problems)
     if _is_rosparam_tree(doc):
         assert doc is not None
-        return mission_from_tree(doc, source, base_dir, problems)
+        return mission_from_tree(doc, source, base_dir, problems, open_mission=load_mission)
     return mission_from_document(doc, source, base_dir, problems)
 
 
@@ -172,7 +202,7 @@ def _is_ros2_node_section(node: Located) -> bool:
 
 
 def _read_launch(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:
-    return mission_from_launch(text, source, base_dir, problems)
+    return mission_from_launch(text, source, base_dir, problems, open_mission=load_mission)
 
 
 def _read_csv(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:

@@ -15,13 +15,12 @@ override what a ``mission`` file says.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Collection, Mapping
+from collections.abc import Callable
 from contextvars import ContextVar
 from pathlib import Path
-from typing import Any
 
 from navseq.mission import fields
-from navseq.mission.located import Located, from_plain
+from navseq.mission.located import Located
 from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import (
     MISSION_SETTINGS,
@@ -32,6 +31,10 @@ from navseq.mission.navseq_format import (
 from navseq.mission.problems import Problems
 from navseq.mission.tutorial_format import POSITIONS_KEY, YAWS_KEY, waypoints_from_sequences
 
+#: Reads the mission file a ``mission`` parameter names (the loader's ``load_mission``,
+#: handed down by the loader so that this module need not import it).
+OpenMission = Callable[[Path], Mission]
+
 WAYPOINT_SOURCES = (POSITIONS_KEY, YAWS_KEY, "waypoints", "mission")
 MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_KEYS)
 
@@ -40,40 +43,20 @@ MISSION_PARAM_KEYS = (*WAYPOINT_SOURCES, *MISSION_SETTINGS, *POLICY_KEYS)
 _reading_named_file: ContextVar[bool] = ContextVar("_reading_named_file", default=False)
 
 
-def mission_from_params(
-    params: Mapping[str, Any], source: str = "param ~", *, ignore: Collection[str] = ()
-) -> Mission:
-    """The mission a ROS node's private parameters describe.
-
-    ``params`` is the node's private namespace as a dict (``rospy.get_param("~")``);
-    ``source`` prefixes parameter names in messages (``param ~p_seq``). Keys in
-    ``ignore`` belong to the node itself (``action_name``...) and are not checked;
-    any other unknown key is an error naming the closest known one. Raises
-    NavseqError, or MissionErrors when there are several problems.
-    """
-    values = {
-        str(key): from_plain(value, f"{source}{key}")
-        for key, value in params.items()
-        if str(key) not in ignore
-    }
-    namespace = Located(
-        values, source.rstrip() or "params", {key: node.where for key, node in values.items()}
-    )
-    problems = Problems()
-    mission = mission_from_namespace(namespace, problems, base_dir=None, strict=True)
-    problems.raise_if_any()
-    assert mission is not None
-    return mission
-
-
 def mission_from_namespace(
-    namespace: Located, problems: Problems, *, base_dir: Path | None, strict: bool
+    namespace: Located,
+    problems: Problems,
+    *,
+    base_dir: Path | None,
+    strict: bool,
+    open_mission: OpenMission,
 ) -> Mission | None:
     """Build the mission from one parameter namespace, recording every problem.
 
     ``strict`` reports unknown keys (a node's own namespace); launch and rosparam
     files are read leniently, since a node's namespace there may hold other settings.
-    ``base_dir`` anchors relative ``mission`` and ``map`` paths (None: the current folder).
+    ``base_dir`` anchors relative ``mission`` and ``map`` paths (None: the current folder);
+    ``open_mission`` reads the file a ``mission`` parameter names.
     """
     before = len(problems)
     if strict:
@@ -99,7 +82,7 @@ def mission_from_namespace(
         )
         return None
     if given[0] == "mission":
-        base = _mission_from_file(namespace.value["mission"], base_dir, problems)
+        base = _mission_from_file(namespace.value["mission"], base_dir, problems, open_mission)
         if base is None or len(problems) > before:
             return None
         return dataclasses.replace(base, defaults=base.defaults.with_overrides(policy), **settings)
@@ -116,9 +99,10 @@ def mission_from_namespace(
     return Mission(waypoints=waypoints, defaults=Policy(**policy), source=source, **settings)
 
 
-def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems) -> Mission | None:
+def _mission_from_file(
+    node: Located, base_dir: Path | None, problems: Problems, open_mission: OpenMission
+) -> Mission | None:
     from navseq.errors import NavseqError
-    from navseq.mission.loader import load_mission  # the loader reads launch files via here
 
     path = fields.attempt(problems, lambda: read_path(node, "field mission", base_dir))
     if path is None:
@@ -132,7 +116,7 @@ def _mission_from_file(node: Located, base_dir: Path | None, problems: Problems)
         return None
     token = _reading_named_file.set(True)
     try:
-        return load_mission(path)
+        return open_mission(path)
     except NavseqError as error:
         problems.record(error)
         return None

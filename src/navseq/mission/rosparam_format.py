@@ -12,7 +12,7 @@ from pathlib import Path
 
 from navseq.mission.located import Located
 from navseq.mission.model import Mission
-from navseq.mission.params import WAYPOINT_SOURCES, mission_from_namespace
+from navseq.mission.params import WAYPOINT_SOURCES, OpenMission, mission_from_namespace
 from navseq.mission.problems import Problems
 
 
@@ -34,9 +34,11 @@ def mission_from_tree(
     base_dir: Path | None,
     problems: Problems,
     *,
+    open_mission: OpenMission,
     not_followed: list[str] | None = None,
 ) -> Mission | None:
-    """The one mission in a parameter tree; ``not_followed`` names files navseq skipped."""
+    """The one mission in a parameter tree; ``not_followed`` names files navseq skipped,
+    ``open_mission`` reads a file a ``mission`` parameter names."""
     namespaces = find_mission_namespaces(tree)
     if not namespaces:
         hint = ""
@@ -52,5 +54,7 @@ def mission_from_tree(
         )
         return None
     _, namespace = namespaces[0]
-    mission = mission_from_namespace(namespace, problems, base_dir=base_dir, strict=False)
+    mission = mission_from_namespace(
+        namespace, problems, base_dir=base_dir, strict=False, open_mission=open_mission
+    )
     return None if mission is None else dataclasses.replace(mission, source=source)

@@ -69,8 +69,8 @@ from navseq.executor.control import (
 )
 from navseq.executor.events import MissionFinished
 from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
+from navseq.mission.loader import mission_from_params
 from navseq.mission.model import Mission
-from navseq.mission.params import mission_from_params
 from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
 from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from navseq.errors import NavseqError
+from navseq.mission.loader import mission_from_params
 from navseq.mission.located import to_plain
 from navseq.mission.model import Mission
-from navseq.mission.params import mission_from_params
 from navseq.mission.yaml_doc import parse_yaml_value
 
 # The node's own parameters and their defaults. use_sim_time is rclpy's own.

@@ -1,7 +1,7 @@
 """Past runs: the output folders ``navseq run`` (or the studio) left, replayed in time.
 
 A run folder holds the mission as run, ``journal.jsonl`` and ``report.json``. The
-journal is read by :func:`navseq.sinks.journal.read_journal` (its chain checked, as
+journal is read by :func:`navseq.journal.writer.read_journal` (its chain checked, as
 ``navseq run --resume`` checks it) and its events are folded by the live view's own
 rules (:class:`~navseq.studio.runs.LiveView`), so a replayed waypoint is in the state
 the live page showed at that moment. What the page gets is a timeline it can scrub
@@ -73,10 +73,10 @@ def replay_of(
     Raises NavseqError when the folder has no readable journal.
     """
     from navseq.executor import events as ev
+    from navseq.journal.reader import journal_events
+    from navseq.journal.writer import read_journal
     from navseq.mission import load_mission
     from navseq.mission.robot import DEFAULT_PROFILE
-    from navseq.sinks.journal import read_journal
-    from navseq.sinks.journal_reader import journal_events
     from navseq.studio.documents import document_of
     from navseq.studio.runs import LiveView, _latest_report
 
@@ -158,7 +158,7 @@ def _source_as_run(
     folder: Path, source: str, digest: str, may_read: Callable[[Path], bool]
 ) -> Path | None:
     """The journal's mission file where it was run from, if allowed and unchanged since."""
-    from navseq.sinks.journal import mission_digest
+    from navseq.journal.writer import mission_digest
 
     # A relative source was relative to where navseq ran: usually the run folder's parent's.
     for candidate in [Path(source)] if Path(source).is_absolute() else [folder.parent / source]:

@@ -4,7 +4,7 @@ A patrol journals for weeks: its journal may hold millions of lines. The reader 
 holds more than one line: :class:`JournalReader` checks the header first (so a wrong
 file fails fast), then yields the records one at a time (:meth:`JournalReader.entries`)
 while it checks the chain digest of every line. What a caller keeps of them is its own
-business (:mod:`navseq.sinks.journal_state` folds them into a bounded state).
+business (:mod:`navseq.journal.state` folds them into a bounded state).
 
 Against hostile input, what is bounded is each line (:data:`MAX_LINE_BYTES`), not the
 whole file: a legitimate journal of a week-long patrol is read whatever its size.
@@ -27,7 +27,7 @@ from typing import Any, BinaryIO
 from navseq.errors import NavseqError
 from navseq.executor import events as ev
 from navseq.files import open_input_file
-from navseq.sinks.journal_format import (
+from navseq.journal.format import (
     CHAINED_SINCE,
     JOURNAL_FORMAT,
     JOURNAL_VERSION,

@@ -6,7 +6,7 @@
   beyond the view as triangles on its border, and a ring where a run was cut short;
 - :func:`place_labels` labels all of them when they fit, else the first, the last,
   the failures and a spread-out sample, never two labels on top of each other
-  (:mod:`navseq.sinks.picture_labels`).
+  (:mod:`navseq.sinks.picture.labels`).
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from navseq.mission.model import Mission
-from navseq.sinks.picture_labels import LabelPlacer, spread_order
-from navseq.sinks.picture_style import (
+from navseq.sinks.picture.labels import LabelPlacer, spread_order
+from navseq.sinks.picture.style import (
     ALARMING,
     COINCIDENT,
     DISC,
@@ -37,8 +37,8 @@ from navseq.sinks.picture_style import (
     Status,
     WaypointOutcomes,
 )
-from navseq.sinks.picture_thin import Groups, coincident_groups
-from navseq.sinks.picture_view import Layout, pose_arrows
+from navseq.sinks.picture.thin import Groups, coincident_groups
+from navseq.sinks.picture.view import Layout, pose_arrows
 from navseq.text import printable
 
 if TYPE_CHECKING:

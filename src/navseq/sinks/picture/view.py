@@ -6,7 +6,7 @@
 - :func:`draw_map` draws the occupancy grid cropped to the view and reduced to about a
   cell per pixel, with its edge; :func:`draw_plans` and :func:`draw_trajectory` draw
   the legs' plans and the driven path thinned to the pixels
-  (:mod:`navseq.sinks.picture_thin`); :func:`draw_start` the start pose and robot.
+  (:mod:`navseq.sinks.picture.thin`); :func:`draw_start` the start pose and robot.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 
 from navseq.geometry import Pose2D
-from navseq.sinks.picture_style import (
+from navseq.sinks.picture.style import (
     AXES_HEIGHT_RANGE,
     AXES_WIDTH,
     BOTTOM,
@@ -34,7 +34,7 @@ from navseq.sinks.picture_style import (
     TOP,
     TRAJECTORY_SEGMENTS,
 )
-from navseq.sinks.picture_thin import map_image, occupancy_levels, thin_segments
+from navseq.sinks.picture.thin import map_image, occupancy_levels, thin_segments
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

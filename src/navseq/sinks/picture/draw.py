@@ -6,14 +6,14 @@ signal waits for it):
 
 - the occupancy grid in metres with its true extent and orientation (free white,
   occupied black, unknown grey, as in map_server images and RViz), cropped to the
-  view and reduced to about one cell per pixel (:mod:`navseq.sinks.picture_thin`);
+  view and reduced to about one cell per pixel (:mod:`navseq.sinks.picture.thin`);
 - every waypoint coloured by its meaningful outcome (:func:`waypoint_outcomes`):
   reached green, skipped orange, failed red, interrupted pink, not run grey. While
   there is room, each waypoint is a numbered disc with an arrow along its yaw and its
   pass-through radius dashed; a crowded mission gets small dots instead;
 - labels that never collide with one another, with the markers that matter or with
   the legend (which sits outside the axes): all of them when they fit, else the
-  first, the last, the failures and a spread-out sample (:mod:`~navseq.sinks.picture_labels`);
+  first, the last, the failures and a spread-out sample (:mod:`~navseq.sinks.picture.labels`);
 - waypoints on top of one another drawn as one marker with a count ("×3") and the
   list of their numbers; waypoints outside the view drawn as triangles on its border,
   pointing towards them, with their coordinates;
@@ -23,10 +23,10 @@ signal waits for it):
   mission name and its result.
 
 This module reads the run (:func:`waypoint_outcomes` is the only place that reads a
-result's visits) and puts the picture together; the helpers draw: ``picture_view``
-(view, layout, map, paths), ``picture_marks`` (markers and labels), ``picture_legend``
-(side panel), with ``picture_style`` (colours, sizes, budgets), ``picture_thin`` and
-``picture_labels`` (the numpy and placement work).
+result's visits) and puts the picture together; the helpers draw: ``view``
+(view, layout, map, paths), ``marks`` (markers and labels), ``legend``
+(side panel), with ``style`` (colours, sizes, budgets), ``thin`` and
+``labels`` (the numpy and placement work).
 """
 
 from __future__ import annotations
@@ -43,15 +43,15 @@ from navseq.executor.result import MissionResult
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
-from navseq.sinks.picture_legend import side_panel
-from navseq.sinks.picture_marks import (
+from navseq.sinks.picture.legend import side_panel
+from navseq.sinks.picture.marks import (
     draw_markers,
     draw_numbered_details,
     group_markers,
     place_labels,
     square,
 )
-from navseq.sinks.picture_style import (
+from navseq.sinks.picture.style import (
     DISC,
     STATUS_COLOURS,
     STATUS_LABELS,
@@ -59,7 +59,7 @@ from navseq.sinks.picture_style import (
     Status,
     WaypointOutcomes,
 )
-from navseq.sinks.picture_view import (
+from navseq.sinks.picture.view import (
     Box,
     area_of_interest,
     draw_map,

@@ -22,7 +22,7 @@ resumed run starts a fresh line after it.
 A patrol journals for weeks, so the journal grows with the events that matter, not
 with time: every visit's start, finish and failed attempts are kept, with the first
 plan of each attempt (as corners, :data:`PATH_TOLERANCE`); the driven path is kept as
-a thinned polyline of ``WaypointProgress`` events (:mod:`navseq.sinks.journal_progress`:
+a thinned polyline of ``WaypointProgress`` events (:mod:`navseq.journal.path`:
 its corners, the pose at every arrival, every change of the stack's recovery count,
 and one at least every :data:`HEARTBEAT` seconds). Positions in progress and plans are
 written to 0.1 mm.
@@ -34,7 +34,7 @@ chain breaks: resuming from it could re-run reached waypoints or skip unreached 
 The header records the run's options (``run``: loops, navigator, ...), so that a resume
 continues the mission as it was started.
 
-Reading (:func:`read_journal`, :mod:`navseq.sinks.journal_state`) streams the journal
+Reading (:func:`read_journal`, :mod:`navseq.journal.state`) streams the journal
 and folds it into a bounded state. Fields added to an event type later
 (``AttemptFailed``'s ``status``, ``text``, ``duration``, ``distance_driven``, ``loop``)
 default when an older journal lacks them, so journals written by earlier versions
@@ -57,8 +57,7 @@ from navseq.errors import NavseqError
 from navseq.executor import events as ev
 from navseq.executor.resume import ResumePoint
 from navseq.files import open_input_file
-from navseq.mission.reading import MAX_MISSION_BYTES
-from navseq.sinks.journal_format import (
+from navseq.journal.format import (
     CHAIN_DIGITS,
     JOURNAL_FORMAT,
     JOURNAL_VERSION,
@@ -66,14 +65,15 @@ from navseq.sinks.journal_format import (
     json_default,
     sealed,
 )
-from navseq.sinks.journal_progress import HEARTBEAT, PATH_TOLERANCE, ProgressThinner
-from navseq.sinks.journal_reader import MAX_LINE_BYTES
-from navseq.sinks.journal_state import (
+from navseq.journal.path import HEARTBEAT, PATH_TOLERANCE, ProgressThinner
+from navseq.journal.reader import MAX_LINE_BYTES
+from navseq.journal.state import (
     JournalState,
     NothingToResume,
     read_journal,
     resume_point,
 )
+from navseq.mission.reading import MAX_MISSION_BYTES
 from navseq.track import simplify_path
 
 #: Decimals of the positions (m), angles (rad) and distances written in progress and

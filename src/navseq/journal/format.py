@@ -4,7 +4,7 @@ A journal is JSON lines: a header, then one record per line (``{"kind": "event",
 "type": "WaypointStarted", "t": ..., ...}`` or ``{"kind": "resumed", ...}``). Every line
 ends with ``"chain"``: the first 16 hex digits of the sha256 of the previous line's
 chain and this line's record, so that a line edited, removed or moved by hand breaks
-the chain where it was changed (see :mod:`navseq.sinks.journal`).
+the chain where it was changed (see :mod:`navseq.journal.writer`).
 
 This module holds what both sides must agree on: the format name and version, the
 chain (:func:`sealed`, :func:`unsealed`), the event types a journal may hold, and how

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from navseq.geometry import Pose2D
-from navseq.sinks.picture_marks import Markers
-from navseq.sinks.picture_style import (
+from navseq.sinks.picture.marks import Markers
+from navseq.sinks.picture.style import (
     AXES_WIDTH,
     GAP,
     LEFT,
@@ -18,7 +18,7 @@ from navseq.sinks.picture_style import (
     Status,
     WaypointOutcomes,
 )
-from navseq.sinks.picture_view import Layout
+from navseq.sinks.picture.view import Layout
 
 if TYPE_CHECKING:
     from matplotlib.collections import LineCollection

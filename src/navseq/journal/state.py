@@ -1,6 +1,6 @@
 """What a journal says about a run, folded as it is read, in bounded memory.
 
-:func:`read_journal` streams the journal (:class:`~navseq.sinks.journal_reader.
+:func:`read_journal` streams the journal (:class:`~navseq.journal.reader.
 JournalReader`) and keeps only what a resume, a rebuilt report and a rebuilt picture
 need, however long the run:
 
@@ -28,7 +28,7 @@ from navseq.errors import NavseqError
 from navseq.executor import events as ev
 from navseq.executor.result import AttemptResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
-from navseq.sinks.journal_reader import Damaged, Event, JournalReader, Resumed
+from navseq.journal.reader import Damaged, Event, JournalReader, Resumed
 from navseq.sinks.recorder import RunRecorder
 
 #: The most waypoints a journaled mission may claim: a visit log for that many is
@@ -311,7 +311,7 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
     That is the visit that was active when the run ended (or the one after the last
     finished visit, if the run ended between two). Reached and skipped visits are not
     run again: they come with the point (``earlier``), counted. With ``mission_digest``
-    (see :func:`~navseq.sinks.journal.mission_digest`), a mission file that changed
+    (see :func:`~navseq.journal.writer.mission_digest`), a mission file that changed
     since the journal was written is refused.
     """
     source = str(state.path)

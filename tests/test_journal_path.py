@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from navseq.executor.events import WaypointProgress
-from navseq.sinks.journal_progress import HEARTBEAT, PATH_TOLERANCE, ProgressThinner
+from navseq.journal.path import HEARTBEAT, PATH_TOLERANCE, ProgressThinner
 
 
 def pose(t: float, x: float, y: float) -> WaypointProgress:

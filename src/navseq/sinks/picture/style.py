@@ -1,6 +1,6 @@
 """How the mission picture looks: outcome colours, sizes, the layout's inches, budgets.
 
-Shared by the modules that draw the picture (:mod:`navseq.sinks.picture` and its
+Shared by the modules that draw the picture (:mod:`navseq.sinks.picture.draw` and its
 helpers), so that a colour or a size is said once.
 """
 
