@@ -12,6 +12,12 @@ from pathlib import Path
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
+    # The one-line summary (``navseq --help``) names the usual output only; the command's
+    # own help says that the output's name picks the format.
+    parser.description = (
+        "write any supported mission format as navseq YAML, or, for an OUTPUT ending in "
+        ".launch, as the tutorial's launch file (p_seq / yea_seq for move_base_seq)"
+    )
     parser.add_argument(
         "input",
         type=Path,
@@ -22,7 +28,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "output",
         type=Path,
         metavar="OUTPUT",
-        help="navseq YAML file to write (.launch: the tutorial's launch file, p_seq/yea_seq)",
+        help="file to write: navseq YAML, or, for a name ending in .launch, the "
+        "tutorial's launch file (p_seq / yea_seq; what that format cannot hold, such as "
+        "names and policies, is said on stderr)",
     )
     parser.add_argument("--force", action="store_true", help="overwrite OUTPUT if it exists")
 
