@@ -22,7 +22,8 @@ import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
-FENCE = re.compile(r"^(\s*)```(\w*)\s*$")
+# A fence: its indent, its language and the rest of its info string (```` ```python ros1 ````).
+FENCE = re.compile(r"^(\s*)```(\w*)(?:[ \t]+([^`]*?))?\s*$")
 SHELL_LANGUAGES = {"bash", "sh", "shell"}
 EXIT_LINE = re.compile(r"^\(exit (\d+)\)$")
 
@@ -140,6 +141,55 @@ def examples_in(path: Path) -> list[Example]:
             continue
         block.append(line[len(indent) :] if line.startswith(indent) else line)
     return examples
+
+
+NOT_RUN = re.compile(r"^\s*<!-- not run here: (?P<reason>.*?) -->\s*$")
+
+
+@dataclass
+class Block:
+    """One fenced block of the docs: its language, its text, and why it is not run (if
+    the line before it says so: ``<!-- not run here: REASON -->``)."""
+
+    path: Path
+    line: int  # the opening fence's line
+    language: str
+    info: str  # what follows the language on the fence line: ``ros1`` in ```` ```python ros1 ````
+    text: str
+    not_run_because: str | None
+
+    @property
+    def where(self) -> str:
+        return f"{self.path.name}:{self.line}"
+
+
+def blocks_in(path: Path) -> list[Block]:
+    """Every fenced block of a markdown file, in document order."""
+    blocks: list[Block] = []
+    lines = path.read_text(encoding="utf-8").splitlines()
+    opened: tuple[int, str, str, str] | None = None  # line, language, info, indent
+    body: list[str] = []
+    last_text = ""
+    reason: str | None = None
+    for number, line in enumerate(lines, start=1):
+        fence = FENCE.match(line)
+        if opened is None:
+            if fence:
+                marker = NOT_RUN.match(last_text)
+                opened = (number, fence.group(2), (fence.group(3) or "").strip(), fence.group(1))
+                body = []
+                reason = marker.group("reason").strip() if marker else None
+            elif line.strip():
+                last_text = line
+            continue
+        start, language, info, indent = opened
+        if fence and fence.group(1) == indent and not fence.group(2):
+            blocks.append(Block(path, start, language, info, "\n".join(body) + "\n", reason))
+            opened = None
+            last_text = line
+            continue
+        body.append(line[len(indent) :] if line.startswith(indent) else line)
+    return blocks
 
 
 def normalise(text: str) -> str:
