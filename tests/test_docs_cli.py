@@ -125,3 +125,31 @@ def test_convert_help_says_a_launch_output_is_the_tutorials_launch_file() -> Non
     text = " ".join(done.stdout.split())
     assert ".launch, the tutorial's launch file" in text
     assert "p_seq / yea_seq" in text
+
+
+def test_the_schema_versions_the_docs_name_are_the_ones_written() -> None:
+    import json
+
+    from navseq.sinks import json_events, report
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    assert re.findall(r"`report\.json` \(schema (\d+)\)", readme) == [str(report.SCHEMA_VERSION)]
+    schema = json.loads((REPO / "docs/schemas/report.schema.json").read_text())
+    assert schema["properties"]["schema_version"]["const"] == report.SCHEMA_VERSION
+    events = re.findall(r'\{"event": "<type>", "schema_version": (\d+)', CLI_DOC.read_text())
+    assert events == [str(json_events.SCHEMA_VERSION)]
+
+
+def test_every_exit_status_of_the_cli_is_in_the_readme_and_cli_md() -> None:
+    import navseq.cli as cli
+
+    statuses = {value for name, value in vars(cli).items() if name.startswith("EXIT_")}
+    statuses |= {128 + 1}  # SIGHUP ends a run like SIGTERM (cli._TERMINATING)
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    sentence = re.search(r"Exit status: (.*?)\n\n", readme, flags=re.S)
+    assert sentence is not None
+    in_readme = {int(n) for n in re.findall(r"\b(\d+)\b", sentence.group(1))}
+    in_cli_md = {int(n) for n in re.findall(r"^\| (\d+) \|", CLI_DOC.read_text(), re.M)}
+    assert statuses <= in_cli_md
+    # The README's short list leaves out only a reader that went away (`| head`).
+    assert statuses - {cli.EXIT_SIGPIPE} <= in_readme
