@@ -2,7 +2,7 @@
 real rclpy actions (ROS 2), navseq and the plain client loop both complete every goal.
 
 They are scripts nothing else imports: without this, a renamed API breaks them silently
-until someone reruns the README's figures.
+until someone reruns the figures of docs/performance.md.
 """
 
 from __future__ import annotations
