@@ -110,6 +110,12 @@ class Harness:
     def skip(self, t: float, reason: str = "skipped by operator") -> list[Command]:
         return self._keep(self.executor.skip(t, reason))
 
+    def pause(self, t: float) -> list[Command]:
+        return self._keep(self.executor.pause(t))
+
+    def resume(self, t: float) -> list[Command]:
+        return self._keep(self.executor.resume(t))
+
     def interrupt(self, t: float, reason: str) -> list[Command]:
         return self._keep(self.executor.interrupt(t, reason))
 

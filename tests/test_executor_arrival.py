@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 from cli_support import navseq, write_mission
 from helpers_executor import Harness, line_mission
 from navseq.executor import SendGoal, run_mission
+from navseq.executor.arrival import ARRIVAL_SLACK_M, ARRIVAL_SLACK_RAD
 from navseq.executor.events import AttemptFailed, WaypointFinished, WaypointOutcome
-from navseq.executor.machine import ARRIVAL_SLACK_M, ARRIVAL_SLACK_RAD
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance

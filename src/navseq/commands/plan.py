@@ -81,6 +81,10 @@ def run(args: argparse.Namespace) -> int:
         )
     if not (0.0 < args.time_limit <= 3600.0):
         raise NavseqError("must be more than 0 and at most 3600 seconds", source="--time-limit")
+    if args.order == "shortest":
+        from navseq.extras import require_extra
+
+        require_extra("plan", "--order shortest")  # before any leg is planned
     if args.out is not None and args.out.exists() and not args.force:
         # Refused before any work: nothing the user wrote is replaced unasked.
         raise NavseqError(

@@ -49,6 +49,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import secrets
 
+    from navseq.extras import require_extra
+
+    require_extra("studio", "the studio")  # before the imports that need it
+
     from navseq.commands.common import require_file
     from navseq.errors import NavseqError
     from navseq.studio.app import StudioConfig

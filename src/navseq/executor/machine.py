@@ -17,6 +17,9 @@ navigator's clock):
   :class:`~navseq.executor.control.MissionControl`);
 * :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash).
 
+Its states and the only ways between them are the table in
+:mod:`navseq.executor.states`; every state change goes through it.
+
 Pausing cancels the active goal (the robot stops) and holds the run in
 :attr:`ExecutorState.PAUSED`, where no deadline runs: on resume the goal timeout, the
 stall timeout, a dwell, a retry back-off and the server wait all move on by the time
@@ -34,32 +37,24 @@ the active goal without counting it as a failed attempt.
 
 The executor believes the robot, not only the navigation stack:
 
-* **Arrival.** Every SUCCEEDED is checked against the robot's pose (move_base can end
-  a fresh goal SUCCEEDED with the robot metres away, ros-planning/navigation #949; Nav2
-  can end a goal that preempted another SUCCEEDED where the old one ended). Farther
-  than the goal tolerance (a pass-through visit: its radius) plus
-  :data:`ARRIVAL_SLACK_M` (or, where the robot stops, turned more than the yaw
-  tolerance plus :data:`ARRIVAL_SLACK_RAD`), the attempt fails with a reason like
-  ``succeeded far from goal (2.38 m)`` and the waypoint's policy decides what follows.
-* **Progress** (the stall timeout) is judged on one measure per attempt, the best
-  one available: the navigator's distance remaining along its plan, else the
-  distance along the latest ``GoalPlan`` from the robot's projection onto it, else
-  the straight-line distance. Switching to a better measure restarts the best
-  distance from the new measure's value; a re-plan shifts it by how much longer or
-  shorter the new plan is from where the robot stands, so neither counts as
-  progress nor as its loss. The stall clock itself is never restarted by either.
+* **Arrival.** Every SUCCEEDED is checked against the robot's pose
+  (:mod:`navseq.executor.arrival`); a robot that is not there fails the attempt with
+  a reason like ``succeeded far from goal (2.38 m)``, and the waypoint's policy
+  decides what follows.
+* **Progress** (the stall timeout) is judged per goal by an
+  :class:`~navseq.executor.monitor.AttemptMonitor`, on the best measure of the
+  distance to go that the navigator allows.
 * **Distance driven** adds up odometry poses when the navigator gives them
-  (continuous, free of localisation jumps), map poses otherwise.
+  (continuous, free of localisation jumps), map poses otherwise
+  (:class:`~navseq.executor.odometer.Odometer`).
 """
 
 from __future__ import annotations
 
-import enum
-import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
 
 from navseq.errors import NavseqError
+from navseq.executor.arrival import arrival_miss, goal_tolerance
 from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
 from navseq.executor.events import (
     AttemptFailed,
@@ -77,10 +72,14 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
-from navseq.executor.result import AttemptResult, MissionResult, VisitLog, WaypointResult
-from navseq.executor.resume import ResumePoint
-from navseq.geometry import Pose2D, normalize_angle, remaining_along_path
-from navseq.mission.model import FailureAction, Mission, Policy, Waypoint
+from navseq.executor.monitor import AttemptMonitor
+from navseq.executor.odometer import Odometer
+from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.resume import ResumePoint, check_resume_point, visit_log
+from navseq.executor.states import ExecutorState, Trigger, next_state
+from navseq.executor.visit import Visit, next_position
+from navseq.geometry import Pose2D
+from navseq.mission.model import FailureAction, Mission, Policy
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
 from navseq.navigators.base import (
     Goal,
@@ -96,77 +95,18 @@ from navseq.track import simplify_path
 
 #: Pause between a failed attempt and the next one, so a failing stack is not hammered.
 RETRY_BACKOFF = 1.0
-#: The distance to the goal must drop this much below its best to count as progress (m).
-PROGRESS_DISTANCE = 0.05
-#: Near the goal, the yaw error must drop this much below its best to count (rad).
-PROGRESS_YAW = 0.05
-#: Within this distance of the goal, turning towards the goal yaw counts as progress (m).
-YAW_PROGRESS_RADIUS = 0.3
 #: Planned paths are told to sinks simplified to within this distance (m).
 PLAN_TOLERANCE = 0.01
 #: Reason recorded when the navigation server stayed away longer than allowed.
 SERVER_LOST_REASON = "navigation server lost"
-#: Added to the goal's xy tolerance when checking a SUCCEEDED against the robot's pose
-#: (m): amcl's pose jitters by a few centimetres, and the pose the executor sees may be
-#: a tick (0.1 s, 0.02 m at TurtleBot3 speed) older than the stack's own.
-ARRIVAL_SLACK_M = 0.10
-#: Added to the goal's yaw tolerance in the same check (rad, about 6°), for the same
-#: reasons (amcl's heading jitter, a robot still settling its last turn).
-ARRIVAL_SLACK_RAD = 0.10
+
+#: How a pause ends for a state whose deadline simply goes on (the others resend the goal).
+_GOES_ON = {
+    ExecutorState.DWELLING: Trigger.DWELL_GOES_ON,
+    ExecutorState.WAITING_RETRY: Trigger.BACKOFF_GOES_ON,
+}
 
 MissionListener = Callable[[MissionEvent], None]
-
-
-class ExecutorState(enum.Enum):
-    """Where the mission run is. Exactly one waypoint visit is current outside IDLE/FINISHED."""
-
-    IDLE = "idle"  # start() not called yet
-    ACTIVE = "active"  # a goal is out; waiting for its result, a timeout or pass-through
-    DWELLING = "dwelling"  # goal reached; waiting the waypoint's dwell time
-    WAITING_RETRY = "waiting_retry"  # attempt failed; back-off before the next attempt
-    WAITING_SERVER = "waiting_server"  # server gone; the goal is resent when it is back
-    PAUSED = "paused"  # the operator paused: no goal out, no deadline running
-    FINISHED = "finished"  # the mission ended (see result.reason)
-
-
-class _Measure(enum.IntEnum):
-    """How the distance still to go is measured; a higher value is a better measure."""
-
-    STRAIGHT = 1  # straight line to the goal: no plan known
-    PLAN = 2  # along the latest GoalPlan, from the robot's projection onto it
-    NAVIGATOR = 3  # the navigator's own distance remaining (along its plan)
-
-
-@dataclass
-class _Attempt:
-    """The goal currently out for the current visit, and how well it is going."""
-
-    goal: Goal
-    sent_at: float
-    last_progress_at: float
-    best_distance: float | None = None  # on ``measure``; None: the next value sets it
-    best_yaw_error: float | None = None
-    measure: _Measure | None = None  # the best measure seen for this goal so far
-    plan: tuple[tuple[float, float], ...] | None = None  # the latest GoalPlan's path
-    feedback_seen: bool = False
-
-
-@dataclass
-class _Visit:
-    """One pass at one waypoint (a patrol visits each waypoint once per loop)."""
-
-    loop: int
-    index: int
-    waypoint: Waypoint
-    policy: Policy
-    result: WaypointResult
-    first_sent_at: float | None = None
-    reached_at: float | None = None
-    attempt_sent_at: float = 0.0  # when the current attempt's goal was first sent
-    attempt_start_distance: float = 0.0  # the visit's distance driven at that moment
-    # The stack's count of recovery behaviours for the current attempt's goal, when the
-    # stack gives one (Nav2's number_of_recoveries); None: not known.
-    attempt_recoveries: int | None = None
 
 
 class MissionExecutor:
@@ -192,37 +132,31 @@ class MissionExecutor:
         if not mission.waypoints:
             raise NavseqError("the mission has no waypoints", source=mission.source)
         if resume is not None:
-            _check_resume_point(mission, resume)
+            check_resume_point(mission, resume)
         self._mission = mission
         self._resume = resume
         self._robot = robot or mission.robot or DEFAULT_PROFILE
         self._listeners: list[MissionListener] = []
         self._state = ExecutorState.IDLE
         # Finished visits: counted per waypoint, the latest kept in full (bounded memory).
-        self._log = VisitLog(mission.waypoints, mission.loops)
-        if resume is not None:
-            if resume.earlier is not None:  # a copy: the point may be used again
-                self._log = resume.earlier.relabelled(mission.waypoints, mission.loops)
-            for done in sorted(resume.done, key=lambda v: (v.loop, v.index)):
-                self._log.add(_result_for(mission, done))
-        self._visit: _Visit | None = None
-        self._attempt: _Attempt | None = None
+        self._log = visit_log(mission, resume)
+        self._visit: Visit | None = None
+        self._monitor: AttemptMonitor | None = None  # the goal out for the current visit
         self._next_goal_id = 1
         self._deadline = 0.0  # end of dwell or back-off, by state
         self._clear_costmaps_before_send = False
         self._server_up = True
         self._server_lost_at = 0.0
-        self._last_pose: Pose2D | None = None  # of the distance driven, map frame
-        self._last_odom_pose: Pose2D | None = None  # of the distance driven, odom frame
+        self._odometer = Odometer()
         self._latest_pose: Pose2D | None = None  # any input's, for the arrival check
         self._start_pose: Pose2D | None = None  # the first robot pose of the run
         self._tick_pose_seen = False
         self._started_at: float | None = None
-        # While PAUSED: the state to go back to, when the pause began, and the attempt
-        # whose goal the pause cancelled (to send again on resume).
+        # While PAUSED: the state to go back to, when the pause began, and the monitor
+        # of the goal the pause cancelled (to send again on resume).
         self._paused_from: ExecutorState | None = None
         self._paused_at = 0.0
-        self._paused_attempt: _Attempt | None = None
+        self._paused_monitor: AttemptMonitor | None = None
         self._now = 0.0
         self._loops_completed = 0
         self._success = False
@@ -254,8 +188,8 @@ class MissionExecutor:
     @property
     def current_goal(self) -> Goal | None:
         """The goal the navigator is pursuing for the mission, if one is out."""
-        if self._state in (ExecutorState.ACTIVE, ExecutorState.WAITING_SERVER) and self._attempt:
-            return self._attempt.goal
+        if self._state in (ExecutorState.ACTIVE, ExecutorState.WAITING_SERVER) and self._monitor:
+            return self._monitor.goal
         return None
 
     @property
@@ -291,11 +225,7 @@ class MissionExecutor:
 
     def goal_tolerance(self, policy: Policy) -> GoalTolerance:
         """The arrival tolerance of a visit: its policy's, else the robot profile's."""
-        default = self._robot.goal_tolerance
-        return GoalTolerance(
-            default.xy_m if policy.xy_tolerance_m is None else policy.xy_tolerance_m,
-            default.yaw_rad if policy.yaw_tolerance_rad is None else policy.yaw_tolerance_rad,
-        )
+        return goal_tolerance(policy, self._robot)
 
     def start(self, now: float, pose: Pose2D | None = None) -> list[Command]:
         """Begin the mission (or resume it); returns the first goal to send.
@@ -336,14 +266,14 @@ class MissionExecutor:
             return self._on_server_lost(now, event.reason or "server lost")
         if isinstance(event, ServerBack):
             return self._on_server_back(now)
-        if self._state is not ExecutorState.ACTIVE or self._attempt is None:
+        if self._state is not ExecutorState.ACTIVE or self._monitor is None:
             return []
-        if getattr(event, "goal_id", None) != self._attempt.goal.goal_id:
+        if getattr(event, "goal_id", None) != self._monitor.goal.goal_id:
             return []  # about a goal we replaced or gave up on
         if isinstance(event, GoalFeedback):
             return self._on_feedback(now, event)
         if isinstance(event, GoalPlan):
-            self._on_plan(event)
+            self._monitor.adopt_plan(event.path, self._latest_pose)
             # Sinks get the plan's corners only: a journal, a picture and markers need no
             # point every grid cell, and a patrol's journal must not grow by whole plans.
             path = simplify_path(event.path, PLAN_TOLERANCE)
@@ -368,14 +298,14 @@ class MissionExecutor:
         commands: list[Command] = []
         if pose is not None or odom_pose is not None:
             self._tick_pose_seen = True
-            self._accumulate_distance(pose, odom_pose)
+            self._drive(pose, odom_pose)
         if pose is not None:
             self._see_pose(pose)
             if self._state is ExecutorState.ACTIVE:
                 commands = self._observe_pose(now, pose, None)
-                attempt = self._attempt
-                if attempt is not None and not attempt.feedback_seen and not commands:
-                    self._emit_progress(now, pose, self._remaining(attempt, pose))
+                monitor = self._monitor
+                if monitor is not None and not monitor.feedback_seen and not commands:
+                    self._emit_progress(now, pose, monitor.remaining(pose))
             if commands:
                 return commands
         return self._check_clock(now)
@@ -391,9 +321,10 @@ class MissionExecutor:
         self._now = max(self._now, now)
         if self._state in (ExecutorState.IDLE, ExecutorState.FINISHED):
             return []
-        if self._state is ExecutorState.PAUSED:
-            self._end_pause(now)
-        if self._state is ExecutorState.DWELLING:
+        interrupted: ExecutorState = self._state
+        if interrupted is ExecutorState.PAUSED:
+            interrupted = self._end_pause(now)
+        if interrupted is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
         else:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
@@ -414,15 +345,13 @@ class MissionExecutor:
         commands: list[Command] = []
         if self._state is ExecutorState.ACTIVE:
             commands.append(CancelGoal())
-        self._paused_from = self._state
+        paused_from = self._paused_from = self._state
         self._paused_at = now
-        self._paused_attempt = self._attempt
-        self._attempt = None  # the cancelled goal's last words are not the mission's
-        self._state = ExecutorState.PAUSED
+        self._paused_monitor = self._monitor
+        self._monitor = None  # the cancelled goal's last words are not the mission's
+        self._move(Trigger.PAUSE)
         self._emit(
-            MissionPaused(
-                t=now, index=self._current.index, reason=reason, state=self._paused_from.value
-            )
+            MissionPaused(t=now, index=self._current.index, reason=reason, state=paused_from.value)
         )
         return commands
 
@@ -434,19 +363,18 @@ class MissionExecutor:
         self._now = max(self._now, now)
         if self._state is not ExecutorState.PAUSED:
             return []
-        attempt = self._paused_attempt
-        resumed = self._end_pause(now)
-        if resumed is ExecutorState.ACTIVE:
-            # Same attempt, fresh goal id: late events of the cancelled goal are ignored.
-            commands = self._send_goal(now)
-            if self._attempt is not None and attempt is not None:
-                shift = now - self._paused_at
-                self._attempt.sent_at = attempt.sent_at + shift
-                self._attempt.last_progress_at = attempt.last_progress_at + shift
-            return commands
-        if resumed is ExecutorState.WAITING_SERVER and self._server_up:
-            return self._send_goal(now)  # the server came back while paused
-        return self._check_clock(now)
+        monitor = self._paused_monitor
+        paused_for = now - self._paused_at
+        interrupted = self._end_pause(now)
+        if interrupted in _GOES_ON:
+            self._move(_GOES_ON[interrupted])
+            return self._check_clock(now)
+        # ACTIVE: the same attempt, a fresh goal id (late events of the cancelled goal
+        # are ignored). WAITING_SERVER: sent if the server came back while paused.
+        commands = self._send_goal(now)
+        if self._monitor is not None and monitor is not None:
+            self._monitor = monitor.resumed(self._monitor.goal, paused_for)
+        return commands
 
     def cancel(self, now: float, reason: str = "cancelled by operator") -> list[Command]:
         """The operator ends the mission: the goal is cancelled, the visit FAILED.
@@ -459,6 +387,12 @@ class MissionExecutor:
     def interrupt(self, now: float, reason: str) -> list[Command]:
         """End the run at once (``reason`` like ``"interrupted: SIGINT"``); cancels the goal."""
         return self._end_now(now, reason)
+
+    # ------------------------------------------------------------------ state changes
+
+    def _move(self, trigger: Trigger) -> None:
+        """The one way the state changes: as the table says, or InvalidTransition."""
+        self._state = next_state(self._state, trigger)
 
     def _end_now(self, now: float, reason: str) -> list[Command]:
         self._now = max(self._now, now)
@@ -473,90 +407,52 @@ class MissionExecutor:
         return [CancelGoal()]
 
     def _end_pause(self, now: float) -> ExecutorState:
-        """Leave PAUSED for the state it interrupted, with its deadlines moved on."""
+        """Move the interrupted state's deadlines on by the pause; the state to go back to.
+
+        The run stays PAUSED: the caller's next trigger takes it out.
+        """
         resumed = self._paused_from
         assert resumed is not None
         shift = max(0.0, now - self._paused_at)
         self._deadline += shift  # dwell or back-off
         if not self._server_up and self._server_lost_at <= self._paused_at:
             self._server_lost_at += shift
-        self._state = resumed
-        self._attempt = None
+        self._monitor = None
         self._paused_from = None
-        self._paused_attempt = None
+        self._paused_monitor = None
         self._emit(MissionResumed(t=now, index=self._current.index, paused_for=shift))
         return resumed
 
     # ------------------------------------------------------------------ visits
 
     @property
-    def _current(self) -> _Visit:
+    def _current(self) -> Visit:
         assert self._visit is not None, "no current visit"
         return self._visit
 
     def _begin_visit(self, now: float, loop: int, index: int, *, new_loop: bool) -> list[Command]:
         if new_loop:
             self._emit(LoopStarted(t=now, loop=loop))
-        waypoint = self._mission.waypoints[index]
-        result = WaypointResult(
-            index=index,
-            loop=loop,
-            name=waypoint.name,
-            x=waypoint.x,
-            y=waypoint.y,
-            yaw_rad=waypoint.yaw_rad,
-        )
-        self._visit = _Visit(loop, index, waypoint, self._mission.policy_for(index), result)
+        self._visit = Visit.of(self._mission, loop, index)
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:
-        visit = self._current
-        visit.result.attempts += 1
-        visit.attempt_sent_at = now
-        visit.attempt_start_distance = visit.result.distance_driven
-        visit.attempt_recoveries = None
+        self._current.start_attempt(now)
         return self._send_goal(now)
-
-    def _passes_through(self, visit: _Visit) -> bool:
-        """Whether the visit ends when the robot comes near, without stopping there."""
-        return (
-            visit.policy.pass_through_m is not None
-            and visit.policy.dwell_s == 0
-            and not self._is_last_visit(visit.loop, visit.index)
-        )
-
-    def _close_attempt(
-        self, now: float, *, reached: bool, status: str | None, reason: str, text: str = ""
-    ) -> AttemptResult:
-        """Record how the current attempt ended in the visit's result."""
-        visit = self._current
-        record = AttemptResult(
-            number=visit.result.attempts,
-            reached=reached,
-            status=status,
-            reason=reason,
-            text=text,
-            duration=max(0.0, now - visit.attempt_sent_at),
-            distance_driven=visit.result.distance_driven - visit.attempt_start_distance,
-            recoveries=visit.attempt_recoveries,
-        )
-        visit.result.attempt_results.append(record)
-        return record
 
     def _send_goal(self, now: float) -> list[Command]:
         """Send the current visit's goal (a fresh goal id), or wait for the server first."""
         if not self._server_up:
-            self._state = ExecutorState.WAITING_SERVER
-            self._attempt = None
+            self._move(Trigger.SERVER_AWAY)
+            self._monitor = None
             return self._check_clock(now)
         visit = self._current
         waypoint = visit.waypoint
         goal = Goal(self._next_goal_id, waypoint.pose, z=waypoint.z, frame=self._mission.frame)
         self._next_goal_id += 1
-        self._attempt = _Attempt(goal=goal, sent_at=now, last_progress_at=now)
-        if visit.first_sent_at is None:
-            visit.first_sent_at = now
-        self._state = ExecutorState.ACTIVE
+        self._monitor = AttemptMonitor(goal, now)
+        visit.goal_sent(now)
+        self._move(Trigger.GOAL_SENT)
         commands: list[Command] = []
         if self._clear_costmaps_before_send:
             commands.append(ClearCostmaps())
@@ -576,26 +472,15 @@ class MissionExecutor:
         )
         return commands
 
-    def _is_last_visit(self, loop: int, index: int) -> bool:
-        loops = self._mission.loops
-        return loops is not None and loop == loops - 1 and index == len(self._mission) - 1
-
-    def _next_position(self, loop: int, index: int) -> tuple[int, int] | None:
-        if index + 1 < len(self._mission):
-            return loop, index + 1
-        if self._mission.loops is None or loop + 1 < self._mission.loops:
-            return loop + 1, 0
-        return None
-
     def _reached(
         self, now: float, *, passed_through: bool, status: str | None = None, text: str = ""
     ) -> list[Command]:
         visit = self._current
         visit.reached_at = now
-        self._close_attempt(now, reached=True, status=status, reason="", text=text)
-        self._attempt = None
+        visit.close_attempt(now, reached=True, status=status, reason="", text=text)
+        self._monitor = None
         if not passed_through and visit.policy.dwell_s > 0:
-            self._state = ExecutorState.DWELLING
+            self._move(Trigger.DWELL)
             self._deadline = now + visit.policy.dwell_s
             self._emit(WaypointDwelling(t=now, index=visit.index, seconds=visit.policy.dwell_s))
             return []
@@ -604,7 +489,7 @@ class MissionExecutor:
 
     def _advance(self, now: float) -> list[Command]:
         visit = self._current
-        following = self._next_position(visit.loop, visit.index)
+        following = next_position(self._mission, visit.loop, visit.index)
         if following is None:
             self._loops_completed += 1
             if self._log.all_reached(self._active_result()):
@@ -623,19 +508,10 @@ class MissionExecutor:
         self, now: float, outcome: WaypointOutcome, reason: str, *, passed_through: bool = False
     ) -> None:
         visit = self._current
-        result = visit.result
-        if outcome is not WaypointOutcome.REACHED and len(result.attempt_results) < result.attempts:
-            # Ended by navseq while a goal was out (interrupt, operator skip, server gone).
-            self._close_attempt(now, reached=False, status=None, reason=reason)
-        end = visit.reached_at if outcome is WaypointOutcome.REACHED else now
-        start = visit.first_sent_at
-        result.outcome = outcome
-        result.reason = reason
-        result.passed_through = passed_through
-        result.duration = (end - start) if (start is not None and end is not None) else 0.0
+        result = visit.finish(now, outcome, reason, passed_through=passed_through)
         if (visit.loop, visit.index) not in self._log:
             self._log.add(result)
-        self._attempt = None
+        self._monitor = None
         self._emit(
             WaypointFinished(
                 t=now,
@@ -651,9 +527,9 @@ class MissionExecutor:
         )
 
     def _finish_mission(self, now: float, reason: str) -> None:
-        self._state = ExecutorState.FINISHED
+        self._move(Trigger.END)
         self._visit = None
-        self._attempt = None
+        self._monitor = None
         self._reason = reason
         self._success = self._log.all_reached(self._active_result())
         self._emit(MissionFinished(t=now, success=self._success, reason=reason))
@@ -674,15 +550,9 @@ class MissionExecutor:
         attempts = visit.result.attempts
         policy = visit.policy
         will_retry = policy.on_failure is FailureAction.RETRY or attempts <= policy.retries
-        self._attempt = None
+        self._monitor = None
         visit.result.reason = reason
-        record = self._close_attempt(
-            now,
-            reached=False,
-            status=status,
-            reason=reason,
-            text=text,
-        )
+        record = visit.close_attempt(now, reached=False, status=status, reason=reason, text=text)
         self._emit(
             AttemptFailed(
                 t=now,
@@ -699,7 +569,7 @@ class MissionExecutor:
             )
         )
         if will_retry:
-            self._state = ExecutorState.WAITING_RETRY
+            self._move(Trigger.RETRY_LATER)
             self._deadline = now + RETRY_BACKOFF
             self._clear_costmaps_before_send = policy.clear_costmaps_on_retry
             return commands
@@ -723,8 +593,8 @@ class MissionExecutor:
             # Not the waypoint's fault: the stack lost track of the goal. Treat it as
             # a vanished server and resend once it reports back.
             self._mark_server_lost(now, event.text or f"goal {event.status or 'LOST'}")
-            self._state = ExecutorState.WAITING_SERVER
-            self._attempt = None
+            self._move(Trigger.SERVER_AWAY)
+            self._monitor = None
             return self._check_clock(now)
         status = event.status or "FAILED"
         return self._attempt_failed(now, status, cancel=False, status=status, text=event.text)
@@ -732,35 +602,16 @@ class MissionExecutor:
     def _arrival_miss(self) -> str | None:
         """Why a SUCCEEDED is not believed (the robot is not there), or None.
 
-        Every SUCCEEDED is checked. A visit where the robot stops allows the goal
-        tolerance plus :data:`ARRIVAL_SLACK_M`, and the yaw tolerance plus
-        :data:`ARRIVAL_SLACK_RAD`. A pass-through visit allows its radius (or the goal
-        tolerance, if larger: the stack may legitimately end the goal there before the
-        robot comes within the radius) plus the same slack, and no yaw: passing through
-        does not turn to the goal's heading. Nav2 can end a goal that preempted another
-        SUCCEEDED with the robot still at the preempted goal (its tree keeps following
-        the old path until the next re-plan), so pass-through visits need the check as
-        much as stops. Without any robot pose the SUCCEEDED is believed.
+        Every SUCCEEDED is checked against the latest pose any input gave; without
+        one the SUCCEEDED is believed.
         """
         visit = self._current
-        attempt = self._attempt
+        monitor = self._monitor
         pose = self._latest_pose
-        if pose is None or attempt is None:
+        if pose is None or monitor is None:
             return None
-        tolerance = self.goal_tolerance(visit.policy)
-        goal = attempt.goal.pose
-        off = pose.distance_to(goal)
-        passes = self._passes_through(visit)
-        radius = visit.policy.pass_through_m if passes else None
-        allowed = tolerance.xy_m if radius is None else max(radius, tolerance.xy_m)
-        if off > allowed + ARRIVAL_SLACK_M:
-            return f"succeeded far from goal ({off:.2f} m)"
-        if passes:
-            return None
-        yaw_off = abs(normalize_angle(goal.yaw - pose.yaw))
-        if yaw_off > tolerance.yaw_rad + ARRIVAL_SLACK_RAD:
-            return f"succeeded {math.degrees(yaw_off):.0f}° off the goal yaw"
-        return None
+        radius = visit.policy.pass_through_m if visit.passes_through else None
+        return arrival_miss(pose, monitor.goal.pose, self.goal_tolerance(visit.policy), radius)
 
     def _mark_server_lost(self, now: float, reason: str) -> None:
         if self._server_up:
@@ -771,8 +622,8 @@ class MissionExecutor:
     def _on_server_lost(self, now: float, reason: str) -> list[Command]:
         self._mark_server_lost(now, reason)
         if self._state is ExecutorState.ACTIVE:
-            self._state = ExecutorState.WAITING_SERVER
-            self._attempt = None
+            self._move(Trigger.SERVER_AWAY)
+            self._monitor = None
         return []
 
     def _on_server_back(self, now: float) -> list[Command]:
@@ -788,14 +639,12 @@ class MissionExecutor:
     def _check_clock(self, now: float) -> list[Command]:
         state = self._state
         if state is ExecutorState.ACTIVE:
-            attempt = self._attempt
+            monitor = self._monitor
             policy = self._current.policy
-            assert attempt is not None
-            if policy.goal_timeout_s is not None and now - attempt.sent_at >= policy.goal_timeout_s:
-                return self._attempt_failed(now, "timeout", cancel=True)
-            stalled_for = now - attempt.last_progress_at
-            if policy.stall_timeout_s is not None and stalled_for >= policy.stall_timeout_s:
-                return self._attempt_failed(now, "stalled", cancel=True)
+            assert monitor is not None
+            overdue = monitor.overdue(now, policy.goal_timeout_s, policy.stall_timeout_s)
+            if overdue is not None:
+                return self._attempt_failed(now, overdue, cancel=True)
         elif state is ExecutorState.DWELLING:
             if now >= self._deadline:
                 self._finish_visit(now, WaypointOutcome.REACHED, "")
@@ -814,28 +663,21 @@ class MissionExecutor:
     # ------------------------------------------------------------------ poses
 
     def _on_feedback(self, now: float, event: GoalFeedback) -> list[Command]:
-        attempt = self._attempt
-        assert attempt is not None
-        attempt.feedback_seen = True
+        monitor = self._monitor
+        assert monitor is not None
+        monitor.feedback_seen = True
         if event.recoveries is not None:
             self._current.attempt_recoveries = event.recoveries
         if not self._tick_pose_seen:
-            self._accumulate_distance(event.pose)
+            self._drive(event.pose)
         self._see_pose(event.pose)
         commands = self._observe_pose(now, event.pose, event.distance_remaining)
-        if not commands and self._attempt is attempt:
+        if not commands and self._monitor is monitor:
             remaining = event.distance_remaining
             if remaining is None:
-                remaining = self._remaining(attempt, event.pose)
+                remaining = monitor.remaining(event.pose)
             self._emit_progress(now, event.pose, remaining, event.recoveries, event.navigation_time)
         return commands
-
-    @staticmethod
-    def _remaining(attempt: _Attempt, pose: Pose2D) -> float:
-        """Distance to go for display: along the known plan, else straight."""
-        if attempt.plan is not None:
-            return remaining_along_path(attempt.plan, pose.x, pose.y)
-        return pose.distance_to(attempt.goal.pose)
 
     def _see_pose(self, pose: Pose2D | None) -> None:
         if pose is not None:
@@ -843,102 +685,30 @@ class MissionExecutor:
             if self._start_pose is None:
                 self._start_pose = pose
 
-    def _accumulate_distance(self, pose: Pose2D | None, odom_pose: Pose2D | None = None) -> None:
-        step = 0.0
-        if odom_pose is not None:
-            if self._last_odom_pose is not None:
-                step = self._last_odom_pose.distance_to(odom_pose)
-        elif pose is not None and self._last_pose is not None:
-            step = self._last_pose.distance_to(pose)
+    def _drive(self, pose: Pose2D | None, odom_pose: Pose2D | None = None) -> None:
+        """Add the step since the previous poses to the current visit's distance driven."""
+        step = self._odometer.step(pose, odom_pose)
         if self._visit is not None:
             self._visit.result.distance_driven += step
-        if pose is not None:
-            self._last_pose = pose
-        # Forgotten when missing, so that odometry coming back does not count the gap
-        # a second time (the map poses counted it).
-        self._last_odom_pose = odom_pose
-
-    def _on_plan(self, event: GoalPlan) -> None:
-        """Adopt a new plan for the attempt; keep the best distance on its measure.
-
-        A re-plan moves the best distance by how much the remaining path changed
-        where the robot stands, so a longer detour is not a lost progress and a
-        shorter one not a gained one. Where the change cannot be measured (no
-        earlier plan or no pose), the next value restarts the best distance.
-        """
-        attempt = self._attempt
-        assert attempt is not None
-        if not event.path:
-            return
-        old, attempt.plan = attempt.plan, event.path
-        if attempt.best_distance is None or attempt.measure not in (
-            _Measure.PLAN,
-            _Measure.NAVIGATOR,
-        ):
-            return  # a straight-line measure gives way to the plan at the next pose
-        pose = self._latest_pose
-        if old is None or pose is None:
-            attempt.best_distance = None
-            return
-        attempt.best_distance += remaining_along_path(
-            event.path, pose.x, pose.y
-        ) - remaining_along_path(old, pose.x, pose.y)
 
     def _observe_pose(
         self, now: float, pose: Pose2D, navigator_distance: float | None
     ) -> list[Command]:
         """Update progress from a pose; pass through the waypoint when close enough."""
-        attempt = self._attempt
+        monitor = self._monitor
         visit = self._current
-        assert attempt is not None
-        goal = attempt.goal.pose
-        straight = pose.distance_to(goal)
+        assert monitor is not None
         radius = visit.policy.pass_through_m
-        if radius is not None and straight <= radius and self._passes_through(visit):
+        if (
+            radius is not None
+            and visit.passes_through
+            and pose.distance_to(monitor.goal.pose) <= radius
+        ):
             # The next goal replaces this one at once, without a cancel: the robot
             # keeps rolling instead of braking at every intermediate point.
             return self._reached(now, passed_through=True)
-
-        progressed = self._distance_progressed(attempt, pose, straight, navigator_distance)
-        if straight <= YAW_PROGRESS_RADIUS:
-            # Turning in place to the goal yaw is progress too.
-            yaw_error = abs(normalize_angle(goal.yaw - pose.yaw))
-            if attempt.best_yaw_error is None:
-                attempt.best_yaw_error = yaw_error
-            elif yaw_error <= attempt.best_yaw_error - PROGRESS_YAW:
-                attempt.best_yaw_error = yaw_error
-                progressed = True
-        if progressed:
-            attempt.last_progress_at = now
+        monitor.observe(now, pose, navigator_distance)
         return []
-
-    @staticmethod
-    def _distance_progressed(
-        attempt: _Attempt, pose: Pose2D, straight: float, navigator_distance: float | None
-    ) -> bool:
-        """Whether the distance to go dropped, judged on the attempt's best measure."""
-        if navigator_distance is not None:
-            measure, distance = _Measure.NAVIGATOR, navigator_distance
-        elif attempt.measure is _Measure.NAVIGATOR:
-            return False  # a pose alone says nothing on the navigator's measure
-        elif attempt.plan is not None:
-            measure = _Measure.PLAN
-            distance = remaining_along_path(attempt.plan, pose.x, pose.y)
-        elif attempt.measure is None or attempt.measure is _Measure.STRAIGHT:
-            measure, distance = _Measure.STRAIGHT, straight
-        else:
-            return False
-        if attempt.measure is None or measure > attempt.measure:
-            # Different measures are not comparable: start afresh on the better one.
-            attempt.measure, attempt.best_distance = measure, distance
-            return False
-        if attempt.best_distance is None:
-            attempt.best_distance = distance
-            return False
-        if distance <= attempt.best_distance - PROGRESS_DISTANCE:
-            attempt.best_distance = distance
-            return True
-        return False
 
     def _emit_progress(
         self,
@@ -968,49 +738,10 @@ class MissionExecutor:
             listener(event)
 
 
-def _check_resume_point(mission: Mission, resume: ResumePoint) -> None:
-    count = len(mission)
-    if not 0 <= resume.index < count:
-        raise NavseqError(
-            f"the journal resumes at waypoint {resume.index + 1}, "
-            f"but the mission has only {count} waypoint(s)",
-            source=mission.source,
-        )
-    if resume.loop < 0 or (mission.loops is not None and resume.loop >= mission.loops):
-        raise NavseqError(
-            f"the journal resumes in loop {resume.loop + 1}, "
-            f"but the mission runs {mission.loops} loop(s)",
-            source=mission.source,
-        )
-    if resume.earlier is not None and resume.earlier.waypoint_count != count:
-        raise NavseqError(
-            f"the journal records a mission of {resume.earlier.waypoint_count} waypoint(s), "
-            f"but the mission has {count}",
-            source=mission.source,
-        )
-    for done in resume.done:
-        if not 0 <= done.index < count:
-            raise NavseqError(
-                f"the journal records waypoint {done.index + 1}, "
-                f"but the mission has only {count} waypoint(s)",
-                source=mission.source,
-            )
-
-
-def _result_for(mission: Mission, done: WaypointResult) -> WaypointResult:
-    """An earlier run's visit, with the waypoint's details taken from the mission."""
-    waypoint = mission.waypoints[done.index]
-    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
-
-
 __all__ = [
-    "ARRIVAL_SLACK_M",
-    "ARRIVAL_SLACK_RAD",
-    "PROGRESS_DISTANCE",
-    "PROGRESS_YAW",
+    "PLAN_TOLERANCE",
     "RETRY_BACKOFF",
     "SERVER_LOST_REASON",
-    "YAW_PROGRESS_RADIUS",
     "ExecutorState",
     "MissionExecutor",
     "MissionListener",

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+from navseq.errors import NavseqError
 from navseq.executor.result import VisitLog, WaypointResult
+from navseq.mission.model import Mission
 
 
 @dataclass(frozen=True)
@@ -28,3 +30,54 @@ class ResumePoint:
     done: tuple[WaypointResult, ...] = field(default=())
     previous_duration: float = 0.0
     earlier: VisitLog | None = None
+
+
+def check_resume_point(mission: Mission, resume: ResumePoint) -> None:
+    """Refuse a resume point that does not fit ``mission`` (a journal of another mission)."""
+    count = len(mission)
+    if not 0 <= resume.index < count:
+        raise NavseqError(
+            f"the journal resumes at waypoint {resume.index + 1}, "
+            f"but the mission has only {count} waypoint(s)",
+            source=mission.source,
+        )
+    if resume.loop < 0 or (mission.loops is not None and resume.loop >= mission.loops):
+        raise NavseqError(
+            f"the journal resumes in loop {resume.loop + 1}, "
+            f"but the mission runs {mission.loops} loop(s)",
+            source=mission.source,
+        )
+    if resume.earlier is not None and resume.earlier.waypoint_count != count:
+        raise NavseqError(
+            f"the journal records a mission of {resume.earlier.waypoint_count} waypoint(s), "
+            f"but the mission has {count}",
+            source=mission.source,
+        )
+    for done in resume.done:
+        if not 0 <= done.index < count:
+            raise NavseqError(
+                f"the journal records waypoint {done.index + 1}, "
+                f"but the mission has only {count} waypoint(s)",
+                source=mission.source,
+            )
+
+
+def visit_log(mission: Mission, resume: ResumePoint | None) -> VisitLog:
+    """The visits finished before this run: none, or the earlier runs' (a fresh copy)."""
+    log = VisitLog(mission.waypoints, mission.loops)
+    if resume is None:
+        return log
+    if resume.earlier is not None:  # a copy: the point may be used again
+        log = resume.earlier.relabelled(mission.waypoints, mission.loops)
+    for done in sorted(resume.done, key=lambda v: (v.loop, v.index)):
+        log.add(_result_for(mission, done))
+    return log
+
+
+def _result_for(mission: Mission, done: WaypointResult) -> WaypointResult:
+    """An earlier run's visit, with the waypoint's details taken from the mission."""
+    waypoint = mission.waypoints[done.index]
+    return replace(done, name=waypoint.name, x=waypoint.x, y=waypoint.y, yaw_rad=waypoint.yaw_rad)
+
+
+__all__ = ["ResumePoint", "check_resume_point", "visit_log"]

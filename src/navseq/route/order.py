@@ -3,7 +3,8 @@
 A travelling-salesman problem over the lengths the robot would drive: the planned path
 between every two waypoints on the robot's costmap (the planner the simulator drives
 with), or straight lines when no map is known. OR-tools' routing solver finds the
-order (a first tour by cheapest arc, then guided local search for ``time_limit_s``).
+order (a first tour by cheapest arc, then guided local search for ``time_limit_s``);
+it comes with the ``navseq[plan]`` extra.
 
 What stays where it is, so that the new order is a mission the user still recognises:
 
@@ -28,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from navseq.errors import NavseqError
+from navseq.extras import require_extra
 
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
@@ -98,6 +100,7 @@ def shortest_order(
 
     ``keep_last``: the file's last waypoint stays last (the robot ends at its dock).
     """
+    require_extra("plan", "the shortest order")
     waypoints = [(w.x, w.y) for w in mission.waypoints]
     if len(waypoints) > MAX_WAYPOINTS:
         raise NavseqError(

@@ -28,6 +28,7 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.extras import MissingExtra
 from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
@@ -634,6 +635,8 @@ def api(handler: Handler) -> Handler:
             response = JSONResponse(error.body, status_code=error.status)
         except DraftRefused as error:
             response = JSONResponse({"error": str(error)}, status_code=400)
+        except MissingExtra as error:  # not the draft's fault: the install lacks a part
+            response = JSONResponse({"error": str(error)}, status_code=501)
         except NavseqError as error:
             problems = problems_of([error])
             response = JSONResponse(
