@@ -157,6 +157,28 @@ def test_outcome_of_a_sink_that_fails_is_exit_2_with_the_report_written(tmp_path
     assert json.loads(outcome.report_path.read_text())["exit_code"] == 2
 
 
+def test_outcome_of_an_interrupted_run_is_128_plus_the_signal_and_the_report_says_so(
+    tmp_path: Path,
+) -> None:
+    from navseq.signals import Terminated
+
+    mission = write_mission(tmp_path / "square.yaml", SQUARE)
+
+    signalled: list[str] = []
+
+    def terminated_after_the_first(event: ev.MissionEvent) -> None:
+        if isinstance(event, ev.WaypointFinished) and not signalled:
+            signalled.append("SIGTERM")
+            raise Terminated("SIGTERM")  # as the guard's handler raises it
+
+    session = prepare(RunRequest(mission, navigator=scripted(), outputs=Outputs(tmp_path / "o")))
+    outcome = session.run([terminated_after_the_first])
+    assert (outcome.exit_status, outcome.interrupted, outcome.error) == (143, "SIGTERM", None)
+    assert outcome.report_path is not None
+    report = json.loads(outcome.report_path.read_text())
+    assert report["exit_code"] == 143 and report["totals"]["reached"] == 1
+
+
 def test_a_face_s_own_navigator_runs_without_files_and_without_signal_handlers(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -301,3 +323,20 @@ def test_the_argparse_check_finds_a_namespace(tmp_path: Path) -> None:
         "import argparse",
         "a Namespace",
     ]
+
+
+def test_the_run_service_keeps_no_mutable_state_at_module_level() -> None:
+    """Sessions share nothing: no module of navseq.run holds a list, dict or set of its own."""
+    mutable = (ast.List, ast.Dict, ast.Set, ast.ListComp, ast.DictComp, ast.SetComp)
+    found = []
+    for path in sorted((SOURCE / "run").glob("*.py")):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
+            if isinstance(value, mutable) and not _is_all(node):
+                found.append(f"{path.name}:{node.lineno}")
+    assert found == []
+
+
+def _is_all(node: ast.stmt) -> bool:
+    targets = node.targets if isinstance(node, ast.Assign) else []
+    return any(isinstance(target, ast.Name) and target.id == "__all__" for target in targets)

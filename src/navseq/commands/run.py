@@ -26,7 +26,7 @@ from navseq.commands.common import (
 from navseq.errors import NavseqError
 from navseq.navigators import registry
 from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
-from navseq.run.request import Outputs, RunRequest
+from navseq.run.request import Loops, Outputs, RunRequest
 from navseq.run.session import prepare
 from navseq.text import printable
 
@@ -202,9 +202,9 @@ def request_of(args: argparse.Namespace) -> RunRequest:
     navigator = None
     if args.navigator is not None:
         navigator = settings_from(navigator_kind(args.navigator), given)
-    loops: int | str | None = None
+    loops: Loops | None = None
     if "loops" in vars(args):  # given on the command line (None = forever)
-        loops = "forever" if args.loops is None else args.loops
+        loops = "forever" if args.loops is None else int(args.loops)
     return RunRequest(
         mission=args.mission,
         navigator=navigator,
@@ -212,7 +212,7 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         map=args.map,
         start=args.start,
         robot=args.robot,
-        loops=loops,  # type: ignore[arg-type]  # parse_loops: an int >= 1 or None
+        loops=loops,
         first=args.from_waypoint,
         last=args.to_waypoint,
         only=args.only,

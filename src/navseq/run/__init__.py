@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from navseq.run.outcome import RunOutcome
 from navseq.run.request import Outputs, RunRequest, UseNavigator
-from navseq.run.session import Session, prepare, run_request
+from navseq.run.session import Session, prepare
 
 __all__ = [
     "Outputs",
@@ -41,5 +41,4 @@ __all__ = [
     "Session",
     "UseNavigator",
     "prepare",
-    "run_request",
 ]

@@ -510,9 +510,4 @@ def _remove_if_unused(folder: Path) -> None:
         pass  # tidying up only
 
 
-def run_request(request: RunRequest, listeners: Iterable[MissionListener] = ()) -> RunOutcome:
-    """``prepare(request).run(listeners)``: one run, no signal handlers touched."""
-    return prepare(request).run(listeners)
-
-
-__all__ = ["NoteSink", "Session", "prepare", "run_request"]
+__all__ = ["NoteSink", "Session", "prepare"]
