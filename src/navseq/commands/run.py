@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -152,8 +152,8 @@ def add_navigator_options(parser: argparse.ArgumentParser) -> None:
             "default": None,
             "help": argparse.SUPPRESS if option.hidden else info.help,
         }
-        if info.parse is not None:
-            kwargs["type"] = _argument_type(info.parse)
+        if info.parse is not None:  # its ValueError: argparse's "invalid float value"
+            kwargs["type"] = info.parse
         if info.metavar is not None:
             kwargs["metavar"] = info.metavar
         if option.hidden:
@@ -172,19 +172,6 @@ def _kinds_title(kinds: tuple[str, ...]) -> str:
     if len(kinds) == 1:
         return f"{kinds[0]} navigator"
     return f"{', '.join(kinds[:-1])} and {kinds[-1]} navigators"
-
-
-def _argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
-    """``parse`` with its ValueError as argparse's usage error (argparse names the type)."""
-
-    def argument(text: str) -> Any:
-        try:
-            return parse(text)
-        except ValueError as error:
-            raise argparse.ArgumentTypeError(str(error) or f"invalid value: {text!r}") from None
-
-    argument.__name__ = getattr(parse, "__name__", "value")
-    return argument
 
 
 def request_of(args: argparse.Namespace) -> RunRequest:

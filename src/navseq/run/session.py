@@ -121,7 +121,7 @@ class Session:
         if outputs is None:
             for note in self.notes:
                 say(note)
-            ran = self._drive(face, control, guard, journal=None, recorder=None)
+            ran = self._drive(face, control, guard, lambda: None, recorder=None)
             return RunOutcome(
                 ran.result,
                 ran.exit_status,
@@ -193,8 +193,15 @@ class Session:
                 say(note)
             if outputs.picture is not False:
                 import_picture_modules()
-            journal = fresh if fresh is not None else self._continued_journal(journal_path)
-            ran = self._drive(face, control, guard, journal, self._new_recorder())
+            ran = self._drive(
+                face,
+                control,
+                guard,
+                # A resumed journal is continued once the navigator is there: a stack that
+                # does not answer leaves the journal as it was.
+                lambda: fresh if fresh is not None else self._continued_journal(journal_path),
+                self._new_recorder(),
+            )
         except BaseException:
             # No result to report (e.g. no navigation server, or a signal before the run
             # began): leave no journal of nothing behind.
@@ -260,7 +267,7 @@ class Session:
         face: list[MissionListener],
         control: MissionControl | None,
         guard: SignalGuard,
-        journal: JournalWriter | None,
+        open_journal: Callable[[], JournalWriter | None],
         recorder: RunRecorder | None,
     ) -> _Ran:
         """Run the mission; from the moment it ends, shutdown signals are only counted."""
@@ -270,8 +277,9 @@ class Session:
         navigator = self.make_navigator()
         error: NavseqError | None = None
         navigator_start, wall_start = navigator.now(), time.monotonic()
-        mine = [sink for sink in (journal, recorder) if sink is not None]
         try:
+            journal = open_journal()
+            mine = [sink for sink in (journal, recorder) if sink is not None]
             with contextlib.ExitStack() as entered:
                 for listener in face:
                     if isinstance(listener, contextlib.AbstractContextManager):
