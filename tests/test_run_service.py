@@ -201,6 +201,28 @@ def test_a_face_s_own_navigator_runs_without_files_and_without_signal_handlers(
     assert len(navigator.sent_goals) == 2  # driven through the face's navigator
 
 
+def test_a_node_may_ask_for_the_report_and_picture_of_its_own_navigator_s_run(
+    tmp_path: Path,
+) -> None:
+    """No journal (the mission came from parameters, not a file), but report and picture."""
+    mission = Mission((Waypoint(1.0, 0.0, name="a"),), source="param ~p_seq")
+    request = RunRequest(
+        mission,
+        navigator=UseNavigator(ScriptedNavigator(), {"kind": "ros1", "action": "move_base"}),
+        outputs=Outputs(tmp_path / "out", journal=False),
+    )
+    outcome = prepare(request).run()
+    assert outcome.exit_status == 0 and outcome.journal_path is None
+    assert sorted(path.name for path in (tmp_path / "out").iterdir()) == [
+        "mission.png",
+        "report.json",
+    ]
+    assert outcome.report_path is not None
+    report = json.loads(outcome.report_path.read_text())
+    assert report["navigator"] == {"kind": "ros1", "action": "move_base"}
+    assert "journal" not in report["files"]
+
+
 # -- resume -----------------------------------------------------------------------------
 
 
