@@ -122,8 +122,11 @@ def test_a_start_pose_is_refused_for_a_robot_that_is_where_it_is(tmp_path: Path)
 def test_outcome_all_reached_is_exit_0_with_the_files_it_names(tmp_path: Path) -> None:
     mission = write_mission(tmp_path / "square.yaml", SQUARE)
     out = tmp_path / "out"
-    outcome = prepare(RunRequest(mission, navigator=scripted(), outputs=Outputs(out))).run()
+    session = prepare(RunRequest(mission, navigator=scripted(), outputs=Outputs(out)))
+    outcome = session.run()
     assert outcome.exit_status == 0 and outcome.result.success and outcome.error is None
+    with pytest.raises(RuntimeError, match="runs once"):
+        session.run()
     assert outcome.folder == out and outcome.not_written == {}
     assert outcome.report_path == out / "report.json"
     assert outcome.picture_path == out / "mission.png" and outcome.picture_path.exists()

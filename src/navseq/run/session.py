@@ -86,6 +86,8 @@ class Session:
     part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
+    # A navigator is made ready for one run (a ROS connection is closed after it).
+    _started: bool = field(default=False, init=False, repr=False)
 
     @property
     def numbers(self) -> list[int] | None:
@@ -114,6 +116,9 @@ class Session:
         """
         from navseq.signals import SignalGuard
 
+        if self._started:
+            raise RuntimeError("a Session runs once: prepare a new one to run again")
+        self._started = True
         guard = signals if signals is not None else SignalGuard(install=False)
         say = on_note if on_note is not None else _ignore
         face = list(listeners)
