@@ -155,8 +155,7 @@ def test_sigint_ends_a_forever_patrol_with_exit_130_and_an_interrupted_report(tm
 def test_a_sim_run_inflates_the_map_once_for_preflight_and_navigation(tmp_path, monkeypatch):
     """Inflating a large map is the slow part of start-up: pre-flight and the simulated
     navigation server share one costmap."""
-    from navseq.cli import build_parser
-    from navseq.commands.run import prepare
+    from navseq.run import RunRequest, prepare
     from navseq.sim import costmap as costmap_module
 
     inflated = []
@@ -167,7 +166,7 @@ def test_a_sim_run_inflates_the_map_once_for_preflight_and_navigation(tmp_path, 
         return real_inflate(grid, params)
 
     monkeypatch.setattr(costmap_module, "inflate", counting_inflate)
-    setup = prepare(build_parser().parse_args(["run", str(arena_mission(tmp_path))]))
+    setup = prepare(RunRequest(arena_mission(tmp_path)))
     navigator = setup.make_navigator()
     assert len(inflated) == 1
     assert navigator.world.server.costmap.grid is setup.grid

@@ -154,13 +154,13 @@ def test_a_changed_outcome_in_a_journal_line_is_refused(tmp_path):
 
 def test_lock_refusal_names_the_holder(tmp_path):
     from navseq.errors import NavseqError
-    from navseq.runlock import RunLock
+    from navseq.run.runlock import RunLock
 
     holder = subprocess.Popen(
         [
             os.sys.executable,
             "-c",
-            "import sys, time; from pathlib import Path; from navseq.runlock import RunLock; "
+            "import sys, time; from pathlib import Path; from navseq.run.runlock import RunLock; "
             "RunLock(Path(sys.argv[1])).acquire(); print('held', flush=True); time.sleep(30)",
             str(tmp_path),
         ],
@@ -193,6 +193,7 @@ def test_the_journal_has_its_header_before_the_slow_first_steps(tmp_path, monkey
 
     from navseq import cli
     from navseq.commands import run as run_command
+    from navseq.run import products
 
     mission = write_mission(tmp_path / "patrol.yaml", PATROL)
     out, killed, connecting = tmp_path / "out", tmp_path / "killed", tmp_path / "connecting"
@@ -201,13 +202,13 @@ def test_the_journal_has_its_header_before_the_slow_first_steps(tmp_path, monkey
     def snapshot_as_if_killed_here() -> None:
         shutil.copytree(out, killed)  # what a kill -9 at this moment would leave
 
-    def prepare(args: Any) -> Any:
-        setup = real_prepare(args)
-        make = setup.make_navigator
-        setup.make_navigator = lambda: (shutil.copytree(out, connecting), make())[1]
-        return setup
+    def prepare(request: Any) -> Any:
+        session = real_prepare(request)
+        make = session.make_navigator
+        session.make_navigator = lambda: (shutil.copytree(out, connecting), make())[1]
+        return session
 
-    monkeypatch.setattr(run_command, "_import_picture_modules", snapshot_as_if_killed_here)
+    monkeypatch.setattr(products, "import_picture_modules", snapshot_as_if_killed_here)
     monkeypatch.setattr(run_command, "prepare", prepare)
     assert cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)]) == 0
     monkeypatch.undo()
@@ -223,13 +224,13 @@ def test_the_journal_has_its_header_before_the_slow_first_steps(tmp_path, monkey
 
 def test_a_signal_before_the_run_began_leaves_no_journal_behind(tmp_path, monkeypatch, capsys):
     from navseq import cli
-    from navseq.commands import run as run_command
+    from navseq.run import products
     from navseq.signals import Terminated
 
     def terminated() -> None:
         raise Terminated("SIGTERM")
 
-    monkeypatch.setattr(run_command, "_import_picture_modules", terminated)
+    monkeypatch.setattr(products, "import_picture_modules", terminated)
     mission = write_mission(tmp_path / "patrol.yaml", PATROL)
     out = tmp_path / "out"
     assert cli.main(["run", str(mission), "--navigator", "scripted", "--out", str(out)]) == 143

@@ -398,7 +398,7 @@ def test_only_stale_temporaries_of_our_own_outputs_are_removed(tmp_path: Path) -
     import fcntl
     import os
 
-    from navseq.commands.run_outputs import remove_stale_temporaries
+    from navseq.run.files import remove_stale_temporaries
 
     stale = [
         ".report.json.0123abcd.tmp",

@@ -29,6 +29,7 @@ from navseq.mission.robot import RobotProfile
 if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.navigators.sim import SimNavigator
+    from navseq.run import RunRequest, UseNavigator
 
 #: A path given as text or as a :class:`~pathlib.Path`.
 PathLike = str | os.PathLike[str]
@@ -75,7 +76,7 @@ def load_mission(path: PathLike) -> Mission:
     Raises :class:`~navseq.errors.NavseqError` naming the file, line and field of
     every problem (:class:`~navseq.errors.MissionErrors` when there are several).
     """
-    from navseq.commands.common import require_file
+    from navseq.files import require_file
     from navseq.mission.loader import load_mission as load
 
     path = Path(path)
@@ -97,8 +98,8 @@ def validate_file(
     ``robot:``, else the TurtleBot3 burger). ``start`` (default: the mission's
     ``start:``) is checked too.
     """
-    from navseq.commands.common import require_file
     from navseq.commands.validate import mission_file_problems
+    from navseq.files import require_file
 
     try:
         require_file(Path(path), "mission")
@@ -127,7 +128,8 @@ def check_mission(
     fit, or that cannot be reached from the one before is a problem. ``robot`` and
     ``start`` default to the mission's.
     """
-    from navseq.commands.common import choose_robot, costmap_for_map, preflight_errors
+    from navseq.commands.common import costmap_for_map, preflight_errors
+    from navseq.mission.robot_format import choose_robot
 
     map_path = Path(map) if map is not None else mission.map
     if map_path is None:
@@ -158,7 +160,8 @@ def order_waypoints(
     solver searches for ``time_limit_s``; an order no shorter than the mission's own
     leaves it as it is.
     """
-    from navseq.commands.common import choose_robot, legs_on_map
+    from navseq.commands.common import legs_on_map
+    from navseq.mission.robot_format import choose_robot
     from navseq.route.legs import lengths
     from navseq.route.order import shortest_order
 
@@ -166,6 +169,31 @@ def order_waypoints(
     legs = legs_on_map(map_path, choose_robot(robot, mission))
     ordering = shortest_order(mission, lengths(legs), time_limit_s, keep_last=keep_last)
     return ordering.apply(mission)
+
+
+def _no_files_request(
+    mission: Mission,
+    *,
+    navigator: UseNavigator | None = None,
+    map: PathLike | None = None,
+    start: Pose2D | None = None,
+    robot: RobotLike | None = None,
+    preflight: bool = True,
+    server_wait_s: float = 10.0,
+) -> RunRequest:
+    """The run service's request for a run of the API's: it writes no files."""
+    from navseq.run import RunRequest
+
+    return RunRequest(
+        mission=mission,
+        navigator=navigator,
+        map=Path(map) if map is not None else None,
+        start=start,
+        robot=robot,
+        preflight=preflight,
+        outputs=None,
+        server_wait=server_wait_s,
+    )
 
 
 def sim_navigator(
@@ -184,21 +212,44 @@ def sim_navigator(
     checked against the map first and every problem is raised together as
     :class:`~navseq.errors.MissionErrors` before anything moves.
     """
-    from navseq.commands.common import choose_robot
     from navseq.navigators.sim import SimNavigator
-    from navseq.sim.occupancy import load_map
-    from navseq.simrun import prepare_sim_world
+    from navseq.run import prepare
 
-    map_path = Path(map) if map is not None else mission.map
-    if map_path is None:
-        raise NavseqError(
-            "the simulator needs a map: pass map= or give the mission a map:",
-            source=mission.source,
-        )
-    profile = choose_robot(robot, mission)
-    start = start if start is not None else mission.start
-    ready = prepare_sim_world(mission, load_map(map_path), start, profile, preflight=preflight)
-    return SimNavigator(ready.world)
+    request = _no_files_request(mission, map=map, start=start, robot=robot, preflight=preflight)
+    navigator = prepare(request).make_navigator()
+    assert isinstance(navigator, SimNavigator)
+    return navigator
+
+
+def _run_in_service(request: RunRequest, on_event: EventCallback | None) -> MissionResult:
+    """Prepare and run ``request`` with the process's signal handling (the main thread's:
+    SIGINT, SIGTERM and SIGHUP stop the robot, then raise MissionInterrupted)."""
+    from navseq.executor.runner import MissionInterrupted
+    from navseq.run import prepare
+    from navseq.signals import SignalGuard
+
+    session = prepare(request)
+    listeners = [] if on_event is None else [_EventCallback(on_event)]
+    guard = SignalGuard()
+    try:
+        outcome = session.run(listeners, signals=guard)
+    finally:
+        guard.restore()
+    if outcome.interrupted is not None:
+        raise MissionInterrupted(outcome.interrupted, outcome.result)
+    if outcome.stopped_by is not None:
+        raise outcome.stopped_by
+    return outcome.result
+
+
+class _EventCallback:
+    """A mission listener calling the user's ``on_event`` (whatever it returns)."""
+
+    def __init__(self, on_event: EventCallback) -> None:
+        self.on_event = on_event
+
+    def __call__(self, event: MissionEvent) -> None:
+        self.on_event(event)
 
 
 def run_mission(
@@ -218,21 +269,14 @@ def run_mission(
     propagates. ``robot`` gives the arrival check's goal tolerance (default: the
     mission's ``robot:``). The navigator is not closed: call its ``close()``.
     """
-    from navseq.commands.common import choose_robot
-    from navseq.executor.runner import run_mission as run
+    from navseq.run import UseNavigator
 
-    def listener(event: MissionEvent) -> None:
-        if on_event is not None:
-            on_event(event)
-
-    listeners = [listener] if on_event is not None else []
-    return run(
-        mission,
-        navigator,
-        listeners,
-        robot=choose_robot(robot, mission),
-        server_wait=server_wait_s,
+    given = UseNavigator(navigator, {"kind": type(navigator).__name__})
+    # No pre-flight: the navigator is the caller's, and so is its map.
+    request = _no_files_request(
+        mission, navigator=given, robot=robot, preflight=False, server_wait_s=server_wait_s
     )
+    return _run_in_service(request, on_event)
 
 
 def simulate(
@@ -246,15 +290,11 @@ def simulate(
 ) -> MissionResult:
     """Run ``mission`` on the embedded simulator and return the result.
 
-    :func:`sim_navigator` then :func:`run_mission`: the same simulator, pre-flight
-    check and executor as ``navseq run``, in simulated time (as fast as the CPU goes).
-    Writes no files.
+    The run service's run, as ``navseq run`` makes it: the same simulator, pre-flight
+    check and executor, in simulated time (as fast as the CPU goes). Writes no files.
     """
-    navigator = sim_navigator(mission, map=map, start=start, robot=robot, preflight=preflight)
-    try:
-        return run_mission(mission, navigator, on_event=on_event, robot=robot)
-    finally:
-        navigator.close()
+    request = _no_files_request(mission, map=map, start=start, robot=robot, preflight=preflight)
+    return _run_in_service(request, on_event)
 
 
 class MissionRun:
@@ -281,7 +321,7 @@ class MissionRun:
         robot: RobotLike | None = None,
         server_wait_s: float = 10.0,
     ) -> None:
-        from navseq.commands.common import choose_robot
+        from navseq.mission.robot_format import choose_robot
 
         self.mission = mission
         self.navigator = navigator

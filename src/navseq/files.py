@@ -181,6 +181,26 @@ def read_input_bytes(
     return data
 
 
+def require_file(path: Path, what: str) -> None:
+    """A clear NavseqError unless ``path``, given by the user as ``what``, is a regular file.
+
+    A FIFO or a device would hang or never end when read, so they are refused here,
+    before anything opens them.
+    """
+    shown = printable(str(path))
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise NavseqError(f"no such file: {shown}", source=what) from None
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the name
+        reason = error.strerror if isinstance(error, OSError) else "not a valid file name"
+        raise NavseqError(f"cannot read {shown}: {reason or error}", source=what) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise NavseqError(f"{shown} is a directory, not a file", source=what)
+    if not stat.S_ISREG(info.st_mode):
+        raise NavseqError(f"{shown} is not a regular file (a device, pipe or socket?)", source=what)
+
+
 def limit_from_environment(variable: str, default: int) -> int:
     """A positive whole-number limit that the environment variable ``variable`` may raise."""
     written = os.environ.get(variable, "").strip()

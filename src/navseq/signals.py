@@ -13,7 +13,9 @@ before it raises, so a second signal that follows at once finds no gap. *Deferri
 signals are only counted; an operator who insists (signals twice more) may give up a
 step that may be given up, such as drawing the picture (:meth:`SignalGuard.abortable`),
 never the report. :meth:`SignalGuard.restore` puts the original handlers back.
-Handlers can only be set in the main thread; elsewhere the guard does nothing.
+Handlers can only be set in the main thread; elsewhere the guard does nothing, and a
+guard made with ``install=False`` never sets any (a run hosted by a library, a fleet or
+a worker thread: signals are the host's business there).
 """
 
 from __future__ import annotations
@@ -44,10 +46,12 @@ class StepAbandoned(Exception):
 class SignalGuard:
     """The run's handling of SIGINT, SIGTERM and SIGHUP; see the module docstring.
 
-    ``received`` lists the names of the signals that arrived, in order.
+    ``received`` lists the names of the signals that arrived, in order. With
+    ``install=False`` the guard touches no handler at all.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, *, install: bool = True) -> None:
+        self.install = install
         self.received: list[str] = []
         self._original: dict[int, Any] = {}
         self._abort_at: int | None = None
@@ -83,7 +87,7 @@ class SignalGuard:
             self._abort_at = None
 
     def _save_originals(self) -> bool:
-        if threading.current_thread() is not threading.main_thread():
+        if not self.install or threading.current_thread() is not threading.main_thread():
             return False
         if not self._original:
             self._original = {signum: signal.getsignal(signum) for signum in SHUTDOWN_SIGNALS}

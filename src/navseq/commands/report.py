@@ -44,7 +44,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import require_file
-    from navseq.runlock import RunLock
+    from navseq.run.runlock import RunLock
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
     if args.run.is_dir() and not journal.exists():
@@ -86,10 +86,10 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     that a long journal is not read twice. The caller holds the folder's run lock;
     temporaries a killed run left there are removed.
     """
-    from navseq.commands.run_outputs import output_error, remove_stale_temporaries
     from navseq.files import write_atomically
     from navseq.journal.writer import read_journal
     from navseq.mission.part import number_visits
+    from navseq.run.files import output_error, remove_stale_temporaries
     from navseq.sinks.report import report_json
 
     if state is None or state.path != journal or not state.is_current():

@@ -25,7 +25,7 @@ from __future__ import annotations
 import functools
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
 from navseq.mission import fields
@@ -40,6 +40,9 @@ from navseq.mission.robot import (
     circle_footprint,
 )
 from navseq.mission.yaml_doc import parse_yaml
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
 
 # file key -> (RobotProfile field, unit shown in messages, factor from file to profile units)
 _NUMBER_KEYS: dict[str, tuple[str, str, float]] = {
@@ -161,6 +164,22 @@ def robot_from_option(text: str) -> RobotProfile:
             source="--robot",
         )
     return read_robot_file(path)
+
+
+def choose_robot(option: str | RobotProfile | None, mission: Mission | None) -> RobotProfile:
+    """The robot to plan and check for: ``--robot`` > the mission's ``robot:`` > default.
+
+    ``--robot`` (a built-in name or a file) is read here, not by argparse, so that a bad
+    name or file is one NavseqError (exit 2) like every other input problem. The Python
+    API may pass a :class:`RobotProfile` itself.
+    """
+    if isinstance(option, RobotProfile):
+        return option
+    if option is not None:
+        return robot_from_option(option)
+    if mission is not None and mission.robot is not None:
+        return mission.robot
+    return DEFAULT_PROFILE
 
 
 def read_robot_file(path: Path) -> RobotProfile:
@@ -288,4 +307,11 @@ def _encloses_origin(points: list[tuple[float, float]]) -> bool:
     return inside and abs(area) > 1e-12
 
 
-__all__ = ["ROBOT_KEYS", "builtin_profile", "read_robot", "read_robot_file", "robot_from_option"]
+__all__ = [
+    "ROBOT_KEYS",
+    "builtin_profile",
+    "choose_robot",
+    "read_robot",
+    "read_robot_file",
+    "robot_from_option",
+]

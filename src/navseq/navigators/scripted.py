@@ -23,7 +23,6 @@ so that simulated time runs at that multiple of wall time (for signal tests).
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import time
@@ -44,6 +43,7 @@ from navseq.navigators.base import (
     ServerLost,
 )
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.navigators.settings import ScriptedNavigatorSettings
 
 
 @dataclass(frozen=True)
@@ -320,23 +320,23 @@ def behaviours_of(script: str) -> list[Behaviour]:
     return behaviours
 
 
-def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
-    """``navseq run --navigator scripted`` (hidden): the double, for the CLI's tests."""
+def create(settings: ScriptedNavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
+    """The ``scripted`` kind (hidden from ``--help``): the double, for the CLI's tests."""
     grid = draft.optional_map()
     start = draft.start
 
     def make_navigator() -> ScriptedNavigator:
         return ScriptedNavigator(
-            behaviours_of(args.scripted_script),
+            behaviours_of(settings.scripted_script),
             start=start,
-            speed=args.scripted_speed,
-            realtime=args.scripted_realtime,
-            log_path=args.scripted_log,
+            speed=settings.scripted_speed,
+            realtime=settings.scripted_realtime,
+            log_path=settings.scripted_log,
         )
 
     return NavigatorSetup(
         make_navigator=make_navigator,
-        info={"kind": "scripted", "speed": args.scripted_speed},
+        info={"kind": "scripted", "speed": settings.scripted_speed},
         grid=grid,
     )
 

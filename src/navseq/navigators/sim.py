@@ -17,11 +17,12 @@ Events follow what an actionlib client of move_base would see:
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from navseq.geometry import Pose2D
 from navseq.navigators.base import (
@@ -33,10 +34,16 @@ from navseq.navigators.base import (
     NavEvent,
 )
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.navigators.settings import SimNavigatorSettings
 from navseq.sim.navserver import NavParams, NavState
 from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
 from navseq.track import Track
+
+if TYPE_CHECKING:
+    from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
+    from navseq.sim.occupancy import OccupancyGrid
 
 # The simulated server plays move_base, so its results carry actionlib's status names.
 _SUCCEEDED, _ABORTED, _PREEMPTED = "SUCCEEDED", "ABORTED", "PREEMPTED"
@@ -197,24 +204,74 @@ class SimNavigator:
             )
 
 
-def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
-    """``navseq run --navigator sim``: the simulated world on the mission's map.
+@dataclass(frozen=True)
+class SimReady:
+    """A simulated world for a mission, and where its robot starts."""
+
+    world: SimWorld
+    start: Pose2D
+    start_defaulted: bool  # True: no start was given, the simulator chose ``start``
+
+
+def prepare_sim_world(
+    mission: Mission,
+    grid: OccupancyGrid,
+    start: Pose2D | None,
+    robot: RobotProfile,
+    *,
+    preflight: bool = True,
+    numbers: Sequence[int] | None = None,
+) -> SimReady:
+    """The simulated world for ``mission`` on ``grid`` with ``robot``.
+
+    ``start`` None puts the robot at the roomy point nearest the map origin. With
+    ``preflight``, every waypoint is checked against the costmap first and all problems
+    are raised together as :class:`~navseq.errors.MissionErrors`, naming waypoints by
+    ``numbers`` (their numbers in the file, when ``mission`` is a part of it). One
+    costmap serves pre-flight and the simulated navigation server alike, and pre-flight
+    comes before the world is built: it lists every problem at once, where building
+    the world would stop at the first (a start inside an obstacle).
+    """
+    from navseq.errors import MissionErrors
+    from navseq.preflight import check_mission
+    from navseq.sim.costmap import Costmap
+    from navseq.sim.profile import SimSettings
+
+    settings = SimSettings.of(robot)
+    defaulted = start is None
+    if start is None:
+        start = default_start(grid, settings.footprint)
+    costmap = Costmap.from_grid(grid, settings.costmap_params)
+    if preflight:
+        problems = check_mission(mission, costmap, start, numbers=numbers, robot=robot)
+        if problems:
+            raise MissionErrors(problems)
+    world = SimWorld(
+        grid,
+        start,
+        costmap=costmap,
+        nav_params=settings.nav_params,
+        footprint=settings.footprint,
+    )
+    return SimReady(world, start, defaulted)
+
+
+def create(settings: SimNavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
+    """The ``sim`` kind: the simulated world on the mission's map, paced at ``draft.realtime``.
 
     With no start pose given, the robot starts at the roomy point nearest the map
     origin (said in a note). One costmap serves pre-flight and the simulated server.
     """
-    from navseq.commands.common import format_pose
     from navseq.errors import NavseqError
-    from navseq.simrun import prepare_sim_world
+    from navseq.run.values import format_pose
 
     if draft.map_path is None:
         raise NavseqError(
-            "the simulator needs a map: give --map MAP.yaml or a map: key in the mission",
+            "the simulator needs a map: give --map MAP.yaml (map= in the Python API) or a "
+            "map: key in the mission",
             source=draft.mission.source,
         )
     grid = load_map(draft.map_path)
-    # The same preparation as the Python API's simulate(): default start, pre-flight on
-    # the one costmap the simulated server also uses, the world.
     ready = prepare_sim_world(
         draft.mission,
         grid,
@@ -232,7 +289,7 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
             f"{format_pose(ready.start)}, the roomy point nearest the map origin"
         )
     world = ready.world
-    realtime = getattr(args, "realtime", None)
+    realtime = draft.realtime
     return NavigatorSetup(
         make_navigator=lambda: SimNavigator(world, realtime=realtime),
         info={"kind": "sim", "robot": draft.robot.name},

@@ -13,7 +13,6 @@ robot's namespace, else ``/map``: :mod:`navseq.navigators.stack_map`), read by
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -26,6 +25,7 @@ from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.navigators.settings import Ros1NavigatorSettings, with_defaults
 from navseq.navigators.stack_map import (
     GRAPH_LOOK,
     MAP_TOPIC,
@@ -135,26 +135,29 @@ def connect_for_run(
     return Ros1Connection(navigator, topics, robot, note)
 
 
-def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
-    """``navseq run --navigator ros1``: the connection, then pre-flight on a known map.
+def create(settings: Ros1NavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
+    """The ``ros1`` kind: the connection, then pre-flight on a known map.
 
     Before anything is written the server must answer and its clock run; the robot
     comes from move_base's parameters unless the user named one (``--robot`` or the
     mission's ``robot:``), and pre-flight then checks against the stack's own robot.
     """
     mission = draft.mission
-    frame = args.frame or mission.frame
-    map_wait = map_wait_setting(args.map_wait)
+    settings = with_defaults(settings)
+    assert settings.action is not None and settings.ns is not None
+    assert settings.settle is not None
+    frame = settings.frame or mission.frame
+    map_wait = map_wait_setting(settings.map_wait)
     connection = connect_for_run(
         mission,
-        action=args.action,
+        action=settings.action,
         frame=frame,
-        namespace=args.ns,
-        settle=args.settle,
-        read_robot=getattr(args, "robot", None) is None and mission.robot is None,
+        namespace=settings.ns,
+        settle=settings.settle,
+        read_robot=not draft.robot_given,
     )
-    info: dict[str, object] = {"kind": "ros1", "action": args.action, "frame": frame}
-    info["ns"] = args.ns
+    info: dict[str, object] = {"kind": "ros1", "action": settings.action, "frame": frame}
+    info["ns"] = settings.ns
     notes = []
     if connection.robot is not None and connection.robot_note is not None:
         draft.robot = connection.robot
@@ -165,7 +168,7 @@ def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
         grid = draft.optional_map()
         if draft.map_path is None:
             # No map file: the one the stack latches, checked for the robot it drives.
-            topics = map_topics(own_map_topic(args.ns))
+            topics = map_topics(own_map_topic(settings.ns))
             used = preflight_on_stack_map(draft, read_stack_map, topics, frame or "map", map_wait)
             grid = used.grid
             info["map_source"] = used.source

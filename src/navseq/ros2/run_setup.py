@@ -17,10 +17,9 @@ This module imports rclpy (through the navigator): the registry imports it only 
 
 from __future__ import annotations
 
-import argparse
-
 from navseq.errors import NavseqError
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
+from navseq.navigators.settings import Nav2NavigatorSettings, with_defaults
 from navseq.navigators.stack_map import (
     MAP_TOPIC,
     map_topics,
@@ -46,28 +45,30 @@ def sim_time_setting(text: str) -> bool | None:
     raise NavseqError(f"expected auto, true or false, not {text!r}", source="--use-sim-time")
 
 
-def create(args: argparse.Namespace, draft: NavigatorDraft) -> NavigatorSetup:
-    """The connection, then pre-flight on a known map; NavseqError on any problem."""
+def create(settings: Nav2NavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
+    """The ``nav2`` kind: the connection, then pre-flight on a known map; NavseqError on
+    any problem."""
     mission = draft.mission
-    frame = args.frame or mission.frame
-    namespace = namespace_of(args.ns or "")
-    use_sim_time = sim_time_setting(args.use_sim_time)
-    server_timeout = float(args.server_timeout)
+    settings = with_defaults(settings)
+    frame = settings.frame or mission.frame
+    namespace = namespace_of(settings.ns or "")
+    use_sim_time = sim_time_setting(str(settings.use_sim_time))
+    server_timeout = float(settings.server_timeout)
     if not 0.0 < server_timeout < float("inf"):
         raise NavseqError(
-            f"must be > 0 seconds, not {args.server_timeout}", source="--server-timeout"
+            f"must be > 0 seconds, not {settings.server_timeout}", source="--server-timeout"
         )
-    action = args.action
+    action = settings.action
     if not action or any(c.isspace() for c in action):
         raise NavseqError(f"{action!r} is not an action name", source="--action")
-    map_wait = map_wait_setting(args.map_wait)
+    map_wait = map_wait_setting(settings.map_wait)
     navigator = Nav2Navigator(action, frame, namespace=namespace, use_sim_time=use_sim_time)
     notes = []
     robot_source = None
     map_source = None
     try:
         navigator.require_server(server_timeout)
-        if getattr(args, "robot", None) is None and mission.robot is None:
+        if not draft.robot_given:
             # The robot Nav2 drives, as its own parameters say, unless the user named one:
             # its goal checker's tolerance is the one arrival is judged by.
             params = navigator.read_parameters(NODES)

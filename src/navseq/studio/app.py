@@ -476,7 +476,7 @@ class Studio:
         return replay_of(folder, roots.relative(folder), self.base_dir, may_read=roots.contains)
 
     def start_run(self, body: dict[str, Any]) -> dict[str, Any]:
-        from navseq.studio.runs import RunRequest, StudioRun
+        from navseq.studio.runs import StudioRun, StudioRunOrder
 
         realtime = body.get("realtime")
         if realtime is not None and not (
@@ -502,7 +502,7 @@ class Studio:
         assert checked.mission is not None
         stem = self.config.mission_path.stem if self.config.mission_path else "mission"
         run = StudioRun(
-            RunRequest(checked.mission, stem, None if realtime is None else float(realtime)),
+            StudioRunOrder(checked.mission, stem, None if realtime is None else float(realtime)),
             self.config.out_base,
         )
         run.start()  # NavseqError (pre-flight problems) -> 422 with them

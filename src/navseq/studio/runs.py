@@ -1,10 +1,11 @@
 """A mission run on the embedded simulator from the studio, in a thread, watched live.
 
 The run is ``navseq run``'s own: the draft is written by the mission writer into a new
-output folder (``navseq-out/<mission>-<time>/``, like ``navseq run``'s), then
-:func:`navseq.commands.run.prepare` and :func:`~navseq.commands.run.execute` run it
-with their journal, progress, report and picture, so the folder is the one the CLI
-leaves and ``navseq run --resume`` / ``navseq report`` work on it. The studio adds a
+output folder (``navseq-out/<mission>-<time>/``, like ``navseq run``'s), then the run
+service (:mod:`navseq.run`) prepares and runs a :class:`~navseq.run.request.RunRequest`
+for it, with its journal, report and picture, so the folder is the one the CLI leaves
+and ``navseq run --resume`` / ``navseq report`` work on it. The run's thread is not the
+main thread: it asks for no signal handling (the studio's server has its own). The studio adds a
 mission listener (:class:`LiveView`) that folds the mission events into what the page
 draws, and a :class:`~navseq.executor.control.MissionControl` through which the page's
 stop, pause and skip reach the run's thread as executor inputs (stop cancels the goal,
@@ -13,7 +14,6 @@ as Ctrl-C does).
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import json
 import math
@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from navseq.executor.events import MissionEvent
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
+    from navseq.run.session import Session
 
 #: Trail points kept for the page (older ones are thinned to every other one).
 MAX_TRAIL_POINTS = 4000
@@ -38,7 +39,7 @@ TRAIL_STEP_M = 0.02
 
 
 @dataclass(frozen=True)
-class RunRequest:
+class StudioRunOrder:
     """What the page asked to run: the checked mission and the pace."""
 
     mission: Mission
@@ -180,75 +181,72 @@ class LiveView:
 class StudioRun:
     """One run: its thread, its control mailbox and its live view."""
 
-    def __init__(self, request: RunRequest, out_base: Path) -> None:
+    def __init__(self, order: StudioRunOrder, out_base: Path) -> None:
         from navseq.executor.control import MissionControl
 
-        self.request = request
+        self.order = order
         self.out_base = out_base
         self.control: MissionControl = MissionControl()
-        robot = request.mission.robot
+        robot = order.mission.robot
         from navseq.mission.robot import DEFAULT_PROFILE
 
         footprint = [(float(x), float(y)) for x, y in (robot or DEFAULT_PROFILE).footprint]
-        self.view = LiveView(len(request.mission.waypoints), footprint)
+        self.view = LiveView(len(order.mission.waypoints), footprint)
         self._thread: threading.Thread | None = None
         self.folder: Path | None = None
         self.stop_requested = False
 
     def start(self) -> None:
         """Prepare as ``navseq run`` does (raises NavseqError), then run in a thread."""
-        from navseq.commands import run as run_command
-
-        setup, args = self._prepare(run_command)
-        self._thread = threading.Thread(
-            target=self._run, args=(run_command, setup, args), name="navseq-studio-run"
-        )
+        session = self._prepare()
+        self._thread = threading.Thread(target=self._run, args=(session,), name="navseq-studio-run")
         self._thread.start()
 
-    def _prepare(self, run_command: Any) -> tuple[Any, argparse.Namespace]:
-        from navseq.commands.output import create_run_folder, default_run_folder
+    def _prepare(self) -> Session:
         from navseq.mission.writer import write_mission
+        from navseq.run import Outputs, RunRequest, prepare
+        from navseq.run.folder import create_run_folder, default_run_folder
 
-        folder = create_run_folder(
-            self.out_base / default_run_folder(self.request.stem), fresh=True
-        )
-        mission_file = folder / f"{self.request.stem}.yaml"
+        stem = self.order.stem
+        folder = create_run_folder(self.out_base / default_run_folder(stem), fresh=True)
+        mission_file = folder / f"{stem}.yaml"
         try:
-            # The mission as run, beside its journal: --resume and `navseq report` need it.
-            write_mission(self.request.mission, mission_file)
-            parser = argparse.ArgumentParser(prog="navseq run")
-            run_command.configure(parser)
-            argv = [str(mission_file), "--out", str(folder)]
-            if self.request.realtime is not None:
-                argv += ["--realtime", repr(self.request.realtime)]
-            args = parser.parse_args(argv)
-            setup = run_command.prepare(args)
+            # The mission as run, beside its journal: a resume and `navseq report` need it.
+            write_mission(self.order.mission, mission_file)
+            session = prepare(
+                RunRequest(
+                    mission=mission_file,
+                    outputs=Outputs(folder=folder),
+                    realtime=self.order.realtime,
+                )
+            )
         except BaseException:
             mission_file.unlink(missing_ok=True)
             with contextlib.suppress(OSError):
                 folder.rmdir()
             raise
-        setup.control = self.control
-        setup.listeners.append(self.view)
-        make_navigator = setup.make_navigator
+        make_navigator = session.make_navigator
 
         def watched_navigator() -> Navigator:
             navigator = make_navigator()
             self.view.navigator = navigator
             return navigator
 
-        setup.make_navigator = watched_navigator
+        session.make_navigator = watched_navigator
         self.folder = folder
         # Shown as navseq run says it: relative to where the studio was started.
         self.view.folder = os.path.relpath(folder, self.out_base)
-        return setup, args
+        return session
 
-    def _run(self, run_command: Any, setup: Any, args: argparse.Namespace) -> None:
+    def _run(self, session: Session) -> None:
         report: dict[str, Any] | None = None
         error: str | None = None
         code: int | None = None
         try:
-            code = run_command.execute(setup, args)
+            outcome = session.run([self.view], control=self.control)
+            code = outcome.exit_status
+            if outcome.error is not None:
+                error = str(outcome.error)
         except NavseqError as failure:
             error = str(failure)
         except Exception as failure:  # shown on the page; the server goes on
