@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from cli_support import NAVSEQ, write_mission
 from navseq.errors import NavseqError
 from navseq.mission.robot import TURTLEBOT3_BURGER, TURTLEBOT3_WAFFLE
-from navseq.ros1.navstack_params import parse_footprint, profile_from_navstack_params
+from navseq.roscore.stack_profile import parse_footprint, profile_from_navstack_params
 from ros_clients import start_scripted_server
 from ros_support import RosMaster
 
