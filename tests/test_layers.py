@@ -60,7 +60,7 @@ CORE_MODULES = [
     "navseq.sinks.report",
     "navseq.sinks.picture.draw",
     *(f"navseq.roscore.{name}" for name in ("clock", "server", "goals", "navigator")),
-    *(f"navseq.roscore.{name}" for name in ("client", "stack_profile")),
+    *(f"navseq.roscore.{name}" for name in ("client", "stack_profile", "node", "operator")),
 ]
 
 

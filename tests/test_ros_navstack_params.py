@@ -1,4 +1,4 @@
-"""The robot profile from a running move_base's parameters (navseq.ros1.navstack_params).
+"""The robot profile from a running move_base's parameters (navseq.roscore.stack_profile).
 
 The parsing is checked in process on parameter trees shaped like move_base's; the
 whole path — parameters on a real rosmaster, ``navseq run --navigator ros1`` reading

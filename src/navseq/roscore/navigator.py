@@ -100,6 +100,12 @@ class NavigatorCore:
 
     def time_jumped_back(self, jump: ClockJump) -> None:
         """End the tracked goal as a failed attempt and cancel it (module :mod:`.clock`)."""
+        with self.book.lock:
+            tracked = self.book.goal_id is not None
+        if not tracked:
+            # Nothing to fail: the executor's next wait simply runs on the new clock.
+            self.client.warn(f"ROS time jumped back {jump.seconds:.1f} s")
+            return
         self.client.warn(jump.text)
         self.client.cancel_goal()
         with self.book.lock:
@@ -108,8 +114,6 @@ class NavigatorCore:
                 self._on_drop()
         if goal_id is not None:
             self.inbox.put(GoalDone.failed(goal_id, CLOCK_JUMP_STATUS, jump.text))
-        else:
-            self.inbox.wake()
 
     def wait_for_valid_time(self, clock_wait: float, how_to_fix: str) -> None:
         wait_for_valid_time(self.client.now, self.client.check_running, clock_wait, how_to_fix)
