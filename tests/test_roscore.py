@@ -88,6 +88,23 @@ def test_a_jump_between_two_spins_is_seen_too():
     assert [type(e) for e in navigator.inbox.drain()] == [GoalDone]
 
 
+def test_a_goal_sent_after_the_jump_stands():
+    """The server went away with its simulator and came back on a clock started anew:
+    the goal resent then is on the new clock, and the jump fails nothing."""
+    client = FakeClient()
+    navigator = core(client)
+    client.times = [100.0, 101.0]
+    navigator.spin(1.0, navigator.has_news)
+    client.times = [5.0]
+    navigator.sending_goal()
+    with navigator.book.lock:
+        navigator.book.start(8)
+    client.times = [5.1, 6.2]
+    navigator.spin(1.0, navigator.has_news)
+    assert navigator.inbox.drain() == [] and navigator.book.goal_id == 8
+    assert client.warnings == ["ROS time jumped back 96.0 s"] and client.cancels == 0
+
+
 def test_time_jumping_back_with_no_goal_out_fails_nothing():
     client = FakeClient()
     navigator = core(client)

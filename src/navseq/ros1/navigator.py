@@ -211,7 +211,6 @@ class Ros1Navigator:
         self._book = self._core.book
         self._feedback_pose: Pose2D | None = None
         self._closed = False
-        self._clear_costmaps_warned: set[str] = set()  # kinds of clear failure said
         # Created after the state its callbacks read: they may run at once.
         self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
@@ -325,6 +324,7 @@ class Ros1Navigator:
 
     def send_goal(self, goal: Goal) -> None:
         self._settle_after_result()
+        self._core.sending_goal()
         frame = self.frame or goal.frame or "map"
         stamp = self._stamp_now() if self.stamp == "now" else rospy.Time(0)
         message = move_base_goal(goal.pose, frame, stamp, goal.z)
@@ -403,7 +403,7 @@ class Ros1Navigator:
         try:
             rospy.wait_for_service(service, timeout=self.clear_wait)
         except rospy.ROSException:
-            self._warn_clear_once("unavailable", f"{service} unavailable, retrying without it")
+            self._core.warn_once("unavailable", f"{service} unavailable, retrying without it")
             return
         answered = threading.Event()
         errors: list[Exception] = []
@@ -418,18 +418,13 @@ class Ros1Navigator:
 
         threading.Thread(target=call, name="navseq-clear-costmaps", daemon=True).start()
         if not answered.wait(max(deadline - time.monotonic(), 0.0)):
-            self._warn_clear_once(
+            self._core.warn_once(
                 "silent",
                 f"{service} did not answer within {self.clear_wait:g} s, "
                 "retrying without waiting for it",
             )
         elif errors:
-            self._warn_clear_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
-
-    def _warn_clear_once(self, kind: str, text: str) -> None:
-        if kind not in self._clear_costmaps_warned:
-            self._clear_costmaps_warned.add(kind)
-            rospy.logwarn("navseq: %s", text)
+            self._core.warn_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
 
     def robot_pose(self) -> Pose2D | None:
         if self._tf_buffer is not None:

@@ -185,7 +185,6 @@ class Nav2Navigator:
         self._odom_pose: Pose2D | None = None
         self._last_now = 0.0
         self._closed = False
-        self._clear_warned: set[str] = set()  # clear services already warned about
         # /tf with the frames prefixed by the namespace, and the namespace's own tf.
         self._tf = FrameTree()
         self._local_tf = FrameTree() if self.namespace else None
@@ -323,6 +322,7 @@ class Nav2Navigator:
         )
 
     def send_goal(self, goal: Goal) -> None:
+        self._core.sending_goal()
         frame = self.frame or goal.frame or "map"
         message = navigate_goal(goal.pose, frame, self._node.get_clock().now().to_msg(), goal.z)
         with self._book.lock:
@@ -365,11 +365,16 @@ class Nav2Navigator:
         for _name, done in calls:
             done.wait(max(deadline - time.monotonic(), 0.0))
         silent = [name for name, done in calls if not done.is_set()]
-        self._warn_clear_once(missing, "unavailable: retrying without clearing that costmap")
-        self._warn_clear_once(
-            silent,
-            f"did not answer within {self.clear_wait:g} s: retrying without waiting for it",
-        )
+        for name in missing:
+            self._core.warn_once(
+                f"missing {name}", f"{name} unavailable: retrying without clearing that costmap"
+            )
+        for name in silent:
+            self._core.warn_once(
+                f"silent {name}",
+                f"{name} did not answer within {self.clear_wait:g} s: retrying without "
+                "waiting for it",
+            )
 
     def read_parameters(
         self, nodes: Mapping[str, str], timeout: float = PARAMS_WAIT
@@ -471,12 +476,6 @@ class Nav2Navigator:
 
         self._in_ros(ask)
         return done, found
-
-    def _warn_clear_once(self, services: Sequence[str], what: str) -> None:
-        new = [name for name in services if name not in self._clear_warned]
-        if new:
-            self._clear_warned.update(new)
-            self._node.get_logger().warning(f"{', '.join(new)} {what}")
 
     def robot_pose(self) -> Pose2D | None:
         frame = self.frame or "map"

@@ -81,6 +81,7 @@ class NavigatorCore:
         self.watch = ServerWatch(client.server_present, client.server_ready, lost_after)
         self._on_drop = on_drop
         self._clock_watch = ClockWatch()
+        self._warned: set[str] = set()
 
     # -- time ------------------------------------------------------------------------
 
@@ -115,6 +116,14 @@ class NavigatorCore:
         if goal_id is not None:
             self.inbox.put(GoalDone.failed(goal_id, CLOCK_JUMP_STATUS, jump.text))
 
+    def sending_goal(self) -> None:
+        """Look at the clock as a goal goes out. A jump back seen now came before this
+        goal, which is stamped and timed on the new clock: it fails nothing (a restarted
+        simulator whose server came back gets the goal resent, and that one stands)."""
+        jump = self._clock_watch.look(self.client.now())
+        if jump is not None:
+            self.client.warn(f"ROS time jumped back {jump.seconds:.1f} s")
+
     def wait_for_valid_time(self, clock_wait: float, how_to_fix: str) -> None:
         wait_for_valid_time(self.client.now, self.client.check_running, clock_wait, how_to_fix)
 
@@ -146,6 +155,16 @@ class NavigatorCore:
     def has_news(self) -> bool:
         """An event is queued, or the server was just lost or is back."""
         return self.inbox.has_events() or self.watch.news()
+
+    # -- retries ---------------------------------------------------------------------
+
+    def warn_once(self, key: str, text: str) -> None:
+        """Warn ``text`` the first time ``key`` comes up. A clear-costmaps service that
+        is missing or silent is said once per run: a warning on every retry would bury
+        the rest of the log, and the retry goes out anyway (after a bounded wait)."""
+        if key not in self._warned:
+            self._warned.add(key)
+            self.client.warn(text)
 
     # -- closing -----------------------------------------------------------------------
 
