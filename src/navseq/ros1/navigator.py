@@ -202,7 +202,8 @@ class Ros1Navigator:
         self._last_result: tuple[float, str] | None = None
 
         # The tracked goal (its handle: a ClientGoalHandle), the events for poll(), the
-        # server watch and the clock rules: shared with ROS 2.
+        # server watch and the clock rules: shared with ROS 2. lost_after 0: "present"
+        # already means a status within status_timeout (server_present).
         self._core = NavigatorCore(
             self, self.resolved_action, lost_after=0.0, cancel_wait=cancel_wait
         )
