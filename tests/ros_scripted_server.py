@@ -13,6 +13,8 @@ Each goal it receives, in arrival order, follows the next behaviour of ``--scrip
 ``recall``   leave it pending, then cancel it: RECALLED after SECONDS
 ``hang``     accept and never finish (only a cancel or a newer goal ends it)
 ``die``      accept, then the whole process exits abruptly after SECONDS (server lost)
+``jump``     accept, and after SECONDS set ``/clock`` back by :data:`JUMP_BACK` (a simulator
+             restart); then like ``hang``. Needs ``--clock``.
 
 Like move_base, a newer goal preempts the active one and a cancel request ends an active
 goal PREEMPTED (a pending one RECALLED). Everything observable — goals with their poses,
@@ -22,6 +24,12 @@ frames and stamps, cancels, results, clear_costmaps calls — is appended as JSO
 ``--clear-costmaps`` says how its ``clear_costmaps`` service behaves: ``answer`` (at
 once), ``silent`` (takes the call, logs it, never answers: a move_base stuck in a long
 recovery) or ``absent`` (no such service).
+
+``--clock`` publishes ``/clock`` (from :data:`CLOCK_START` s, at wall speed), as a
+simulator does; the client must run with ``/use_sim_time`` true. ``--cancel ignore``
+makes the server deaf to cancel requests (a wedged move_base): actionlib's server would
+otherwise acknowledge every cancel by itself (PREEMPTING / RECALLING), whatever the
+server's own callback does.
 
 It is a real actionlib ``ActionServer`` on a real ROS master; nothing is mocked.
 """
@@ -43,10 +51,31 @@ import rospy
 from geometry_msgs.msg import PoseStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseFeedback, MoveBaseResult
 from nav_msgs.msg import Path as PathMsg
+from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
 
-KINDS = ("succeed", "abort", "reject", "preempt", "recall", "hang", "die")
+KINDS = ("succeed", "abort", "reject", "preempt", "recall", "hang", "die", "jump")
 FEEDBACK_PERIOD = 0.1  # s of wall time between feedback messages
+CLOCK_START = 100.0  # s: where --clock starts
+JUMP_BACK = 90.0  # s the clock goes back on a ``jump``
+CLOCK_PERIOD = 0.01  # s of wall time between /clock messages
+
+
+class JumpingClock:
+    """``/clock`` at wall speed from CLOCK_START; :meth:`jump_back` sets it back."""
+
+    def __init__(self) -> None:
+        self._pub = rospy.Publisher("/clock", Clock, queue_size=10)
+        self._zero = time.monotonic() - CLOCK_START
+        threading.Thread(target=self._run, daemon=True).start()
+
+    def jump_back(self) -> None:
+        self._zero += JUMP_BACK
+
+    def _run(self) -> None:
+        while not rospy.is_shutdown():
+            self._pub.publish(Clock(clock=rospy.Time.from_sec(time.monotonic() - self._zero)))
+            time.sleep(CLOCK_PERIOD)
 
 
 @dataclass(frozen=True)
@@ -83,6 +112,8 @@ class ScriptedMoveBase:
         then: Behaviour,
         log: Path | None,
         clear_costmaps: str = "answer",
+        clock: JumpingClock | None = None,
+        cancel: str = "answer",
     ):
         self._script = list(script)
         self._then = then
@@ -95,9 +126,13 @@ class ScriptedMoveBase:
         self._clear_answers = clear_costmaps == "answer"
         if clear_costmaps != "absent":
             rospy.Service(f"{action}/clear_costmaps", Empty, self._clear_costmaps)
+        self._clock = clock
         self._server = actionlib.ActionServer(
             action, MoveBaseAction, self._on_goal, self._on_cancel, auto_start=False
         )
+        if cancel == "ignore":
+            # Before start(), which subscribes this very attribute to the cancel topic.
+            self._server.internal_cancel_callback = self._ignore_cancel
         self._server.start()
 
     # -- log ---------------------------------------------------------------------------
@@ -173,6 +208,9 @@ class ScriptedMoveBase:
                     status = "PREEMPTED" if tracked.accepted else "RECALLED"
                     self._finish(tracked, status, "canceled by the client")
 
+    def _ignore_cancel(self, goal_id: Any) -> None:
+        self.log("cancel_ignored", id=goal_id.id)
+
     def _clear_costmaps(self, _request: Any) -> EmptyResponse:
         self.log("clear_costmaps")
         while not self._clear_answers and not rospy.is_shutdown():
@@ -209,7 +247,12 @@ class ScriptedMoveBase:
                 elapsed = now - tracked.received
                 if tracked.accepted:
                     self._feedback(tracked, min(1.0, elapsed / max(seconds, 1e-3)))
-                if kind == "hang" or elapsed < seconds:
+                if kind == "jump" and elapsed >= seconds and not tracked.extra.get("jumped"):
+                    tracked.extra["jumped"] = True
+                    assert self._clock is not None, "jump needs --clock"
+                    self._clock.jump_back()
+                    self.log("jump", back=JUMP_BACK)
+                if kind in ("hang", "jump") or elapsed < seconds:
                     continue
                 if kind == "succeed" and not tracked.arrival_published:
                     # Feedback and result travel on separate topics: give the feedback
@@ -256,10 +299,15 @@ def main() -> None:
     parser.add_argument(
         "--clear-costmaps", choices=("answer", "silent", "absent"), default="answer"
     )
+    parser.add_argument("--clock", action="store_true", help="publish /clock (see doc)")
+    parser.add_argument("--cancel", choices=("answer", "ignore"), default="answer")
     args = parser.parse_args(rospy.myargv()[1:])
     script = [Behaviour.parse(item) for item in args.script.split()]
     rospy.init_node(args.node_name)
-    server = ScriptedMoveBase(args.action, script, args.then, args.log, args.clear_costmaps)
+    clock = JumpingClock() if args.clock else None
+    server = ScriptedMoveBase(
+        args.action, script, args.then, args.log, args.clear_costmaps, clock, args.cancel
+    )
     server.log("ready")
     print("scripted move_base ready", flush=True)
     while not rospy.is_shutdown():

@@ -42,7 +42,7 @@ CORE_MODULES = [
     "navseq.ros2",
     "navseq.ros2.standin",
     "navseq.ros2.error_codes",
-    "navseq.ros2.sim_config",
+    "navseq.sim.options",
     "navseq.mission",
     "navseq.executor.machine",
     "navseq.executor.runner",
@@ -63,6 +63,8 @@ CORE_MODULES = [
     "navseq.journal.writer",
     "navseq.sinks.report",
     "navseq.sinks.picture.draw",
+    *(f"navseq.roscore.{name}" for name in ("clock", "server", "goals", "navigator")),
+    *(f"navseq.roscore.{name}" for name in ("client", "stack_profile", "node", "operator")),
 ]
 
 
@@ -162,6 +164,38 @@ def test_only_navseq_ros1_imports_rospy_and_only_navseq_ros2_rclpy():
             offenders.append(f"{path.relative_to(SRC)}: {sorted(wrong)}")
     assert offenders == []
     assert "rospy" in imported_roots(SRC / "ros1" / "navigator.py")  # the check sees imports
+
+
+def _navseq_modules_imported(path: Path) -> set[str]:
+    """Every ``navseq...`` module a module names in an import, anywhere in it."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module)
+    return {name for name in names if name.split(".")[0] == "navseq"}
+
+
+def test_ros1_and_ros2_never_import_each_other():
+    """What ROS 1 and ROS 2 share lives in the ROS-free core (``navseq.roscore`` and the
+    modules it uses); each client library's package only uses it."""
+    offenders = []
+    for own, other in (("ros1", "ros2"), ("ros2", "ros1")):
+        for path in sorted((SRC / own).rglob("*.py")):
+            wrong = {
+                name
+                for name in _navseq_modules_imported(path)
+                if name.split(".")[:2] == ["navseq", other]
+            }
+            if wrong:
+                offenders.append(f"{path.relative_to(SRC)}: {sorted(wrong)}")
+    assert offenders == []
+    # The check sees imports: the ROS 1 navigator does use the shared core.
+    assert any(
+        name.startswith("navseq.roscore")
+        for name in _navseq_modules_imported(SRC / "ros1" / "navseq_node.py")
+    )
 
 
 def test_the_old_ros_package_is_gone():

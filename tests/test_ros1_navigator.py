@@ -373,7 +373,9 @@ def test_rejected_goals_spend_the_retries_then_skip_then_stop(
     first, second = visits_of(tmp_path)
     assert first["outcome"] == "skipped" and second["outcome"] == "failed"
     attempts = first["attempts"] + second["attempts"]
-    assert [(a["status"], a["text"]) for a in attempts] == [("REJECTED", "scripted reject")] * 3
+    assert [(a["status"], a["text"]) for a in attempts] == [
+        ("REJECTED", "the server rejected the goal: scripted reject")
+    ] * 3
     failed = printed_events(navseq.output(), "AttemptFailed")
     assert [(e["index"], e["will_retry"]) for e in failed] == [(0, True), (0, False), (1, False)]
     assert [r["event"] for r in server_log(log)].count("accepted") == 0

@@ -10,7 +10,6 @@ import pytest
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
-from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
     ErrorCode,
@@ -22,6 +21,7 @@ from navseq.ros2.standin import (
     plan_poses,
 )
 from navseq.sim.occupancy import load_map
+from navseq.sim.options import SimConfig, add_arguments, config_from_args
 from navseq.sim.world import SimWorld
 
 MAP = Path(__file__).resolve().parents[1] / "maps" / "turtlebot3_world.yaml"

@@ -1,4 +1,4 @@
-"""The robot profile from a running move_base's parameters (navseq.ros1.navstack_params).
+"""The robot profile from a running move_base's parameters (navseq.roscore.stack_profile).
 
 The parsing is checked in process on parameter trees shaped like move_base's; the
 whole path — parameters on a real rosmaster, ``navseq run --navigator ros1`` reading
@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from cli_support import NAVSEQ, write_mission
 from navseq.errors import NavseqError
 from navseq.mission.robot import TURTLEBOT3_BURGER, TURTLEBOT3_WAFFLE
-from navseq.ros1.navstack_params import parse_footprint, profile_from_navstack_params
+from navseq.roscore.stack_profile import parse_footprint, profile_from_navstack_params
 from ros_clients import start_scripted_server
 from ros_support import RosMaster
 

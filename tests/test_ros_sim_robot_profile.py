@@ -200,7 +200,7 @@ def test_a_waffle_is_simulated_with_its_outline_its_speed_and_its_room_to_turn(
 
     # move_base's parameters describe the waffle, so a client that reads the robot from
     # them (navseq run --navigator ros1) checks the mission with the right outline.
-    from navseq.ros1.navstack_params import profile_from_navstack_params
+    from navseq.roscore.stack_profile import profile_from_navstack_params
 
     read, _ = profile_from_navstack_params(ros_master.get_param("/move_base"), "/move_base")
     assert flat(read.footprint) == pytest.approx(waffle)

@@ -6,7 +6,8 @@
 - :mod:`navseq.ros1.record`: waypoint recorder (``navseq record`` and ``record_node``);
 - :mod:`navseq.ros1.markers`: RViz markers of a mission;
 - :mod:`navseq.ros1.mission_topics`: a mission listener publishing markers and a JSON status;
-- :mod:`navseq.ros1.navstack_params`: the robot profile from a running move_base's params;
+- :mod:`navseq.ros1.navstack_params`: a running move_base's params, fetched (the rules
+  that read them: :mod:`navseq.roscore.stack_profile`);
 - :mod:`navseq.ros1.run_setup`: ``navseq run --navigator ros1``'s connection to the stack
   (the ``create`` of the kind in :mod:`navseq.navigators.registry`);
 - :mod:`navseq.ros1.conversions`: navseq types <-> ROS 1 messages, shared by all nodes
@@ -17,5 +18,9 @@
 - :mod:`navseq.ros1.sim_launcher`: ``navseq sim --ros1``, those two nodes (and a rosmaster
   when none answers) started and stopped as child processes.
 
-Importing this package imports nothing from ROS; each module does so itself.
+What ROS 1 and ROS 2 do alike (clock and server waits, goal bookkeeping, the node's
+run and exit status, the services' answers, the robot from the stack's parameters)
+lives once in the ROS-free :mod:`navseq.roscore`; this package never imports
+``navseq.ros2``. Importing this package imports nothing from ROS; each module does so
+itself.
 """

@@ -10,11 +10,12 @@ How it stays out of actionlib's traps:
 - It uses actionlib's lower-level ``ActionClient``, which reports every status a server
   can give (SUCCEEDED, ABORTED, REJECTED, PREEMPTED, RECALLED, and LOST when the server
   forgets a goal) for any goal, also one replaced by a newer goal.
-- A server that stops publishing its status for ``status_timeout`` seconds (move_base
-  publishes it at 5 Hz) is reported as :class:`ServerLost`; the executor then waits and
-  resends the goal after :class:`ServerBack`, which is reported once the server
-  publishes again *and* has connected to our goal and cancel topics (so the resent goal
-  cannot vanish in transit).
+- What ROS 1 and ROS 2 do alike is :class:`~navseq.roscore.navigator.NavigatorCore`'s:
+  a server that stops publishing its status for ``status_timeout`` seconds (move_base
+  publishes it at 5 Hz) is :class:`ServerLost`, and :class:`ServerBack` once it
+  publishes again *and* has connected to our goal and cancel topics (so the resent
+  goal cannot vanish in transit); a rejected goal, ROS time jumping back and a cancel
+  that is never answered are handled as :mod:`navseq.roscore.navigator` says.
 
 Time: :meth:`now` is the navigation stack's clock and :meth:`spin` waits on it, so
 under ``use_sim_time`` the executor's timeouts run on the simulation clock. Which clock
@@ -27,7 +28,8 @@ wall time and bounded, for a valid (non-zero) clock, so no timeout or journal ti
 counted from time 0 before the first ``/clock`` (actionlib #137); none is a
 :class:`NavseqError` naming ``/clock`` and ``use_sim_time``. The server wait itself is
 on wall time and needs no clock. :meth:`spin` returns early as soon as a callback
-queues an event (or the server is lost or back).
+queues an event (or the server is lost or back, or ROS time jumped back:
+:mod:`navseq.roscore.clock`).
 
 move_base's SUCCEEDED race (ros-planning/navigation #949): a goal sent a few
 milliseconds after the previous goal's result can inherit the plan still being computed
@@ -75,26 +77,24 @@ from navseq.navigators.base import (
     GoalFeedback,
     GoalOutcome,
     NavEvent,
-    ServerBack,
-    ServerLost,
 )
-from navseq.navigators.inbox import EventInbox
-from navseq.navigators.plans import PlanMatcher
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
+from navseq.roscore.clock import CLOCK_WAIT
+from navseq.roscore.navigator import CANCEL_WAIT, REJECTED_STATUS, NavigatorCore, rejected
 
 DEFAULT_NODE_NAME = "navseq"
 MASTER_WAIT = 5.0  # s of wall time to find a ROS master before giving up
-CANCEL_FLUSH = 1.0  # s of wall time to let a cancel reach the server when closing
-# Longest wall-time wait in spin() between looks at the clock, the server and shutdown.
-SPIN_SLICE = 0.1
 DEFAULT_SETTLE = 0.05  # s of wall time between a result and the next goal (race #949)
 # Longest wall-time wait for the server's status array to list a finished goal as such.
 STATUS_LISTING_WAIT = 0.5
-CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
 CLEAR_WAIT = 1.0  # s of wall time clear_costmaps waits for move_base, service lookup included
 # actionlib_msgs/GoalStatus codes of a finished goal.
 _TERMINAL_CODES = frozenset({2, 3, 4, 5, 8, 9})
+# Client states in which the server has taken in our cancel.
+_CANCEL_SEEN = (CommState.RECALLING, CommState.PREEMPTING, CommState.DONE)
+# move_base never rejects a goal itself; a server that does without a word:
+REJECTED_CAUSE = "it gave no reason"
 
 
 def ensure_node(name: str = DEFAULT_NODE_NAME, *, anonymous: bool = True) -> None:
@@ -176,6 +176,7 @@ class Ros1Navigator:
         odom_frame: str = "odom",
         clock_wait: float = CLOCK_WAIT,
         clear_wait: float = CLEAR_WAIT,
+        cancel_wait: float = CANCEL_WAIT,
     ):
         if stamp not in ("now", "latest"):
             raise NavseqError(f"stamp must be 'now' or 'latest', not {stamp!r}", subject="stamp")
@@ -200,19 +201,17 @@ class Ros1Navigator:
         # (wall time, actionlib goal id) of the last result of a goal we tracked.
         self._last_result: tuple[float, str] | None = None
 
-        # Callbacks leave events here and wake spin() (also on anything else it must
-        # look at: a status, the clock).
-        self._inbox = EventInbox()
-        self._plans = PlanMatcher()  # a plan is the goal's it ends at (a stale one is not)
-        self._lock = threading.Lock()
-        self._handle: Any = None  # ClientGoalHandle of the goal we track, if any
-        self._goal_id: int | None = None
-        self._send_seq = 0  # increases with every goal sent; identifies the tracked one
-        self._accepted = False
-        self._server_up: bool | None = None  # None: not checked yet
+        # The tracked goal (its handle: a ClientGoalHandle), the events for poll(), the
+        # server watch and the clock rules: shared with ROS 2. lost_after 0: "present"
+        # already means a status within status_timeout (server_present).
+        self._core = NavigatorCore(
+            self, self.resolved_action, lost_after=0.0, cancel_wait=cancel_wait
+        )
+        self._inbox = self._core.inbox
+        self._plans = self._core.plans
+        self._book = self._core.book
         self._feedback_pose: Pose2D | None = None
         self._closed = False
-        self._clear_costmaps_warned: set[str] = set()  # kinds of clear failure said
         # Created after the state its callbacks read: they may run at once.
         self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
@@ -258,24 +257,10 @@ class Ros1Navigator:
         News is an event queued by an actionlib callback, or the server lost or back.
         Like ``rospy.sleep``: under ``use_sim_time`` the wait is on the simulation clock
         and, while the clock has not started (time zero), lasts until ``seconds`` after
-        it starts; raises ``rospy.ROSInterruptException`` on ROS shutdown and
-        ``ROSTimeMovedBackwardsException`` when ROS time jumps back.
+        it starts; raises ``rospy.ROSInterruptException`` on ROS shutdown. ROS time
+        jumping back ends the tracked goal (:mod:`navseq.roscore.clock`).
         """
-        start = self.now()
-        while not self._has_news():
-            now = self.now()
-            if start == 0.0:
-                start = now  # the simulation clock has not started: wait from when it does
-            elif now < start:
-                raise rospy.exceptions.ROSTimeMovedBackwardsException(start - now)
-            elif now - start >= seconds:
-                return
-            if rospy.is_shutdown():
-                raise rospy.ROSInterruptException("ROS shutdown request")
-            wait = SPIN_SLICE
-            if self._clock_sub is None:
-                wait = min(wait, start + seconds - now)  # wall clock: ROS time is wall time
-            self._inbox.wait(wait)
+        self._core.spin(seconds, self._has_news)
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait (wall time) for the server, then settle the clock (see the module doc).
@@ -283,15 +268,32 @@ class Ros1Navigator:
         Raises :class:`NavseqError` when the server is there but no valid ROS time
         comes within ``clock_wait`` seconds.
         """
-        deadline = time.monotonic() + timeout
-        while not self._server_ready():
-            if time.monotonic() >= deadline or rospy.is_shutdown():
-                return False
-            time.sleep(0.02)
-        self._server_up = True
+        if not self._core.wait_for_server(timeout, rospy.is_shutdown):
+            return False
         self._follow_the_stacks_clock()
-        self._wait_for_valid_time()
+        self._core.wait_for_valid_time(
+            self.clock_wait,
+            "set /use_sim_time false (rosparam set /use_sim_time false) for a robot on wall time",
+        )
         return True
+
+    # -- the client library, as navseq.roscore asks for it (ClientLibrary) -------------
+
+    def clock_wakes(self) -> bool:
+        return self._clock_sub is not None
+
+    def check_running(self) -> None:
+        if rospy.is_shutdown():
+            raise rospy.ROSInterruptException("ROS shutdown request")
+
+    def server_present(self) -> bool:
+        return self._status_fresh()
+
+    def server_ready(self) -> bool:
+        return self._status_fresh() and self._client.server_connected()
+
+    def warn(self, text: str) -> None:
+        rospy.logwarn("navseq: %s", text)
 
     def _follow_the_stacks_clock(self) -> None:
         """Take time from /clock if the stack set /use_sim_time after rospy started."""
@@ -310,21 +312,6 @@ class Ros1Navigator:
         self._clock_time = 0.0
         self._clock_sub = rospy.Subscriber("/clock", Clock, self._on_clock, queue_size=1)
 
-    def _wait_for_valid_time(self) -> None:
-        deadline = time.monotonic() + self.clock_wait
-        while self.now() <= 0.0:
-            if time.monotonic() >= deadline:
-                raise NavseqError(
-                    f"ROS time is still 0 after {self.clock_wait:g} s: /use_sim_time is true "
-                    "but nothing publishes /clock. Start the simulator that drives /clock, "
-                    "or set /use_sim_time false (rosparam set /use_sim_time false) for a "
-                    "robot on wall time",
-                    source="/clock",
-                )
-            if rospy.is_shutdown():
-                raise rospy.ROSInterruptException("ROS shutdown request")
-            time.sleep(0.02)
-
     def require_server(self, timeout: float) -> None:
         """Like :meth:`wait_for_server`, but a missing server is a clear :class:`NavseqError`."""
         if not self.wait_for_server(timeout):
@@ -338,38 +325,35 @@ class Ros1Navigator:
 
     def send_goal(self, goal: Goal) -> None:
         self._settle_after_result()
+        self._core.sending_goal()
         frame = self.frame or goal.frame or "map"
         stamp = self._stamp_now() if self.stamp == "now" else rospy.Time(0)
         message = move_base_goal(goal.pose, frame, stamp, goal.z)
-        with self._lock:
+        with self._book.lock:
             # The previous goal is simply no longer tracked: like move_base's own
             # preemption, the new goal replaces it without stopping the robot. Callbacks
             # carry the send number, so a replaced goal's late callbacks are ignored even
             # when the same goal is sent again (pause/resume).
-            self._send_seq += 1
-            seq = self._send_seq
-            self._goal_id = goal.goal_id
-            self._accepted = False
-            self._handle = None
+            seq = self._book.start(goal.goal_id)
             self._plans.track(goal.goal_id, goal.pose, frame)
-        # Not under self._lock: actionlib holds its own locks while calling our callbacks,
-        # which take self._lock; holding ours while it takes its own would deadlock.
+        # Not under the book's lock: actionlib holds its own locks while calling our callbacks,
+        # which take the book's lock; holding ours while it takes its own would deadlock.
         handle = self._client.send_goal(
             message,
             transition_cb=lambda h: self._on_transition(seq, goal.goal_id, h),
             feedback_cb=lambda h, fb: self._on_feedback(seq, goal.goal_id, fb),
         )
-        with self._lock:
+        with self._book.lock:
             # actionlib only keeps a weak reference: this one keeps the goal's callbacks alive.
-            if seq == self._send_seq and handle.get_comm_state() != CommState.DONE:
-                self._handle = handle
+            if self._book.is_current(seq) and handle.get_comm_state() != CommState.DONE:
+                self._book.handle = handle
 
     def _settle_after_result(self) -> None:
         """Keep a goal that follows a result out of move_base's race (module doc)."""
         if self.settle <= 0:
             return
-        with self._lock:
-            replacing = self._handle is not None  # an active goal: no result to race with
+        with self._book.lock:
+            replacing = self._book.handle is not None  # an active goal: no result to race with
             last = self._last_result
         if replacing or last is None:
             return
@@ -394,9 +378,12 @@ class Ros1Navigator:
         )
 
     def cancel_goal(self) -> None:
-        with self._lock:
-            handle = self._handle
-        if handle is None or handle.get_comm_state() == CommState.DONE:
+        with self._book.lock:
+            asked, handle = self._book.ask_cancel()
+            if asked and (handle is None or handle.get_comm_state() == CommState.DONE):
+                self._book.cancel_answered.set()  # nothing out there to cancel
+                return
+        if not asked:
             return
         try:
             handle.cancel()
@@ -417,7 +404,7 @@ class Ros1Navigator:
         try:
             rospy.wait_for_service(service, timeout=self.clear_wait)
         except rospy.ROSException:
-            self._warn_clear_once("unavailable", f"{service} unavailable, retrying without it")
+            self._core.warn_once("unavailable", f"{service} unavailable, retrying without it")
             return
         answered = threading.Event()
         errors: list[Exception] = []
@@ -432,18 +419,13 @@ class Ros1Navigator:
 
         threading.Thread(target=call, name="navseq-clear-costmaps", daemon=True).start()
         if not answered.wait(max(deadline - time.monotonic(), 0.0)):
-            self._warn_clear_once(
+            self._core.warn_once(
                 "silent",
                 f"{service} did not answer within {self.clear_wait:g} s, "
                 "retrying without waiting for it",
             )
         elif errors:
-            self._warn_clear_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
-
-    def _warn_clear_once(self, kind: str, text: str) -> None:
-        if kind not in self._clear_costmaps_warned:
-            self._clear_costmaps_warned.add(kind)
-            rospy.logwarn("navseq: %s", text)
+            self._core.warn_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
 
     def robot_pose(self) -> Pose2D | None:
         if self._tf_buffer is not None:
@@ -473,90 +455,65 @@ class Ros1Navigator:
         return None
 
     def poll(self) -> list[NavEvent]:
-        return [*self._inbox.drain(), *self._check_server()]
+        why_lost = f"no status for {self.status_timeout:g} s"
+        return [*self._inbox.drain(), *self._core.check_server(why_lost)]
 
     def close(self) -> None:
+        """Cancel the tracked goal and wait (bounded) until move_base takes the cancel in."""
         if self._closed:
             return
         self._closed = True
-        self.cancel_goal()
-        self._wait_cancel_delivered(CANCEL_FLUSH)
+        self._core.cancel_and_wait()
 
     def _has_news(self) -> bool:
         """:meth:`poll` has something to report: a queued event, or the server lost or back."""
-        return self._inbox.has_events() or self._server_news()
-
-    # -- server liveness ---------------------------------------------------------------
-
-    def _server_news(self) -> bool:
-        """:meth:`_check_server` would report ServerLost or ServerBack now."""
-        if self._server_up is None:
-            return False
-        if self._server_up:
-            return not self._status_fresh()
-        return self._server_ready()
+        return self._core.has_news()
 
     def _status_fresh(self) -> bool:
         last = self._client.last_status_wall
         return last is not None and time.monotonic() - last <= self.status_timeout
 
-    def _server_ready(self) -> bool:
-        return self._status_fresh() and self._client.server_connected()
-
-    def _check_server(self) -> list[NavEvent]:
-        if self._server_up is None:
-            self._server_up = self._server_ready()
-            return []
-        if self._server_up and not self._status_fresh():
-            self._server_up = False
-            with self._lock:
-                # The goal died with the server: stop tracking it; the executor resends.
-                self._handle = None
-                self._goal_id = None
-            return [
-                ServerLost(f"no status from {self.resolved_action} for {self.status_timeout:g} s")
-            ]
-        if not self._server_up and self._server_ready():
-            self._server_up = True
-            return [ServerBack()]
-        return []
-
     # -- actionlib callbacks (rospy threads: only record and enqueue) ---------------------
 
     def _on_transition(self, seq: int, goal_id: int, handle: Any) -> None:
-        with self._lock:
-            if seq != self._send_seq or self._goal_id is None:
+        with self._book.lock:
+            if not self._book.is_current(seq):
                 return  # a goal we replaced or gave up on
             state = handle.get_comm_state()
+            if state in _CANCEL_SEEN:
+                self._book.cancel_answered.set()
             # PENDING only means the server received it; ACTIVE means it took it on.
-            if state == CommState.ACTIVE and not self._accepted:
-                self._accepted = True
+            if state == CommState.ACTIVE and not self._book.accepted:
+                self._book.accepted = True
                 self._inbox.put(GoalAccepted(goal_id))
             elif state == CommState.DONE:
                 outcome, status = terminal_status_of(handle.get_goal_status()) or (
                     GoalOutcome.LOST,
                     "LOST",
                 )
+                text = handle.get_goal_status_text()
                 if outcome is GoalOutcome.LOST:
                     # The server forgot the goal (e.g. restarted quickly): let poll()
                     # announce ServerBack once it is ready, so the executor resends.
-                    self._server_up = False
-                self._inbox.put(GoalDone(goal_id, outcome, status, handle.get_goal_status_text()))
+                    self._core.watch.forget()
+                if status == REJECTED_STATUS:
+                    self._inbox.put(rejected(goal_id, text, REJECTED_CAUSE))
+                else:
+                    self._inbox.put(GoalDone(goal_id, outcome, status, text))
                 self._last_result = (
                     time.monotonic(),
                     handle.comm_state_machine.action_goal.goal_id.id,
                 )
-                self._handle = None
-                self._goal_id = None
+                self._book.drop()
 
     def _on_feedback(self, seq: int, goal_id: int, feedback: Any) -> None:
         pose = pose2d_from_pose(feedback.base_position.pose)
         self._feedback_pose = pose
-        if seq == self._send_seq and self._goal_id is not None:
+        if self._book.is_current(seq):
             self._inbox.put(GoalFeedback(goal_id, pose))
 
     def _on_plan(self, path: Any) -> None:
-        if self._goal_id is None:
+        if self._book.goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in path.poses)
         plan = self._plans.plan_for(points, path.header.frame_id)
@@ -564,7 +521,7 @@ class Ros1Navigator:
             self._inbox.put(plan)
 
     def _on_status(self) -> None:
-        if self._server_up is False:
+        if self._core.watch.up is False:
             self._inbox.wake()  # the server may be back: let spin() check
 
     def _on_clock(self, clock: Any) -> None:
@@ -576,19 +533,6 @@ class Ros1Navigator:
         self._inbox.wake()
         # Runs before rospy closes its publishers (rosnode kill, signal_shutdown), so
         # the cancel still goes out and the robot does not drive on without us.
-        self.cancel_goal()
-        self._wait_cancel_delivered(CANCEL_FLUSH)
-
-    def _wait_cancel_delivered(self, timeout: float) -> None:
-        """Give a cancel time to reach the server: until it acknowledges, or ``timeout``."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            with self._lock:
-                handle = self._handle
-            if handle is None or handle.get_comm_state() in (
-                CommState.RECALLING,
-                CommState.PREEMPTING,
-                CommState.DONE,
-            ):
-                return
-            time.sleep(0.02)
+        if not self._closed:
+            self._closed = True
+            self._core.cancel_and_wait()

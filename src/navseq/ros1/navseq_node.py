@@ -41,6 +41,10 @@ expected end, not an interruption: whether by SIGINT/SIGTERM (roslaunch's shutdo
 ``rosnode kill`` or the master, the exit status is the mission's own 0 or 1. Bad
 parameters and a missing action server still exit at once with 2.
 
+The run (its log lines, ending, exit status and keep-alive) and the services' answers
+are shared with the ROS 2 node: :mod:`navseq.roscore.node` and
+:mod:`navseq.roscore.operator`; this module only speaks rospy.
+
 With ``~end_launch`` true (demo.launch sets it), a node started by roslaunch ends the
 whole launch when the mission is over: it sends SIGINT to that roslaunch, as Ctrl-C
 would, and stays up until the shutdown reaches it (exit status: the mission's 0 or 1).
@@ -61,24 +65,21 @@ import rospy
 from std_srvs.srv import Trigger, TriggerResponse
 
 from navseq.errors import NavseqError, error_text
-from navseq.executor.control import (
-    MissionControl,
-    StopRequested,
-    cancelled_by_operator,
-    operator_reason,
-)
+from navseq.executor.control import MissionControl
 from navseq.executor.events import MissionFinished
-from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
 from navseq.mission.loader import mission_from_params
 from navseq.mission.model import Mission
+from navseq.mission.robot import RobotProfile
 from navseq.ros1.launch_end import end_parent_launch
 from navseq.ros1.mission_topics import MissionTopics
-from navseq.ros1.navigator import CANCEL_FLUSH, Ros1Navigator, ensure_node
+from navseq.ros1.navigator import Ros1Navigator, ensure_node
 from navseq.ros1.navstack_params import read_navstack_profile
 from navseq.ros1.params import bool_param
-from navseq.signals import StopSignals, ignore_until_exit
+from navseq.roscore.navigator import CANCEL_WAIT
+from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
+from navseq.roscore.operator import OPERATOR_SERVICES, OperatorDesk
+from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
-from navseq.text import printable
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -97,9 +98,8 @@ NODE_PARAMS: dict[str, Any] = {
     "odom_frame": "odom",
 }
 # s to wait for rospy to name its shutdown reason: it does so only after the navigator's
-# shutdown hook has waited (up to CANCEL_FLUSH) for the goal's cancel to go out.
-SHUTDOWN_REASON_WAIT = CANCEL_FLUSH + 1.0
-KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a shutdown while kept alive
+# shutdown hook has waited (up to CANCEL_WAIT) for the server to take the cancel in.
+SHUTDOWN_REASON_WAIT = CANCEL_WAIT + 1.0
 
 
 def log_line(line: LogLine) -> None:
@@ -156,33 +156,45 @@ def read_params() -> tuple[Mission, dict[str, Any]]:
     return mission, settings
 
 
-def _trigger_service(name: str, control: MissionControl, topics: MissionTopics) -> None:
-    """``~pause``, ``~resume``, ``~cancel``: executor inputs, answered by the run's thread."""
+class RospyFace:
+    """The ROS 1 node's side of :class:`~navseq.roscore.node.NodeFace`: rospy's log
+    (each line starting ``navseq:``), private names, move_base's parameters."""
 
-    def handle(_request: Any) -> TriggerResponse:
-        if topics.over is not None:
-            # Nobody takes requests any more: a request would only be refused.
-            return TriggerResponse(success=False, message=f"nothing to {name}: {topics.over}")
-        ok, message = control.request(name, operator_reason(name, f"~{name}"))
-        return TriggerResponse(success=ok, message=message)
+    def __init__(self, action: str) -> None:
+        self.action = action
 
-    rospy.Service(f"~{name}", Trigger, handle)
+    def info(self, text: str) -> None:
+        rospy.loginfo("navseq: %s", text)
+
+    def warn(self, text: str) -> None:
+        rospy.logwarn("navseq: %s", text)
+
+    def error(self, text: str) -> None:
+        rospy.logerr("navseq: %s", text)
+
+    def service_name(self, kind: str) -> str:
+        return f"~{kind}"
+
+    def robot_from_stack(self) -> tuple[RobotProfile, str]:
+        return read_navstack_profile(self.action)
+
+    def running(self) -> bool:
+        return not rospy.core.is_shutdown_requested()
 
 
-def _skip_service(topics: MissionTopics, control: MissionControl) -> None:
-    def handle(_request: Any) -> TriggerResponse:
-        index = topics.active_waypoint
-        if topics.over is not None:
-            return TriggerResponse(success=False, message=f"nothing to skip: {topics.over}")
-        if index is None:
-            # Filed now, the request would skip whichever waypoint comes next.
-            return TriggerResponse(success=False, message="no waypoint is underway")
-        control.request_skip(operator_reason("skip", "~skip"))
-        return TriggerResponse(
-            success=True, message=f"waypoint {index + 1} skipped; going on with the next one"
-        )
+def offer_operator_services(desk: OperatorDesk) -> None:
+    """``~pause``, ``~resume``, ``~skip``, ``~cancel``; rospy serves each call on a thread
+    of its own, so a handler may wait (bounded) for the mission's answer."""
 
-    rospy.Service("~skip", Trigger, handle)
+    def handler(kind: str) -> Callable[[Any], TriggerResponse]:
+        def handle(_request: Any) -> TriggerResponse:
+            ok, message = desk.answer_blocking(kind)
+            return TriggerResponse(success=ok, message=message)
+
+        return handle
+
+    for kind in OPERATOR_SERVICES:
+        rospy.Service(f"~{kind}", Trigger, handler(kind))
 
 
 def run_node() -> int:
@@ -191,7 +203,7 @@ def run_node() -> int:
         mission, settings = read_params()
     except NavseqError as error:
         rospy.logerr("navseq: %s", error_text(error))
-        return 2
+        return EXIT_BAD_SETUP
     try:
         navigator = Ros1Navigator(
             action=str(settings["action"]),
@@ -205,76 +217,32 @@ def run_node() -> int:
         )
     except (NavseqError, TypeError, ValueError) as error:
         rospy.logerr("navseq: bad node parameter (param ~): %s", error_text(error))
-        return 2
+        return EXIT_BAD_SETUP
+    face = RospyFace(navigator.resolved_action)
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
-    for name in ("pause", "resume", "cancel"):
-        _trigger_service(name, control, topics)
-    _skip_service(topics, control)
-    try:
-        rospy.loginfo(
-            "navseq: %d waypoints from %s; waiting for %s",
-            len(mission),
-            printable(mission.source),
-            navigator.resolved_action,
-        )
-        navigator.require_server(float(settings["server_wait"]))
-        robot = mission.robot
-        if robot is None:
-            # Arrival is judged with the tolerance move_base's local planner uses.
-            robot, note = read_navstack_profile(navigator.resolved_action)
-            rospy.loginfo("navseq: %s", note)
-        result = run_mission(
-            mission,
-            navigator,
-            # The robot also gives the log's time still to go.
-            [topics, LogProgress(mission, log_line, robot=robot)],
-            tick=float(settings["tick"]),
-            control=control,
-            robot=robot,
-        )
-    except NavseqError as error:
-        rospy.logerr("navseq: %s", error_text(error))
-        topics.publish_status({"state": "error", "reason": str(error)})
-        return 2
-    except MissionInterrupted as interrupted:
-        _log_interrupted(interrupted.signal_name)
-        return interrupted.exit_code
-    except KeyboardInterrupt:
-        # Ctrl-C while still waiting for the action server: no goal is out yet.
-        rospy.logwarn("navseq: interrupted (SIGINT) while waiting for the action server")
-        return SIGNAL_EXIT_CODES["SIGINT"]
-    except StopRequested as shutdown:
-        # rosnode kill / master shutdown: the navigator's shutdown hook cancelled the goal.
-        _log_interrupted(str(shutdown))
-        return 1
-    except rospy.ROSInterruptException:
-        # A shutdown seen first by rospy.sleep (simulated time), not by the poll.
-        _log_interrupted("ROS shutdown")
-        return 1
-    else:
-        if cancelled_by_operator(result.reason):
-            rospy.logwarn("navseq: mission cancelled by the operator (~cancel)")
-            topics.over = "the mission was cancelled"
-        elif result.success:
-            rospy.loginfo("navseq: mission succeeded (%s)", result.reason)
-            topics.over = "the mission has ended (succeeded)"
-        else:
-            rospy.logwarn(
-                "navseq: mission ended without reaching every waypoint (%s)", result.reason
-            )
-            topics.over = "the mission has ended (failed)"
-        code = result.exit_code
-    finally:
-        navigator.close()
+    offer_operator_services(OperatorDesk(control, topics.state, face.service_name))
+    run = run_node_mission(
+        face,
+        mission,
+        navigator,
+        topics,
+        control,
+        server_wait=float(settings["server_wait"]),
+        tick=float(settings["tick"]),
+        log=lambda robot: LogProgress(mission, log_line, robot=robot),
+        shutdowns=(rospy.ROSInterruptException,),
+    )
+    if not run.ran_to_end:
+        return run.code
     if settings["end_launch"]:
-        return end_launch(code)
+        return end_launch(face, run.code)
     if settings["keep_alive"]:
-        return stay_up(code)
-    return code
+        return stay_up(face, run.code, "mission over; staying up (~keep_alive) until shut down")
+    return run.code
 
 
-def end_launch(mission_code: int) -> int:
+def end_launch(face: RospyFace, mission_code: int) -> int:
     """Ask the roslaunch that started the node to shut down, then wait for it to stop us."""
 
     def signal_roslaunch() -> str | None:
@@ -282,38 +250,11 @@ def end_launch(mission_code: int) -> int:
         return None if why_not is None else f"~end_launch: {why_not}"
 
     return stay_up(
-        mission_code, "mission over; ending the launch (~end_launch)", then=signal_roslaunch
+        face,
+        mission_code,
+        "mission over; ending the launch (~end_launch)",
+        then=signal_roslaunch,
     )
-
-
-def stay_up(
-    mission_code: int,
-    why: str = "mission over; staying up (~keep_alive) until shut down",
-    then: Callable[[], str | None] | None = None,
-) -> int:
-    """Keep the node (its latched topics and services) up until it is shut down.
-
-    Returns ``mission_code`` however the node is stopped: the mission is over, so a
-    signal interrupts nothing, and roslaunch (which stops nodes with SIGINT) should
-    not see a finished mission as a failure. ``then`` runs once the node's signal
-    handlers are in place (ending the launch sends a SIGINT that comes straight back);
-    a reason it returns means there is nothing to wait for: the node just exits.
-    """
-    # rospy's own signal handlers are off (see ensure_node); the node's are set here.
-    with StopSignals() as stop:
-        rospy.loginfo("navseq: %s", why)
-        if then is not None and (why_not := then()) is not None:
-            rospy.logwarn("navseq: %s; the node just exits", why_not)
-            return mission_code
-        while not rospy.core.is_shutdown_requested() and not stop.wait(KEEP_ALIVE_POLL):
-            pass
-    if stop.received:
-        rospy.loginfo("navseq: %s; shutting down", stop.received[0])
-    return mission_code
-
-
-def _log_interrupted(cause: str) -> None:
-    rospy.logwarn("navseq: interrupted (%s); the active goal was cancelled", cause)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -45,7 +45,7 @@ from typing import IO, Any
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
-from navseq.ros2.sim_config import SimConfig
+from navseq.sim.options import SimConfig
 
 CALLER_ID = "/navseq_sim"
 READY_TIMEOUT = 60.0  # s for both nodes to start (rospy imports are slow on a busy machine)

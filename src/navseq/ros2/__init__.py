@@ -2,7 +2,9 @@
 
 This package is the only place that imports rclpy and ROS 2 messages, except the
 ROS-free rules in :mod:`navseq.ros2.standin`, which import neither (tests use them in
-process). Importing ``navseq.ros2`` itself imports nothing from ROS 2.
+process). Importing ``navseq.ros2`` itself imports nothing from ROS 2. What ROS 1 and
+ROS 2 do alike lives once in the ROS-free :mod:`navseq.roscore` (the simulator's
+options in :mod:`navseq.sim.options`); this package never imports ``navseq.ros1``.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ under the robot's namespace:
 They are read through each node's ``list_parameters`` / ``get_parameters`` services
 (:meth:`navseq.ros2.navigator.Nav2Navigator.read_parameters`) and turned into the
 same parameter tree ROS 1's move_base has, so that one set of rules
-(:func:`navseq.ros1.navstack_params.profile_from_navstack_params`, ROS-free) reads
+(:func:`navseq.roscore.stack_profile.profile_from_navstack_params`, ROS-free) reads
 both stacks. A node that does not answer is left out: what it would have said keeps
 the base profile's value, and the note says what was read.
 """
@@ -31,7 +31,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
-from navseq.ros1.navstack_params import profile_from_navstack_params
+from navseq.roscore.stack_profile import profile_from_navstack_params
 
 #: Our name for each Nav2 node read -> its name relative to the robot's namespace.
 NODES = {

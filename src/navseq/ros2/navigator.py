@@ -9,15 +9,16 @@ executor's. How it maps Nav2 onto :class:`~navseq.navigators.base.Navigator`:
   client preempted ends ABORTED in Nav2: that is a failed attempt too, and the policy
   decides); a rejected goal -> failed ``REJECTED`` (Nav2 rejects while bt_navigator is
   not active: its action server exists from configure on, so it is found, but takes
-  goals only once activated); a result ``UNKNOWN`` (a restarted server that never heard
-  of the goal) -> lost.
+  goals only once activated; :func:`navseq.roscore.navigator.rejected`); a result
+  ``UNKNOWN`` (a restarted server that never heard of the goal) -> lost.
 - Pass-through: a new goal simply replaces the tracked one; Nav2 preempts its running
   goal with it, so the robot keeps rolling. The replaced goal's late result (ABORTED,
   "preempted") is not tracked any more and never reaches the executor.
 - A server that disappears from the ROS graph for ``lost_after`` seconds is
   :class:`ServerLost` (the goal died with it); once the server is back,
-  :class:`ServerBack`, and the executor resends. How fast DDS notices a killed
-  process is its lease duration (Cyclone DDS: 10 s by default).
+  :class:`ServerBack`, and the executor resends (the rule is shared with ROS 1:
+  :mod:`navseq.roscore.server`). How fast DDS notices a killed process is its lease
+  duration (Cyclone DDS: 10 s by default).
 - Costmaps are cleared through Nav2's ``global_costmap/clear_entirely_global_costmap``
   and ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``),
   waiting (bounded, ``clear_wait`` for both) for the answers so the retry plans on the
@@ -42,7 +43,8 @@ Time: :meth:`now` is the node's clock. With ``use_sim_time`` (True, or None: "au
 on when someone publishes ``/clock`` once the server is found, as Nav2 run in
 simulation does) it is ROS time from ``/clock``; :meth:`wait_for_server` then waits,
 bounded, for a valid (non-zero) clock, so no timeout counts from time 0. Goals are
-stamped with that clock.
+stamped with that clock. Time jumping back ends the tracked goal as a failed attempt
+(:mod:`navseq.roscore.clock` says why, for ROS 1 and ROS 2 alike).
 
 The node: by default a :class:`~navseq.ros2.session.Ros2Session` of the navigator's
 own (rclpy in a context of its own, without rclpy's signal handlers: navseq's runner
@@ -84,12 +86,8 @@ from navseq.navigators.base import (
     GoalFeedback,
     GoalOutcome,
     NavEvent,
-    ServerBack,
-    ServerLost,
 )
 from navseq.navigators.catchup import ResultHold
-from navseq.navigators.inbox import EventInbox
-from navseq.navigators.plans import PlanMatcher
 from navseq.navigators.stack_map import MAP_WAIT, MapCatch, StackMap, stack_map_from_message
 from navseq.ros2.messages import (
     add_transforms,
@@ -99,18 +97,17 @@ from navseq.ros2.messages import (
     terminal_status,
 )
 from navseq.ros2.session import Ros2Session
+from navseq.roscore.clock import CLOCK_WAIT
+from navseq.roscore.navigator import CANCEL_WAIT, NavigatorCore, rejected
 
 DEFAULT_ACTION = "navigate_to_pose"
 DEFAULT_NODE_NAME = "navseq"
-CLOCK_WAIT = 10.0  # s of wall time for a valid ROS time once the server is found
-CANCEL_WAIT = 2.0  # s of wall time close() waits for Nav2's answer to a cancel
 CLEAR_WAIT = 1.0  # s of wall time for both clear-costmap services' answers
 PARAMS_WAIT = 2.0  # s of wall time to read the robot from Nav2's node parameters
 # Nav2's action servers reject a goal only while their lifecycle node is not active
 # (configured, not yet activated; or deactivated): name the likely cause.
-REJECTED_TEXT = "Nav2 rejected the goal (is bt_navigator active?)"
+REJECTED_CAUSE = "Nav2 takes goals only while bt_navigator is active; is it?"
 LOST_AFTER = 0.3  # s of wall time the server must be gone from the graph to be lost
-SPIN_SLICE = 0.1  # longest wall-time wait in spin() between looks at the clock
 COSTMAP_SERVICES = (
     "global_costmap/clear_entirely_global_costmap",
     "local_costmap/clear_entirely_local_costmap",
@@ -170,24 +167,24 @@ class Nav2Navigator:
         self.lost_after = lost_after
         self._sim_time_asked = use_sim_time
 
-        # Callbacks leave events here and wake spin() (also on every /clock message).
-        self._inbox = EventInbox()
-        self._plans = PlanMatcher()  # a plan (and distance remaining) is the goal it ends at
         self._result_hold = ResultHold()  # a SUCCEEDED waits for /tf to catch up with it
-        self._lock = threading.Lock()
-        self._send_seq = 0  # goes up with every goal sent (and when one is dropped)
-        self._goal_id: int | None = None  # the executor's id of the goal tracked
-        self._handle: Any = None  # its ClientGoalHandle, once Nav2 accepted it
-        self._cancel_seq = 0  # the send number a cancel was asked for (0: none)
-        self._cancel_answered = threading.Event()
-        self._cancel_answered.set()  # nothing to wait for
-        self._server_up: bool | None = None  # None: not checked yet
-        self._absent_since: float | None = None
+        # The tracked goal (its handle: a ClientGoalHandle, once Nav2 accepted it), the
+        # events for poll() (woken on every /clock message too), the server watch and
+        # the clock rules: shared with ROS 1.
+        self._core = NavigatorCore(
+            self,
+            self.resolved_action,
+            lost_after=lost_after,
+            cancel_wait=cancel_wait,
+            on_drop=self._result_hold.drop,
+        )
+        self._inbox = self._core.inbox
+        self._plans = self._core.plans  # a plan (and distance remaining) is the goal it ends at
+        self._book = self._core.book
         self._feedback_pose: Pose2D | None = None
         self._odom_pose: Pose2D | None = None
         self._last_now = 0.0
         self._closed = False
-        self._clear_warned: set[str] = set()  # clear services already warned about
         # /tf with the frames prefixed by the namespace, and the namespace's own tf.
         self._tf = FrameTree()
         self._local_tf = FrameTree() if self.namespace else None
@@ -261,21 +258,10 @@ class Nav2Navigator:
 
         Under ``use_sim_time`` each ``/clock`` message wakes the wait to look at the
         time, and a wait begun before the clock starts lasts until ``seconds`` after
-        it does. A clock that jumps back (a restarted simulator) restarts the wait.
+        it does. A clock that jumps back (a restarted simulator) ends the tracked goal
+        (:mod:`navseq.roscore.clock`).
         """
-        start = self.now()
-        while not self._has_news():
-            now = self.now()
-            if start == 0.0 or now < start:
-                start = now
-            elif now - start >= seconds:
-                return
-            if not self._context.ok():
-                raise NavseqError("ROS 2 was shut down", source="rclpy")
-            wait = SPIN_SLICE
-            if self._clock_sub is None:
-                wait = min(wait, max(start + seconds - now, 0.0))
-            self._inbox.wait(wait)
+        self._core.spin(seconds, self._has_news)
 
     def wait_for_server(self, timeout: float) -> bool:
         """Wait (wall time) for the server, then settle the clock (module docstring).
@@ -283,15 +269,31 @@ class Nav2Navigator:
         Raises :class:`NavseqError` when the server is there but no valid ROS time
         comes within ``clock_wait`` seconds.
         """
-        deadline = time.monotonic() + timeout
-        while not self._client.server_is_ready():
-            if time.monotonic() >= deadline or not self._context.ok():
-                return False
-            time.sleep(0.02)
-        self._server_up = True
+        if not self._core.wait_for_server(timeout, lambda: not self._context.ok()):
+            return False
         self._follow_the_stacks_clock()
-        self._wait_for_valid_time()
+        self._core.wait_for_valid_time(
+            self.clock_wait, "run with --use-sim-time false for a robot on wall time"
+        )
         return True
+
+    # -- the client library, as navseq.roscore asks for it (ClientLibrary) -------------
+
+    def clock_wakes(self) -> bool:
+        return self._clock_sub is not None
+
+    def check_running(self) -> None:
+        if not self._context.ok():
+            raise NavseqError("ROS 2 was shut down", source="rclpy")
+
+    def server_present(self) -> bool:
+        return self._context.ok() and bool(self._client.server_is_ready())
+
+    def server_ready(self) -> bool:
+        return self.server_present()
+
+    def warn(self, text: str) -> None:
+        self._node.get_logger().warning(text)
 
     def require_server(self, timeout: float) -> None:
         """Like :meth:`wait_for_server`, but a missing server is a clear :class:`NavseqError`."""
@@ -319,29 +321,15 @@ class Nav2Navigator:
             Clock, "/clock", lambda _msg: self._inbox.wake(), qos_profile_sensor_data
         )
 
-    def _wait_for_valid_time(self) -> None:
-        deadline = time.monotonic() + self.clock_wait
-        while self.now() <= 0.0:
-            if time.monotonic() >= deadline:
-                raise NavseqError(
-                    f"ROS time is still 0 after {self.clock_wait:g} s: use_sim_time is on but "
-                    "nothing publishes /clock. Start the simulator that drives /clock, or "
-                    "run with --use-sim-time false for a robot on wall time",
-                    source="/clock",
-                )
-            time.sleep(0.02)
-
     def send_goal(self, goal: Goal) -> None:
+        self._core.sending_goal()
         frame = self.frame or goal.frame or "map"
         message = navigate_goal(goal.pose, frame, self._node.get_clock().now().to_msg(), goal.z)
-        with self._lock:
+        with self._book.lock:
             # The goal tracked so far is simply dropped: Nav2 preempts it with this one
             # without stopping the robot. Callbacks carry the send number, so the dropped
             # goal's late result is ignored, also when the same goal is sent again.
-            self._send_seq += 1
-            seq = self._send_seq
-            self._goal_id = goal.goal_id
-            self._handle = None
+            seq = self._book.start(goal.goal_id)
             self._plans.track(goal.goal_id, goal.pose, frame)
             self._result_hold.drop()  # a held result of the replaced goal is void
         self._in_ros(self._send, seq, goal.goal_id, message)
@@ -351,13 +339,9 @@ class Nav2Navigator:
 
         A goal not accepted yet is cancelled as soon as Nav2 accepts it.
         """
-        with self._lock:
-            if self._goal_id is None or self._cancel_seq == self._send_seq:
-                return
-            self._cancel_seq = self._send_seq
-            self._cancel_answered.clear()
-            handle = self._handle
-        if handle is not None:
+        with self._book.lock:
+            asked, handle = self._book.ask_cancel()
+        if asked and handle is not None:
             self._in_ros(self._send_cancel, handle)
 
     def clear_costmaps(self) -> None:
@@ -381,11 +365,16 @@ class Nav2Navigator:
         for _name, done in calls:
             done.wait(max(deadline - time.monotonic(), 0.0))
         silent = [name for name, done in calls if not done.is_set()]
-        self._warn_clear_once(missing, "unavailable: retrying without clearing that costmap")
-        self._warn_clear_once(
-            silent,
-            f"did not answer within {self.clear_wait:g} s: retrying without waiting for it",
-        )
+        for name in missing:
+            self._core.warn_once(
+                f"missing {name}", f"{name} unavailable: retrying without clearing that costmap"
+            )
+        for name in silent:
+            self._core.warn_once(
+                f"silent {name}",
+                f"{name} did not answer within {self.clear_wait:g} s: retrying without "
+                "waiting for it",
+            )
 
     def read_parameters(
         self, nodes: Mapping[str, str], timeout: float = PARAMS_WAIT
@@ -488,12 +477,6 @@ class Nav2Navigator:
         self._in_ros(ask)
         return done, found
 
-    def _warn_clear_once(self, services: Sequence[str], what: str) -> None:
-        new = [name for name in services if name not in self._clear_warned]
-        if new:
-            self._clear_warned.update(new)
-            self._node.get_logger().warning(f"{', '.join(new)} {what}")
-
     def robot_pose(self) -> Pose2D | None:
         frame = self.frame or "map"
         pose = self._lookup(frame, self.base_frames, self._tf_base_frames)
@@ -512,8 +495,7 @@ class Nav2Navigator:
         """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
         if self._closed:
             return
-        self.cancel_goal()
-        self._cancel_answered.wait(self.cancel_wait)
+        self._core.cancel_and_wait()
         self.now()  # keep the clock's last value for after close
         self._closed = True
         if self._owns_session:
@@ -542,47 +524,10 @@ class Nav2Navigator:
     # -- server liveness ---------------------------------------------------------------
 
     def _has_news(self) -> bool:
-        return (
-            self._inbox.has_events()
-            or self._result_hold.ready(time.monotonic())
-            or self._server_news()
-        )
-
-    def _server_news(self) -> bool:
-        """:meth:`_check_server` would report ServerLost or ServerBack now."""
-        if self._server_up is None or not self._context.ok():
-            return False
-        ready = self._client.server_is_ready()
-        if not self._server_up:
-            return bool(ready)
-        if ready:
-            self._absent_since = None
-            return False
-        now = time.monotonic()
-        if self._absent_since is None:
-            self._absent_since = now
-        return now - self._absent_since >= self.lost_after
+        return self._core.has_news() or self._result_hold.ready(time.monotonic())
 
     def _check_server(self) -> list[NavEvent]:
-        if self._server_up is None:
-            if self._context.ok():
-                self._server_up = bool(self._client.server_is_ready())
-            return []
-        if not self._server_news():
-            return []
-        if self._server_up:
-            self._server_up = False
-            with self._lock:
-                # The goal died with the server: stop tracking it; the executor resends.
-                self._result_hold.drop()
-                self._send_seq += 1
-                self._goal_id = None
-                self._handle = None
-                self._cancel_answered.set()
-            return [ServerLost(f"{self.resolved_action} left the ROS graph")]
-        self._server_up = True
-        self._absent_since = None
-        return [ServerBack()]
+        return self._core.check_server("it left the ROS graph")
 
     # -- on the executor's thread: rclpy calls and callbacks (record and enqueue) --------
 
@@ -594,7 +539,7 @@ class Nav2Navigator:
 
     def _send_cancel(self, handle: Any) -> None:
         future = handle.cancel_goal_async()
-        future.add_done_callback(lambda _done: self._cancel_answered.set())
+        future.add_done_callback(lambda _done: self._book.cancel_answered.set())
 
     def _call_clear(self, client: Any, done: threading.Event) -> None:
         future = client.call_async(ClearEntireCostmap.Request())
@@ -603,18 +548,19 @@ class Nav2Navigator:
     def _on_goal_response(self, seq: int, goal_id: int, future: Any) -> None:
         error = future.exception()
         handle = None if error is not None else future.result()
-        with self._lock:
-            current = seq == self._send_seq and self._goal_id == goal_id
-            if not current:
+        with self._book.lock:
+            if not self._book.is_current(seq, goal_id):
                 return  # replaced meanwhile: Nav2 preempts it with the newer goal
             if handle is None or not handle.accepted:
-                self._goal_id = None
-                self._cancel_answered.set()
-                text = f"the goal request failed: {error}" if error else REJECTED_TEXT
-                self._inbox.put(GoalDone.failed(goal_id, "REJECTED", text))
+                self._book.drop()
+                if error is not None:
+                    text = f"the goal request failed: {error}"
+                    self._inbox.put(GoalDone.failed(goal_id, "REJECTED", text))
+                else:
+                    self._inbox.put(rejected(goal_id, "", REJECTED_CAUSE))
                 return
-            self._handle = handle
-            cancel_now = self._cancel_seq == seq
+            self._book.handle = handle
+            cancel_now = self._book.cancel_pending(seq)
             self._inbox.put(GoalAccepted(goal_id))
         if cancel_now:
             self._send_cancel(handle)
@@ -622,12 +568,10 @@ class Nav2Navigator:
         result.add_done_callback(lambda done: self._on_result(seq, goal_id, done))
 
     def _on_result(self, seq: int, goal_id: int, future: Any) -> None:
-        with self._lock:
-            if seq != self._send_seq or self._goal_id != goal_id:
+        with self._book.lock:
+            if not self._book.is_current(seq, goal_id):
                 return  # a goal we replaced or gave up on
-            self._goal_id = None
-            self._handle = None
-            self._cancel_answered.set()  # a finished goal needs no cancel
+            self._book.drop()  # a finished goal needs no cancel
         error = future.exception()
         if error is not None:
             self._inbox.put(GoalDone.lost(goal_id, f"no result: {error}"))
@@ -652,7 +596,7 @@ class Nav2Navigator:
         feedback = message.feedback
         pose = pose2d_from_pose(feedback.current_pose.pose)
         self._feedback_pose = pose
-        if seq != self._send_seq or self._goal_id != goal_id:
+        if not self._book.is_current(seq, goal_id):
             return
         remaining = float(feedback.distance_remaining)
         if not self._plans.distance_is_this_goals():
@@ -682,7 +626,7 @@ class Nav2Navigator:
         self._odom_pose = pose2d_from_pose(message.pose.pose)
 
     def _on_plan(self, message: Any) -> None:
-        if self._goal_id is None:
+        if self._book.goal_id is None:
             return
         points = tuple((p.pose.position.x, p.pose.position.y) for p in message.poses)
         plan = self._plans.plan_for(points, message.header.frame_id)

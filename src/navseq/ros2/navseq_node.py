@@ -27,6 +27,10 @@ server, 130 / 143 interrupted by SIGINT / SIGTERM. With ``keep_alive`` the node 
 up after the mission (markers and status keep their final state) until it is stopped,
 and then exits with the mission's 0 or 1.
 
+The run (its log lines, ending, exit status and keep-alive) and the services' answers
+are shared with the ROS 1 node: :mod:`navseq.roscore.node` and
+:mod:`navseq.roscore.operator`; this module only speaks rclpy.
+
 Threads: the node's executor spins on a thread of its own
 (:class:`~navseq.ros2.session.Ros2Session`); the mission runs on the main thread,
 where the signals arrive. Service handlers are coroutines: they file the request with
@@ -47,13 +51,7 @@ from rclpy.task import Future
 from std_srvs.srv import Trigger
 
 from navseq.errors import NavseqError, error_text
-from navseq.executor.control import (
-    MissionControl,
-    OperatorRequest,
-    StopRequested,
-    cancelled_by_operator,
-    operator_reason,
-)
+from navseq.executor.control import MissionControl, OperatorRequest
 from navseq.executor.events import (
     AttemptFailed,
     MissionEvent,
@@ -62,19 +60,18 @@ from navseq.executor.events import (
     WaypointOutcome,
     WaypointProgress,
 )
-from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
+from navseq.mission.robot import RobotProfile
 from navseq.ros2.mission_topics import MissionTopics
 from navseq.ros2.nav2_params import NODES, profile_from_nav2_params
 from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.node_params import NodeSettings, read_node_params
 from navseq.ros2.session import Ros2Session
-from navseq.signals import StopSignals, ignore_until_exit
+from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
+from navseq.roscore.operator import OPERATOR_SERVICES, SERVICE_ANSWER_WAIT, OperatorDesk
+from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import RunView, describe
-from navseq.text import printable
 
 NODE_NAME = "navseq"
-SERVICE_ANSWER_WAIT = 5.0  # s of wall time a service waits for the mission's answer
-KEEP_ALIVE_POLL = 0.1  # s of wall time between two looks for a signal while kept alive
 
 
 class WaypointLog:
@@ -106,18 +103,47 @@ class WaypointLog:
             self.logger.info(f"{text}")
 
 
-class OperatorServices:
-    """``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel``: requests to the mission's thread."""
+class RclpyFace:
+    """The ROS 2 node's side of :class:`~navseq.roscore.node.NodeFace`: the node's
+    logger, ``~/`` names, Nav2's node parameters."""
 
-    def __init__(self, session: Ros2Session, control: MissionControl, topics: MissionTopics):
+    def __init__(self, session: Ros2Session, navigator: Nav2Navigator) -> None:
         self.session = session
-        self.control = control
-        self.state = topics.state
+        self.navigator = navigator
+        self.logger = session.node.get_logger()
+
+    def info(self, text: str) -> None:
+        self.logger.info(text)
+
+    def warn(self, text: str) -> None:
+        self.logger.warning(text)
+
+    def error(self, text: str) -> None:
+        self.logger.error(text)
+
+    def service_name(self, kind: str) -> str:
+        return f"~/{kind}"
+
+    def robot_from_stack(self) -> tuple[RobotProfile, str]:
+        params = self.navigator.read_parameters(NODES)
+        return profile_from_nav2_params(params, self.navigator.namespace)
+
+    def running(self) -> bool:
+        return self.session.ok()
+
+
+class OperatorServices:
+    """``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel``, answered by
+    :class:`~navseq.roscore.operator.OperatorDesk` without holding the executor."""
+
+    def __init__(self, session: Ros2Session, desk: OperatorDesk) -> None:
+        self.session = session
+        self.desk = desk
         # A group of their own: while a handler awaits the mission's answer its group is
         # busy, and in the node's default group that would hold back /clock, Nav2's
         # feedback and results - which the mission needs to answer.
         group = MutuallyExclusiveCallbackGroup()
-        for name in ("pause", "resume", "skip", "cancel"):
+        for name in OPERATOR_SERVICES:
             session.node.create_service(
                 Trigger, f"~/{name}", self._handler(name), callback_group=group
             )
@@ -131,16 +157,9 @@ class OperatorServices:
         return handle
 
     async def _answer(self, name: str) -> tuple[bool, str]:
-        if self.state.over is not None:
-            # Nobody takes requests any more: a request would only be refused.
-            return False, f"nothing to {name}: {self.state.over}"
-        if name == "skip":
-            index = self.state.active_waypoint
-            if index is None:
-                # Filed now, the request would skip whichever waypoint comes next.
-                return False, "no waypoint is underway"
-            self.control.request_skip(operator_reason("skip", "~/skip"))
-            return True, f"waypoint {index + 1} skipped; going on with the next one"
+        at_once = self.desk.answer_at_once(name)
+        if at_once is not None:
+            return at_once
         answered: Future = Future(executor=self.session.executor)
 
         def wake(request: OperatorRequest) -> None:
@@ -149,16 +168,14 @@ class OperatorServices:
                 # The awaiting handler runs again when the executor looks next: now.
                 self.session.executor.wake()
 
-        request = self.control.submit(name, operator_reason(name, f"~/{name}"), wake)
+        request = self.desk.submit(name, wake)
         # The run answers within one tick; the timer only guards against a stuck run.
         timer = threading.Timer(SERVICE_ANSWER_WAIT, lambda: wake(request))
         timer.daemon = True
         timer.start()
         await answered
         timer.cancel()
-        if not request.done.is_set():
-            return False, f"{name}: the mission did not respond within {SERVICE_ANSWER_WAIT:g} s"
-        return request.ok, request.message
+        return self.desk.answer_of(request)
 
 
 def make_navigator(session: Ros2Session, settings: NodeSettings) -> Nav2Navigator:
@@ -183,83 +200,24 @@ def run_node(session: Ros2Session) -> int:
         navigator = make_navigator(session, settings)
     except NavseqError as error:
         logger.error(error_text(error))
-        return 2
+        return EXIT_BAD_SETUP
+    face = RclpyFace(session, navigator)
     topics = MissionTopics(node, mission)
     control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
-    OperatorServices(session, control, topics)
-    code = 2
-    try:
-        logger.info(
-            f"{len(mission)} waypoints from {printable(mission.source)}; "
-            f"waiting for {navigator.resolved_action}"
-        )
-        navigator.require_server(settings.server_wait)
-        robot = mission.robot
-        if robot is None:
-            # Arrival is judged with the tolerance of Nav2's own goal checker.
-            params = navigator.read_parameters(NODES)
-            robot, note = profile_from_nav2_params(params, navigator.namespace)
-            logger.info(note)
-        result = run_mission(
-            mission,
-            navigator,
-            [topics, WaypointLog(mission, logger)],
-            tick=settings.tick,
-            control=control,
-            robot=robot,
-        )
-    except NavseqError as error:
-        logger.error(error_text(error))
-        topics.publish_status({"state": "error", "reason": str(error)})
-        topics.state.over = "the mission could not run"
-        return 2
-    except MissionInterrupted as interrupted:
-        _log_interrupted(logger, interrupted.signal_name)
-        return interrupted.exit_code
-    except KeyboardInterrupt:
-        # Ctrl-C while still waiting for the action server: no goal is out yet.
-        logger.warning("interrupted (SIGINT) while waiting for the action server")
-        return SIGNAL_EXIT_CODES["SIGINT"]
-    except StopRequested as shutdown:
-        _log_interrupted(logger, str(shutdown))
-        return 1
-    else:
-        if cancelled_by_operator(result.reason):
-            logger.warning("mission cancelled by the operator (~/cancel)")
-            topics.state.over = "the mission was cancelled"
-        elif result.success:
-            logger.info(f"mission succeeded ({result.reason})")
-            topics.state.over = "the mission has ended (succeeded)"
-        else:
-            logger.warning(f"mission ended without reaching every waypoint ({result.reason})")
-            topics.state.over = "the mission has ended (failed)"
-        code = result.exit_code
-    finally:
-        navigator.close()
-    if settings.keep_alive:
-        return stay_up(session, code)
-    return code
-
-
-def stay_up(session: Ros2Session, mission_code: int) -> int:
-    """Keep the node (its latched topics and services) up until it is stopped.
-
-    Returns ``mission_code`` however the node is stopped: the mission is over, so a
-    signal interrupts nothing, and ``ros2 launch`` (which stops nodes with SIGINT)
-    should not see a finished mission as a failure.
-    """
-    logger = session.node.get_logger()
-    logger.info("mission over; staying up (keep_alive) until stopped")
-    with StopSignals() as stop:
-        while session.ok() and not stop.wait(KEEP_ALIVE_POLL):
-            pass
-    if stop.received:
-        logger.info(f"{stop.received[0]}; shutting down")
-    return mission_code
-
-
-def _log_interrupted(logger: Any, cause: str) -> None:
-    logger.warning(f"interrupted ({cause}); the active goal was cancelled")
+    OperatorServices(session, OperatorDesk(control, topics.state, face.service_name))
+    run = run_node_mission(
+        face,
+        mission,
+        navigator,
+        topics,
+        control,
+        server_wait=settings.server_wait,
+        tick=settings.tick,
+        log=lambda _robot: WaypointLog(mission, logger),
+    )
+    if run.ran_to_end and settings.keep_alive:
+        return stay_up(face, run.code, "mission over; staying up (keep_alive) until shut down")
+    return run.code
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -28,7 +28,7 @@ from navseq.navigators.stack_map import (
 )
 from navseq.ros2.nav2_params import NODES, profile_from_nav2_params
 from navseq.ros2.navigator import Nav2Navigator, join_name
-from navseq.ros2.sim_config import namespace_of
+from navseq.sim.options import namespace_of
 
 SERVER_WAIT = 30.0  # s of wall time for the action server by default (ROS 1 waits as long)
 

@@ -118,7 +118,6 @@ from navseq.ros2.messages import (
     time_msg,
     transform_stamped,
 )
-from navseq.ros2.sim_config import SimConfig, add_arguments, config_from_args
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
     Ending,
@@ -130,6 +129,7 @@ from navseq.ros2.standin import (
 )
 from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
+from navseq.sim.options import SimConfig, add_arguments, config_from_args
 from navseq.sim.profile import SimSettings
 from navseq.sim.world import SimWorld, default_start
 from navseq.text import printable
