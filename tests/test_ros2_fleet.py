@@ -24,11 +24,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from navseq.commands.sim_options import add_arguments, config_from_args
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.sim.fleet import SeenRobots, other_robots_problem
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
-from navseq.sim.options import add_arguments, config_from_args
 from ros2_support import ros2_environment, ros2_prefix
 
 REPO = Path(__file__).resolve().parents[1]

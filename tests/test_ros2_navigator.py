@@ -651,7 +651,7 @@ def test_goals_rejected_while_bt_navigator_is_inactive_spend_the_retries_then_th
     attempts = first["attempts"] + second["attempts"]
     assert [a["status"] for a in attempts] == ["REJECTED"] * 3
     assert all("the server rejected the goal: " in a["text"] for a in attempts)
-    assert all("bt_navigator is active" in a["text"] for a in attempts)
+    assert all("is bt_navigator active?" in a["text"] for a in attempts)
     failed = printed_events(done.stdout, "AttemptFailed")
     assert [(e["index"], e["will_retry"], e["status"]) for e in failed] == [
         (0, True, "REJECTED"),

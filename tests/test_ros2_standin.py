@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from navseq.commands.sim_options import add_arguments, config_from_args
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.ros2.standin import (
@@ -21,7 +22,7 @@ from navseq.ros2.standin import (
     plan_poses,
 )
 from navseq.sim.occupancy import load_map
-from navseq.sim.options import SimConfig, add_arguments, config_from_args
+from navseq.sim.options import SimConfig
 from navseq.sim.world import SimWorld
 
 MAP = Path(__file__).resolve().parents[1] / "maps" / "turtlebot3_world.yaml"

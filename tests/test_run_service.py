@@ -314,7 +314,6 @@ ARGPARSE_ALLOWED = (
     "commands/",
     "cli.py",
     "ros1/record.py",
-    "ros2/sim_config.py",
     "ros2/sim_node.py",
 )
 

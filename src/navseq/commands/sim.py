@@ -3,7 +3,7 @@
 ``--ros2`` runs :mod:`navseq.ros2.sim_node` (Nav2's interfaces) in this process; ``--ros1``
 starts the ROS 1 sim nodes (move_base's interface) as child processes, and a rosmaster
 when none answers (:mod:`navseq.ros1.sim_launcher`). Either serves until Ctrl-C (exit 0).
-Both take the same options (:mod:`navseq.sim.options`), checked before any ROS is
+Both take the same options (:mod:`navseq.commands.sim_options`), checked before any ROS is
 imported; without the chosen ROS the command says so and exits 2.
 """
 
@@ -20,7 +20,7 @@ ROS2_MISSING = (
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    from navseq.sim.options import add_arguments
+    from navseq.commands.sim_options import add_arguments
 
     middleware = parser.add_mutually_exclusive_group(required=True)
     middleware.add_argument(
@@ -38,7 +38,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.sim.options import config_from_args
+    from navseq.commands.sim_options import config_from_args
 
     # Bad options are reported even where the chosen ROS is missing.
     config = config_from_args(args, ros1=args.ros1)

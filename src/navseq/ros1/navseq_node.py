@@ -160,6 +160,8 @@ class RospyFace:
     """The ROS 1 node's side of :class:`~navseq.roscore.node.NodeFace`: rospy's log
     (each line starting ``navseq:``), private names, move_base's parameters."""
 
+    kind = "ros1"
+
     def __init__(self, action: str) -> None:
         self.action = action
 

@@ -106,7 +106,7 @@ CLEAR_WAIT = 1.0  # s of wall time for both clear-costmap services' answers
 PARAMS_WAIT = 2.0  # s of wall time to read the robot from Nav2's node parameters
 # Nav2's action servers reject a goal only while their lifecycle node is not active
 # (configured, not yet activated; or deactivated): name the likely cause.
-REJECTED_CAUSE = "Nav2 takes goals only while bt_navigator is active; is it?"
+REJECTED_CAUSE = "is bt_navigator active? Nav2 takes goals only while it is"
 LOST_AFTER = 0.3  # s of wall time the server must be gone from the graph to be lost
 COSTMAP_SERVICES = (
     "global_costmap/clear_entirely_global_costmap",

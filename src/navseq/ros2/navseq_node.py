@@ -107,6 +107,8 @@ class RclpyFace:
     """The ROS 2 node's side of :class:`~navseq.roscore.node.NodeFace`: the node's
     logger, ``~/`` names, Nav2's node parameters."""
 
+    kind = "nav2"
+
     def __init__(self, session: Ros2Session, navigator: Nav2Navigator) -> None:
         self.session = session
         self.navigator = navigator

@@ -105,6 +105,7 @@ from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
+from navseq.commands.sim_options import add_arguments, config_from_args
 from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
@@ -129,7 +130,7 @@ from navseq.ros2.standin import (
 )
 from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
-from navseq.sim.options import SimConfig, add_arguments, config_from_args
+from navseq.sim.options import SimConfig
 from navseq.sim.profile import SimSettings
 from navseq.sim.world import SimWorld, default_start
 from navseq.text import printable

@@ -9,7 +9,9 @@ their parameters and services) to :func:`run_node_mission`, which:
 2. takes the robot profile from the mission's ``robot:``, else from the running
    stack's parameters (arrival is judged with the stack's own goal tolerance), and
    logs where it came from;
-3. runs the mission (:func:`run_node_missions`'s single call of the executor's run);
+3. runs the mission through the run service (:mod:`navseq.run`: the node's own
+   navigator, its topics and log as the sinks, no files, SIGINT / SIGTERM cancel the
+   goal);
 4. ends it: cancelled by the operator (a warning naming the service), succeeded
    (info) or failed (a warning); the status topic and the services then say the
    mission is over;
@@ -32,11 +34,12 @@ from typing import Protocol
 from navseq.errors import NavseqError, error_text
 from navseq.executor.control import MissionControl, StopRequested, cancelled_by_operator
 from navseq.executor.machine import MissionListener
-from navseq.executor.runner import SIGNAL_EXIT_CODES, MissionInterrupted, run_mission
+from navseq.executor.runner import SIGNAL_EXIT_CODES
 from navseq.mission.model import Mission
 from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import Navigator
-from navseq.signals import StopSignals
+from navseq.run import RunRequest, UseNavigator, prepare
+from navseq.signals import SignalGuard, StopSignals
 from navseq.sinks.mission_status import StatusPublisher
 from navseq.text import printable
 
@@ -55,6 +58,9 @@ class NodeNavigator(Navigator, Protocol):
 
 class NodeFace(Protocol):
     """What one ROS version's node does its own way."""
+
+    #: The navigator kind the report and status name (``ros1``, ``nav2``).
+    kind: str
 
     def info(self, text: str) -> None: ...
 
@@ -112,17 +118,35 @@ def run_node_mission(
             # Arrival is judged with the tolerance the stack's own goal checker uses.
             robot, note = face.robot_from_stack()
             face.info(note)
-        result = run_mission(
-            mission, navigator, [topics, log(robot)], tick=tick, control=control, robot=robot
+        session = prepare(
+            RunRequest(
+                mission,
+                navigator=UseNavigator(
+                    navigator, {"kind": face.kind, "action": navigator.resolved_action}
+                ),
+                robot=robot,
+                preflight=False,  # the node has no map file; the stack checks its goals
+                outputs=None,  # a node's record is its topics and its log
+                server_wait=server_wait,
+                tick=tick,
+            )
         )
+        guard = SignalGuard()  # the node's main thread: a shutdown signal cancels the goal
+        try:
+            outcome = session.run([topics, log(robot)], control=control, signals=guard)
+        finally:
+            guard.restore()
+        if outcome.error is not None:  # a sink that could not do its job stopped the run
+            raise outcome.error
+        if outcome.interrupted is not None:
+            _log_interrupted(face, outcome.interrupted)
+            return NodeRun(outcome.exit_status, ran_to_end=False)
+        result = outcome.result
     except NavseqError as error:
         face.error(error_text(error))
         topics.publish_status({"state": "error", "reason": str(error)})
         state.over = "the mission could not run"
         return NodeRun(EXIT_BAD_SETUP, ran_to_end=False)
-    except MissionInterrupted as interrupted:
-        _log_interrupted(face, interrupted.signal_name)
-        return NodeRun(interrupted.exit_code, ran_to_end=False)
     except KeyboardInterrupt:
         # Ctrl-C while still waiting for the action server: no goal is out yet.
         face.warn("interrupted (SIGINT) while waiting for the action server")
@@ -148,7 +172,7 @@ def run_node_mission(
     else:
         face.warn(f"mission ended without reaching every waypoint ({result.reason})")
         state.over = "the mission has ended (failed)"
-    return NodeRun(result.exit_code, ran_to_end=True)
+    return NodeRun(outcome.exit_status, ran_to_end=True)
 
 
 def stay_up(

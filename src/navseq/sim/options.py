@@ -1,20 +1,20 @@
-"""The simulator's settings: command-line options and their checks, without ROS.
+"""The simulator's settings and their checks, without ROS.
 
 Shared by ``python -m navseq.ros2.sim_node``, ``navseq sim --ros2`` and ``navseq sim
---ros1`` (:mod:`navseq.ros1.sim_launcher`) so that all take the same options with the
-same meaning; importing this module imports no ROS.
+--ros1`` (:mod:`navseq.ros1.sim_launcher`) so that all check the same settings the same
+way; their command-line options are in :mod:`navseq.commands.sim_options`. Importing
+this module imports no ROS.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from navseq.commands.common import parse_pose, require_file
 from navseq.errors import NavseqError
+from navseq.files import require_file
 from navseq.geometry import Pose2D
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.fleet import other_robots_problem
@@ -30,73 +30,6 @@ def default_map() -> Path | None:
     """The TurtleBot3 world of a source checkout (``maps/`` next to ``src/``), if there."""
     candidate = Path(__file__).resolve().parents[3] / "maps" / "turtlebot3_world.yaml"
     return candidate if candidate.is_file() else None
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--map",
-        type=Path,
-        metavar="MAP",
-        help="map_server YAML (default: the TurtleBot3 world of a source checkout)",
-    )
-    parser.add_argument(
-        "--start",
-        type=parse_pose,
-        metavar="X,Y,YAW",
-        help="start pose, metres, metres, degrees (default: the roomy point nearest the "
-        "map origin)",
-    )
-    parser.add_argument(
-        "--ns",
-        default="",
-        metavar="NS",
-        help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose with --ros2, "
-        "/robot1/move_base with --ros1; frames robot1/odom, robot1/base_footprint)",
-    )
-    parser.add_argument(
-        "--speed",
-        type=float,
-        default=1.0,
-        metavar="S",
-        help="simulated seconds per wall second; 1 = wall-clock time, otherwise /clock is "
-        "published and clients should use use_sim_time (default 1)",
-    )
-    parser.add_argument(
-        "--robot",
-        metavar="NAME|FILE",
-        help="robot profile: a built-in name (turtlebot3_burger, turtlebot3_waffle, "
-        "turtlebot3_waffle_pi) or a YAML file like a mission's robot: section "
-        "(default turtlebot3_burger)",
-    )
-    parser.add_argument(
-        "--other-robots",
-        default="",
-        metavar="NS[,NS...]",
-        help="namespaces of the other simulated robots of a fleet (e.g. robot2): their "
-        "poses are read from /tf (map -> NS/odom -> NS/base_footprint) and their "
-        "footprints (this robot's model) are obstacles to plan around and never to drive "
-        "into (see launch/multi_robot.launch.py)",
-    )
-    parser.add_argument(
-        "--follow-clock",
-        nargs="?",
-        const="true",
-        default="false",
-        metavar="true|false",
-        help="step with the /clock another simulator node publishes instead of a clock of "
-        "its own: a fleet faster than wall-clock time has one robot with --speed S and the "
-        "others with --follow-clock, all on one simulated time",
-    )
-    parser.add_argument(
-        "--replan-period",
-        type=float,
-        default=0.0,
-        metavar="S",
-        help="(--ros2, for tests) simulated seconds between the re-plans of Nav2's default "
-        'tree (its RateController hz="1.0" is 1 s): a navigate_to_pose goal that preempts '
-        "another keeps the old path until the next re-plan, and ends SUCCEEDED if the robot "
-        "reaches the old goal first, as on Nav2. 0 (default): planned at once",
-    )
 
 
 @dataclass(frozen=True)
@@ -184,29 +117,42 @@ def replan_period_of(value: float, *, ros1: bool = False) -> float:
     return value
 
 
-def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
-    """The checked settings; every bad value is a NavseqError naming its option.
+def checked_config(
+    *,
+    map_yaml: Path | None,
+    start: Pose2D | None = None,
+    namespace: str = "",
+    speed: float = 1.0,
+    robot: str | None = None,
+    other_robots: str = "",
+    follow_clock: str = "false",
+    replan_period: float = 0.0,
+    ros1: bool = False,
+) -> SimConfig:
+    """The checked settings from the values the options hold; every bad value is a
+    NavseqError naming its option.
 
+    ``robot``: a built-in profile name or a profile YAML file (None: the default robot).
     ``ros1``: for ``navseq sim --ros1``, whose nodes live under ROS 1's name rules.
     """
     from navseq.mission.robot_format import robot_from_option
 
-    map_yaml = args.map if args.map is not None else default_map()
+    map_yaml = map_yaml if map_yaml is not None else default_map()
     if map_yaml is None:
         raise NavseqError("no map: give --map MAP.yaml (a map_server YAML)", source="--map")
     require_file(map_yaml, "--map")
-    speed = float(args.speed)
+    speed = float(speed)
     if not (math.isfinite(speed) and 0.0 < speed <= MAX_SPEED):
-        raise NavseqError(f"must be > 0 and <= {MAX_SPEED:g}, got {args.speed}", source="--speed")
-    robot = robot_from_option(args.robot) if args.robot is not None else DEFAULT_PROFILE
-    namespace = namespace_of(args.ns, ros1=ros1)
+        raise NavseqError(f"must be > 0 and <= {MAX_SPEED:g}, got {speed:g}", source="--speed")
+    profile = robot_from_option(robot) if robot is not None else DEFAULT_PROFILE
+    own = namespace_of(namespace, ros1=ros1)
     return SimConfig(
         map_yaml=map_yaml,
-        start=args.start,
-        namespace=namespace,
+        start=start,
+        namespace=own,
         speed=speed,
-        robot=robot,
-        other_robots=other_robots_of(args.other_robots, namespace, ros1=ros1),
-        follow_clock=follow_clock_of(args.follow_clock, speed),
-        replan_period=replan_period_of(float(args.replan_period), ros1=ros1),
+        robot=profile,
+        other_robots=other_robots_of(other_robots, own, ros1=ros1),
+        follow_clock=follow_clock_of(follow_clock, speed),
+        replan_period=replan_period_of(float(replan_period), ros1=ros1),
     )

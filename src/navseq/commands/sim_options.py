@@ -1,0 +1,95 @@
+"""The simulator's command-line options, shared by ``navseq sim`` and
+``python -m navseq.ros2.sim_node`` so that both take the same options with the same
+meaning; the checks behind them are :func:`navseq.sim.options.checked_config`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from navseq.commands.common import parse_pose
+from navseq.sim.options import SimConfig, checked_config
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The simulator's options (map, start, namespace, speed, robot, fleet, clock)."""
+    parser.add_argument(
+        "--map",
+        type=Path,
+        metavar="MAP",
+        help="map_server YAML (default: the TurtleBot3 world of a source checkout)",
+    )
+    parser.add_argument(
+        "--start",
+        type=parse_pose,
+        metavar="X,Y,YAW",
+        help="start pose, metres, metres, degrees (default: the roomy point nearest the "
+        "map origin)",
+    )
+    parser.add_argument(
+        "--ns",
+        default="",
+        metavar="NS",
+        help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose with --ros2, "
+        "/robot1/move_base with --ros1; frames robot1/odom, robot1/base_footprint)",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="simulated seconds per wall second; 1 = wall-clock time, otherwise /clock is "
+        "published and clients should use use_sim_time (default 1)",
+    )
+    parser.add_argument(
+        "--robot",
+        metavar="NAME|FILE",
+        help="robot profile: a built-in name (turtlebot3_burger, turtlebot3_waffle, "
+        "turtlebot3_waffle_pi) or a YAML file like a mission's robot: section "
+        "(default turtlebot3_burger)",
+    )
+    parser.add_argument(
+        "--other-robots",
+        default="",
+        metavar="NS[,NS...]",
+        help="namespaces of the other simulated robots of a fleet (e.g. robot2): their "
+        "poses are read from /tf (map -> NS/odom -> NS/base_footprint) and their "
+        "footprints (this robot's model) are obstacles to plan around and never to drive "
+        "into (see launch/multi_robot.launch.py)",
+    )
+    parser.add_argument(
+        "--follow-clock",
+        nargs="?",
+        const="true",
+        default="false",
+        metavar="true|false",
+        help="step with the /clock another simulator node publishes instead of a clock of "
+        "its own: a fleet faster than wall-clock time has one robot with --speed S and the "
+        "others with --follow-clock, all on one simulated time",
+    )
+    parser.add_argument(
+        "--replan-period",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="(--ros2, for tests) simulated seconds between the re-plans of Nav2's default "
+        'tree (its RateController hz="1.0" is 1 s): a navigate_to_pose goal that preempts '
+        "another keeps the old path until the next re-plan, and ends SUCCEEDED if the robot "
+        "reaches the old goal first, as on Nav2. 0 (default): planned at once",
+    )
+
+
+def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
+    """The checked settings of parsed options; every bad value is a NavseqError naming
+    its option. ``ros1``: for ``navseq sim --ros1`` (ROS 1's name rules)."""
+    return checked_config(
+        map_yaml=args.map,
+        start=args.start,
+        namespace=args.ns,
+        speed=args.speed,
+        robot=args.robot,
+        other_robots=args.other_robots,
+        follow_clock=args.follow_clock,
+        replan_period=args.replan_period,
+        ros1=ros1,
+    )
