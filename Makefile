@@ -6,11 +6,12 @@ STAMP := $(VENV)/.installed
 # pytest-xdist workers. The ROS, ROS 2 and browser tests spend most of their time
 # waiting on real time (nodes, servers, a robot driving at 1x-4x), so on a 2-core
 # machine more workers than cores pay; each ROS test has its own rosmaster port or
-# ROS 2 domain (tests/ros2_support.py leases domains across workers). worksteal: the
-# slowest files do not all end up queued on one worker.
+# ROS 2 domain (tests/ros2_support.py leases domains across workers). loadgroup: a
+# module whose tests share a Nav2 bringup or a browser runs on one worker
+# (tests/conftest.py groups them).
 TEST_WORKERS ?= 4
 FAST_WORKERS ?= 2
-PYTEST_PARALLEL = -n $(TEST_WORKERS) --dist worksteal
+PYTEST_PARALLEL = -n $(TEST_WORKERS) --dist loadgroup
 
 .PHONY: demo test test-fast test-pythons lint bench fuzz venv clean
 
