@@ -10,7 +10,7 @@ STAMP := $(VENV)/.installed
 # module whose tests share a Nav2 bringup or a browser runs on one worker
 # (tests/conftest.py groups them).
 TEST_WORKERS ?= 4
-FAST_WORKERS ?= 2
+FAST_WORKERS ?= 4
 PYTEST_PARALLEL = -n $(TEST_WORKERS) --dist loadgroup
 
 .PHONY: demo test test-fast test-pythons lint bench fuzz venv clean
@@ -31,7 +31,8 @@ test: $(STAMP)
 	$(VENV)/bin/python -m pytest $(PYTEST_PARALLEL)
 
 # The edit-test loop: every test that needs no ROS and no browser, on FAST_WORKERS
-# workers (CPU-bound tests: one per core). `make test` runs these too.
+# workers (half their time is spent waiting on the navseq processes they start, so
+# more workers than cores pay here too). `make test` runs these too.
 test-fast: $(STAMP)
 	$(VENV)/bin/python -m pytest -n $(FAST_WORKERS) --dist worksteal \
 		-m "not ros and not ros2 and not browser"
