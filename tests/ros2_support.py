@@ -52,7 +52,10 @@ def private_domain_id() -> int:
     for domain in random.sample(DOMAIN_IDS, len(DOMAIN_IDS)):
         if domain in _leases:
             continue
-        handle = open(DOMAIN_LOCKS / f"{domain}.lock", "w")  # noqa: SIM115 (held open)
+        try:
+            handle = open(DOMAIN_LOCKS / f"{domain}.lock", "a")  # noqa: SIM115 (held open)
+        except OSError:  # another user's lock file
+            continue
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
