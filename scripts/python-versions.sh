@@ -17,7 +17,8 @@
 # ../shared/python/ next to the repository, then /work/shared/python/.
 # Arguments: the versions to run (default: every archive found), e.g. `3.10`.
 # Extra pytest arguments: $NAVSEQ_PYTEST_ARGS (e.g. "tests/test_yaml_fast_path.py");
-# workers: $NAVSEQ_TEST_WORKERS (default 2).
+# workers: $NAVSEQ_TEST_WORKERS (default 4: the tests wait on the processes they start
+# about half the time, so more workers than the machine's 2 cores pay, as in `make test`).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$repo"
@@ -106,9 +107,11 @@ for version in "${versions[@]}"; do
   unpack "$version" "$archive"
   make_venv "$version"
   venv=".venv${version//./}"
-  # pytest-xdist (a dev extra) spreads the tests over two workers.
+  # pytest-xdist (a dev extra) spreads the tests over the workers.
   workers=()
-  if "$venv/bin/python" -c 'import xdist' 2>/dev/null; then workers=(-n "${NAVSEQ_TEST_WORKERS:-2}"); fi
+  if "$venv/bin/python" -c 'import xdist' 2>/dev/null; then
+    workers=(-n "${NAVSEQ_TEST_WORKERS:-4}" --dist worksteal)
+  fi
   echo "python-versions: Python $("$venv/bin/python" -c 'import platform; print(platform.python_version())'): non-ROS tests"
   start=$SECONDS
   if ! "$venv/bin/python" -m pytest -q -p no:cacheprovider "${workers[@]}" \

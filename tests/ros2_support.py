@@ -5,23 +5,72 @@ ROS 2 is found in ``$NAVSEQ_ROS2_PREFIX``, else ``/opt/ros2min`` (where
 already sourced ROS 2 (``$AMENT_PREFIX_PATH``). Tests never import rclpy in the pytest
 process: ``LD_LIBRARY_PATH`` must be set before a process starts, and rclpy, like rospy,
 keeps global state. Every ROS 2 client and server runs as a subprocess started with
-:func:`ros2_environment`, which gives the run its own ``ROS_DOMAIN_ID`` and keeps DDS
-discovery on the loopback.
+:func:`ros2_environment`, which gives the run its own ``ROS_DOMAIN_ID`` (leased: see
+:func:`private_domain_id`) and keeps DDS discovery on the loopback.
 """
 
 from __future__ import annotations
 
+import fcntl
 import os
 import random
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
+from collections import OrderedDict
 from collections.abc import Mapping
 from pathlib import Path
+from typing import IO
 
 DEFAULT_PREFIX = Path("/opt/ros2min")
 PYTHON_DIR = f"python{sys.version_info.major}.{sys.version_info.minor}"
+
+# Domain IDs 1-101: with CycloneDDS's port mapping, higher IDs reach Linux's ephemeral
+# ports (0 is everyone's default domain).
+DOMAIN_IDS = range(1, 102)
+DOMAIN_LOCKS = Path(tempfile.gettempdir()) / "navseq-ros2-domains"
+# How many domains one test process keeps leased: tests in a process run one after
+# another, so only the newest few can still have processes up (a module's shared sim
+# node); older leases go back to the pool for the other xdist workers and test runs.
+LEASES_PER_PROCESS = 12
+_leases: OrderedDict[int, IO[str]] = OrderedDict()
+
+
+def private_domain_id() -> int:
+    """A ROS_DOMAIN_ID that no other test process on this machine holds right now.
+
+    xdist workers and other test runs pick at the same time: a random pick could give two
+    live tests one domain, and each would see the other's nodes and goals. Each domain
+    is leased by an exclusive lock on its file in ``DOMAIN_LOCKS``, held until this
+    process has leased ``LEASES_PER_PROCESS`` newer ones or exits (the kernel drops the
+    lock of a crashed process). Were every domain held, this process's oldest lease is
+    reused.
+    """
+    DOMAIN_LOCKS.mkdir(exist_ok=True)
+    for domain in random.sample(DOMAIN_IDS, len(DOMAIN_IDS)):
+        if domain in _leases:
+            continue
+        try:
+            handle = open(DOMAIN_LOCKS / f"{domain}.lock", "a")  # noqa: SIM115 (held open)
+        except OSError:  # another user's lock file
+            continue
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _leases[domain] = handle
+        while len(_leases) > LEASES_PER_PROCESS:
+            _, oldest = _leases.popitem(last=False)
+            oldest.close()  # closing the file drops its lock
+        return domain
+    if _leases:
+        domain, handle = _leases.popitem(last=False)
+        _leases[domain] = handle
+        return domain
+    return random.choice(DOMAIN_IDS)
 
 
 def ros2_prefix() -> Path | None:
@@ -52,7 +101,7 @@ def ros2_environment(
     # Debian 12 has unrelated ROS 2 libraries with another ABI: this tree's lib first.
     first("LD_LIBRARY_PATH", prefix / "lib")
     first("PATH", prefix / "bin")
-    env["ROS_DOMAIN_ID"] = str(random.randint(1, 101) if domain_id is None else domain_id)
+    env["ROS_DOMAIN_ID"] = str(private_domain_id() if domain_id is None else domain_id)
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env.pop("ROS_LOCALHOST_ONLY", None)  # deprecated in Jazzy: every process would warn
     env["RMW_IMPLEMENTATION"] = "rmw_cyclonedds_cpp"

@@ -42,13 +42,39 @@ def _skip_reason() -> str | None:
     return None
 
 
-@pytest.fixture
-def studio(tmp_path: Path) -> Iterator[tuple[str, Path, subprocess.Popen[str]]]:
+def _skip_unless_there() -> None:
     reason = _skip_reason()
     if reason is not None:
         if os.environ.get("NAVSEQ_EXPECT_BROWSER") == "1":  # CI installed it: must not skip
             pytest.fail(reason)
         pytest.skip(reason)
+
+
+@pytest.fixture(scope="module")
+def chromium() -> Iterator[Any]:
+    """One headless Chromium for the module's tests (it takes seconds to start); each
+    test opens its pages in a context of its own (see :func:`new_page`), so no cookie,
+    storage or dialog handler goes from one test to the next."""
+    _skip_unless_there()
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+def new_page(browser: Any) -> Any:
+    """A page in a fresh browser context; closing the page's context closes it."""
+    context = browser.new_context(viewport={"width": 1400, "height": 860})
+    return context.new_page()
+
+
+@pytest.fixture
+def studio(tmp_path: Path) -> Iterator[tuple[str, Path, subprocess.Popen[str]]]:
+    _skip_unless_there()
     shutil.copytree(REPO / "examples", tmp_path / "examples")
     shutil.copytree(REPO / "maps", tmp_path / "maps")
     process = subprocess.Popen(
@@ -82,13 +108,10 @@ def studio(tmp_path: Path) -> Iterator[tuple[str, Path, subprocess.Popen[str]]]:
 
 
 @pytest.fixture
-def page(studio: tuple[str, Path, Any]) -> Iterator[Any]:
-    from playwright.sync_api import sync_playwright
-
+def page(studio: tuple[str, Path, Any], chromium: Any) -> Iterator[Any]:
     url = studio[0]
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        page = browser.new_page(viewport={"width": 1400, "height": 860})
+    page = new_page(chromium)
+    try:
         page.errors = []  # type: ignore[attr-defined]
         page.on(
             "console",
@@ -99,10 +122,10 @@ def page(studio: tuple[str, Path, Any]) -> Iterator[Any]:
         page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
         # The tests below start from the opened mission checked and its legs drawn.
         page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
-        try:
-            yield page
-        finally:
-            browser.close()
+        yield page
+    finally:
+        for context in chromium.contexts:  # a second tab too
+            context.close()
 
 
 def screen_point(page: Any, x: float, y: float) -> tuple[float, float]:
@@ -235,34 +258,30 @@ def message_of(page: Any, starts: str) -> str:
 
 
 def test_the_page_is_ready_before_the_first_check_and_plans_come_after(
-    studio: tuple[str, Path, Any],
+    studio: tuple[str, Path, Any], chromium: Any
 ) -> None:
     """The first paint (map drawn, markers placed, the file's problems listed) does
     not wait for the pre-flight and the planned legs, which take seconds on a big map:
     here the check's answer is held back until the page says it is ready."""
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        try:
-            page = browser.new_page(viewport={"width": 1400, "height": 860})
-            held: list[Any] = []
-            page.route("**/api/check", lambda route: held.append(route))
-            page.goto(studio[0])
-            page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
-            assert page.get_by_test_id("map-image").count() == 1
-            assert page.get_by_test_id("waypoint-marker").count() == 7
-            assert len(held) == 1  # asked at once, not answered yet
-            assert page.evaluate("document.body.dataset.planned") is None
-            assert page.locator(".leg-label").count() == 0
-            assert "checking and planning" in page.locator("#route").inner_text()
-            held[0].continue_()
-            page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
-            assert page.locator(".leg-label").count() == 7  # every leg drawn with its length
-            route = page.locator("#route").inner_text()
-            assert "checking" not in route and " m · " in route
-        finally:
-            browser.close()
+    page = new_page(chromium)
+    try:
+        held: list[Any] = []
+        page.route("**/api/check", lambda route: held.append(route))
+        page.goto(studio[0])
+        page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+        assert page.get_by_test_id("map-image").count() == 1
+        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert len(held) == 1  # asked at once, not answered yet
+        assert page.evaluate("document.body.dataset.planned") is None
+        assert page.locator(".leg-label").count() == 0
+        assert "checking and planning" in page.locator("#route").inner_text()
+        held[0].continue_()
+        page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
+        assert page.locator(".leg-label").count() == 7  # every leg drawn with its length
+        route = page.locator("#route").inner_text()
+        assert "checking" not in route and " m · " in route
+    finally:
+        page.context.close()
 
 
 def test_the_shortest_order_is_one_undoable_edit(page: Any, studio: tuple[str, Path, Any]) -> None:

@@ -205,6 +205,18 @@ def _shallow_events(text: str, source: str, offset: int) -> Iterator[yaml.Event]
             elif isinstance(event, _COLLECTION_ENDS):
                 depth -= 1
             yield event
+    except yaml.MarkedYAMLError as error:
+        # libyaml 0.2.6 (in PyYAML's wheels since 6.0.2; Debian 12 has 0.2.5) refuses a
+        # collection 1000 levels deep in its scanner, which reads a flow collection's
+        # openings ahead before the parser hands out their events: the refusal comes
+        # before the depth above is passed, and is the same refusal.
+        mark = error.problem_mark
+        if mark is not None and "maximum nesting depth" in (error.problem or ""):
+            raise NavseqError(
+                f"is nested more than {MAX_DEPTH} levels deep",
+                source=f"{source}:{mark.line + 1 + offset}",
+            ) from None
+        return
     except yaml.YAMLError:
         return
 
