@@ -28,7 +28,7 @@ SETTING_KEY = "navseq.setting"
 
 
 class NavigatorSettings(Protocol):
-    """Any kind's settings: a dataclass whose fields were declared with :func:`setting`."""
+    """Any kind's settings: a dataclass whose fields were declared with :func:`option` metadata."""
 
     __dataclass_fields__: ClassVar[dict[str, Any]]
 
@@ -130,8 +130,9 @@ class Ros1NavigatorSettings:
         default=None,
         metadata=option(
             "--settle",
-            "wall seconds between a goal's result and the next goal, against move_base's "
-            "SUCCEEDED race (navigation #949); 0: off (default 0.05)",
+            "wall seconds between a goal's result and the next goal, meant against "
+            "move_base's SUCCEEDED race (navigation #949) but not shown to help: the "
+            "arrival check catches the race; 0: off (default 0.05)",
             default=0.05,
             parse=float,
             metavar="S",
