@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import itertools
+import math
 from pathlib import Path
 
 from navseq import cli
 from navseq.studio.replay import replay_of
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def states_over_time(replay: dict) -> list[list[str]]:
@@ -67,3 +71,31 @@ def test_a_command_line_run_replays_with_its_mission_only_if_allowed_and_unchang
     # Edited since the run: the waypoints drawn would not be those that were run.
     (tmp_path / "line.yaml").write_text("waypoints:\n  - {x: 9.0, y: 9.0, yaw: 0}\n")
     assert replay_of(folder, "out", tmp_path, inside(tmp_path))["mission"] is None
+
+
+def test_the_replayed_trail_is_the_driven_one_never_through_a_pillar(tmp_path: Path) -> None:
+    """Every replayed pose is one the robot reported, and the trail drawn between them
+    stays off the arena's pillars and walls (goals drawn as poses cut through them)."""
+    from navseq.executor import events as ev
+    from navseq.journal.reader import journal_events
+    from navseq.sim.occupancy import load_map
+
+    out = tmp_path / "out"
+    mission = REPO / "examples" / "turtlebot3_world.yaml"
+    assert cli.main(["run", str(mission), "--out", str(out), "--no-picture"]) == 0
+    replay = replay_of(out, "out", tmp_path, inside(REPO))
+    reported = [
+        (event.x, event.y)
+        for event in journal_events(out / "journal.jsonl")
+        if isinstance(event, ev.WaypointProgress)
+    ]
+    assert len(replay["poses"]) == len(reported) > 10
+    for (_, x, y, _), (rx, ry) in zip(replay["poses"], reported, strict=True):
+        assert math.dist((x, y), (rx, ry)) <= 0.05
+    grid = load_map(REPO / "maps" / "turtlebot3_world.yaml")
+    occupied = grid.occupied_mask()
+    for (_, x0, y0, _), (_, x1, y1, _) in itertools.pairwise(replay["poses"]):
+        steps = max(2, int(math.dist((x0, y0), (x1, y1)) / 0.01))
+        for k in range(steps + 1):
+            row, col = grid.world_to_cell(x0 + (x1 - x0) * k / steps, y0 + (y1 - y0) * k / steps)
+            assert not occupied[row, col], f"the trail crosses an obstacle at {x0:.2f},{y0:.2f}"

@@ -5,8 +5,9 @@ journal is read by :func:`navseq.journal.writer.read_journal` (its chain checked
 ``navseq run --resume`` checks it) and its events are folded by the live view's own
 rules (:class:`~navseq.studio.runs.LiveView`), so a replayed waypoint is in the state
 the live page showed at that moment. What the page gets is a timeline it can scrub
-with a slider: robot poses (the journal keeps the driven path's corners, the pose at
-every arrival and one at least every 30 s; the page draws the robot in between), each
+with a slider: robot poses, only those the robot reported (the journal keeps the
+driven path's corners, the pose at every arrival and one at least every 30 s, all
+within 5 cm of the path driven; the page draws the robot in between), each
 change of the waypoints' states (only the waypoints that changed, so that the timeline
 grows with the run, not with the run times the mission's length), and each planned
 path, all on one clock starting at 0.
@@ -107,7 +108,9 @@ def replay_of(
         before = (fold.current, fold.loop, fold.status)
         fold(event)
         t = round(event.t - start_t, 3)
-        if isinstance(event, ev.WaypointProgress | ev.WaypointStarted):
+        # Only poses the robot reported: a goal (WaypointStarted) is where it was sent,
+        # not where it was, and drawn as a pose it cut the trail through walls.
+        if isinstance(event, ev.WaypointProgress):
             poses.append(
                 [t, round(event.x, 3), round(event.y, 3), round(math.degrees(event.yaw), 2)]
             )
