@@ -122,7 +122,9 @@ def test_the_studios_order_without_or_tools_answers_with_the_extra(tmp_path: Pat
         roots = FileRoots([mission.parent, Path("maps").resolve()], mission.parent)
         config = StudioConfig(token="t", roots=roots, mission_path=mission,
                               out_base=Path(sys.argv[1]))
-        client = TestClient(create_app(config), headers={"x-navseq-token": "t"})
+        client = TestClient(
+            create_app(config), base_url="http://127.0.0.1", headers={"x-navseq-token": "t"}
+        )
         document = client.get("/api/mission").json()["mission"]
         answer = client.post("/api/order", json={"mission": document})
         print(json.dumps({"status": answer.status_code, "body": answer.json()}))

@@ -19,6 +19,8 @@ from navseq.studio.security import FileRoots
 
 REPO = Path(__file__).resolve().parents[1]
 TOKEN = "test-token"
+LOCAL = "http://127.0.0.1:8765"
+JSON_BODY = {"content-type": "application/json"}
 PILLAR = (1.0, 0.0)  # on the west face of the arena's middle east pillar (an occupied cell)
 
 
@@ -35,7 +37,7 @@ def make_client(workspace: Path, mission: str = "examples/turtlebot3_world.yaml"
     config = StudioConfig(
         token=TOKEN, roots=roots, mission_path=mission_path, out_base=workspace / "out"
     )
-    return TestClient(create_app(config), headers={"x-navseq-token": TOKEN})
+    return TestClient(create_app(config), base_url=LOCAL, headers={"x-navseq-token": TOKEN})
 
 
 @pytest.fixture
@@ -50,7 +52,7 @@ def opened(client: TestClient) -> dict:
 
 
 def test_every_request_needs_the_token(client: TestClient) -> None:
-    bare = TestClient(client.app)
+    bare = TestClient(client.app, base_url=LOCAL)
     for path in ("/", "/api/mission", "/static/studio.js", "/api/map"):
         answer = bare.get(path)
         assert answer.status_code == 403, path
@@ -67,6 +69,42 @@ def test_a_post_from_another_origin_is_refused(client: TestClient) -> None:
         "/api/check", json={"mission": {}}, headers={"origin": "http://evil.example"}
     )
     assert answer.status_code == 403
+
+
+def test_a_request_for_a_foreign_host_name_is_refused_even_with_the_token(
+    client: TestClient,
+) -> None:
+    """DNS rebinding: a page at evil.example made to resolve to 127.0.0.1 sends its own
+    name as Host and as Origin, so the origin check alone would let it through."""
+    foreign = {"host": "evil.example:8765", "origin": "http://evil.example:8765"}
+    answer = client.post("/api/check", json={"mission": {}}, headers=foreign)
+    assert answer.status_code == 421
+    assert client.get("/api/mission", headers={"host": "evil.example"}).status_code == 421
+    for host in ("localhost:8765", "127.0.0.1:8765", "[::1]:8765", "LOCALHOST"):
+        assert client.get("/api/mission", headers={"host": host}).status_code == 200, host
+
+
+def test_a_body_not_declared_json_is_refused(client: TestClient) -> None:
+    """A cross-site form may post text/plain without a preflight: only JSON is taken."""
+    answer = client.post(
+        "/api/check", content=b'{"mission": {}}', headers={"content-type": "text/plain"}
+    )
+    assert answer.status_code == 415
+    assert "application/json" in answer.json()["error"]
+    assert client.post("/api/check", json={"mission": {}}).status_code != 415
+
+
+def test_every_answer_keeps_the_page_out_of_frames_and_foreign_code_out_of_the_page(
+    client: TestClient,
+) -> None:
+    bare = TestClient(client.app, base_url=LOCAL)
+    answers = [client.get("/"), client.get("/static/studio.js"), client.get("/api/mission")]
+    answers.append(bare.get("/api/mission"))  # refused for want of the token: still headed
+    for answer in answers:
+        policy = answer.headers["content-security-policy"]
+        assert "frame-ancestors 'none'" in policy and "script-src 'self'" in policy
+        assert answer.headers["x-content-type-options"] == "nosniff"
+        assert answer.headers["referrer-policy"] == "no-referrer"
 
 
 def test_the_mission_comes_as_its_document_with_units_and_version(
@@ -172,7 +210,7 @@ def test_the_draft_problems_are_those_of_navseq_validate(
 def test_bad_requests_get_a_4xx_with_a_message(
     client: TestClient, body: bytes, status: int, said: str
 ) -> None:
-    answer = client.post("/api/check", content=body)
+    answer = client.post("/api/check", content=body, headers=JSON_BODY)
     assert answer.status_code == status
     assert said in answer.json()["error"]
 
@@ -340,7 +378,7 @@ def test_a_new_mission_on_a_map(workspace: Path) -> None:
         mission_path=mission_path,
         map_path=(workspace / "maps/turtlebot3_world.yaml").resolve(),
     )
-    client = TestClient(create_app(config), headers={"x-navseq-token": TOKEN})
+    client = TestClient(create_app(config), base_url=LOCAL, headers={"x-navseq-token": TOKEN})
     body = client.get("/api/mission").json()
     assert body["exists"] is False and body["mission"]["waypoints"] == []
     document = body["mission"]

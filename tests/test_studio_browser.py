@@ -66,9 +66,16 @@ def chromium() -> Iterator[Any]:
             browser.close()
 
 
-def new_page(browser: Any) -> Any:
-    """A page in a fresh browser context; closing the page's context closes it."""
-    context = browser.new_context(viewport={"width": 1400, "height": 860})
+def new_page(browser: Any, *, enforce_csp: bool = False) -> Any:
+    """A page in a fresh browser context; closing the page's context closes it.
+
+    Playwright evaluates the tests' string expressions (``wait_for_function``) with
+    ``eval``, which the studio's Content-Security-Policy forbids: the harness bypasses
+    the policy unless ``enforce_csp`` (the test that proves the page works under it).
+    """
+    context = browser.new_context(
+        viewport={"width": 1400, "height": 860}, bypass_csp=not enforce_csp
+    )
     return context.new_page()
 
 
@@ -305,7 +312,7 @@ def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:
     url, workspace, _ = studio
-    second = page.context.browser.new_page(viewport={"width": 1400, "height": 860})
+    second = page.context.new_page()  # a second tab of the same browser session
     second.errors = []  # type: ignore[attr-defined]
     second.on("pageerror", lambda error: second.errors.append(str(error)))
     second.goto(url)
@@ -429,3 +436,24 @@ def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, P
     assert "/ " in page.get_by_test_id("replay-clock").inner_text()
     assert at(duration) == ["reached"] * 7
     assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_the_page_works_under_its_content_security_policy(
+    studio: tuple[str, Path, Any], chromium: Any
+) -> None:
+    """The studio's policy (scripts and styles from itself only, no eval, no frames) is
+    enforced here: the page opens, checks and draws the mission without one violation."""
+    page = new_page(chromium, enforce_csp=True)
+    errors: list[str] = []
+    page.on(
+        "console", lambda message: errors.append(message.text) if message.type == "error" else None
+    )
+    page.on("pageerror", lambda error: errors.append(str(error)))
+    try:
+        page.goto(studio[0])
+        page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
+        assert page.get_by_test_id("waypoint-row").count() == 7
+        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert errors == []
+    finally:
+        page.context.close()

@@ -25,7 +25,7 @@ from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
-from starlette.types import ASGIApp, Receive, Scope, Send
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from navseq.errors import NavseqError
 from navseq.extras import MissingExtra
@@ -41,7 +41,15 @@ from navseq.studio.documents import (
     version_of,
 )
 from navseq.studio.mapview import MapView
-from navseq.studio.security import COOKIE_NAME, TOKEN_HEADER, FileRoots, token_matches
+from navseq.studio.security import (
+    COOKIE_NAME,
+    LOCAL_NAMES,
+    RESPONSE_HEADERS,
+    TOKEN_HEADER,
+    FileRoots,
+    host_allowed,
+    token_matches,
+)
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -76,6 +84,7 @@ class StudioConfig:
     mission_path: Path | None = None  # the mission file opened (may not exist yet)
     map_path: Path | None = None  # --map
     out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
+    host_names: frozenset[str] = LOCAL_NAMES  # names a request's Host may say (+ IPs)
 
 
 class ApiError(Exception):
@@ -562,28 +571,41 @@ def map_stamp(path: Path) -> tuple[int, ...]:
 
 
 class TokenGate:
-    """ASGI middleware: every request must carry the token (query, header or cookie).
+    """ASGI middleware: every request must carry the token (query, header or cookie)
+    and name this machine as its host; every answer carries the security headers.
 
     State-changing requests from another origin are refused too, so that a page from
     elsewhere that somehow got the cookie sent cannot drive the studio.
     """
 
-    def __init__(self, app: ASGIApp, token: str) -> None:
+    def __init__(self, app: ASGIApp, token: str, host_names: frozenset[str] = LOCAL_NAMES) -> None:
         self.app = app
         self.token = token
+        self.host_names = host_names
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] not in ("http", "websocket"):
             await self.app(scope, receive, send)
             return
+        send = _with_security_headers(send)
         request = Request(scope)
+        if not host_allowed(request.headers.get("host"), self.host_names):
+            response: Response = JSONResponse(
+                {
+                    "error": "this navseq studio answers only requests for this machine's "
+                    "address (open the URL it printed at start)"
+                },
+                status_code=421,
+            )
+            await response(scope, receive, send)
+            return
         given = (
             request.query_params.get("token")
             or request.headers.get(TOKEN_HEADER)
             or request.cookies.get(COOKIE_NAME)
         )
         if not token_matches(given, self.token):
-            response: Response = JSONResponse(
+            response = JSONResponse(
                 {"error": "this navseq studio needs its token: open the URL it printed at start"},
                 status_code=403,
             )
@@ -599,11 +621,32 @@ class TokenGate:
         await self.app(scope, receive, send)
 
 
+def _with_security_headers(send: Send) -> Send:
+    """``send``, adding :data:`RESPONSE_HEADERS` to the answer's start."""
+
+    async def sending(message: Message) -> None:
+        if message["type"] == "http.response.start":
+            headers = list(message.get("headers", []))
+            present = {name.lower() for name, _ in headers}
+            for name, value in RESPONSE_HEADERS.items():
+                if name.encode() not in present:
+                    headers.append((name.encode(), value.encode()))
+            message = {**message, "headers": headers}
+        await send(message)
+
+    return sending
+
+
 async def read_json(request: Request, limit: int = MAX_BODY_BYTES) -> dict[str, Any]:
-    """The request's JSON object; 413 past ``limit`` bytes, 400 for anything not JSON."""
+    """The request's JSON object; 413 past ``limit`` bytes, 415 for a body not declared
+    JSON (a cross-site form may send ``text/plain`` without asking), 400 for anything
+    not JSON."""
     declared = request.headers.get("content-length")
     if declared is not None and declared.isdigit() and int(declared) > limit:
         raise ApiError(413, f"the request body is over the limit of {limit} bytes")
+    declared_type = request.headers.get("content-type", "").split(";", 1)[0].strip().lower()
+    if declared_type != "application/json":
+        raise ApiError(415, "the request body must be JSON (content-type: application/json)")
     chunks: list[bytes] = []
     size = 0
     async for chunk in request.stream():
@@ -757,5 +800,5 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     ]
     app = Starlette(routes=routes)
     app.state.studio = studio
-    app.add_middleware(TokenGate, token=config.token)
+    app.add_middleware(TokenGate, token=config.token, host_names=config.host_names)
     return app

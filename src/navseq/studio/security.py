@@ -1,8 +1,12 @@
-"""What the studio lets a request do: the token, and the folders files may be under.
+"""What the studio lets a request do: the token, the host, and the folders files may be under.
 
 The studio runs on the user's machine with the user's rights, so a web page from
-elsewhere must not be able to use it (the token, compared in constant time, and a
-SameSite cookie), and the page itself may touch only the folders the user named at
+elsewhere must not be able to use it: the token (compared in constant time, and a
+SameSite cookie), a ``Host`` that names this machine (a page whose domain was made to
+resolve to 127.0.0.1, DNS rebinding, says its own name there), JSON bodies only (a
+cross-site form can send ``text/plain`` without asking), and headers that keep the
+page out of frames and other sites' scripts and styles out of the page
+(:data:`RESPONSE_HEADERS`). The page itself may touch only the folders the user named at
 start: the mission's and the map's folders, or ``--root``. A path that leaves them
 (``..``, a symlink pointing out, an absolute path elsewhere) is refused with a
 message saying which folders are allowed.
@@ -11,6 +15,7 @@ message saying which folders are allowed.
 from __future__ import annotations
 
 import hmac
+import ipaddress
 import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -22,6 +27,38 @@ from navseq.text import printable
 COOKIE_NAME = "navseq_studio_token"
 #: The request header an API client may send the token in instead.
 TOKEN_HEADER = "x-navseq-token"
+#: Host names a request may say it is for, besides IP literals and ``--host``'s name.
+LOCAL_NAMES = frozenset({"localhost"})
+#: Sent with every answer. The page loads its scripts, styles and Leaflet from the
+#: studio only; styles may be inline because Leaflet positions its panes with them.
+RESPONSE_HEADERS = {
+    "content-security-policy": (
+        "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+        "img-src 'self' data: blob:; connect-src 'self'; object-src 'none'; "
+        "base-uri 'none'; form-action 'self'; frame-ancestors 'none'"
+    ),
+    "x-content-type-options": "nosniff",
+    "x-frame-options": "DENY",
+    # The page's first URL carries the token: never hand it on to another site.
+    "referrer-policy": "no-referrer",
+}
+
+
+def host_allowed(host_header: str | None, names: frozenset[str] = LOCAL_NAMES) -> bool:
+    """Whether a ``Host`` header names this machine: an IP literal, or one of ``names``."""
+    if not host_header:
+        return False
+    host = host_header.strip().lower()
+    if host.startswith("["):  # [::1]:8000
+        literal, _, _ = host[1:].partition("]")
+        name = literal
+    else:
+        name = host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    try:
+        ipaddress.ip_address(name)
+    except ValueError:
+        return name in names
+    return True
 
 
 def token_matches(given: str | None, expected: str) -> bool:
