@@ -306,6 +306,18 @@ def test_a_patrol_point_interrupted_after_1806_good_laps_is_reached_with_a_ring(
     assert "5,418/5,419 visits reached" in fig.axes[0].get_title(loc="left")
 
 
+def test_a_waypoint_the_operator_cancelled_on_is_not_drawn_failed():
+    """A Stop or ~cancel cuts the visit short as Ctrl-C does: the robot did not fail it."""
+    w = WAYPOINTS[1]
+    reason = "cancelled by the operator (~cancel)"
+    visits = [
+        WaypointResult(0, 0, None, WAYPOINTS[0].x, WAYPOINTS[0].y, 0.0, REACHED),
+        WaypointResult(1, 0, None, w.x, w.y, 0.0, FAILED, reason=reason),
+    ]
+    outcomes = waypoint_outcomes(MissionResult(False, reason, visits, duration=30.0), 3)
+    assert outcomes[1] is Status.INTERRUPTED and list(outcomes.interrupted) == [False, True, False]
+
+
 def test_a_patrol_longer_than_the_report_lists_is_drawn_from_its_totals():
     """The result of a long patrol lists only its last visits; the picture counts all."""
     from navseq.executor.result import VisitLog

@@ -350,8 +350,10 @@ def test_stop_cancels_the_goal_and_the_report_is_written(client: TestClient) -> 
     assert stopped["ok"], stopped
     state = wait_for_run(client)
     assert state["status"] == "stopped"
-    assert state["report"]["reason"] == "stopped from the studio"
+    assert state["report"]["reason"] == "cancelled by the operator (the studio)"
     assert state["report"]["totals"]["reached"] < 7
+    # The waypoint being driven to was stopped, not failed by the robot.
+    assert "failed" not in state["waypoints"] and "stopped" in state["waypoints"]
     assert client.post("/api/run/stop").status_code == 409  # nothing left to stop
 
 

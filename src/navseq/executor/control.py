@@ -39,6 +39,13 @@ def cancelled_by_operator(reason: str) -> bool:
     return reason.startswith(CANCELLED)
 
 
+def ended_from_outside(reason: str) -> bool:
+    """Whether a visit's or mission's reason says it was cut short from outside (the
+    operator's cancel, a signal, a crash of the process) rather than failed by the
+    robot: such a visit was stopped, not failed."""
+    return cancelled_by_operator(reason) or reason.startswith("interrupted")
+
+
 class StopRequested(Exception):
     """The process running the mission is being shut down; ``str()`` says why."""
 

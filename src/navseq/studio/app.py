@@ -28,6 +28,7 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.executor.control import operator_reason
 from navseq.extras import MissingExtra
 from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
 from navseq.studio.documents import (
@@ -754,7 +755,9 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         if kind is None:
             raise ApiError(404, "unknown run action; stop, pause, resume or skip")
         run = studio.current_run()
-        reason = "stopped from the studio" if kind == "cancel" else f"{kind} from the studio"
+        # The operator's words as on every face, so that the report, the status and the
+        # page tell a Stop from a failure ("cancelled by the operator (the studio)").
+        reason = operator_reason(kind, "the studio")
         ok, message = await run_in_threadpool(run.operate, kind, reason)
         return JSONResponse({"ok": ok, "message": message}, status_code=200 if ok else 409)
 

@@ -27,7 +27,7 @@ from navseq.errors import NavseqError
 
 if TYPE_CHECKING:
     from navseq.executor.control import MissionControl
-    from navseq.executor.events import MissionEvent
+    from navseq.executor.events import MissionEvent, WaypointFinished
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
     from navseq.run.session import Session
@@ -102,7 +102,7 @@ class LiveView:
             elif isinstance(event, ev.WaypointDwelling):
                 self._set(event.index, "dwelling")
             elif isinstance(event, ev.WaypointFinished):
-                self._set(event.index, event.outcome.value)
+                self._set(event.index, _shown_outcome(event))
             elif isinstance(event, ev.MissionPaused):
                 self.status = "paused"
             elif isinstance(event, ev.MissionResumed):
@@ -288,6 +288,17 @@ class StudioRun:
             return True
         self._thread.join(timeout)
         return not self._thread.is_alive()
+
+
+def _shown_outcome(event: WaypointFinished) -> str:
+    """A visit's state on the page: one cut short by Stop (or a signal) was stopped, not
+    failed, though the executor ends it FAILED."""
+    from navseq.executor.control import ended_from_outside
+    from navseq.executor.events import WaypointOutcome
+
+    if event.outcome is WaypointOutcome.FAILED and ended_from_outside(event.reason):
+        return "stopped"
+    return event.outcome.value
 
 
 def _latest_report(folder: Path | None) -> dict[str, Any] | None:

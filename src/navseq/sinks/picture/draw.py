@@ -104,15 +104,18 @@ _SEVERITY: dict[Any, int] = {
 
 
 def _is_interruption(visit: Any) -> bool:
-    """A visit ended by a signal or crash, not by the robot: the run's end, not its failure."""
-    return str(getattr(visit, "reason", "")).startswith("interrupted")
+    """A visit ended by a signal, a crash or the operator's cancel, not by the robot: the
+    run's end, not its failure."""
+    from navseq.executor.control import ended_from_outside
+
+    return ended_from_outside(str(getattr(visit, "reason", "")))
 
 
 def waypoint_outcomes(result: MissionResult, count: int) -> WaypointOutcomes:
     """What each waypoint's marker says: the one place the picture reads a result's visits.
 
     The meaningful outcome of a waypoint is its worst visit that ran to an end: failed,
-    else skipped, else reached. A visit cut short by Ctrl-C or a signal is not a
+    else skipped, else reached. A visit cut short by Ctrl-C, a signal or a cancel is not a
     failure of the waypoint: a patrol point reached 1806 times and interrupted once is
     reached (drawn with an "interrupted here" ring), and a waypoint whose only visit
     was interrupted is *interrupted*, not failed. Never visited: not run.
