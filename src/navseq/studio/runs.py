@@ -71,6 +71,9 @@ class LiveView:
         self.error: str | None = None
         self.navigator: Navigator | None = None
         self._start_t: float | None = None
+        # The clock shows the mission's running time: a pause holds it, as it holds every
+        # deadline of the run, so that it does not jump by the pause on Resume.
+        self._paused_s = 0.0
         # Waypoint states changed since take_changes() (a replay's timeline is made of them).
         self._changed: set[int] = set()
         self._reset = False
@@ -83,7 +86,9 @@ class LiveView:
         with self._lock:
             if self._start_t is None:
                 self._start_t = event.t
-            self.clock_s = event.t - self._start_t
+            if isinstance(event, ev.MissionResumed):
+                self._paused_s += max(0.0, event.paused_for)
+            self.clock_s = max(self.clock_s, event.t - self._start_t - self._paused_s)
             if isinstance(event, ev.MissionStarted):
                 self.status = "running"
             elif isinstance(event, ev.LoopStarted):
