@@ -15,7 +15,7 @@ from cli_support import navseq
 from navseq.journal.writer import HEARTBEAT
 from navseq.mission import load_mission
 from navseq.studio.app import MAX_BODY_BYTES, StudioConfig, create_app
-from navseq.studio.security import FileRoots
+from navseq.studio.security import FileRoots, allowed_hosts, host_allowed
 
 REPO = Path(__file__).resolve().parents[1]
 TOKEN = "test-token"
@@ -78,10 +78,27 @@ def test_a_request_for_a_foreign_host_name_is_refused_even_with_the_token(
     name as Host and as Origin, so the origin check alone would let it through."""
     foreign = {"host": "evil.example:8765", "origin": "http://evil.example:8765"}
     answer = client.post("/api/check", json={"mission": {}}, headers=foreign)
-    assert answer.status_code == 421
-    assert client.get("/api/mission", headers={"host": "evil.example"}).status_code == 421
+    assert answer.status_code == 403
+    assert "this machine" in answer.json()["error"]
+    for host in ("evil.example", "10.0.0.7:8765", "127.0.0.2"):
+        assert client.get("/api/mission", headers={"host": host}).status_code == 403, host
     for host in ("localhost:8765", "127.0.0.1:8765", "[::1]:8765", "LOCALHOST"):
         assert client.get("/api/mission", headers={"host": host}).status_code == 200, host
+
+
+@pytest.mark.parametrize(
+    ("listen", "host", "allowed"),
+    [
+        ("127.0.0.1", "my-laptop.local:8765", False),
+        ("my-laptop.local", "my-laptop.local:8765", True),  # --host given by name
+        ("192.168.1.5", "192.168.1.5:8765", True),
+        ("192.168.1.5", "192.168.1.6:8765", False),
+        ("0.0.0.0", "192.168.1.6:8765", True),  # every interface: any of its addresses
+        ("0.0.0.0", "evil.example:8765", False),  # ... but never a name
+    ],
+)
+def test_the_hosts_a_request_may_name_follow_host(listen: str, host: str, allowed: bool) -> None:
+    assert host_allowed(host, allowed_hosts(listen)) is allowed
 
 
 def test_a_body_not_declared_json_is_refused(client: TestClient) -> None:

@@ -91,15 +91,14 @@ def run(args: argparse.Namespace) -> int:
         map_path = roots.resolve(str(args.map.resolve()), "--map")
     if mission is not None:
         roots.resolve(str(mission.resolve()), "MISSION")  # refused outside --root
-    from navseq.studio.security import LOCAL_NAMES
+    from navseq.studio.security import allowed_hosts
 
     config = StudioConfig(
         token=secrets.token_urlsafe(24),
         roots=roots,
         mission_path=mission.resolve() if mission is not None else None,
         map_path=map_path,
-        # --host given as a name (my-laptop.local): requests naming it are for us too.
-        host_names=LOCAL_NAMES | {args.host.lower()},
+        hosts=allowed_hosts(args.host),
     )
     return serve(config, args.host, args.port, open_browser=not args.no_browser)
 

@@ -85,7 +85,7 @@ class StudioConfig:
     mission_path: Path | None = None  # the mission file opened (may not exist yet)
     map_path: Path | None = None  # --map
     out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
-    host_names: frozenset[str] = LOCAL_NAMES  # names a request's Host may say (+ IPs)
+    hosts: frozenset[str] = LOCAL_NAMES  # what a request's Host may say (allowed_hosts)
 
 
 class ApiError(Exception):
@@ -579,10 +579,10 @@ class TokenGate:
     elsewhere that somehow got the cookie sent cannot drive the studio.
     """
 
-    def __init__(self, app: ASGIApp, token: str, host_names: frozenset[str] = LOCAL_NAMES) -> None:
+    def __init__(self, app: ASGIApp, token: str, hosts: frozenset[str] = LOCAL_NAMES) -> None:
         self.app = app
         self.token = token
-        self.host_names = host_names
+        self.hosts = hosts
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] not in ("http", "websocket"):
@@ -590,13 +590,13 @@ class TokenGate:
             return
         send = _with_security_headers(send)
         request = Request(scope)
-        if not host_allowed(request.headers.get("host"), self.host_names):
+        if not host_allowed(request.headers.get("host"), self.hosts):
             response: Response = JSONResponse(
                 {
                     "error": "this navseq studio answers only requests for this machine's "
                     "address (open the URL it printed at start)"
                 },
-                status_code=421,
+                status_code=403,
             )
             await response(scope, receive, send)
             return
@@ -803,5 +803,5 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     ]
     app = Starlette(routes=routes)
     app.state.studio = studio
-    app.add_middleware(TokenGate, token=config.token, host_names=config.host_names)
+    app.add_middleware(TokenGate, token=config.token, hosts=config.hosts)
     return app

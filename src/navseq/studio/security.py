@@ -3,7 +3,8 @@
 The studio runs on the user's machine with the user's rights, so a web page from
 elsewhere must not be able to use it: the token (compared in constant time, and a
 SameSite cookie), a ``Host`` that names this machine (a page whose domain was made to
-resolve to 127.0.0.1, DNS rebinding, says its own name there), JSON bodies only (a
+resolve to 127.0.0.1, DNS rebinding, says its own name there: only the loopback names
+and ``--host`` are taken), JSON bodies only (a
 cross-site form can send ``text/plain`` without asking), and headers that keep the
 page out of frames and other sites' scripts and styles out of the page
 (:data:`RESPONSE_HEADERS`). The page itself may touch only the folders the user named at
@@ -27,8 +28,11 @@ from navseq.text import printable
 COOKIE_NAME = "navseq_studio_token"
 #: The request header an API client may send the token in instead.
 TOKEN_HEADER = "x-navseq-token"
-#: Host names a request may say it is for, besides IP literals and ``--host``'s name.
-LOCAL_NAMES = frozenset({"localhost"})
+#: Hosts a request may say it is for, besides ``--host``: this machine's loopback names.
+LOCAL_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})
+#: ``--host`` values that listen on every interface: the machine is then reached by any
+#: of its addresses, so any IP address is a host of ours (names still are not).
+EVERY_INTERFACE = frozenset({"0.0.0.0", "::", ""})
 #: Sent with every answer. The page loads its scripts, styles and Leaflet from the
 #: studio only; styles may be inline because Leaflet positions its panes with them.
 RESPONSE_HEADERS = {
@@ -44,21 +48,30 @@ RESPONSE_HEADERS = {
 }
 
 
-def host_allowed(host_header: str | None, names: frozenset[str] = LOCAL_NAMES) -> bool:
-    """Whether a ``Host`` header names this machine: an IP literal, or one of ``names``."""
+def allowed_hosts(listen_host: str) -> frozenset[str]:
+    """The hosts requests may name when the studio listens on ``listen_host``."""
+    return LOCAL_NAMES | {listen_host.strip().strip("[]").lower()}
+
+
+def host_allowed(host_header: str | None, hosts: frozenset[str] = LOCAL_NAMES) -> bool:
+    """Whether a ``Host`` header (``name``, ``name:port``, ``[::1]:port``) is one of
+    ``hosts``; with a host of :data:`EVERY_INTERFACE` among them, any IP address is."""
     if not host_header:
         return False
     host = host_header.strip().lower()
-    if host.startswith("["):  # [::1]:8000
-        literal, _, _ = host[1:].partition("]")
-        name = literal
+    if host.startswith("["):
+        name = host[1:].partition("]")[0]
     else:
         name = host.rsplit(":", 1)[0] if host.count(":") == 1 else host
-    try:
-        ipaddress.ip_address(name)
-    except ValueError:
-        return name in names
-    return True
+    if name in hosts:
+        return True
+    if hosts & EVERY_INTERFACE:
+        try:
+            ipaddress.ip_address(name)
+        except ValueError:
+            return False
+        return True
+    return False
 
 
 def token_matches(given: str | None, expected: str) -> bool:
