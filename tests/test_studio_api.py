@@ -315,6 +315,26 @@ def test_save_as_a_new_file_and_a_mission_with_pre_flight_problems(
     assert not (workspace / "examples/bad.yaml").exists()
 
 
+@pytest.mark.parametrize(
+    ("target", "said"),
+    [
+        ("../maps/turtlebot3_world.yaml", "a map_server map"),
+        ("tutorial_params.yaml", "a ROS parameter file"),
+    ],
+)
+def test_save_as_never_replaces_a_file_that_is_not_a_navseq_mission(
+    client: TestClient, workspace: Path, target: str, said: str
+) -> None:
+    """Even confirmed: a map saved over with a mission is a broken map."""
+    document = opened(client)["mission"]
+    path = workspace / "examples" / target
+    before = path.read_bytes()
+    answer = client.post("/api/save", json={"mission": document, "path": target, "overwrite": True})
+    assert answer.status_code == 409
+    assert said in answer.json()["error"] and "nothing was written" in answer.json()["error"]
+    assert path.read_bytes() == before
+
+
 def wait_for_run(client: TestClient, timeout: float = 60.0) -> dict:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:

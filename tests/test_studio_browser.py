@@ -457,3 +457,28 @@ def test_the_page_works_under_its_content_security_policy(
         assert errors == []
     finally:
         page.context.close()
+
+
+def test_closing_the_tab_with_unsaved_edits_asks_first_and_not_once_saved(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    seen: list[str] = []
+
+    def answer(dialog: Any) -> None:
+        seen.append(dialog.type)
+        if dialog.type == "beforeunload":
+            dialog.dismiss()  # stay on the page
+        else:
+            dialog.accept()  # Save's "replace it?"
+
+    page.on("dialog", answer)
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    page.close(run_before_unload=True)
+    page.wait_for_timeout(500)
+    assert seen == ["beforeunload"] and not page.is_closed()  # the edit is kept
+    page.get_by_test_id("save").click()
+    page.wait_for_selector("text=saved", timeout=10_000)
+    seen.clear()
+    with page.expect_event("close", timeout=5_000):
+        page.close(run_before_unload=True)
+    assert "beforeunload" not in seen  # saved: nothing to lose, nothing asked

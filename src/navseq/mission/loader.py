@@ -180,6 +180,14 @@ def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mi
     return mission_from_document(doc, source, base_dir, problems)
 
 
+def is_navseq_document(doc: Located) -> bool:
+    """Whether a parsed YAML document is a mission in navseq's own format (not a ROS
+    parameter tree, not another kind of YAML)."""
+    if not doc.is_mapping or _is_rosparam_tree(doc):
+        return False
+    return any(key in doc.value for key in _NAVSEQ_KEYS)
+
+
 def _is_rosparam_tree(doc: Located | None) -> bool:
     """A mapping without navseq's own top-level keys, giving p_seq/yea_seq somewhere.
 

@@ -37,6 +37,7 @@ from navseq.studio.documents import (
     DraftRefused,
     check_draft,
     empty_document,
+    not_a_navseq_mission,
     open_document,
     problems_of,
     version_of,
@@ -341,6 +342,14 @@ class Studio:
             if exists:
                 if not target.is_file():
                     raise ApiError(409, f"{printable(target.name)} is not a regular file")
+                other = not_a_navseq_mission(target)
+                if other is not None:
+                    raise ApiError(
+                        409,
+                        f"{printable(target.name)} is {other}, not a navseq mission: saving "
+                        "would replace it; nothing was written. Save under another name",
+                        conflict="not a mission",
+                    )
                 current = version_of(target)
                 if isinstance(expected, dict) and expected.get("sha256") != current["sha256"]:
                     raise ApiError(

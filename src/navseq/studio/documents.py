@@ -252,3 +252,30 @@ __all__ = [
     "open_document",
     "version_of",
 ]
+
+
+def not_a_navseq_mission(path: Path) -> str | None:
+    """What the file at ``path`` is when it is not a navseq mission (a save over it would
+    destroy it): ``"a map_server map"`` ..., or None for a navseq mission (or no file)."""
+    from navseq.mission.loader import is_navseq_document
+    from navseq.mission.problems import Problems
+    from navseq.mission.reading import read_mission_text
+    from navseq.mission.rosparam_format import find_mission_namespaces
+    from navseq.mission.yaml_doc import parse_yaml
+
+    if not path.exists():
+        return None
+    try:
+        doc = parse_yaml(read_mission_text(path), str(path), Problems())
+    except NavseqError:
+        return "a file that is not YAML navseq can read"
+    if doc is None or not doc.is_mapping:
+        return "a YAML file that is not a navseq mission"
+    if is_navseq_document(doc):
+        return None
+    keys = set(doc.value)
+    if {"image", "resolution"} <= keys:
+        return "a map_server map (its image and resolution)"
+    if find_mission_namespaces(doc):
+        return "a ROS parameter file (p_seq / yea_seq), which the studio imports but never writes"
+    return "a YAML file that is not a navseq mission (no waypoints: or navseq: key)"

@@ -115,6 +115,13 @@ function restore(from, to) {
   changed();
 }
 function changed() { render(); check(); }
+// Edits not saved yet: closing or reloading the tab asks first (the browser's own dialog).
+const unsaved = () => S.saved !== undefined && JSON.stringify(S.doc) !== S.saved;
+window.addEventListener("beforeunload", (e) => {
+  if (!unsaved()) return;
+  e.preventDefault();
+  e.returnValue = "";
+});
 const round = (v, d) => Math.round(v * 10 ** d) / 10 ** d;
 
 map.on("click", (e) => {
@@ -436,6 +443,7 @@ async function save(path) {
   }
   if (!answer.ok) { say(answer.data.error, true); return; }
   S.version = answer.data.version;
+  S.saved = JSON.stringify(body.mission);
   if (!path) S.exists = true;
   if (path) { S.name = answer.data.path; $("mission-name").textContent = S.name; }
   const n = answer.data.problems.length;
@@ -752,6 +760,7 @@ async function main() {
     return;
   }
   S.doc = answer.data.mission;
+  S.saved = JSON.stringify(S.doc);
   S.version = answer.data.version;
   S.units = answer.data.units;
   S.name = answer.data.name;
