@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import json
 import shutil
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from starlette.testclient import TestClient
@@ -298,6 +300,79 @@ def test_a_stale_version_is_a_conflict_and_nothing_is_lost(
     assert stale.status_code == 409 and stale.json()["conflict"] == "changed"
     assert "changed on disk since it was opened" in stale.json()["error"]
     assert load_mission(workspace / "examples/turtlebot3_world.yaml").waypoints[0].name == "first"
+
+
+def save_edited(client: TestClient, path: Path, edit: Any) -> list[str]:
+    """Open, ``edit(document)``, save over the file; the unified diff of the file."""
+    before = path.read_text()
+    body = opened(client)
+    edit(body["mission"])
+    answer = client.post(
+        "/api/save",
+        json={"mission": body["mission"], "version": body["version"], "overwrite": True},
+    )
+    assert answer.status_code == 200, answer.json()
+    assert answer.json()["kept_formatting"] is True
+    return [
+        line
+        for line in difflib.unified_diff(before.splitlines(), path.read_text().splitlines(), n=0)
+        if line[:1] in "+-" and line[:3] not in ("+++", "---")
+    ]
+
+
+def test_save_changes_only_the_lines_of_what_was_edited(
+    client: TestClient, workspace: Path
+) -> None:
+    """The example is commented, aligned and written with integers: one field edited,
+    one line changes, its comment kept."""
+    path = workspace / "examples/turtlebot3_world.yaml"
+
+    def move_east_dock(document: dict) -> None:
+        document["waypoints"][1]["x"] = 1.7
+
+    assert save_edited(client, path, move_east_dock) == [
+        "-  - {name: east-dock, x: 1.75, y: -0.55, yaw: 90}",
+        "+  - {name: east-dock, x: 1.7, y: -0.55, yaw: 90}",
+    ]
+
+    def shorter_timeout(document: dict) -> None:
+        document["defaults"]["goal_timeout"] = 90
+
+    assert save_edited(client, path, shorter_timeout) == [
+        "-  goal_timeout: 120        # s for one attempt at a waypoint",
+        "+  goal_timeout: 90         # s for one attempt at a waypoint",  # comment column kept
+    ]
+    assert load_mission(path).waypoints[1].x == pytest.approx(1.7)
+
+
+def test_inserting_and_deleting_waypoints_leaves_the_others_and_comments_alone(
+    client: TestClient, workspace: Path
+) -> None:
+    path = workspace / "examples/turtlebot3_world.yaml"
+    text = path.read_text().replace(
+        "yaw: 90}\n", "yaw: 90}   # the dock's charger faces north\n", 1
+    )
+    path.write_text(text)
+
+    def insert_and_delete(document: dict) -> None:
+        document["waypoints"].insert(1, {"name": "new", "x": 0.5, "y": -1.6, "yaw": 45})
+        del document["waypoints"][4]  # north-dock, now fifth
+
+    assert save_edited(client, path, insert_and_delete) == [
+        "+  - {name: new, x: 0.5, y: -1.6, yaw: 45}",
+        "-  - {name: north-dock, x: 0.0, y: 1.75, yaw: 180}",
+    ]
+    assert "# the dock's charger faces north" in path.read_text()
+    names = [w.name for w in load_mission(path).waypoints]
+    assert names == [
+        "south-gate",
+        "new",
+        "east-dock",
+        "inner-east",
+        "west-gate",
+        "inner-west",
+        "home",
+    ]
 
 
 def test_save_as_a_new_file_and_a_mission_with_pre_flight_problems(

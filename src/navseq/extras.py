@@ -1,7 +1,7 @@
 """Optional capabilities installed as pip extras, and one clear error when one is missing.
 
 A ROS node's install needs neither a web server nor a 30 MB route solver, so they are
-extras: ``navseq[studio]`` (starlette, uvicorn) for ``navseq studio`` and
+extras: ``navseq[studio]`` (starlette, uvicorn, ruamel.yaml) for ``navseq studio`` and
 ``navseq[plan]`` (OR-tools) for the shortest visiting order. Whatever needs one calls
 :func:`require_extra` before it imports the modules, and the user reads which
 ``pip install`` brings them instead of a traceback.
@@ -15,7 +15,7 @@ from navseq.errors import NavseqError
 
 #: Each extra's name (as in ``pip install 'navseq[NAME]'``) and the modules it brings.
 EXTRAS: dict[str, tuple[str, ...]] = {
-    "studio": ("starlette", "uvicorn"),
+    "studio": ("starlette", "uvicorn", "ruamel.yaml"),
     "plan": ("ortools.constraint_solver.pywrapcp",),
 }
 

@@ -180,6 +180,12 @@ def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mi
     return mission_from_document(doc, source, base_dir, problems)
 
 
+def mission_from_yaml_text(text: str, source: str, base_dir: Path) -> Mission | None:
+    """The mission a YAML text (navseq or rosparam) holds, None when it has problems;
+    relative paths in it are relative to ``base_dir``, as for a file there."""
+    return _read_yaml(text, source, base_dir, Problems())
+
+
 def is_navseq_document(doc: Located) -> bool:
     """Whether a parsed YAML document is a mission in navseq's own format (not a ROS
     parameter tree, not another kind of YAML)."""

@@ -36,6 +36,7 @@ from navseq.studio.documents import (
     CheckedDraft,
     DraftRefused,
     check_draft,
+    document_of,
     empty_document,
     not_a_navseq_mission,
     open_document,
@@ -367,12 +368,16 @@ class Studio:
                         conflict="exists",
                         version=current,
                     )
-            write_mission(mission, target, overwrite=exists)
+            kept = exists and _save_keeping_the_file(target, document, mission)
+            if not kept:
+                write_mission(mission, target, overwrite=exists)
             version = version_of(target)
         return {
             "path": self.roots.relative(target),
             "version": version,
             "problems": [problem.as_json() for problem in checked.problems],
+            # True: only what changed was written (comments, order, numbers kept).
+            "kept_formatting": kept,
         }
 
     # -- files: import, export -----------------------------------------------------------
@@ -575,6 +580,37 @@ def map_stamp(path: Path) -> tuple[int, ...]:
     except Exception:  # the loader says what is wrong with a bad map; the YAML's stamp will do
         pass
     return tuple(stamp)
+
+
+def _save_keeping_the_file(target: Path, document: Any, mission: Mission) -> bool:
+    """Write into ``target`` only what the page changed since the file was opened; False
+    (nothing written) when that cannot give exactly ``mission``, so that the caller
+    writes the mission whole instead."""
+    from navseq.files import write_atomically
+    from navseq.mission.loader import mission_from_yaml_text
+    from navseq.studio.roundtrip import merged_mission_text
+
+    if not isinstance(document, dict):
+        return False
+    before, _ = open_document(target, target.parent)
+    if before is None:
+        return False
+    try:
+        original = target.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    text = merged_mission_text(original, before, document)
+    if text is None:
+        return False
+    try:
+        merged = mission_from_yaml_text(text, str(target), target.parent)
+    except NavseqError:
+        return False
+    # The merged file must read as the very mission the page meant, or it is not used.
+    if merged is None or document_of(merged, target.parent) != document_of(mission, target.parent):
+        return False
+    write_atomically(target, text)
+    return True
 
 
 # --- HTTP ------------------------------------------------------------------------------
