@@ -313,7 +313,6 @@ def test_two_sim_sessions_run_at_once_in_two_threads_and_keep_to_their_own(
 ARGPARSE_ALLOWED = (
     "commands/",
     "cli.py",
-    "ros1/record.py",
     "ros2/sim_node.py",
 )
 

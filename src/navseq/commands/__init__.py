@@ -8,7 +8,7 @@ A subcommand module provides two functions:
 Modules are imported when the parser is built, so they must import only light
 things at module level (argparse, pathlib) and import the heavy machinery (the
 simulator, matplotlib, rospy) inside ``run``. Adding a subcommand is one module
-plus one line in :data:`SUBCOMMANDS` (``navseq record`` lives in ``navseq.ros1.record``).
+plus one line in :data:`SUBCOMMANDS`.
 """
 
 from __future__ import annotations
@@ -68,10 +68,9 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
     Subcommand(
         "studio", "make, check and run missions on the map in a browser", "navseq.commands.studio"
     ),
-    # Lives with the ROS code; it imports rospy only when recording starts.
     Subcommand(
         "record",
         "record waypoints from RViz goals (or a pose topic) into a mission file (ROS 1)",
-        "navseq.ros1.record",
+        "navseq.commands.record",
     ),
 )

@@ -11,13 +11,12 @@ never loses what was recorded, and the file is always a valid navseq mission.
 An existing file is never replaced unless ``overwrite`` is asked for; the file is only
 created once the first waypoint arrives (a mission cannot be empty).
 
-This module is also the ``navseq record`` subcommand (:func:`configure`, :func:`run`) and
-the ``record_node`` ROS node (:func:`main`); rospy is imported only when recording starts.
+:func:`record_main` is what ``navseq record`` (:mod:`navseq.commands.record`) and the
+``record_node`` ROS node (:func:`main`) run; rospy is imported only when recording starts.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import signal
 import sys
@@ -31,7 +30,7 @@ from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D
 from navseq.text import printable
 
-DEFAULT_TOPIC = "/move_base_simple/goal"
+DEFAULT_TOPIC = "/move_base_simple/goal"  # RViz's "2D Nav Goal"
 NODE_NAME = "navseq_record"
 
 
@@ -195,42 +194,6 @@ def record_main(
     )
     rospy.signal_shutdown("recording finished")
     return 0
-
-
-# -- `navseq record` subcommand ----------------------------------------------------------
-
-
-def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("out", type=Path, help="mission file to write (navseq YAML)")
-    parser.add_argument(
-        "--topic",
-        default=DEFAULT_TOPIC,
-        help="pose topic: PoseStamped, or PoseWithCovarianceStamped for */initialpose "
-        f"(default {DEFAULT_TOPIC})",
-    )
-    parser.add_argument("--force", action="store_true", help="replace an existing file")
-    parser.add_argument(
-        "--from-tf",
-        action="store_true",
-        help="also offer the ~record service that records the robot's current TF pose",
-    )
-    parser.add_argument(
-        "--base-frame",
-        default="base_footprint",
-        help="the robot's TF frame whose pose --from-tf records (default base_footprint)",
-    )
-    parser.add_argument("--frame", default="map", help="frame of TF-recorded poses (default map)")
-
-
-def run(args: argparse.Namespace) -> int:
-    return record_main(
-        args.out,
-        args.topic,
-        overwrite=args.force,
-        from_tf=args.from_tf,
-        base_frame=args.base_frame,
-        frame=args.frame,
-    )
 
 
 # -- `rosrun navseq record_node` --------------------------------------------------------
