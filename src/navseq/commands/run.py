@@ -119,6 +119,20 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=None,  # None: not given (a resume takes the journal's)
         help="do not draw mission.png",
     )
+    parser.add_argument(
+        "--record",
+        action="store_true",
+        default=None,  # None: not given (the mission's record:, or a resume's journal)
+        help="record the run as run.mcap in the output folder (map, pose, odometry, /tf, "
+        "plans, goals, waypoint markers, events) for Foxglove and ros2 bag; "
+        "needs pip install 'navseq[record]'",
+    )
+    parser.add_argument(
+        "--record-format",
+        choices=("ros2", "ros1"),
+        default=None,
+        help="the recording's message encoding: ros2 (CDR, the default) or ros1",
+    )
     add_robot_option(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
@@ -205,7 +219,10 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         only=args.only,
         preflight=not args.no_preflight,
         outputs=Outputs(
-            folder=args.out, picture=None if args.no_picture is None else not args.no_picture
+            folder=args.out,
+            picture=None if args.no_picture is None else not args.no_picture,
+            record=args.record,
+            record_format=args.record_format,
         ),
         resume=args.resume,
         realtime=args.realtime,

@@ -52,6 +52,7 @@ if TYPE_CHECKING:
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.recorder import RunRecorder
+    from navseq.sinks.recording.sink import RecordingSink
 
 #: Called with each note on the run (one line) at the moment a face should show it.
 NoteSink = Callable[[str], None]
@@ -88,6 +89,14 @@ class Session:
     listeners: list[MissionListener] = field(default_factory=list)
     # A navigator is made ready for one run (a ROS connection is closed after it).
     _started: bool = field(default=False, init=False, repr=False)
+
+    @property
+    def records(self) -> bool:
+        """Whether the run is recorded as MCAP (``--record``, or the mission's ``record:``)."""
+        outputs = self.request.outputs
+        if outputs is None:
+            return False
+        return outputs.record if outputs.record is not None else self.mission.record
 
     @property
     def numbers(self) -> list[int] | None:
@@ -188,6 +197,9 @@ class Session:
             # Resuming appends to the run's own journal; a new run starts a new one.
             journal_path = self.journal or reserve_file(folder, "journal.jsonl")
         fresh: JournalWriter | None = None
+        recording = self._new_recording(outputs, folder)
+        if recording is not None:
+            face = [*face, recording]
         try:
             # A new journal gets its header at once, before the slow steps (the picture's
             # imports, the navigator's connection): a run killed during them used to
@@ -214,8 +226,15 @@ class Session:
                 fresh.close()
             if journal_path is not None and self.journal is None:
                 _discard_unused(journal_path)
+            if recording is not None and recording.path.stat().st_size == 0:
+                recording.path.unlink()  # reserved, never begun
             raise
         files = RunFiles(paths={} if journal_path is None else {"journal": str(journal_path)})
+        if recording is not None:
+            if recording.error is None:
+                files.paths["recording"] = str(recording.path)
+            else:
+                files.failed["recording"] = recording.error
         exit_status = write_outputs(
             folder,
             files,
@@ -237,6 +256,22 @@ class Session:
             error=error,
             stopped_by=ran.error,
             clock=ran.clock,
+        )
+
+    def _new_recording(self, outputs: Outputs, folder: Path) -> RecordingSink | None:
+        """The run's MCAP recording if one is asked for: ``run.mcap``, or the first free
+        ``run-N.mcap`` (a resumed run records beside the first file)."""
+        from navseq.run.folder import reserve_file
+        from navseq.sinks.recording.sink import RecordingSink
+
+        if not self.records:
+            return None
+        return RecordingSink(
+            reserve_file(folder, "run.mcap"),
+            "ros1" if outputs.record_format == "ros1" else "ros2",
+            self.mission,
+            self.grid,
+            numbers=self.numbers,
         )
 
     def _new_journal(self, journal_path: Path) -> JournalWriter:
@@ -444,6 +479,10 @@ def prepare(request: RunRequest) -> Session:
     )
     if kind is not None:
         session.run_options = run_options(request, kind, mission, map_path, draft.start)
+    if session.records:
+        from navseq.extras import require_extra
+
+        require_extra("record", "recording the run (--record)")
     return session
 
 

@@ -1,0 +1,217 @@
+"""The run's recording (``run.mcap``): a mission listener writing ROS topics as it goes.
+
+What is written, on which topic (all stamped with the run's clock, log time in ns):
+
+========================  ================================  ==============================
+topic                     type                              when
+========================  ================================  ==============================
+``/map``                  nav_msgs/OccupancyGrid            once, when the mission starts
+``/navseq/pose``          geometry_msgs/PoseStamped (map)   every progress event (~10 Hz)
+``/odom``                 nav_msgs/Odometry                 every progress event
+``/tf``                   tf2_msgs/TFMessage                every progress event
+``/plan``                 nav_msgs/Path                     every plan the stack reports
+``/navseq/goal``          geometry_msgs/PoseStamped         every goal sent
+``/navseq/waypoints``     visualization_msgs/MarkerArray    at the start, each goal, each end
+``/navseq/events``        JSON (events.schema.json)         every mission event
+========================  ================================  ==============================
+
+The frames are those the run knows: the mission's frame (``map``), ``odom`` and
+``base_footprint``. navseq sees the robot's pose in the map only, so ``map → odom`` is
+the identity and ``odom → base_footprint`` the pose (the simulator's own frames are
+exactly these); the odometry's velocity is the change between two poses.
+
+The file is written as the run goes, chunk by chunk, and flushed at least every
+:data:`FLUSH_PERIOD` seconds of wall time and at each waypoint's end: a process killed
+mid-run leaves a file readable up to its last complete chunk. A write that fails (disk
+full) stops the recording, not the mission: :attr:`RecordingSink.error` says why.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import math
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from navseq.executor.events import (
+    MissionEvent,
+    MissionFinished,
+    MissionStarted,
+    WaypointFinished,
+    WaypointPlan,
+    WaypointProgress,
+    WaypointStarted,
+)
+from navseq.geometry import Pose2D, normalize_angle
+from navseq.mission.model import Mission
+from navseq.sim.occupancy import OccupancyGrid
+from navseq.sinks.mission_status import MissionStatus
+from navseq.sinks.recording import messages as msg
+from navseq.sinks.recording.encoding import McapRecording, RecordingFormat
+
+#: Seconds of wall time between two flushes at most: what a crash can lose.
+FLUSH_PERIOD = 1.0
+ODOM_FRAME = "odom"
+BASE_FRAME = "base_footprint"
+EVENTS_SCHEMA_NAME = "navseq.MissionEvent"
+#: Topic -> ROS type of every ROS topic the sink writes (the events are JSON).
+TOPICS = {
+    "/map": "nav_msgs/OccupancyGrid",
+    "/navseq/pose": "geometry_msgs/PoseStamped",
+    "/odom": "nav_msgs/Odometry",
+    "/tf": "tf2_msgs/TFMessage",
+    "/plan": "nav_msgs/Path",
+    "/navseq/goal": "geometry_msgs/PoseStamped",
+    "/navseq/waypoints": "visualization_msgs/MarkerArray",
+}
+EVENTS_TOPIC = "/navseq/events"
+
+
+class RecordingSink:
+    """Writes ``path`` (an MCAP file) from the run's events; a context manager.
+
+    ``grid`` is the map the run uses (None: no ``/map``); ``numbers`` the waypoints'
+    positions in the mission file when the run is a part of it (for the events'
+    ``number``). The file is opened on entering and finished on leaving.
+    """
+
+    def __init__(
+        self,
+        path: Path,
+        record_format: RecordingFormat,
+        mission: Mission,
+        grid: OccupancyGrid | None = None,
+        *,
+        numbers: Sequence[int] | None = None,
+        wall_clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.path = path
+        self.record_format = record_format
+        self.error: str | None = None
+        self._mission = mission
+        self._frame = mission.frame
+        self._grid = grid
+        self._numbers = numbers
+        self._status = MissionStatus(mission)
+        self._recording: McapRecording | None = None
+        self._wall_clock = wall_clock
+        self._last_flush = 0.0
+        self._map_written = False
+        self._last_pose: tuple[float, Pose2D] | None = None
+        self._velocity = (0.0, 0.0)
+
+    def __enter__(self) -> RecordingSink:
+        from navseq.sinks.recording.definitions import events_schema
+
+        self._events_schema = events_schema()
+        try:
+            self._recording = McapRecording(self.path.open("wb"), self.record_format)
+        except OSError as error:
+            self._fail(error)
+        self._last_flush = self._wall_clock()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        recording, self._recording = self._recording, None
+        if recording is not None:
+            try:
+                recording.finish()
+            except OSError as error:
+                self._fail(error)
+
+    def __call__(self, event: MissionEvent) -> None:
+        if self._recording is None:
+            return
+        try:
+            self._write(event)
+        except OSError as error:
+            self._fail(error)
+            return
+        if isinstance(event, (WaypointFinished, MissionFinished)) or (
+            self._wall_clock() - self._last_flush >= FLUSH_PERIOD
+        ):
+            self._flush()
+
+    # -- internals -----------------------------------------------------------------------
+
+    def _write(self, event: MissionEvent) -> None:
+        t = event.t
+        update = self._status.update(event)
+        if isinstance(event, MissionStarted):
+            self._last_pose = None
+            if self._grid is not None and not self._map_written:
+                self._ros("/map", t, msg.occupancy_grid(t, self._frame, self._grid))
+                self._map_written = True
+            self._markers(t)
+        elif isinstance(event, WaypointProgress):
+            self._robot(t, Pose2D(event.x, event.y, event.yaw))
+        elif isinstance(event, WaypointPlan):
+            self._ros("/plan", t, msg.path(t, self._frame, event.path))
+        elif isinstance(event, WaypointStarted):
+            goal = Pose2D(event.x, event.y, event.yaw)
+            z = self._mission.waypoints[event.index].z
+            self._ros("/navseq/goal", t, msg.pose_stamped(t, self._frame, goal, z))
+        if update is not None and update.markers_changed:
+            self._markers(t)
+        self._event(event)
+
+    def _robot(self, t: float, where: Pose2D) -> None:
+        last = self._last_pose
+        if last is not None and t > last[0]:
+            dt = t - last[0]
+            heading = math.atan2(where.y - last[1].y, where.x - last[1].x)
+            forward = 1.0 if math.cos(heading - where.yaw) >= 0 else -1.0
+            speed = forward * math.hypot(where.x - last[1].x, where.y - last[1].y) / dt
+            self._velocity = (speed, normalize_angle(where.yaw - last[1].yaw) / dt)
+        self._last_pose = (t, where)
+        self._ros("/navseq/pose", t, msg.pose_stamped(t, self._frame, where))
+        self._ros("/odom", t, msg.odometry(t, ODOM_FRAME, BASE_FRAME, where, *self._velocity))
+        identity = Pose2D(0.0, 0.0, 0.0)
+        transforms = [
+            msg.transform(t, self._frame, ODOM_FRAME, identity),
+            msg.transform(t, ODOM_FRAME, BASE_FRAME, where),
+        ]
+        self._ros("/tf", t, msg.tf_message(transforms))
+
+    def _markers(self, t: float) -> None:
+        self._ros("/navseq/waypoints", t, msg.marker_array(t, self._status.markers()))
+
+    def _event(self, event: MissionEvent) -> None:
+        from navseq.sinks.json_events import event_to_json
+
+        assert self._recording is not None
+        self._recording.write_json(
+            EVENTS_TOPIC,
+            EVENTS_SCHEMA_NAME,
+            self._events_schema,
+            event_to_json(event, self._numbers).encode(),
+            msg.nanoseconds(event.t),
+        )
+
+    def _ros(self, topic: str, t: float, message: dict[str, Any]) -> None:
+        assert self._recording is not None
+        self._recording.write(topic, TOPICS[topic], message, msg.nanoseconds(t))
+
+    def _flush(self) -> None:
+        assert self._recording is not None
+        try:
+            self._recording.flush()
+        except OSError as error:
+            self._fail(error)
+        self._last_flush = self._wall_clock()
+
+    def _fail(self, error: OSError) -> None:
+        """Stop recording (the mission goes on) and say why."""
+        why = "the disk is full" if error.errno == errno.ENOSPC else error.strerror or str(error)
+        self.error = f"{self.path}: cannot write it: {why}"
+        recording, self._recording = self._recording, None
+        if recording is not None:
+            # The file is as complete as it can be; the error above says why.
+            with contextlib.suppress(OSError, ValueError):
+                recording.finish()
+
+
+__all__ = ["EVENTS_TOPIC", "FLUSH_PERIOD", "TOPICS", "RecordingSink"]
