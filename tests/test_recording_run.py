@@ -1,0 +1,97 @@
+"""Recording as part of a run: asked for by the mission, after a crash, on resume, refused.
+
+The file's content is tests/test_recording.py's business; here: which files a run
+leaves, what survives ``kill -9``, and what the user is told.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import signal
+import struct
+from pathlib import Path
+
+from mcap.exceptions import EndOfFile
+from mcap.reader import NonSeekingReader, make_reader
+from mcap_ros2.decoder import DecoderFactory
+
+from cli_support import EXAMPLES, journal_events, navseq, start_navseq, wait_for
+from navseq import cli
+
+MISSION = EXAMPLES / "turtlebot3_world.yaml"
+
+
+def survivor_topics(path: Path) -> list[str]:
+    """The topics of the messages a streaming reader gets from a file, in file order,
+    up to where it ends (a file whose writer died has no summary)."""
+    reader = NonSeekingReader(io.BytesIO(path.read_bytes()))
+    topics = []
+    try:
+        for _, channel, _ in reader.iter_messages(log_time_order=False):
+            topics.append(channel.topic)
+    except (EndOfFile, struct.error):
+        pass
+    return topics
+
+
+def test_record_true_in_the_mission_records_without_the_option(tmp_path: Path) -> None:
+    mission = tmp_path / "recorded.yaml"
+    text = MISSION.read_text().replace("loops: 1", "loops: 1\nrecord: true")
+    mission.write_text(text.replace("../maps/", str(EXAMPLES.parent / "maps") + "/"))
+    out = tmp_path / "out"
+    assert cli.main(["run", str(mission), "--out", str(out), "--to", "2"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["files"]["recording"] == str(out / "run.mcap")
+    with (out / "run.mcap").open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics is not None
+    assert summary.statistics.message_count > 100
+
+
+def test_record_must_be_true_or_false_in_a_mission(tmp_path: Path) -> None:
+    mission = tmp_path / "wrong.yaml"
+    mission.write_text("navseq: 1\nrecord: always\nwaypoints:\n  - {x: 0, y: 0, yaw: 0}\n")
+    done = navseq("validate", mission, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "record" in done.stderr and "must be true or false" in done.stderr
+
+
+def test_an_unknown_record_format_is_exit_2_naming_the_choices(tmp_path: Path) -> None:
+    done = navseq("run", MISSION, "--record", "--record-format", "ros3", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "--record-format" in done.stderr and "'ros2', 'ros1'" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "navseq-out").exists()
+
+
+def test_a_killed_run_leaves_a_readable_recording_and_resume_records_beside_it(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "out"
+    first = start_navseq(
+        "run", MISSION, "--record", "--realtime", "8", "--json", "--out", out, cwd=tmp_path
+    )
+    journal = out / "journal.jsonl"
+    try:
+        wait_for(lambda: len(journal_events(journal, "WaypointFinished")) >= 2, 60, "2 waypoints")
+        first.send_signal(signal.SIGKILL)
+        first.wait(timeout=20)
+    finally:
+        first.kill()
+        first.communicate()
+    # Flushed at every waypoint's end: what the journal says is done is in the recording.
+    topics = survivor_topics(out / "run.mcap")
+    assert topics.count("/map") == 1 and topics.count("/navseq/goal") >= 2
+    assert topics.count("/navseq/pose") > 50
+
+    done = navseq("run", "--resume", journal, "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["files"]["recording"] == str(out / "run-2.mcap")
+    assert survivor_topics(out / "run.mcap") == topics  # the first file is left as it was
+    with (out / "run-2.mcap").open("rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        goals = [m for _, c, _, m in reader.iter_decoded_messages(topics=["/navseq/goal"])]
+    assert 0 < len(goals) <= 6  # the waypoints left, the active one again
+    assert (goals[-1].pose.position.x, goals[-1].pose.position.y) == (-2.0, -0.5)  # home
