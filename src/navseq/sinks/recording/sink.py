@@ -2,23 +2,24 @@
 
 What is written, on which topic (all stamped with the run's clock, log time in ns):
 
-========================  ================================  ==============================
-topic                     type                              when
-========================  ================================  ==============================
-``/map``                  nav_msgs/OccupancyGrid            once, when the mission starts
-``/navseq/pose``          geometry_msgs/PoseStamped (map)   every progress event (~10 Hz)
-``/odom``                 nav_msgs/Odometry                 every progress event
-``/tf``                   tf2_msgs/TFMessage                every progress event
-``/plan``                 nav_msgs/Path                     every plan the stack reports
-``/navseq/goal``          geometry_msgs/PoseStamped         every goal sent
-``/navseq/waypoints``     visualization_msgs/MarkerArray    at the start, each goal, each end
-``/navseq/events``        JSON (events.schema.json)         every mission event
-========================  ================================  ==============================
+=====================  ================================  ================================
+topic                  type                              when
+=====================  ================================  ================================
+``/map``               nav_msgs/OccupancyGrid            once, when the mission starts
+``/navseq/pose``       geometry_msgs/PoseStamped (map)   every progress event (~5 Hz, sim)
+``/odom``              nav_msgs/Odometry                 every progress event
+``/tf``                tf2_msgs/TFMessage                every progress event
+``/plan``              nav_msgs/Path                     every plan the stack reports
+``/navseq/goal``       geometry_msgs/PoseStamped         every goal sent
+``/navseq/waypoints``  visualization_msgs/MarkerArray    at the start, each goal, each end
+``/navseq/events``     JSON (events.schema.json)         every mission event
+=====================  ================================  ================================
 
 The frames are those the run knows: the mission's frame (``map``), ``odom`` and
 ``base_footprint``. navseq sees the robot's pose in the map only, so ``map → odom`` is
 the identity and ``odom → base_footprint`` the pose (the simulator's own frames are
-exactly these); the odometry's velocity is the change between two poses.
+exactly these); the odometry's velocity is the change between two poses. The events'
+JSON Schema is an attachment of the file (:meth:`McapRecording.write_json` says why).
 
 The file is written as the run goes, chunk by chunk, and flushed at least every
 :data:`FLUSH_PERIOD` seconds of wall time and at each waypoint's end: a process killed
@@ -56,7 +57,7 @@ from navseq.sinks.recording.encoding import McapRecording, RecordingFormat
 FLUSH_PERIOD = 1.0
 ODOM_FRAME = "odom"
 BASE_FRAME = "base_footprint"
-EVENTS_SCHEMA_NAME = "navseq.MissionEvent"
+EVENTS_SCHEMA_FILE = "events.schema.json"  # the attachment holding it
 #: Topic -> ROS type of every ROS topic the sink writes (the events are JSON).
 TOPICS = {
     "/map": "nav_msgs/OccupancyGrid",
@@ -185,7 +186,7 @@ class RecordingSink:
         assert self._recording is not None
         self._recording.write_json(
             EVENTS_TOPIC,
-            EVENTS_SCHEMA_NAME,
+            EVENTS_SCHEMA_FILE,
             self._events_schema,
             event_to_json(event, self._numbers).encode(),
             msg.nanoseconds(event.t),
