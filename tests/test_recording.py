@@ -235,3 +235,19 @@ def test_a_file_cut_at_a_random_byte_reads_up_to_its_last_complete_chunk(
         assert len(survived) == complete, f"cut at byte {cut} of {len(data)}"
         assert survived == whole[: len(survived)]
     assert Counter(topic for topic, _ in whole)["/map"] == 1
+
+
+def test_the_foxglove_layout_shows_topics_the_recording_has(ros2_run: Path) -> None:
+    layout = json.loads((REPO / "docs" / "foxglove" / "navseq-layout.json").read_text())
+    panels = layout["configById"]
+    three_d = panels["3D!navseq"]
+    assert three_d["followTf"] == "map"
+    shown = set(three_d["topics"])
+    shown.add(panels["RawMessages!navseqevents"]["topicPath"])
+    shown |= {path["value"].split(".")[0] for path in panels["Plot!navseqspeed"]["paths"]}
+    with (ros2_run / "run.mcap").open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    recorded = {channel.topic for channel in summary.channels.values()}
+    assert {"/map", "/navseq/pose", "/plan", "/navseq/waypoints", "/navseq/events"} <= shown
+    assert shown <= recorded
