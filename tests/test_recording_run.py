@@ -95,3 +95,35 @@ def test_a_killed_run_leaves_a_readable_recording_and_resume_records_beside_it(
         goals = [m for _, c, _, m in reader.iter_decoded_messages(topics=["/navseq/goal"])]
     assert 0 < len(goals) <= 6  # the waypoints left, the active one again
     assert (goals[-1].pose.position.x, goals[-1].pose.position.y) == (-2.0, -0.5)  # home
+
+
+def test_navseq_report_rebuilds_report_and_picture_from_the_recording_without_journal(
+    tmp_path: Path,
+) -> None:
+    import jsonschema
+
+    out = tmp_path / "out"
+    assert cli.main(["run", str(MISSION), "--out", str(out), "--record"]) == 0
+    original = json.loads((out / "report.json").read_text())
+    for name in ("journal.jsonl", "report.json", "mission.png"):
+        (out / name).unlink()
+
+    done = navseq("report", out, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["rebuilt_from_recording"] is True
+    assert report["files"]["recording"] == str(out / "run.mcap")
+    assert "journal" not in report["files"]
+    assert report["totals"] == original["totals"]
+    outcomes = [(v["number"], v["outcome"], v["distance_m"]) for v in report["visits"]]
+    assert outcomes == [(v["number"], v["outcome"], v["distance_m"]) for v in original["visits"]]
+    assert report["exit_code"] == 0 and report["success"] is True
+    schema = json.loads((EXAMPLES.parent / "docs" / "schemas" / "report.schema.json").read_text())
+    jsonschema.validate(report, schema)
+    assert (out / "mission.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_navseq_report_of_a_folder_without_journal_or_recording_says_so(tmp_path: Path) -> None:
+    done = navseq("report", tmp_path, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "no journal.jsonl and no run.mcap" in done.stderr

@@ -266,12 +266,25 @@ class Session:
 
         if not self.records:
             return None
+        metadata = None
+        if self.mission_path is not None and self.digest is not None:
+            import datetime
+
+            from navseq.sinks.recording.reading import run_metadata
+
+            metadata = run_metadata(
+                str(self.mission_path.resolve()),
+                self.digest,
+                datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                self.run_options,
+            )
         return RecordingSink(
             reserve_file(folder, "run.mcap"),
             "ros1" if outputs.record_format == "ros1" else "ros2",
             self.mission,
             self.grid,
             numbers=self.numbers,
+            run_metadata=metadata,
         )
 
     def _new_journal(self, journal_path: Path) -> JournalWriter:

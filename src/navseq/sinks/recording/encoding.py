@@ -102,6 +102,10 @@ class McapRecording:
             self._channels[topic] = channel
         self._writer.add_message(channel, log_time_ns, data, log_time_ns)
 
+    def add_metadata(self, name: str, fields: Mapping[str, str]) -> None:
+        """Write a metadata record (``name``, string fields)."""
+        self._writer.add_metadata(name, dict(fields))
+
     def flush(self) -> None:
         """Write the open chunk and hand everything to the operating system."""
         if not self._finished:

@@ -33,7 +33,7 @@ import contextlib
 import errno
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -76,7 +76,9 @@ class RecordingSink:
 
     ``grid`` is the map the run uses (None: no ``/map``); ``numbers`` the waypoints'
     positions in the mission file when the run is a part of it (for the events'
-    ``number``). The file is opened on entering and finished on leaving.
+    ``number``); ``run_metadata`` what ``navseq report`` needs to rebuild the run from
+    the recording (:func:`navseq.sinks.recording.reading.run_metadata`). The file is
+    opened on entering and finished on leaving.
     """
 
     def __init__(
@@ -87,6 +89,7 @@ class RecordingSink:
         grid: OccupancyGrid | None = None,
         *,
         numbers: Sequence[int] | None = None,
+        run_metadata: Mapping[str, str] | None = None,
         wall_clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.path = path
@@ -96,6 +99,7 @@ class RecordingSink:
         self._frame = mission.frame
         self._grid = grid
         self._numbers = numbers
+        self._run_metadata = run_metadata
         self._status = MissionStatus(mission)
         self._recording: McapRecording | None = None
         self._wall_clock = wall_clock
@@ -110,6 +114,10 @@ class RecordingSink:
         self._events_schema = events_schema()
         try:
             self._recording = McapRecording(self.path.open("wb"), self.record_format)
+            if self._run_metadata is not None:
+                from navseq.sinks.recording.reading import RUN_METADATA
+
+                self._recording.add_metadata(RUN_METADATA, self._run_metadata)
         except OSError as error:
             self._fail(error)
         self._last_flush = self._wall_clock()
