@@ -126,4 +126,4 @@ def test_navseq_report_rebuilds_report_and_picture_from_the_recording_without_jo
 def test_navseq_report_of_a_folder_without_journal_or_recording_says_so(tmp_path: Path) -> None:
     done = navseq("report", tmp_path, cwd=tmp_path)
     assert done.returncode == 2
-    assert "no journal.jsonl and no run.mcap" in done.stderr
+    assert "holds no recording (run.mcap)" in done.stderr

@@ -59,8 +59,8 @@ def run(args: argparse.Namespace) -> int:
         if not recordings:
             raise NavseqError(
                 f"{printable(str(args.run))} is not a run's output folder (it has no "
-                f"{JOURNAL_NAME} and no run.mcap); give the folder navseq run wrote "
-                f"(navseq-out/...) or its {JOURNAL_NAME}",
+                f"{JOURNAL_NAME}) and holds no recording (run.mcap); give the folder "
+                f"navseq run wrote (navseq-out/...) or its {JOURNAL_NAME}",
                 source="RUN",
             )
     else:
