@@ -10,8 +10,12 @@ import io
 import json
 import signal
 import struct
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
+import jsonschema
 from mcap.exceptions import EndOfFile
 from mcap.reader import NonSeekingReader, make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -20,6 +24,7 @@ from cli_support import EXAMPLES, journal_events, navseq, start_navseq, wait_for
 from navseq import cli
 
 MISSION = EXAMPLES / "turtlebot3_world.yaml"
+DOCS = EXAMPLES.parent / "docs"
 
 
 def survivor_topics(path: Path) -> list[str]:
@@ -87,6 +92,10 @@ def test_a_killed_run_leaves_a_readable_recording_and_resume_records_beside_it(
 
     done = navseq("run", "--resume", journal, "--json", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
+    last = json.loads(done.stdout.splitlines()[-1])
+    assert last["event"] == "RunFinished"
+    assert last["files"]["recording"] == str(out / "run-2.mcap")
+    jsonschema.validate(last, json.loads((DOCS / "schemas" / "events.schema.json").read_text()))
     report = json.loads((out / "report.json").read_text())
     assert report["files"]["recording"] == str(out / "run-2.mcap")
     assert survivor_topics(out / "run.mcap") == topics  # the first file is left as it was
@@ -100,8 +109,6 @@ def test_a_killed_run_leaves_a_readable_recording_and_resume_records_beside_it(
 def test_navseq_report_rebuilds_report_and_picture_from_the_recording_without_journal(
     tmp_path: Path,
 ) -> None:
-    import jsonschema
-
     out = tmp_path / "out"
     assert cli.main(["run", str(MISSION), "--out", str(out), "--record"]) == 0
     original = json.loads((out / "report.json").read_text())
@@ -118,7 +125,7 @@ def test_navseq_report_rebuilds_report_and_picture_from_the_recording_without_jo
     outcomes = [(v["number"], v["outcome"], v["distance_m"]) for v in report["visits"]]
     assert outcomes == [(v["number"], v["outcome"], v["distance_m"]) for v in original["visits"]]
     assert report["exit_code"] == 0 and report["success"] is True
-    schema = json.loads((EXAMPLES.parent / "docs" / "schemas" / "report.schema.json").read_text())
+    schema = json.loads((DOCS / "schemas" / "report.schema.json").read_text())
     jsonschema.validate(report, schema)
     assert (out / "mission.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
 
@@ -127,3 +134,42 @@ def test_navseq_report_of_a_folder_without_journal_or_recording_says_so(tmp_path
     done = navseq("report", tmp_path, cwd=tmp_path)
     assert done.returncode == 2
     assert "holds no recording (run.mcap)" in done.stderr
+
+
+# As tests/test_layers.py: every import of ROS fails, as on a machine without it.
+NO_ROS = textwrap.dedent(
+    """
+    import importlib.abc, sys
+
+    ROS = ("rospy", "genpy", "genmsg", "roslib", "rclpy", "std_msgs", "geometry_msgs",
+           "nav_msgs", "visualization_msgs", "tf2_msgs", "builtin_interfaces", "rosbag")
+
+    class NoRos(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name.split(".")[0] in ROS:
+                raise ModuleNotFoundError(f"No module named {name!r} (no ROS here)")
+            return None
+
+    sys.meta_path.insert(0, NoRos())
+    from navseq.cli import main
+    sys.exit(main(sys.argv[1:]))
+    """
+)
+
+
+def test_a_ros1_recording_needs_no_ros_installed(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    args = ["run", str(MISSION), "--to", "2", "--record", "--record-format", "ros1"]
+    done = subprocess.run(
+        [sys.executable, "-c", NO_ROS, *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    from mcap_ros1.decoder import DecoderFactory as Ros1DecoderFactory
+
+    with (out / "run.mcap").open("rb") as stream:
+        reader = make_reader(stream, decoder_factories=[Ros1DecoderFactory()])
+        (grid,) = [m for _, _, _, m in reader.iter_decoded_messages(topics=["/map"])]
+    assert (grid.info.width, grid.info.height) == (384, 384)

@@ -20,9 +20,8 @@ from typing import Any
 from navseq.errors import NavseqError
 from navseq.journal.reader import Entry, Event, JournalHeader, Resumed
 from navseq.journal.state import JournalState
+from navseq.sinks.recording.sink import EVENTS_TOPIC, RUN_METADATA
 
-#: The metadata record holding the run's journal header fields.
-RUN_METADATA = "navseq.run"
 RECORDING_NAME = re.compile(r"run(?:-([0-9]+))?\.mcap")
 #: The journal format version the header fields follow.
 HEADER_VERSION = 1
@@ -100,7 +99,6 @@ def _read(path: Path) -> tuple[dict[str, str] | None, list[Entry]]:
 
     from navseq.journal.format import event_from_record
     from navseq.sinks.json_events import event_fields
-    from navseq.sinks.recording.sink import EVENTS_TOPIC
 
     metadata: dict[str, str] | None = None
     events_channel: int | None = None

@@ -69,6 +69,8 @@ TOPICS = {
     "/navseq/waypoints": "visualization_msgs/MarkerArray",
 }
 EVENTS_TOPIC = "/navseq/events"
+#: The metadata record holding what a journal's header says (navseq report reads it).
+RUN_METADATA = "navseq.run"
 
 
 class RecordingSink:
@@ -115,8 +117,6 @@ class RecordingSink:
         try:
             self._recording = McapRecording(self.path.open("wb"), self.record_format)
             if self._run_metadata is not None:
-                from navseq.sinks.recording.reading import RUN_METADATA
-
                 self._recording.add_metadata(RUN_METADATA, self._run_metadata)
         except OSError as error:
             self._fail(error)
@@ -223,4 +223,4 @@ class RecordingSink:
                 recording.finish()
 
 
-__all__ = ["EVENTS_TOPIC", "FLUSH_PERIOD", "TOPICS", "RecordingSink"]
+__all__ = ["EVENTS_TOPIC", "FLUSH_PERIOD", "RUN_METADATA", "TOPICS", "RecordingSink"]
