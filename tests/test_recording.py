@@ -119,8 +119,8 @@ def check_recording(run: Path, ros: McapDecoderFactory, type_name: Callable[[str
     assert plans[0].header.frame_id == "map"
     last_marker = by_topic["/navseq/waypoints"][-1].markers
     assert len(last_marker) == 2 * len(waypoints)  # an arrow and a label each
-    colours = {(m.color.r, m.color.g, m.color.b) for m in last_marker}
-    assert [pytest.approx(c, abs=1e-6) for c in colours] == [GREEN]  # all reached
+    for marker in last_marker:  # all reached
+        assert (marker.color.r, marker.color.g, marker.color.b) == pytest.approx(GREEN, abs=1e-6)
 
     events = by_topic["/navseq/events"]
     assert events[0]["event"] == "MissionStarted" and events[-1]["event"] == "MissionFinished"
@@ -251,3 +251,29 @@ def test_the_foxglove_layout_shows_topics_the_recording_has(ros2_run: Path) -> N
     recorded = {channel.topic for channel in summary.channels.values()}
     assert {"/map", "/navseq/pose", "/plan", "/navseq/waypoints", "/navseq/events"} <= shown
     assert shown <= recorded
+
+
+def test_a_long_missions_markers_change_one_waypoint_at_a_time(tmp_path: Path) -> None:
+    """All markers at the start; then only the changed waypoint's, so that a recording
+    of a 100 000-waypoint mission does not grow with the square of its waypoints."""
+    from navseq.executor.events import (
+        MissionStarted,
+        WaypointFinished,
+        WaypointOutcome,
+        WaypointStarted,
+    )
+    from navseq.mission.model import Mission, Waypoint
+    from navseq.sinks.recording.sink import FULL_MARKERS_UP_TO, RecordingSink
+
+    count = FULL_MARKERS_UP_TO + 1
+    mission = Mission(tuple(Waypoint(float(i), 0.0) for i in range(count)))
+    path = tmp_path / "run.mcap"
+    with RecordingSink(path, "ros2", mission) as sink:
+        sink(MissionStarted(0.0, count, 1))
+        sink(WaypointStarted(1.0, 7, 0, 1, 1, 7.0, 0.0, 0.0))
+        sink(WaypointFinished(2.0, 7, 0, WaypointOutcome.REACHED, 1, 1.0, 1.0))
+    arrays = [m for topic, _, m in decoded(path, Ros2DecoderFactory()) if topic.endswith("points")]
+    assert [len(a.markers) for a in arrays] == [2 * count, 2, 2]
+    assert {m.id for m in arrays[-1].markers} == {7}
+    for marker in arrays[-1].markers:
+        assert (marker.color.r, marker.color.g, marker.color.b) == pytest.approx(GREEN, abs=1e-6)

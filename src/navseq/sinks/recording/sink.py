@@ -53,6 +53,9 @@ from navseq.sinks.mission_status import MissionStatus
 from navseq.sinks.recording import messages as msg
 from navseq.sinks.recording.encoding import McapRecording, RecordingFormat
 
+#: Missions up to this many waypoints get every marker at each change (a player that
+#: shows only a topic's latest message shows them all); longer ones the changed ones.
+FULL_MARKERS_UP_TO = 500
 #: Seconds of wall time between two flushes at most: what a crash can lose.
 FLUSH_PERIOD = 1.0
 ODOM_FRAME = "odom"
@@ -164,7 +167,10 @@ class RecordingSink:
             z = self._mission.waypoints[event.index].z
             self._ros("/navseq/goal", t, msg.pose_stamped(t, self._frame, goal, z))
         if update is not None and update.markers_changed:
-            self._markers(t)
+            changed = getattr(event, "index", None)
+            self._markers(
+                t, None if isinstance(event, WaypointStarted) and changed == 0 else changed
+            )
         self._event(event)
 
     def _robot(self, t: float, where: Pose2D) -> None:
@@ -185,8 +191,15 @@ class RecordingSink:
         ]
         self._ros("/tf", t, msg.tf_message(transforms))
 
-    def _markers(self, t: float) -> None:
-        self._ros("/navseq/waypoints", t, msg.marker_array(t, self._status.markers()))
+    def _markers(self, t: float, changed: int | None = None) -> None:
+        """The waypoint markers: all of them, or of a long mission only the ``changed``
+        waypoint's (a marker replaces the one with its namespace and id, so the rest
+        stay as they were; all of them at every change would grow with the square of
+        the waypoints: 10¹⁰ markers for 100 000)."""
+        specs = self._status.markers()
+        if changed is not None and len(self._mission.waypoints) > FULL_MARKERS_UP_TO:
+            specs = [spec for spec in specs if spec.id == changed]
+        self._ros("/navseq/waypoints", t, msg.marker_array(t, specs))
 
     def _event(self, event: MissionEvent) -> None:
         from navseq.sinks.json_events import event_to_json
