@@ -173,3 +173,19 @@ def test_a_ros1_recording_needs_no_ros_installed(tmp_path: Path) -> None:
         reader = make_reader(stream, decoder_factories=[Ros1DecoderFactory()])
         (grid,) = [m for _, _, _, m in reader.iter_decoded_messages(topics=["/map"])]
     assert (grid.info.width, grid.info.height) == (384, 384)
+
+
+def test_record_topics_is_refused_where_it_cannot_work(tmp_path: Path) -> None:
+    done = navseq("run", MISSION, "--record-topics", "/scan", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "--record-topics: adds topics to a recording: add --record" in done.stderr
+    done = navseq("run", MISSION, "--record", "--record-topics", "/scan", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "with --navigator ros1 only (not sim)" in done.stderr
+    # Refused before navseq looks for a ROS master (there is none here).
+    ros1 = ("--navigator", "ros1", "--record", "--record-topics", "/scan")
+    done = navseq("run", MISSION, *ros1, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "records the ROS 1 stack's messages as they are published" in done.stderr
+    assert "--record-format ros1" in done.stderr
+    assert not (tmp_path / "navseq-out").exists()

@@ -71,8 +71,12 @@ class Outputs:
     picture: bool | None = None
     record: bool | None = None
     record_format: str | None = None
+    record_topics: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        for topic in self.record_topics:
+            if not topic or any(ch.isspace() for ch in topic):
+                raise _refuse("outputs", f"record_topics: {topic!r} is no ROS topic name")
         formats = ("ros2", "ros1")  # navseq.sinks.recording.FORMATS, without importing mcap
         if self.record_format is not None and self.record_format not in formats:
             raise _refuse(

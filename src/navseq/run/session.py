@@ -285,6 +285,7 @@ class Session:
             self.grid,
             numbers=self.numbers,
             run_metadata=metadata,
+            published_topics=outputs.record_topics,
         )
 
     def _new_journal(self, journal_path: Path) -> JournalWriter:
@@ -339,6 +340,12 @@ class Session:
                         entered.enter_context(listener)
                 if journal is not None:
                     entered.enter_context(journal)
+                if self.records:  # its stack's topics, from now on (--record-topics)
+                    from navseq.sinks.recording.sink import RecordingSink
+
+                    for listener in face:
+                        if isinstance(listener, RecordingSink):
+                            listener.tap(navigator)
                 try:
                     result = run_mission(
                         self.mission,
@@ -469,6 +476,7 @@ def prepare(request: RunRequest) -> Session:
         realtime=request.realtime,
         robot_given=request.robot is not None or mission.robot is not None,
     )
+    _refuse_record_topics(request.outputs, kind, mission)
     made = _navigator_setup(request, kind, draft)
     session = Session(
         request=request,
@@ -497,6 +505,29 @@ def prepare(request: RunRequest) -> Session:
 
         require_extra("record", "recording the run (--record)")
     return session
+
+
+def _refuse_record_topics(
+    outputs: Outputs | None, kind_of_run: NavigatorKind | None, mission: Mission
+) -> None:
+    """``--record-topics`` where it cannot work, before the navigator connects."""
+    if outputs is None or not outputs.record_topics:
+        return
+    if not (outputs.record if outputs.record is not None else mission.record):
+        raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
+    kind = kind_of_run.name if kind_of_run is not None else "a face's own navigator"
+    if kind != "ros1":
+        raise NavseqError(
+            "records a ROS 1 navigation stack's topics as it publishes them, with "
+            f"--navigator ros1 only (not {kind}); the map, pose, odometry, /tf and plans "
+            "are recorded with any navigator",
+            source="--record-topics",
+        )
+    if outputs.record_format != "ros1":
+        raise NavseqError(
+            "records the ROS 1 stack's messages as they are published: add --record-format ros1",
+            source="--record-topics",
+        )
 
 
 def _settled_navigator(request: RunRequest) -> tuple[RunRequest, NavigatorKind | None]:

@@ -81,6 +81,28 @@ class McapRecording:
         data = self._encoders[type_name](message)
         self._writer.add_message(channel, log_time_ns, data, log_time_ns)
 
+    def write_serialised(
+        self, topic: str, type_name: str, definition: str, data: bytes, log_time_ns: int
+    ) -> None:
+        """Write a message serialised by its publisher, in this file's encoding, as is.
+
+        ``type_name`` and ``definition`` are the publisher's (a ROS 1 connection header's
+        ``type`` and ``message_definition``): the schema is registered from them.
+        """
+        encoding = self._encoding
+        channel = self._channels.get(topic)
+        if channel is None:
+            key = f"published:{type_name}"
+            if key not in self._schemas:
+                self._schemas[key] = self._writer.register_schema(
+                    encoding.schema_name(type_name), encoding.schema_encoding, definition.encode()
+                )
+            channel = self._writer.register_channel(
+                topic, encoding.message_encoding, self._schemas[key]
+            )
+            self._channels[topic] = channel
+        self._writer.add_message(channel, log_time_ns, data, log_time_ns)
+
     def write_json(
         self, topic: str, schema_file: str, schema: str, data: bytes, log_time_ns: int
     ) -> None:

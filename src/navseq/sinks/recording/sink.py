@@ -32,11 +32,13 @@ from __future__ import annotations
 import contextlib
 import errno
 import math
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from navseq.errors import NavseqError
 from navseq.executor.events import (
     MissionEvent,
     MissionFinished,
@@ -95,9 +97,13 @@ class RecordingSink:
         *,
         numbers: Sequence[int] | None = None,
         run_metadata: Mapping[str, str] | None = None,
+        published_topics: Sequence[str] = (),
         wall_clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.path = path
+        #: Topics recorded as the navigation stack publishes them (``--record-topics``,
+        #: :meth:`tap`); navseq's own message on such a topic is not written.
+        self.published_topics = tuple(published_topics)
         self.record_format = record_format
         self.error: str | None = None
         self._mission = mission
@@ -112,6 +118,38 @@ class RecordingSink:
         self._map_written = False
         self._last_pose: tuple[float, Pose2D] | None = None
         self._velocity = (0.0, 0.0)
+        # The stack's messages come on its client library's threads (tap), the
+        # mission's events on the run's: one writer at a time.
+        self._lock = threading.Lock()
+
+    def tap(self, navigator: Any) -> None:
+        """Record :attr:`published_topics` as ``navigator``'s stack publishes them.
+
+        Raises :class:`NavseqError` for a navigator that cannot (``prepare`` refuses
+        those first: the simulator's topics are what navseq writes anyway).
+        """
+        if not self.published_topics:
+            return
+        record_topics = getattr(navigator, "record_topics", None)
+        if record_topics is None:
+            raise NavseqError(
+                "this navigator cannot record its stack's topics", source="--record-topics"
+            )
+        record_topics(self.published_topics, self.write_published)
+
+    def write_published(
+        self, topic: str, type_name: str, definition: str, data: bytes, t: float
+    ) -> None:
+        """Write a message as the stack published it (see :data:`PublishedSink`)."""
+        with self._lock:
+            if self._recording is None:
+                return
+            try:
+                self._recording.write_serialised(
+                    topic, type_name, definition, data, msg.nanoseconds(t)
+                )
+            except OSError as error:
+                self._fail(error)
 
     def __enter__(self) -> RecordingSink:
         from navseq.sinks.recording.definitions import events_schema
@@ -127,25 +165,27 @@ class RecordingSink:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        recording, self._recording = self._recording, None
-        if recording is not None:
-            try:
-                recording.finish()
-            except OSError as error:
-                self._fail(error)
+        with self._lock:
+            recording, self._recording = self._recording, None
+            if recording is not None:
+                try:
+                    recording.finish()
+                except OSError as error:
+                    self._fail(error)
 
     def __call__(self, event: MissionEvent) -> None:
-        if self._recording is None:
-            return
-        try:
-            self._write(event)
-        except OSError as error:
-            self._fail(error)
-            return
-        if isinstance(event, (WaypointFinished, MissionFinished)) or (
-            self._wall_clock() - self._last_flush >= FLUSH_PERIOD
-        ):
-            self._flush()
+        with self._lock:
+            if self._recording is None:
+                return
+            try:
+                self._write(event)
+            except OSError as error:
+                self._fail(error)
+                return
+            if isinstance(event, (WaypointFinished, MissionFinished)) or (
+                self._wall_clock() - self._last_flush >= FLUSH_PERIOD
+            ):
+                self._flush()
 
     # -- internals -----------------------------------------------------------------------
 
@@ -215,6 +255,8 @@ class RecordingSink:
 
     def _ros(self, topic: str, t: float, message: dict[str, Any]) -> None:
         assert self._recording is not None
+        if topic in self.published_topics:
+            return  # the stack's own messages are recorded there
         self._recording.write(topic, TOPICS[topic], message, msg.nanoseconds(t))
 
     def _flush(self) -> None:
