@@ -189,3 +189,18 @@ def test_record_topics_is_refused_where_it_cannot_work(tmp_path: Path) -> None:
     assert "records the ROS 1 stack's messages as they are published" in done.stderr
     assert "--record-format ros1" in done.stderr
     assert not (tmp_path / "navseq-out").exists()
+
+
+def test_record_true_survives_a_round_trip_through_the_mission_writer(tmp_path: Path) -> None:
+    from navseq.mission import load_mission
+    from navseq.mission.writer import dump_mission_yaml
+
+    mission = tmp_path / "recorded.yaml"
+    mission.write_text("navseq: 1\nrecord: true\nwaypoints:\n  - {x: 0, y: 0, yaw: 0}\n")
+    loaded = load_mission(mission)
+    assert loaded.record is True
+    again = tmp_path / "again.yaml"
+    again.write_text(dump_mission_yaml(loaded))
+    assert load_mission(again).record is True
+    mission.write_text("navseq: 1\nwaypoints:\n  - {x: 0, y: 0, yaw: 0}\n")
+    assert "record" not in dump_mission_yaml(load_mission(mission))
