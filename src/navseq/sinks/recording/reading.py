@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from navseq.errors import NavseqError
+from navseq.executor.events import MissionEvent
 from navseq.journal.reader import Entry, Event, JournalHeader, Resumed
 from navseq.journal.state import JournalState
 from navseq.sinks.recording.sink import EVENTS_TOPIC, RUN_METADATA
@@ -74,6 +75,14 @@ def read_recordings(paths: list[Path]) -> JournalState:
         entries.extend(events)
     assert header is not None, "no recordings given"
     return state_from_entries(header, entries)
+
+
+def recorded_events(paths: list[Path]) -> Iterator[MissionEvent]:
+    """Every mission event the recordings ``paths`` hold, in order (as far as each reads)."""
+    for path in paths:
+        for entry in _read(path)[1]:
+            if isinstance(entry, Event):
+                yield entry.event
 
 
 def _header(path: Path, metadata: dict[str, str]) -> JournalHeader:
@@ -137,4 +146,4 @@ def _records(path: Path) -> Iterator[Any]:
         raise NavseqError(f"cannot read it: {error.strerror}", source=str(path)) from None
 
 
-__all__ = ["RUN_METADATA", "read_recordings", "recordings_in", "run_metadata"]
+__all__ = ["read_recordings", "recorded_events", "recordings_in", "run_metadata"]
