@@ -16,6 +16,7 @@ import textwrap
 from pathlib import Path
 
 import jsonschema
+import pytest
 from mcap.exceptions import EndOfFile
 from mcap.reader import NonSeekingReader, make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -204,3 +205,25 @@ def test_record_true_survives_a_round_trip_through_the_mission_writer(tmp_path: 
     assert load_mission(again).record is True
     mission.write_text("navseq: 1\nwaypoints:\n  - {x: 0, y: 0, yaw: 0}\n")
     assert "record" not in dump_mission_yaml(load_mission(mission))
+
+
+def test_a_run_refused_before_its_start_leaves_no_recording(tmp_path: Path) -> None:
+    """No navigation server: nothing ran, so there is nothing to record (as no journal)."""
+    from navseq.errors import NavseqError
+    from navseq.mission.model import Mission, Waypoint
+    from navseq.navigators.scripted import ScriptedNavigator
+    from navseq.run.request import Outputs, RunRequest, UseNavigator
+    from navseq.run.session import prepare
+
+    out = tmp_path / "out"
+    out.mkdir()
+    request = RunRequest(
+        mission=Mission((Waypoint(1.0, 0.0),)),
+        navigator=UseNavigator(ScriptedNavigator(server_available=False), {"kind": "scripted"}),
+        outputs=Outputs(folder=out, journal=False, record=True),
+        preflight=False,
+        server_wait=0.2,
+    )
+    with pytest.raises(NavseqError):
+        prepare(request).run()
+    assert not (out / "run.mcap").exists()

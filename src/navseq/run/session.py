@@ -226,8 +226,8 @@ class Session:
                 fresh.close()
             if journal_path is not None and self.journal is None:
                 _discard_unused(journal_path)
-            if recording is not None and recording.path.stat().st_size == 0:
-                recording.path.unlink()  # reserved, never begun
+            if recording is not None and not recording.began:
+                _discard_unused_recording(recording.path)
             raise
         files = RunFiles(paths={} if journal_path is None else {"journal": str(journal_path)})
         if recording is not None:
@@ -476,7 +476,7 @@ def prepare(request: RunRequest) -> Session:
         realtime=request.realtime,
         robot_given=request.robot is not None or mission.robot is not None,
     )
-    _refuse_record_topics(request.outputs, kind, mission)
+    _check_recording(request.outputs, kind, mission)
     made = _navigator_setup(request, kind, draft)
     session = Session(
         request=request,
@@ -500,20 +500,24 @@ def prepare(request: RunRequest) -> Session:
     )
     if kind is not None:
         session.run_options = run_options(request, kind, mission, map_path, draft.start)
-    if session.records:
-        from navseq.extras import require_extra
-
-        require_extra("record", "recording the run (--record)")
     return session
 
 
-def _refuse_record_topics(
+def _check_recording(
     outputs: Outputs | None, kind_of_run: NavigatorKind | None, mission: Mission
 ) -> None:
-    """``--record-topics`` where it cannot work, before the navigator connects."""
-    if outputs is None or not outputs.record_topics:
+    """A recording that cannot be made (no mcap, ``--record-topics`` where it cannot
+    work) is refused before the navigator connects and before anything is written."""
+    if outputs is None:
         return
-    if not (outputs.record if outputs.record is not None else mission.record):
+    records = outputs.record if outputs.record is not None else mission.record
+    if records:
+        from navseq.extras import require_extra
+
+        require_extra("record", "recording the run (--record)")
+    if not outputs.record_topics:
+        return
+    if not records:
         raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
     kind = kind_of_run.name if kind_of_run is not None else "a face's own navigator"
     if kind != "ros1":
@@ -592,6 +596,12 @@ def _discard_unused(journal: Path) -> None:
             journal.unlink()
     except OSError:
         pass  # tidying up only; the original error matters more
+
+
+def _discard_unused_recording(path: Path) -> None:
+    """Remove a recording of no event: the run did not start (no navigation server)."""
+    with contextlib.suppress(OSError):  # tidying up only; the original error matters more
+        path.unlink()
 
 
 def _remove_if_unused(folder: Path) -> None:

@@ -106,6 +106,9 @@ class RecordingSink:
         self.published_topics = tuple(published_topics)
         self.record_format = record_format
         self.error: str | None = None
+        #: Whether a mission event was recorded (a run refused before its start leaves
+        #: a file of nothing, which the session removes).
+        self.began = False
         self._mission = mission
         self._frame = mission.frame
         self._grid = grid
@@ -177,6 +180,7 @@ class RecordingSink:
         with self._lock:
             if self._recording is None:
                 return
+            self.began = True
             try:
                 self._write(event)
             except OSError as error:
