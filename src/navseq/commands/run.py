@@ -28,6 +28,7 @@ from navseq.navigators import registry
 from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
 from navseq.run.request import Loops, Outputs, RunRequest
 from navseq.run.session import prepare
+from navseq.sinks.recording.encoding import FORMATS
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -129,7 +130,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--record-format",
-        choices=("ros2", "ros1"),
+        choices=FORMATS,
         default=None,
         help="the recording's message encoding: ros2 (CDR, the default) or ros1",
     )

@@ -77,7 +77,8 @@ class Outputs:
         for topic in self.record_topics:
             if not topic or any(ch.isspace() for ch in topic):
                 raise _refuse("outputs", f"record_topics: {topic!r} is no ROS topic name")
-        formats = ("ros2", "ros1")  # navseq.sinks.recording.FORMATS, without importing mcap
+        from navseq.sinks.recording.encoding import FORMATS as formats  # no mcap import
+
         if self.record_format is not None and self.record_format not in formats:
             raise _refuse(
                 "outputs",
