@@ -38,7 +38,15 @@ if _run_by_catkin():
         **generate_distutils_setup(
             packages=PACKAGES,
             package_dir=PACKAGE_DIR,
-            package_data={"navseq": ["py.typed"]},
+            package_data={
+                "navseq": ["py.typed"],
+                # navseq run --record's message definitions (needs pip's mcap packages).
+                "navseq.sinks.recording": [
+                    "definitions/*.json",
+                    "definitions/ros1/*.msg",
+                    "definitions/ros2/*.msg",
+                ],
+            },
         )
     )
 else:

@@ -1,4 +1,5 @@
-"""The optional extras: navseq[studio] (starlette, uvicorn) and navseq[plan] (OR-tools).
+"""The optional extras: navseq[studio] (starlette, uvicorn), navseq[plan] (OR-tools) and
+navseq[record] (mcap and its ROS support).
 
 Each test runs navseq in a fresh Python whose import of the extras' modules fails, as
 on a machine where navseq was installed without them (a ROS node's install): what
@@ -37,7 +38,8 @@ WITHOUT_PRELUDE = textwrap.dedent(
 CLI = "import sys\nfrom navseq.cli import main\nsys.exit(main(sys.argv[1:]))\n"
 STUDIO = ("starlette", "uvicorn")
 PLAN = ("ortools",)
-EVERY_EXTRA = STUDIO + PLAN
+RECORD = ("mcap", "mcap_ros2", "mcap_ros1")
+EVERY_EXTRA = STUDIO + PLAN + RECORD
 
 
 def run_without(
@@ -178,3 +180,13 @@ def test_run_validate_convert_and_report_work_without_any_extra(tmp_path: Path) 
     assert reported.returncode == 0, reported.stderr
     assert json.loads((out / "report.json").read_text())["success"] is True
     assert navseq("sim", "--help").returncode == 0
+
+
+def test_recording_without_mcap_names_the_record_extra_before_the_robot_moves(
+    tmp_path: Path,
+) -> None:
+    out = tmp_path / "out"
+    done = run_without(RECORD, CLI, "run", MISSION, "--record", "--out", str(out))
+    assert_one_clear_message(done, "record")
+    assert "recording the run (--record) needs mcap and mcap_ros2 and mcap_ros1" in done.stderr
+    assert not out.exists()  # nothing written, nothing driven

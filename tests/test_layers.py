@@ -63,6 +63,8 @@ CORE_MODULES = [
     "navseq.journal.writer",
     "navseq.sinks.report",
     "navseq.sinks.picture.draw",
+    "navseq.sinks.recording.sink",
+    "navseq.sinks.recording.reading",
     *(f"navseq.roscore.{name}" for name in ("clock", "server", "goals", "navigator")),
     *(f"navseq.roscore.{name}" for name in ("client", "stack_profile", "node", "operator")),
 ]

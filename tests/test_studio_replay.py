@@ -99,3 +99,25 @@ def test_the_replayed_trail_is_the_driven_one_never_through_a_pillar(tmp_path: P
         for k in range(steps + 1):
             row, col = grid.world_to_cell(x0 + (x1 - x0) * k / steps, y0 + (y1 - y0) * k / steps)
             assert not occupied[row, col], f"the trail crosses an obstacle at {x0:.2f},{y0:.2f}"
+
+
+def test_a_recorded_run_whose_journal_is_gone_replays_from_its_recording(tmp_path: Path) -> None:
+    folder = run_folder(tmp_path, 3, 1)
+    from_journal = replay_of(folder, "out", tmp_path, inside(tmp_path))
+    recorded = tmp_path / "recorded"
+    mission = tmp_path / "line.yaml"
+    argv = ["run", str(mission), "--navigator", "scripted", "--out", str(recorded)]
+    assert cli.main([*argv, "--no-picture", "--record"]) == 0
+    (recorded / "journal.jsonl").unlink()
+    from navseq.studio.replay import run_folders
+
+    assert recorded.resolve() in run_folders([tmp_path])
+    replay = replay_of(recorded, "recorded", tmp_path, inside(tmp_path))
+    assert replay["mission"] is not None
+    assert states_over_time(replay)[-1] == ["reached"] * 3
+    assert [s["changes"] for s in replay["states"]] == [
+        s["changes"] for s in from_journal["states"]
+    ]
+    # Every progress event's pose (the journal keeps only the path's corners).
+    assert len(replay["poses"]) >= len(from_journal["poses"]) > 0
+    assert replay["duration_s"] == from_journal["duration_s"]

@@ -2,7 +2,8 @@
 
 A ROS node's install needs neither a web server nor a 30 MB route solver, so they are
 extras: ``navseq[studio]`` (starlette, uvicorn, ruamel.yaml) for ``navseq studio`` and
-``navseq[plan]`` (OR-tools) for the shortest visiting order. Whatever needs one calls
+``navseq[plan]`` (OR-tools) for the shortest visiting order; ``navseq[record]`` (mcap and
+its ROS support) for ``navseq run --record``. Whatever needs one calls
 :func:`require_extra` before it imports the modules, and the user reads which
 ``pip install`` brings them instead of a traceback.
 """
@@ -17,6 +18,7 @@ from navseq.errors import NavseqError
 EXTRAS: dict[str, tuple[str, ...]] = {
     "studio": ("starlette", "uvicorn", "ruamel.yaml"),
     "plan": ("ortools.constraint_solver.pywrapcp",),
+    "record": ("mcap.writer", "mcap_ros2", "mcap_ros1"),
 }
 
 

@@ -1,5 +1,8 @@
 """``navseq report RUN``: rebuild a run's report and picture from its journal.
 
+(Or from its recordings, ``run.mcap`` ..., when the journal is gone: they keep every
+event and what the journal's header says, :mod:`navseq.sinks.recording.reading`.)
+
 A run killed with ``kill -9`` (or on a full disk) after its last journal line but
 before its report leaves no report; the journal still holds everything the report
 says. This command reads the journal (refusing one that was altered, see
@@ -47,18 +50,23 @@ def run(args: argparse.Namespace) -> int:
     from navseq.run.runlock import RunLock
 
     journal = args.run / JOURNAL_NAME if args.run.is_dir() else args.run
+    recordings: list[Path] = []
     if args.run.is_dir() and not journal.exists():
         from navseq.errors import NavseqError
+        from navseq.sinks.recording.reading import recordings_in
 
-        raise NavseqError(
-            f"{printable(str(args.run))} is not a run's output folder (it has no "
-            f"{JOURNAL_NAME}); give the folder navseq run wrote (navseq-out/...) or its "
-            f"{JOURNAL_NAME}",
-            source="RUN",
-        )
-    require_file(journal, "RUN")
+        recordings = recordings_in(args.run)  # a recorded run: rebuilt from run.mcap
+        if not recordings:
+            raise NavseqError(
+                f"{printable(str(args.run))} is not a run's output folder (it has no "
+                f"{JOURNAL_NAME}) and holds no recording (run.mcap); give the folder "
+                f"navseq run wrote (navseq-out/...) or its {JOURNAL_NAME}",
+                source="RUN",
+            )
+    else:
+        require_file(journal, "RUN")
     with RunLock(journal.parent):  # not while a live run writes them
-        rebuilt = rebuild_outputs(journal)
+        rebuilt = rebuild_outputs(journal, recordings=recordings)
     if not rebuilt.written:
         print(
             f"navseq report: the report in {printable(str(journal.parent))} is complete; "
@@ -79,12 +87,15 @@ class Rebuilt:
     exit_code: int | None
 
 
-def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt:
+def rebuild_outputs(
+    journal: Path, state: JournalState | None = None, *, recordings: list[Path] | None = None
+) -> Rebuilt:
     """Write the missing or broken report / picture of the run in ``journal``.
 
     ``state`` is the journal already read (by a resume that found nothing to run), so
-    that a long journal is not read twice. The caller holds the folder's run lock;
-    temporaries a killed run left there are removed.
+    that a long journal is not read twice. ``recordings``: the journal is gone, the run
+    is read from these (``run.mcap``, ``run-2.mcap`` ..., in order) instead. The caller
+    holds the folder's run lock; temporaries a killed run left there are removed.
     """
     from navseq.files import write_atomically
     from navseq.journal.writer import read_journal
@@ -92,7 +103,13 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     from navseq.run.files import output_error, remove_stale_temporaries
     from navseq.sinks.report import report_json
 
-    if state is None or state.path != journal or not state.is_current():
+    if recordings:
+        from navseq.extras import require_extra
+        from navseq.sinks.recording.reading import read_recordings
+
+        require_extra("record", f"rebuilding the run from {recordings[0].name}")
+        state = read_recordings(recordings)
+    elif state is None or state.path != journal or not state.is_current():
         state = read_journal(journal)
     remove_stale_temporaries(journal.parent)
     whole = journaled_mission(state)
@@ -104,6 +121,10 @@ def rebuild_outputs(journal: Path, state: JournalState | None = None) -> Rebuilt
     written: dict[str, str] = {}
     if not _complete_report(report_path):
         report = _report(state, mission, result, report_path, picture_path, journal)
+        if recordings:  # what the report was rebuilt from, and the recordings it names
+            del report["rebuilt_from_journal"], report["files"]["journal"]
+            report["rebuilt_from_recording"] = True
+            report["files"]["recording"] = str(recordings[-1])
         number_visits(report, part)
         text = report_json(report)
         try:

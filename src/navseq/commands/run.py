@@ -28,6 +28,7 @@ from navseq.navigators import registry
 from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
 from navseq.run.request import Loops, Outputs, RunRequest
 from navseq.run.session import prepare
+from navseq.sinks.recording.encoding import FORMATS
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -119,9 +120,40 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=None,  # None: not given (a resume takes the journal's)
         help="do not draw mission.png",
     )
+    parser.add_argument(
+        "--record",
+        action="store_true",
+        default=None,  # None: not given (the mission's record:, or a resume's journal)
+        help="record the run as run.mcap in the output folder (map, pose, odometry, /tf, "
+        "plans, goals, waypoint markers, events) for Foxglove and ros2 bag; "
+        "needs pip install 'navseq[record]'",
+    )
+    parser.add_argument(
+        "--record-format",
+        choices=FORMATS,
+        default=None,
+        help="the recording's message encoding: ros2 (CDR, the default) or ros1",
+    )
+    parser.add_argument(
+        "--record-topics",
+        type=parse_topics,
+        default=(),
+        metavar="TOPIC[,TOPIC...]",
+        help="with --record and --navigator ros1: also record these topics as the stack "
+        "publishes them (any type, e.g. /scan); a topic navseq records itself (/map, /odom, "
+        "/tf, /plan ...) is then the stack's own",
+    )
     add_robot_option(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
+
+
+def parse_topics(text: str) -> tuple[str, ...]:
+    """``/scan,/amcl_pose``: the topic names, in order, each once."""
+    topics = [topic.strip() for topic in text.split(",") if topic.strip()]
+    if not topics or any(any(ch.isspace() for ch in topic) for topic in topics):
+        raise argparse.ArgumentTypeError(f"expected topic names separated by commas: {text!r}")
+    return tuple(dict.fromkeys(topics))
 
 
 def add_navigator_choice(parser: argparse.ArgumentParser, default: str | None) -> None:
@@ -205,7 +237,11 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         only=args.only,
         preflight=not args.no_preflight,
         outputs=Outputs(
-            folder=args.out, picture=None if args.no_picture is None else not args.no_picture
+            folder=args.out,
+            picture=None if args.no_picture is None else not args.no_picture,
+            record=args.record,
+            record_format=args.record_format,
+            record_topics=args.record_topics,
         ),
         resume=args.resume,
         realtime=args.realtime,

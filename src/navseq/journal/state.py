@@ -19,7 +19,7 @@ A week-long patrol's journal is read in one pass at constant memory.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple, overload
@@ -28,7 +28,7 @@ from navseq.errors import NavseqError
 from navseq.executor import events as ev
 from navseq.executor.result import AttemptResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
-from navseq.journal.reader import Damaged, Event, JournalReader, Resumed
+from navseq.journal.reader import Damaged, Entry, Event, JournalHeader, JournalReader, Resumed
 from navseq.sinks.recorder import RunRecorder
 
 #: The most waypoints a journaled mission may claim: a visit log for that many is
@@ -256,19 +256,38 @@ def read_journal(path: str | os.PathLike[str]) -> JournalState:
             started=header.started,
             run_options=header.run_options,
         )
-        _fold(state, reader)
+        _fold(state, reader.entries())
         state.chain = reader.chain
         state.size = reader.size
     return state
 
 
-def _fold(state: JournalState, reader: JournalReader) -> None:
+def state_from_entries(header: JournalHeader, entries: Iterable[Entry]) -> JournalState:
+    """What a journal with this header and these entries would say, from elsewhere.
+
+    For a run whose journal is gone but whose events were kept another way (its MCAP
+    recording: :mod:`navseq.sinks.recording.reading`); ``Resumed`` entries separate the
+    segments of a resumed run. There is no chain and no size: nothing can append to it.
+    """
+    state = JournalState(
+        path=header.path,
+        version=header.version,
+        mission_source=header.mission_source,
+        mission_digest=header.mission_digest,
+        started=header.started,
+        run_options=header.run_options,
+    )
+    _fold(state, entries)
+    return state
+
+
+def _fold(state: JournalState, entries: Iterable[Entry]) -> None:
     path = state.path
     visits = state.visits
     recorder = state.recorder
     segment_start: float | None = None
     segment_end: float | None = None
-    for entry in reader.entries():
+    for entry in entries:
         if isinstance(entry, Damaged):
             state.damaged_count += 1
             if len(state.damaged_lines) < MAX_DAMAGED_LISTED:
@@ -422,4 +441,5 @@ __all__ = [
     "VisitHistory",
     "read_journal",
     "resume_point",
+    "state_from_entries",
 ]

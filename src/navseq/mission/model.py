@@ -250,6 +250,7 @@ class Mission:
     start: Pose2D | None = None
     server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
     robot: RobotProfile | None = None  # the mission's robot: section; None: not said
+    record: bool = False  # record the run as MCAP (navseq run --record), as record: says
     source: str = field(default="<memory>", compare=False)  # where it was read from
     # For a part of a mission file (``--from``/``--to``/``--only``, see
     # navseq.mission.part): each waypoint's 0-based position in the file, so that every

@@ -39,7 +39,7 @@ FORMAT_VERSION = 1
 FOREVER = "forever"
 DEFAULT_SERVER_TIMEOUT = Mission.__dataclass_fields__["server_timeout"].default
 
-MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout", "robot")
+MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout", "robot", "record")
 OPTIONAL_SETTINGS = ("map", "start", "robot")  # null: none, like leaving the key out
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
@@ -104,7 +104,7 @@ def read_defaults(node: Located | None, problems: Problems) -> Policy:
 
 def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> dict[str, Any]:
     """The mission-wide keys other than policies: frame, map, start, loops, server_timeout,
-    robot."""
+    robot, record."""
     readers = {
         "frame": read_frame,
         "map": lambda entry, subject: read_map_path(entry, subject, base_dir),
@@ -112,6 +112,7 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
         "loops": read_loops,
         "server_timeout": read_server_timeout,
         "robot": read_robot,
+        "record": fields.boolean,
     }
     settings: dict[str, Any] = {}
     for key, reader in readers.items():

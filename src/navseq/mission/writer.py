@@ -109,6 +109,8 @@ def _settings(mission: Mission, base_dir: Path | None) -> dict[str, Any]:
     doc["server_timeout"] = mission.server_timeout
     if mission.robot is not None:
         doc["robot"] = robot_section(mission.robot)
+    if mission.record:
+        doc["record"] = True
     doc["defaults"] = _policy_values(mission.defaults, POLICY_KEYS)
     return doc
 

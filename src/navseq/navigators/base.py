@@ -12,6 +12,7 @@ through :attr:`Navigator.now` and advanced with :meth:`Navigator.spin`.
 from __future__ import annotations
 
 import enum
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -160,3 +161,9 @@ class Navigator(Protocol):
     def close(self) -> None:
         """Release resources; cancels an active goal first."""
         ...
+
+
+#: Where a navigator that can record its stack's topics (``navseq run --record-topics``,
+#: an optional ``record_topics(topics, write)`` method) hands each message, as published:
+#: ``write(topic, type name, full message definition, serialised bytes, time in s)``.
+PublishedSink = Callable[[str, str, str, bytes, float], None]

@@ -53,6 +53,8 @@ jumps, unlike the map pose when localisation corrects itself.
 
 from __future__ import annotations
 
+import functools
+import io
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -77,6 +79,7 @@ from navseq.navigators.base import (
     GoalFeedback,
     GoalOutcome,
     NavEvent,
+    PublishedSink,
 )
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
@@ -212,6 +215,7 @@ class Ros1Navigator:
         self._book = self._core.book
         self._feedback_pose: Pose2D | None = None
         self._closed = False
+        self._taps: list[Any] = []  # subscribers of record_topics
         # Created after the state its callbacks read: they may run at once.
         self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
@@ -463,7 +467,35 @@ class Ros1Navigator:
         if self._closed:
             return
         self._closed = True
+        for tap in self._taps:
+            tap.unregister()
         self._core.cancel_and_wait()
+
+    def record_topics(self, topics: Sequence[str], write: PublishedSink) -> None:
+        """Hand every message published on ``topics`` to ``write`` as it came, serialised.
+
+        ``rospy.AnyMsg`` keeps the bytes undecoded; the publisher's connection header
+        names the type and carries its full definition, so anything a stack publishes
+        is recorded (``navseq run --record-topics /scan``) without its Python message.
+        Stamped with the clock the stack uses (:meth:`now`).
+        """
+        self._taps = [
+            rospy.Subscriber(topic, rospy.AnyMsg, functools.partial(self._on_tapped, topic, write))
+            for topic in topics
+        ]
+
+    def _on_tapped(self, topic: str, write: PublishedSink, message: Any) -> None:
+        if isinstance(message, rospy.AnyMsg):
+            header = getattr(message, "_connection_header", None) or {}
+            type_name, definition = header.get("type"), header.get("message_definition")
+            if type_name and definition is not None:
+                write(topic, type_name, definition, bytes(message._buff), self.now())
+            return
+        # rospy shares one subscription per topic in a process: where this navigator
+        # subscribes already (the plan), its message class decodes for every callback.
+        buffer = io.BytesIO()
+        message.serialize(buffer)
+        write(topic, message._type, message._full_text, buffer.getvalue(), self.now())
 
     def _has_news(self) -> bool:
         """:meth:`poll` has something to report: a queued event, or the server lost or back."""

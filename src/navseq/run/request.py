@@ -59,13 +59,31 @@ class Outputs:
 
     ``folder`` None: ``navseq-out/<mission>-<time>/`` (a resume writes beside its
     journal). ``picture`` None: drawn, or as the resumed run did. The journal (what
-    ``resume`` continues) needs the mission as a file.
+    ``resume`` continues) needs the mission as a file. ``record``: write the run as
+    MCAP (``run.mcap``, :mod:`navseq.sinks.recording`); None: as the mission's
+    ``record:`` says, or as the resumed run did. ``record_format``: ``ros2`` (CDR) or
+    ``ros1``; None: ``ros2``, or as the resumed run did.
     """
 
     folder: Path | None = None
     journal: bool = True
     report: bool = True
     picture: bool | None = None
+    record: bool | None = None
+    record_format: str | None = None
+    record_topics: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        for topic in self.record_topics:
+            if not topic or any(ch.isspace() for ch in topic):
+                raise _refuse("outputs", f"record_topics: {topic!r} is no ROS topic name")
+        from navseq.sinks.recording.encoding import FORMATS as formats  # no mcap import
+
+        if self.record_format is not None and self.record_format not in formats:
+            raise _refuse(
+                "outputs",
+                f"record_format must be {' or '.join(formats)}, not {self.record_format!r}",
+            )
 
 
 @dataclass(frozen=True)

@@ -111,6 +111,11 @@ def continue_as_journaled(
     outputs = request.outputs or Outputs()
     no_picture = None if outputs.picture is None else not outputs.picture
     picture = not notes.settle("--no-picture", no_picture, bool(recorded.get("no_picture", False)))
+    # A recorded run goes on recording, into a new file beside the first (run-2.mcap).
+    record = outputs.record or bool(recorded.get("record", False)) or None
+    record_format = notes.settle(
+        "--record-format", outputs.record_format, recorded.get("record_format")
+    )
     try:
         loops = notes.settle("--loops", request.loops, _journal_loops(recorded))
         map_path = notes.settle("--map", request.map, _journal_map(recorded))
@@ -121,7 +126,9 @@ def continue_as_journaled(
         request,
         navigator=settings_from(kind, values),
         navigator_options={},
-        outputs=dataclasses.replace(outputs, picture=picture),
+        outputs=dataclasses.replace(
+            outputs, picture=picture, record=record, record_format=record_format
+        ),
         loops=loops,
         map=map_path,
         start=start,
@@ -203,6 +210,8 @@ def run_options(
         "navigator": kind.name,
         **{name: getattr(settings, name, None) for name in kind.journaled()},
         "no_picture": outputs.picture is False,
+        "record": bool(outputs.record or mission.record),
+        "record_format": outputs.record_format or "ros2",
         "from_waypoint": request.first,
         "to_waypoint": request.last,
         "only": request.only,

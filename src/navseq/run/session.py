@@ -52,6 +52,7 @@ if TYPE_CHECKING:
     from navseq.signals import SignalGuard
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.recorder import RunRecorder
+    from navseq.sinks.recording.sink import RecordingSink
 
 #: Called with each note on the run (one line) at the moment a face should show it.
 NoteSink = Callable[[str], None]
@@ -88,6 +89,14 @@ class Session:
     listeners: list[MissionListener] = field(default_factory=list)
     # A navigator is made ready for one run (a ROS connection is closed after it).
     _started: bool = field(default=False, init=False, repr=False)
+
+    @property
+    def records(self) -> bool:
+        """Whether the run is recorded as MCAP (``--record``, or the mission's ``record:``)."""
+        outputs = self.request.outputs
+        if outputs is None:
+            return False
+        return outputs.record if outputs.record is not None else self.mission.record
 
     @property
     def numbers(self) -> list[int] | None:
@@ -188,6 +197,9 @@ class Session:
             # Resuming appends to the run's own journal; a new run starts a new one.
             journal_path = self.journal or reserve_file(folder, "journal.jsonl")
         fresh: JournalWriter | None = None
+        recording = self._new_recording(outputs, folder)
+        if recording is not None:
+            face = [*face, recording]
         try:
             # A new journal gets its header at once, before the slow steps (the picture's
             # imports, the navigator's connection): a run killed during them used to
@@ -214,8 +226,15 @@ class Session:
                 fresh.close()
             if journal_path is not None and self.journal is None:
                 _discard_unused(journal_path)
+            if recording is not None and not recording.began:
+                _discard_unused_recording(recording.path)
             raise
         files = RunFiles(paths={} if journal_path is None else {"journal": str(journal_path)})
+        if recording is not None:
+            if recording.error is None:
+                files.paths["recording"] = str(recording.path)
+            else:
+                files.failed["recording"] = recording.error
         exit_status = write_outputs(
             folder,
             files,
@@ -237,6 +256,36 @@ class Session:
             error=error,
             stopped_by=ran.error,
             clock=ran.clock,
+        )
+
+    def _new_recording(self, outputs: Outputs, folder: Path) -> RecordingSink | None:
+        """The run's MCAP recording if one is asked for: ``run.mcap``, or the first free
+        ``run-N.mcap`` (a resumed run records beside the first file)."""
+        from navseq.run.folder import reserve_file
+        from navseq.sinks.recording.sink import RecordingSink
+
+        if not self.records:
+            return None
+        metadata = None
+        if self.mission_path is not None and self.digest is not None:
+            import datetime
+
+            from navseq.sinks.recording.reading import run_metadata
+
+            metadata = run_metadata(
+                str(self.mission_path.resolve()),
+                self.digest,
+                datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                self.run_options,
+            )
+        return RecordingSink(
+            reserve_file(folder, "run.mcap"),
+            "ros1" if outputs.record_format == "ros1" else "ros2",
+            self.mission,
+            self.grid,
+            numbers=self.numbers,
+            run_metadata=metadata,
+            published_topics=outputs.record_topics,
         )
 
     def _new_journal(self, journal_path: Path) -> JournalWriter:
@@ -291,6 +340,12 @@ class Session:
                         entered.enter_context(listener)
                 if journal is not None:
                     entered.enter_context(journal)
+                if self.records:  # its stack's topics, from now on (--record-topics)
+                    from navseq.sinks.recording.sink import RecordingSink
+
+                    for listener in face:
+                        if isinstance(listener, RecordingSink):
+                            listener.tap(navigator)
                 try:
                     result = run_mission(
                         self.mission,
@@ -421,6 +476,7 @@ def prepare(request: RunRequest) -> Session:
         realtime=request.realtime,
         robot_given=request.robot is not None or mission.robot is not None,
     )
+    _check_recording(request.outputs, kind, mission)
     made = _navigator_setup(request, kind, draft)
     session = Session(
         request=request,
@@ -445,6 +501,37 @@ def prepare(request: RunRequest) -> Session:
     if kind is not None:
         session.run_options = run_options(request, kind, mission, map_path, draft.start)
     return session
+
+
+def _check_recording(
+    outputs: Outputs | None, kind_of_run: NavigatorKind | None, mission: Mission
+) -> None:
+    """A recording that cannot be made (no mcap, ``--record-topics`` where it cannot
+    work) is refused before the navigator connects and before anything is written."""
+    if outputs is None:
+        return
+    records = outputs.record if outputs.record is not None else mission.record
+    if records:
+        from navseq.extras import require_extra
+
+        require_extra("record", "recording the run (--record)")
+    if not outputs.record_topics:
+        return
+    if not records:
+        raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
+    kind = kind_of_run.name if kind_of_run is not None else "a face's own navigator"
+    if kind != "ros1":
+        raise NavseqError(
+            "records a ROS 1 navigation stack's topics as it publishes them, with "
+            f"--navigator ros1 only (not {kind}); the map, pose, odometry, /tf and plans "
+            "are recorded with any navigator",
+            source="--record-topics",
+        )
+    if outputs.record_format != "ros1":
+        raise NavseqError(
+            "records the ROS 1 stack's messages as they are published: add --record-format ros1",
+            source="--record-topics",
+        )
 
 
 def _settled_navigator(request: RunRequest) -> tuple[RunRequest, NavigatorKind | None]:
@@ -509,6 +596,12 @@ def _discard_unused(journal: Path) -> None:
             journal.unlink()
     except OSError:
         pass  # tidying up only; the original error matters more
+
+
+def _discard_unused_recording(path: Path) -> None:
+    """Remove a recording of no event: the run did not start (no navigation server)."""
+    with contextlib.suppress(OSError):  # tidying up only; the original error matters more
+        path.unlink()
 
 
 def _remove_if_unused(folder: Path) -> None:

@@ -103,6 +103,25 @@ def event_record(event: MissionEvent, numbers: Sequence[int] | None = None) -> d
     return dict(json_safe(record, DECIMALS))
 
 
+def event_fields(record: Mapping[str, Any]) -> dict[str, Any]:
+    """The event's own fields (radians, ``distance_driven`` ...) of an :func:`event_record`,
+    under ``type``: what the journal keeps of an event, to be read back as one
+    (:func:`navseq.journal.format.event_from_record`). Numbers keep the record's six
+    decimals."""
+    names = {renamed: name for name, (renamed, _) in FIELDS.items()}
+    fields: dict[str, Any] = {"type": record.get("event")}
+    for key, value in record.items():
+        if key in ("event", "schema_version", "number"):
+            continue
+        name = names.get(key, key)
+        if name == "yaw" and isinstance(value, float | int):
+            value = math.radians(value)
+        elif name == "loops" and value == "forever":
+            value = None
+        fields[name] = value
+    return fields
+
+
 def clock_record(navigator_seconds: float, wall_seconds: float) -> dict[str, float | None]:
     """How fast the navigator's clock ran: the report's and ``RunFinished``'s ``clock``.
 

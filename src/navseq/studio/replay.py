@@ -15,9 +15,10 @@ path, all on one clock starting at 0.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -25,17 +26,21 @@ from navseq.errors import NavseqError
 from navseq.text import printable
 
 JOURNAL_NAME = "journal.jsonl"
+RECORDING_NAME = "run.mcap"  # navseq run --record: replayed when the journal is gone
 #: Runs listed at most (newest first): a folder of thousands stays quick to open.
 MAX_RUNS_LISTED = 200
 
 
 def run_folders(searched: list[Path]) -> list[Path]:
-    """Folders holding a journal, under each of ``searched`` (one or two levels down)."""
+    """Folders holding a journal (or a recording, ``run.mcap``), under each of
+    ``searched`` (one or two levels down)."""
     found: dict[Path, float] = {}
     for top in searched:
         if not top.is_dir():
             continue
-        for journal in [*top.glob(f"*/{JOURNAL_NAME}"), *top.glob(f"*/*/{JOURNAL_NAME}")]:
+        kept = [*top.glob(f"*/{JOURNAL_NAME}"), *top.glob(f"*/*/{JOURNAL_NAME}")]
+        kept += [*top.glob(f"*/{RECORDING_NAME}"), *top.glob(f"*/*/{RECORDING_NAME}")]
+        for journal in kept:
             try:
                 found[journal.parent.resolve()] = journal.stat().st_mtime
             except OSError:
@@ -51,7 +56,7 @@ def run_summary(folder: Path, shown: str) -> dict[str, Any]:
     totals = report.get("totals", {}) if report else {}
     return {
         "folder": shown,
-        "modified_s": (folder / JOURNAL_NAME).stat().st_mtime,
+        "modified_s": _run_file(folder).stat().st_mtime,
         "reason": report.get("reason") if report else None,
         "reached": totals.get("reached"),
         "visits": totals.get("visits"),
@@ -82,9 +87,26 @@ def replay_of(
     from navseq.studio.runs import LiveView, _latest_report
 
     journal_path = folder / JOURNAL_NAME
-    if not journal_path.is_file():
-        raise NavseqError(f"{printable(shown)} has no {JOURNAL_NAME}: not a run folder")
-    state = read_journal(journal_path)
+    events: Callable[[], Iterable[ev.MissionEvent]] = functools.partial(
+        journal_events, journal_path
+    )
+    if journal_path.is_file():
+        state = read_journal(journal_path)
+    else:  # a recorded run whose journal is gone: its recordings hold the same events
+        from navseq.sinks.recording.reading import (
+            read_recordings,
+            recorded_events,
+            recordings_in,
+        )
+
+        recordings = recordings_in(folder) if folder.is_dir() else []
+        if not recordings:
+            raise NavseqError(
+                f"{printable(shown)} has no {JOURNAL_NAME} and no {RECORDING_NAME}: "
+                "not a run folder"
+            )
+        state = read_recordings(recordings)
+        events = functools.partial(recorded_events, recordings)
     mission_path = _mission_file(folder, state.mission_source) or _source_as_run(
         folder, state.mission_source, state.mission_digest, may_read
     )
@@ -93,7 +115,7 @@ def replay_of(
     if mission is not None:
         count = len(mission.waypoints)
     else:
-        indices = (getattr(event, "index", -1) for event in journal_events(journal_path))
+        indices = (getattr(event, "index", -1) for event in events())
         count = 1 + max(indices, default=-1)
     fold = LiveView(count, footprint=[])
     poses: list[list[float]] = []
@@ -101,7 +123,7 @@ def replay_of(
     plans: list[dict[str, Any]] = []
     start_t: float | None = None
     last_t = 0.0
-    for event in journal_events(journal_path):
+    for event in events():
         if start_t is None:
             start_t = event.t
         last_t = event.t
@@ -143,6 +165,12 @@ def replay_of(
         "states": states,
         "plans": plans,
     }
+
+
+def _run_file(folder: Path) -> Path:
+    """The file that says a folder holds a run: its journal, else its recording."""
+    journal = folder / JOURNAL_NAME
+    return journal if journal.exists() else folder / RECORDING_NAME
 
 
 def _mission_file(folder: Path, source: str) -> Path | None:
