@@ -38,6 +38,7 @@ from navseq.run.request import Outputs, RunRequest, UseNavigator
 from navseq.run.resume import DEFAULT_KIND, continue_as_journaled, known_kind, read_resume
 
 if TYPE_CHECKING:
+    from navseq.eta.live import EtaEstimator
     from navseq.executor.control import MissionControl
     from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
@@ -88,11 +89,30 @@ class Session:
     listeners: list[MissionListener] = field(default_factory=list)
     # A navigator is made ready for one run (a ROS connection is closed after it).
     _started: bool = field(default=False, init=False, repr=False)
+    _eta: EtaEstimator | None = field(default=None, init=False, repr=False)
+    _eta_made: bool = field(default=False, init=False, repr=False)
 
     @property
     def numbers(self) -> list[int] | None:
         """The run's waypoints' numbers in the mission file, when it runs a part of it."""
         return list(self.part.numbers) if self.part is not None else None
+
+    def eta(self) -> EtaEstimator | None:
+        """The run's ETA (made once, before the robot moves): the mission predicted on the
+        session's map from its start, kept up to date by the run's events. None when it
+        cannot be predicted (see the notes)."""
+        if not self._eta_made:
+            self._eta_made = True
+            from navseq.eta.live import EtaEstimator
+            from navseq.eta.predict import predict_on_map
+
+            try:
+                prediction = predict_on_map(self.mission, self.grid, self.robot, self.start)
+            except Exception as error:  # an ETA is never worth a run
+                self.notes.append(f"no ETA for this run: {error}")
+            else:
+                self._eta = EtaEstimator(prediction)
+        return self._eta
 
     def run(
         self,
@@ -284,7 +304,8 @@ class Session:
         navigator_start, wall_start = navigator.now(), time.monotonic()
         try:
             journal = open_journal()
-            mine = [sink for sink in (journal, recorder) if sink is not None]
+            # The ETA first: the face's sinks show the time to go the event leads to.
+            mine = [sink for sink in (self.eta(), journal, recorder) if sink is not None]
             with contextlib.ExitStack() as entered:
                 for listener in face:
                     if isinstance(listener, contextlib.AbstractContextManager):
