@@ -141,16 +141,18 @@ class DrivenPath:
     end_speed: float  # m/s when the leg ends (0 when it stops)
     end_heading: float  # rad: the direction the robot drives (or last drove) at the end
     end_point: Point
-    remaining_m: np.ndarray
+    remaining_m: np.ndarray  # along the plan to the goal, as a navigation stack says it
     time_left_s: np.ndarray
 
     def time_left(self, remaining_m: float) -> float:
-        """Seconds still to go with ``remaining_m`` metres of the path left."""
+        """Seconds still to go with ``remaining_m`` metres of the plan left to the goal.
+
+        Past the end of the driving (arrived, turning to the goal's yaw) it is the time
+        the end takes: how much of that turn is done, the distance does not say.
+        """
         if remaining_m >= float(self.remaining_m[0]):
             return float(self.time_left_s[0])
-        return float(
-            np.interp(remaining_m, self.remaining_m[::-1], self.time_left_s[::-1], left=0.0)
-        )
+        return float(np.interp(remaining_m, self.remaining_m[::-1], self.time_left_s[::-1]))
 
 
 def drive_path(
@@ -170,7 +172,13 @@ def drive_path(
     leg ends, at speed, where the robot comes within that radius of ``goal`` (the last
     point when not given); otherwise it stops there and turns to ``goal_yaw`` (if given).
     """
-    xy = _smoothed(_resample(points), model.lookahead)
+    planned = _resample(points)
+    xy = _smoothed(planned, model.lookahead)
+    # A navigation stack reports the distance left along its plan to the goal: the
+    # planned path, not the smoothed one, and to the goal, not to where a pass-through
+    # leg ends. ``to_goal`` converts, for :meth:`DrivenPath.time_left`.
+    smoothed_m = _length(xy)
+    per_metre = _length(planned) / smoothed_m if smoothed_m > 0.0 else 1.0
     goal_xy = np.asarray(goal if goal is not None else points[-1], dtype=float)
     if pass_radius is not None:
         near = np.hypot(xy[:, 0] - goal_xy[0], xy[:, 1] - goal_xy[1]) <= pass_radius
@@ -222,7 +230,7 @@ def drive_path(
         end_speed=end_speed,
         end_heading=end_heading,
         end_point=(float(xy[-1, 0]), float(xy[-1, 1])),
-        remaining_m=float(along[-1]) - along,
+        remaining_m=(smoothed_m - along) * per_metre,
         # Still at the start, the turn in place is still to come; once moving, it is done.
         time_left_s=np.concatenate(([duration], (duration - before - times)[1:])),
     )
@@ -239,6 +247,10 @@ def _resample(points: Sequence[Point]) -> np.ndarray:
         fractions = np.linspace(0.0, 1.0, count + 1)[1:, None]
         pieces.append(a + fractions * (b - a))
     return np.vstack(pieces)
+
+
+def _length(xy: np.ndarray) -> float:
+    return float(np.hypot(np.diff(xy[:, 0]), np.diff(xy[:, 1])).sum())
 
 
 def _smoothed(xy: np.ndarray, window_m: float) -> np.ndarray:
