@@ -183,8 +183,11 @@ def main() -> None:
                 f"at {c} %: mean |error| {statistics.fmean(errors):.1f} %, "
                 f"max {max(errors):.1f} %, {within}/{len(errors)} within 3 %"
             )
-        naive = [abs(run.naive_error_percent) for run in chosen]
-        parts.append(f"naive: mean |error| {statistics.fmean(naive):.1f} %, max {max(naive):.1f} %")
+        naive_errors = [abs(run.naive_error_percent) for run in chosen]
+        parts.append(
+            f"naive: mean |error| {statistics.fmean(naive_errors):.1f} %, "
+            f"max {max(naive_errors):.1f} %"
+        )
         print(f"{label} ({len(chosen)} missions): " + "; ".join(parts))
 
 
