@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from navseq.eta.predict import MissionPrediction
 
 
 def format_duration(seconds: float | None) -> str:
@@ -17,4 +21,25 @@ def format_duration(seconds: float | None) -> str:
     return f"{whole // 3600} h {whole % 3600 // 60:02d} min"
 
 
-__all__ = ["format_duration"]
+def prediction_lines(prediction: MissionPrediction, *, has_start: bool) -> list[str]:
+    """What ``navseq plan`` and ``navseq validate`` say about how long the mission takes."""
+    notes = []
+    if not has_start:
+        notes.append("from the first waypoint: the mission has no start:")
+    if not prediction.planned:
+        notes.append("legs with no path left out")
+    note = f" ({'; '.join(notes)})" if notes else ""
+    if prediction.loops is None:
+        return [
+            f"expected duration: each loop ~{format_duration(prediction.loop_expected_s)}, "
+            f"the first ~{format_duration(sum(v.expected_s for v in prediction.first_loop))}"
+            f" (loops forever){note}"
+        ]
+    return [
+        f"expected duration: ~{format_duration(prediction.expected_s)}{note}",
+        f"upper bound: {format_duration(prediction.upper_s)} (every task at its timeout; "
+        "retries and recovery behaviours are not bounded)",
+    ]
+
+
+__all__ = ["format_duration", "prediction_lines"]
