@@ -208,11 +208,17 @@ def drive_path(
         latch = model.xy_tolerance / (1.0 + model.approach_decel / model.accel)
         left = np.maximum(length - along, 0.0)
         caps = np.minimum(caps, np.sqrt(2.0 * model.approach_decel * left))
-        keep = left >= latch
+        # The last sample moved to where the robot latches (samples are STEP_M apart).
+        keep = left > latch
         keep[0] = True
-        xy, along, caps, sharp = xy[keep], along[keep], caps[keep], sharp[keep]
+        arrive_at = max(length - latch, 0.0)
+        last = int(np.count_nonzero(keep))
+        xy = np.vstack((xy[:last], _point_at(xy, along, np.array([arrive_at]))))
+        caps = np.append(caps[:last], math.sqrt(2.0 * model.approach_decel * latch))
+        sharp = np.append(sharp[:last], 0.0)
+        along = np.append(along[:last], arrive_at)
     speeds = _speed_profile(caps, np.diff(along), speed0, model.accel)
-    times = _times(np.diff(along), speeds) + _bend_turns(sharp, model)
+    times = _times(np.diff(along), speeds, model.accel) + _bend_turns(sharp, model)
     after = 0.0
     if stops:
         after += speeds[-1] / model.accel if model.accel > 0 else 0.0
@@ -266,7 +272,12 @@ def _smoothed(xy: np.ndarray, window_m: float) -> np.ndarray:
     kernel = np.ones(2 * half + 1) / (2 * half + 1)
     smooth = np.column_stack([np.convolve(padded[:, k], kernel, mode="valid") for k in range(2)])
     smooth[0], smooth[-1] = xy[0], xy[-1]
-    return smooth
+    # Averaging bunches the points near the ends: space them evenly again.
+    along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(smooth, axis=0).T))))
+    if along[-1] <= 0.0:
+        return smooth
+    even = np.append(np.arange(0.0, along[-1], STEP_M), along[-1])
+    return _point_at(smooth, along, even)
 
 
 def _headings(xy: np.ndarray) -> np.ndarray:
@@ -353,13 +364,18 @@ def _speed_profile(caps: np.ndarray, steps: np.ndarray, start: float, accel: flo
     return speeds
 
 
-def _times(steps: np.ndarray, speeds: np.ndarray) -> np.ndarray:
-    """Seconds from the start to each sample at these speeds (trapezoid rule per step).
+def _times(steps: np.ndarray, speeds: np.ndarray, accel: float) -> np.ndarray:
+    """Seconds from the start to each sample at these speeds.
 
-    A step between two samples at rest (a turn in place at a sharp bend) costs the
-    turn's time instead.
+    Speeding up, the robot accelerates at ``accel`` until it has the next sample's speed
+    and keeps it (a step from rest is mostly driven at the new speed); slowing down, it
+    brakes evenly over the step (the braking profiles are constant decelerations).
     """
-    mean = (speeds[:-1] + speeds[1:]) / 2.0
+    v0, v1 = speeds[:-1], speeds[1:]
     with np.errstate(divide="ignore", invalid="ignore"):
-        each = np.where(mean > 1e-9, steps / np.maximum(mean, 1e-9), 0.0)
+        even = np.where(v0 + v1 > 1e-9, 2.0 * steps / np.maximum(v0 + v1, 1e-9), 0.0)
+        ramp = (v1 * v1 - v0 * v0) / (2.0 * accel)
+        speeding = (v1 > v0) & (ramp < steps)
+        ramp_then_cruise = (v1 - v0) / accel + (steps - ramp) / np.maximum(v1, 1e-9)
+    each = np.where(speeding, ramp_then_cruise, even)
     return np.concatenate(([0.0], np.cumsum(each)))
