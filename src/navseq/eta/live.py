@@ -68,6 +68,7 @@ class EtaEstimator:
     _dwell_until: float | None = None
     _paused_at: float | None = None
     _finished_at: float | None = None
+    _resumed = False  # a resumed run: its actual duration is only what was left
     _estimates: list[_Estimate] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -77,6 +78,7 @@ class EtaEstimator:
     def __call__(self, event: MissionEvent) -> None:
         if isinstance(event, MissionStarted):
             self._start = event.t
+            self._resumed = event.resumed_from is not None
         elif isinstance(event, WaypointStarted):
             if (event.loop, event.index) != self._loop_index:
                 self._loop_index = (event.loop, event.index)
@@ -160,9 +162,12 @@ class EtaEstimator:
 
     def accuracy(self) -> dict[str, Any] | None:
         """The predictions against the actual duration (the report's ``eta``), or None
-        before the mission has ended or when it loops forever."""
+        before the mission has ended, when it loops forever or was resumed (the prediction
+        is the whole mission's)."""
         expected = self.prediction.expected_s
         if self._start is None or self._finished_at is None or expected is None:
+            return None
+        if self._resumed:
             return None
         actual = self._finished_at - self._start
         checks = []
