@@ -338,29 +338,31 @@ def _bend_turns(sharp: np.ndarray, model: DriveModel) -> np.ndarray:
     Each run of samples at a sharp bend is one turn, of the run's largest heading change.
     """
     extra = np.zeros(len(sharp))
-    i = 0
-    while i < len(sharp):
-        if sharp[i] > 0.0:
-            j = i
-            while j + 1 < len(sharp) and sharp[j + 1] > 0.0:
-                j += 1
-            extra[i] += turn_until(float(sharp[i : j + 1].max()), model.rotate_until, model)
-            i = j + 1
-        else:
-            i += 1
+    at_bend = sharp > 0.0
+    if at_bend.any():
+        edges = np.diff(np.concatenate(([0], at_bend.astype(np.int8), [0])))
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        for start, end in zip(starts, ends, strict=True):
+            turn = float(sharp[start:end].max())
+            extra[start] = turn_until(turn, model.rotate_until, model)
     return np.cumsum(extra)
 
 
 def _speed_profile(caps: np.ndarray, steps: np.ndarray, start: float, accel: float) -> np.ndarray:
-    """Speed at each sample: within the caps, changing at most ``accel`` both ways."""
-    speeds = caps.copy()
-    speeds[0] = min(start, caps[0]) if start > 0.0 else 0.0
-    for i in range(1, len(speeds)):  # accelerating
-        reachable = math.sqrt(speeds[i - 1] ** 2 + 2.0 * accel * steps[i - 1])
-        speeds[i] = min(speeds[i], reachable)
-    for i in range(len(speeds) - 2, 0, -1):  # braking for what is ahead
-        reachable = math.sqrt(speeds[i + 1] ** 2 + 2.0 * accel * steps[i])
-        speeds[i] = min(speeds[i], reachable)
+    """Speed at each sample: within the caps, changing at most ``accel`` both ways.
+
+    Speeding up from sample j, the robot has ``v² = v_j² + 2 a (s - s_j)`` at ``s``; the
+    speed at a sample is the least over every sample behind it (and, braking, ahead of
+    it), which a running minimum gives without a loop.
+    """
+    along = np.concatenate(([0.0], np.cumsum(steps)))
+    squared = caps * caps
+    squared[0] = min(start, caps[0]) ** 2 if start > 0.0 else 0.0
+    reach = 2.0 * accel * along
+    ahead = np.minimum.accumulate(squared - reach) + reach  # accelerating
+    behind = np.minimum.accumulate((ahead + reach)[::-1])[::-1] - reach  # braking for what comes
+    behind[0] = ahead[0]  # the robot starts at the speed it has
+    speeds: np.ndarray = np.sqrt(np.maximum(np.minimum(ahead, behind), 0.0))
     return speeds
 
 

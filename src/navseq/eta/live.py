@@ -123,7 +123,7 @@ class EtaEstimator:
             return
         loop, index = self._loop_index
         after = self.prediction.after(loop, index)
-        after_upper = self.prediction.after(loop, index, upper=True)
+        after_upper = self.prediction.after(loop, index, "upper")
         if after is None or after_upper is None:
             self.eta_s = self.eta_upper_s = None  # a patrol that loops forever has no end
             return
@@ -143,22 +143,13 @@ class EtaEstimator:
         tasks = visit.tasks if visit is not None else None
         task_s = tasks.expected_s if tasks is not None else 0.0
         task_upper_s = max(tasks.upper_s, task_s) if tasks is not None else 0.0
-        later_drive = self._later_drive(loop, index)
+        later_drive = self.prediction.after(loop, index, "drive") or 0.0
         drive_left = (self._drive_left_s + later_drive) * ratio
         here = dwell_left + task_s
         self.eta_s = drive_left + here + (after - later_drive)
         self.eta_upper_s = drive_left + dwell_left + task_upper_s + (after_upper - later_drive)
         if not self._estimates or elapsed - self._estimates[-1].elapsed_s >= KEEP_EVERY_S:
             self._estimates.append(_Estimate(elapsed, elapsed + self.eta_s))
-
-    def _later_drive(self, loop: int, index: int) -> float:
-        """Predicted driving of the visits after ``(loop, index)``."""
-        prediction = self.prediction
-        assert prediction.loops is not None
-        visits = prediction.first_loop if loop == 0 else prediction.later_loop
-        rest = sum(v.drive_s for v in visits[index + 1 :])
-        whole = sum(v.drive_s for v in prediction.later_loop)
-        return rest + max(prediction.loops - loop - 1, 0) * whole
 
     def accuracy(self) -> dict[str, Any] | None:
         """The predictions against the actual duration (the report's ``eta``), or None

@@ -22,8 +22,8 @@ Tasks at waypoints plug in through :data:`TaskTimes`; the default is no tasks.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -89,6 +89,9 @@ class MissionPrediction:
     first_loop: tuple[VisitPrediction, ...]
     later_loop: tuple[VisitPrediction, ...]
     loops: int | None
+    _rests: dict[tuple[bool, str], np.ndarray] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def planned(self) -> bool:
@@ -98,35 +101,57 @@ class MissionPrediction:
         visits = self.first_loop if loop == 0 else self.later_loop
         return visits[index]
 
-    def after(self, loop: int, index: int, upper: bool = False) -> float | None:
-        """Seconds of the visits after ``(loop, index)`` to the mission's end (None: forever)."""
+    def after(self, loop: int, index: int, part: Part = "expected") -> float | None:
+        """Seconds of the visits after ``(loop, index)`` to the mission's end (None:
+        forever): their expected time, upper bound or driving alone (``part``)."""
         if self.loops is None:
             return None
-        visits = self.first_loop if loop == 0 else self.later_loop
-        rest = sum(v.upper_s if upper else v.expected_s for v in visits[index + 1 :])
-        whole = sum(v.upper_s if upper else v.expected_s for v in self.later_loop)
-        return rest + max(self.loops - loop - 1, 0) * whole
+        rest = self._rest_after(loop == 0, part)[index]
+        whole = self._rest_after(False, part)[0] + _part_of(self.later_loop[0], part)
+        return float(rest) + max(self.loops - loop - 1, 0) * float(whole)
 
     @property
     def expected_s(self) -> float | None:
         """The whole mission, expected (None: it loops forever)."""
-        return self._total(upper=False)
+        return self._total("expected")
 
     @property
     def upper_s(self) -> float | None:
         """The whole mission with every task taking its timeout (None: forever)."""
-        return self._total(upper=True)
+        return self._total("upper")
 
     @property
     def loop_expected_s(self) -> float:
         """One loop after the first (a patrol's period)."""
         return sum(v.expected_s for v in self.later_loop)
 
-    def _total(self, upper: bool) -> float | None:
+    def _total(self, part: Part) -> float | None:
         if self.loops is None or not self.first_loop:
             return None if self.loops is None else 0.0
-        first = sum(v.upper_s if upper else v.expected_s for v in self.first_loop)
-        return first + (self.after(0, len(self.first_loop) - 1, upper) or 0.0)
+        first = _part_of(self.first_loop[0], part)
+        return first + (self.after(0, 0, part) or 0.0)
+
+    def _rest_after(self, first: bool, part: Part) -> np.ndarray:
+        """For each visit of a loop, the seconds of the visits after it in that loop
+        (worked out once: a progress event asks often, and a mission may have 100 000
+        visits)."""
+        key = (first, part)
+        if key not in self._rests:
+            visits = self.first_loop if first else self.later_loop
+            each = np.array([_part_of(v, part) for v in visits], dtype=float)
+            rest = np.cumsum(each[::-1])[::-1]
+            self._rests[key] = np.append(rest[1:], 0.0)
+        return self._rests[key]
+
+
+#: Which seconds of a visit :meth:`MissionPrediction.after` adds up.
+Part = Literal["expected", "upper", "drive"]
+
+
+def _part_of(visit: VisitPrediction, part: Part) -> float:
+    if part == "drive":
+        return visit.drive_s
+    return visit.upper_s if part == "upper" else visit.expected_s
 
 
 def predict_mission(
