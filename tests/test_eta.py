@@ -190,3 +190,19 @@ def test_the_log_lines_say_when_the_mission_ends() -> None:
         estimator(event)
         log(event)
     assert "; mission ends in ~" in out.getvalue()
+
+
+def test_a_huge_mission_plans_its_first_visits_and_paces_the_rest() -> None:
+    from navseq.eta.text import prediction_lines
+
+    mission = load_mission(EXAMPLE)
+    whole = predict_mission(mission, StraightLegs(), MODEL, mission.start)
+    paced = predict_mission(mission, StraightLegs(), MODEL, mission.start, planned_visits=3)
+    assert paced.paced == 4 and whole.paced == 0
+    assert whole.expected_s is not None and paced.expected_s is not None
+    # The last 4 legs at the seconds per metre of the first 3: close, not equal.
+    assert paced.expected_s == pytest.approx(whole.expected_s, rel=0.3)
+    assert paced.expected_s != whole.expected_s
+    assert (
+        "the last 4 legs at the pace of the first 3" in prediction_lines(paced, has_start=True)[0]
+    )

@@ -21,13 +21,14 @@ Tasks at waypoints plug in through :data:`TaskTimes`; the default is no tasks.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from navseq.eta.drive import DriveModel, DrivenPath, SpeedCap, drive_path
+from navseq.eta.drive import DriveModel, DrivenPath, Point, SpeedCap, drive_path
 
 if TYPE_CHECKING:
     from navseq.geometry import Pose2D
@@ -89,6 +90,7 @@ class MissionPrediction:
     first_loop: tuple[VisitPrediction, ...]
     later_loop: tuple[VisitPrediction, ...]
     loops: int | None
+    paced: int = 0  # visits of each loop paced, not planned (a huge mission)
     _rests: dict[tuple[bool, str], np.ndarray] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
@@ -154,6 +156,12 @@ def _part_of(visit: VisitPrediction, part: Part) -> float:
     return visit.upper_s if part == "upper" else visit.expected_s
 
 
+#: Visits planned and driven on paper before the robot moves; a mission with more has
+#: the rest paced (see :func:`predict_mission`): planning 100 000 legs would hold the
+#: robot for minutes.
+PLANNED_VISITS = 500
+
+
 def predict_mission(
     mission: Mission,
     legs: Legs,
@@ -162,9 +170,14 @@ def predict_mission(
     *,
     speed_cap: SpeedCap | None = None,
     task_times: TaskTimes = no_tasks,
+    planned_visits: int = PLANNED_VISITS,
 ) -> MissionPrediction:
     """The mission's visits predicted; ``start`` None: the first leg starts at the first
-    waypoint (nothing to drive), as nothing says where the robot is."""
+    waypoint (nothing to drive), as nothing says where the robot is.
+
+    The first ``planned_visits`` visits of a loop are planned and driven; each later one
+    is paced: its straight-line distance at the seconds per metre of the planned ones.
+    """
     from navseq.executor.visit import Visit
 
     count = len(mission.waypoints)
@@ -175,28 +188,43 @@ def predict_mission(
     elif count:
         where, heading = (mission.waypoints[0].x, mission.waypoints[0].y), None
     speed = 0.0
+    planned = 0
+    paced_seconds, paced_metres = 0.0, 0.0  # the planned visits' driving and distance
+
+    def driven_leg(visit: Visit, goal: tuple[float, float]) -> DrivenPath | None:
+        nonlocal planned, paced_seconds, paced_metres
+        straight = math.dist(where, goal)
+        if planned >= planned_visits:
+            pace = paced_seconds / paced_metres if paced_metres > 0 else 1 / model.max_speed
+            return paced_leg(goal, straight, straight * pace, visit.waypoint.yaw_rad)
+        planned += 1
+        points = legs.leg(where, goal).points
+        if points is None:
+            return None
+        path = [where, *points[1:-1], goal] if len(points) > 2 else [where, goal]
+        driven = drive_path(
+            path,
+            model,
+            start_heading=heading,
+            start_speed=speed,
+            goal_yaw=visit.waypoint.yaw_rad,
+            pass_radius=visit.policy.pass_through_m if visit.passes_through else None,
+            goal=goal,
+            speed_cap=speed_cap,
+        )
+        paced_seconds += driven.duration_s
+        paced_metres += straight
+        return driven
 
     def loop_of(loop: int) -> tuple[VisitPrediction, ...]:
-        nonlocal where, heading, speed
+        nonlocal where, heading, speed, planned
+        planned = 0  # the first visits of each loop are planned
         visits = []
         for index, waypoint in enumerate(mission.waypoints):
             visit = Visit.of(mission, loop, index)
             goal = (waypoint.x, waypoint.y)
-            planned = legs.leg(where, goal)
-            points = planned.points
-            driven: DrivenPath | None = None
-            if points is not None:
-                path = [where, *points[1:-1], goal] if len(points) > 2 else [where, goal]
-                driven = drive_path(
-                    path,
-                    model,
-                    start_heading=heading,
-                    start_speed=speed,
-                    goal_yaw=waypoint.yaw_rad,
-                    pass_radius=visit.policy.pass_through_m if visit.passes_through else None,
-                    goal=goal,
-                    speed_cap=speed_cap,
-                )
+            driven = driven_leg(visit, goal)
+            if driven is not None:
                 where, heading, speed = driven.end_point, driven.end_heading, driven.end_speed
             else:
                 where, heading, speed = goal, waypoint.yaw_rad, 0.0
@@ -209,7 +237,20 @@ def predict_mission(
 
     first = loop_of(0) if count else ()
     later = loop_of(1) if count and (loops is None or loops > 1) else first
-    return MissionPrediction(first, later, loops)
+    return MissionPrediction(first, later, loops, paced=max(0, count - planned_visits))
+
+
+def paced_leg(goal: Point, metres: float, seconds: float, yaw: float) -> DrivenPath:
+    """A leg not planned: ``metres`` to ``goal`` in ``seconds``, evenly."""
+    return DrivenPath(
+        duration_s=seconds,
+        length_m=metres,
+        end_speed=0.0,
+        end_heading=yaw,
+        end_point=goal,
+        remaining_m=np.array([metres, 0.0]),
+        time_left_s=np.array([seconds, 0.0]),
+    )
 
 
 def costmap_speed_cap(costmap: Costmap, model: DriveModel) -> SpeedCap:
@@ -269,12 +310,14 @@ def predict_legs(
 
 
 __all__ = [
+    "PLANNED_VISITS",
     "MissionPrediction",
     "TaskTime",
     "TaskTimes",
     "VisitPrediction",
     "costmap_speed_cap",
     "no_tasks",
+    "paced_leg",
     "predict_legs",
     "predict_mission",
     "predict_on_map",

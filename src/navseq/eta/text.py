@@ -28,6 +28,11 @@ def prediction_lines(prediction: MissionPrediction, *, has_start: bool) -> list[
         notes.append("from the first waypoint: the mission has no start:")
     if not prediction.planned:
         notes.append("legs with no path left out")
+    if prediction.paced:
+        notes.append(
+            f"the last {prediction.paced} legs at the pace of the first "
+            f"{len(prediction.first_loop) - prediction.paced}, not planned"
+        )
     note = f" ({'; '.join(notes)})" if notes else ""
     if prediction.loops is None:
         return [
