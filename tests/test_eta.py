@@ -206,3 +206,24 @@ def test_a_huge_mission_plans_its_first_visits_and_paces_the_rest() -> None:
     assert (
         "the last 4 legs at the pace of the first 3" in prediction_lines(paced, has_start=True)[0]
     )
+
+
+def test_the_ros_status_messages_carry_the_time_to_go() -> None:
+    from navseq.executor.events import MissionStarted, WaypointProgress, WaypointStarted
+    from navseq.sinks.mission_status import MissionStatus
+
+    mission = load_mission(EXAMPLE)
+    estimator = EtaEstimator(predict_mission(mission, StraightLegs(), MODEL, mission.start))
+    status = MissionStatus(mission)
+    status.eta = estimator
+    update = None
+    for event in (
+        MissionStarted(0.0, 7, 1),
+        WaypointStarted(0.0, 0, 0, 1, 1, -0.55, -1.75, 0.0),
+        WaypointProgress(0.5, 0, -1.9, -0.55, 0.0, 1.5, 0.1),
+    ):
+        estimator(event)
+        update = status.update(event)
+    assert update is not None
+    assert update.status["eta_s"] == pytest.approx(estimator.eta_s, abs=0.05)
+    assert update.status["eta_upper_s"] >= update.status["eta_s"] > 30.0

@@ -305,7 +305,9 @@ class Session:
         try:
             journal = open_journal()
             # The ETA first: the face's sinks show the time to go the event leads to.
-            mine = [sink for sink in (self.eta(), journal, recorder) if sink is not None]
+            eta = self.eta()
+            mine = [sink for sink in (eta, journal, recorder) if sink is not None]
+            _show_eta_on_status_topics([*face, *self.listeners], eta)
             with contextlib.ExitStack() as entered:
                 for listener in face:
                     if isinstance(listener, contextlib.AbstractContextManager):
@@ -372,6 +374,15 @@ class _Ran:
     clock: dict[str, float | None]
     navigator: Navigator
     recorder: RunRecorder | None
+
+
+def _show_eta_on_status_topics(listeners: list[MissionListener], eta: EtaEstimator | None) -> None:
+    """The ROS status topics' progress messages carry the run's ETA."""
+    from navseq.sinks.mission_status import StatusPublisher
+
+    for listener in listeners:
+        if isinstance(listener, StatusPublisher):
+            listener.state.eta = eta
 
 
 def _ignore(note: str) -> None:
