@@ -17,8 +17,9 @@ import pytest
 from cli_support import EXAMPLES, TURTLEBOT3_MAP, navseq, printed_events, write_mission
 from navseq.eta.drive import DriveModel, drive_path, turn_time, turn_until
 from navseq.eta.live import EtaEstimator
-from navseq.eta.predict import TaskTime, predict_legs, predict_mission
+from navseq.eta.predict import MissionPrediction, TaskTime, predict_legs, predict_mission
 from navseq.eta.text import format_duration
+from navseq.geometry import Pose2D
 from navseq.mission import load_mission
 from navseq.mission.robot import DEFAULT_PROFILE
 from navseq.route.legs import StraightLegs
@@ -227,3 +228,27 @@ def test_the_ros_status_messages_carry_the_time_to_go() -> None:
     assert update is not None
     assert update.status["eta_s"] == pytest.approx(estimator.eta_s, abs=0.05)
     assert update.status["eta_upper_s"] >= update.status["eta_s"] > 30.0
+
+
+def test_without_a_start_pose_the_first_leg_is_counted_from_the_robot_s_first_pose() -> None:
+    import dataclasses
+
+    from navseq.executor.events import MissionStarted, WaypointProgress, WaypointStarted
+
+    mission = dataclasses.replace(load_mission(EXAMPLE), start=None)  # as a ROS node has it
+    startless = predict_mission(mission, StraightLegs(), MODEL, None)
+    assert startless.first_loop[0].drive_s == 0.0  # nowhere to drive from
+
+    def from_pose(pose: Pose2D) -> MissionPrediction:
+        return predict_mission(mission, StraightLegs(), MODEL, pose)
+
+    estimator = EtaEstimator(startless, from_pose)
+    for event in (
+        MissionStarted(0.0, 7, 1),
+        WaypointStarted(0.0, 0, 0, 1, 1, -0.55, -1.75, 0.0),
+        WaypointProgress(0.1, 0, -2.0, -0.5, 0.0, 1.9, 0.0),
+    ):
+        estimator(event)
+    assert startless.expected_s is not None and estimator.eta_s is not None
+    assert estimator.eta_s > startless.expected_s + 5.0  # the way to waypoint 1 counts
+    assert estimator.prediction.first_loop[0].drive_s > 5.0

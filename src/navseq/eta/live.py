@@ -20,6 +20,7 @@ Each estimate is kept (elapsed, predicted end); when the mission ends,
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,6 +36,7 @@ from navseq.executor.events import (
     WaypointProgress,
     WaypointStarted,
 )
+from navseq.geometry import Pose2D
 
 #: The achieved-over-predicted driving time is trusted within these limits.
 RATIO_LIMITS = (0.5, 3.0)
@@ -54,9 +56,15 @@ class _Estimate:
 
 @dataclass
 class EtaEstimator:
-    """Time to go for one run of ``prediction``'s mission; feed it every mission event."""
+    """Time to go for one run of ``prediction``'s mission; feed it every mission event.
+
+    ``from_pose``: for a prediction made without a start pose (a ROS node does not know
+    where the robot is before it runs), the prediction from the robot's first pose; it
+    is made once, on the first progress event, and is the run's "before the start".
+    """
 
     prediction: MissionPrediction
+    from_pose: Callable[[Pose2D], MissionPrediction] | None = None
     eta_s: float | None = None
     eta_upper_s: float | None = None
     _start: float | None = None
@@ -87,6 +95,8 @@ class EtaEstimator:
             self._dwell_until = None
             self._update(event.t)
         elif isinstance(event, WaypointProgress):
+            if self.from_pose is not None:
+                self._predict_from(Pose2D(event.x, event.y, event.yaw))
             visit = self._visit
             remaining = event.distance_remaining
             known = remaining is not None and math.isfinite(remaining)
@@ -112,6 +122,16 @@ class EtaEstimator:
         elif isinstance(event, MissionFinished):
             self._finished_at = event.t
             self.eta_s = self.eta_upper_s = 0.0
+
+    def _predict_from(self, pose: Pose2D) -> None:
+        """The prediction from the robot's first pose (its first leg counted now)."""
+        assert self.from_pose is not None
+        from_pose, self.from_pose = self.from_pose, None
+        if self._drive_done_s > 0.0 or self._loop_index != (0, 0):
+            return  # too late: the first leg is behind
+        self.prediction = from_pose(pose)
+        self._visit = self._visit_at(0, 0)
+        self._drive_left_s = self._visit.drive_s if self._visit else 0.0
 
     def _visit_at(self, loop: int, index: int) -> VisitPrediction | None:
         visits = self.prediction.first_loop if loop == 0 else self.prediction.later_loop

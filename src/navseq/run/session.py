@@ -39,6 +39,7 @@ from navseq.run.resume import DEFAULT_KIND, continue_as_journaled, known_kind, r
 
 if TYPE_CHECKING:
     from navseq.eta.live import EtaEstimator
+    from navseq.eta.predict import MissionPrediction
     from navseq.executor.control import MissionControl
     from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
@@ -111,7 +112,13 @@ class Session:
             except Exception as error:  # an ETA is never worth a run
                 self.notes.append(f"no ETA for this run: {error}")
             else:
-                self._eta = EtaEstimator(prediction)
+                from_pose = None
+                if self.start is None:  # counted from the robot's first pose instead
+
+                    def from_pose(pose: Pose2D) -> MissionPrediction:
+                        return predict_on_map(self.mission, self.grid, self.robot, pose)
+
+                self._eta = EtaEstimator(prediction, from_pose)
         return self._eta
 
     def run(
