@@ -285,6 +285,8 @@ def test_a_run_writes_the_usual_output_folder(client: TestClient, workspace: Pat
     report = json.loads((folder / "report.json").read_text())
     assert report["totals"]["reached"] == 7 and report == state["report"]
     assert len(state["trail"]) > 50 and state["pose"] is not None
+    assert state["eta_s"] == 0.0  # over: nothing left to go
+    assert report["eta"]["actual_s"] == report["totals"]["duration_s"]  # the ETA was kept
     # The folder is navseq run's own: navseq report rebuilds from its journal.
     from navseq.journal.writer import read_journal
 
