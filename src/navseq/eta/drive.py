@@ -7,7 +7,8 @@ simulator's :mod:`navseq.sim.controller`) does with a differential-drive robot:
    (more than ``rotate_above``), until it is within ``rotate_until`` of it; the rest of
    that angle is turned while driving. A turn accelerates at the robot's angular
    acceleration up to the turn rate and brakes on the controller's braking profile.
-2. **Drive** the path at the top speed, except where the path bends (pure pursuit
+2. **Drive** the path — averaged over one lookahead, as pure pursuit cuts a grid
+   planner's zigzags and corners — at the top speed, except where it bends (pure pursuit
    drives an arc through the carrot one lookahead ahead; arcs tighter than
    ``regulated_min_radius`` are driven proportionally slower) and near obstacles (an
    optional speed cap from the costmap). Speed changes at the robot's linear
@@ -21,7 +22,7 @@ simulator's :mod:`navseq.sim.controller`) does with a differential-drive robot:
 The path is sampled every :data:`STEP_M` and the speed profile found with a forward pass
 (acceleration) and a backward pass (braking), as in any time-optimal profile along a
 fixed path. What it ignores: replanning, recovery behaviours, other robots, the
-controller's lag behind the path (it drives the path, not the arc the robot cuts).
+controller's lag behind the path (the averaged path stands for what it drives).
 """
 
 from __future__ import annotations
@@ -176,7 +177,7 @@ def drive_path(
     xy = _smoothed(planned, model.lookahead)
     # A navigation stack reports the distance left along its plan to the goal: the
     # planned path, not the smoothed one, and to the goal, not to where a pass-through
-    # leg ends. ``to_goal`` converts, for :meth:`DrivenPath.time_left`.
+    # leg ends. ``per_metre`` converts, for :meth:`DrivenPath.time_left`.
     smoothed_m = _length(xy)
     per_metre = _length(planned) / smoothed_m if smoothed_m > 0.0 else 1.0
     goal_xy = np.asarray(goal if goal is not None else points[-1], dtype=float)
@@ -188,6 +189,14 @@ def drive_path(
     along = np.concatenate(([0.0], np.cumsum(steps)))
     length = float(along[-1])
     headings = _headings(xy)
+    # The direction the robot last drove: of the last step that moved; on a leg of no
+    # length, the heading it had (or the goal's, when neither is known: no turn).
+    moved = headings[steps > 1e-9]
+    heading_at_end = (
+        float(moved[-1])
+        if len(moved)
+        else (start_heading if start_heading is not None else (goal_yaw or 0.0))
+    )
 
     before = 0.0
     speed0 = start_speed
@@ -223,11 +232,11 @@ def drive_path(
     if stops:
         after += speeds[-1] / model.accel if model.accel > 0 else 0.0
         if goal_yaw is not None:
-            final = headings[-1] if len(headings) else (start_heading or 0.0)
-            after += turn_until(normalize_angle(goal_yaw - final), model.yaw_tolerance, model)
+            turn = normalize_angle(goal_yaw - heading_at_end)
+            after += turn_until(turn, model.yaw_tolerance, model)
     duration = before + float(times[-1]) + after
     end_speed = 0.0 if stops else float(speeds[-1])
-    end_heading = float(headings[-1]) if len(headings) else (start_heading or 0.0)
+    end_heading = heading_at_end
     if stops and goal_yaw is not None:
         end_heading = goal_yaw
     return DrivenPath(
