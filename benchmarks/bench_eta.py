@@ -4,7 +4,8 @@ Each mission runs on the simulator (simulated time, as fast as the CPU goes) thr
 the run service, as ``navseq run`` runs it, and its report's ``eta`` section is read:
 the predicted end before the start (0 %) and the latest ones at 25, 50 and 75 % of
 the actual duration, against the actual end; beside them the naive figure (every
-planned leg at the robot's top speed, plus dwell). Missions:
+planned leg at the robot's top speed, plus dwell), and in the summary the same live
+estimate without the correction by achieved speed. Missions:
 
 - the example missions that run on the simulator (``examples/*.yaml`` with a map; a
   patrol that loops forever is run for ``--patrol-loops`` loops);
@@ -33,6 +34,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from navseq.commands.common import costmap_for_robot
+from navseq.eta.live import EtaEstimator
 from navseq.executor.events import AttemptFailed, MissionEvent
 from navseq.mission.robot import DEFAULT_PROFILE
 from navseq.run import RunRequest, Session, prepare
@@ -50,13 +52,15 @@ class Measured:
     predicted_s: dict[int, float]  # at percent -> predicted duration
     failed_attempts: int
     naive_s: float  # planned length / top speed + dwell: the figure navseq plan gave before
+    uncorrected_s: dict[int, float]  # at percent -> predicted, not corrected by achieved speed
 
     @property
     def naive_error_percent(self) -> float:
         return 100.0 * (self.naive_s - self.actual_s) / self.actual_s
 
-    def error_percent(self, at: int) -> float:
-        return 100.0 * (self.predicted_s[at] - self.actual_s) / self.actual_s
+    def error_percent(self, at: int, corrected: bool = True) -> float:
+        predicted = self.predicted_s if corrected else self.uncorrected_s
+        return 100.0 * (predicted[at] - self.actual_s) / self.actual_s
 
 
 def run_measured(name: str, mission: Path, loops: int | None = None) -> Measured:
@@ -69,13 +73,21 @@ def run_measured(name: str, mission: Path, loops: int | None = None) -> Measured
 
     request = RunRequest(mission=mission, outputs=None, loops=loops)
     session = prepare(request)
-    session.run([listen])
     estimator = session.eta()
+    assert estimator is not None
+    # The same prediction followed without the correction by achieved speed, side by side.
+    plain = EtaEstimator(estimator.prediction, correct_by_achieved_speed=False)
+    session.run([plain, listen])
     accuracy = estimator.accuracy() if estimator is not None else None
     if accuracy is None:
         raise SystemExit(f"{name}: no ETA accuracy (the mission did not end?)")
     predicted = {c["at_percent"]: c["predicted_s"] for c in accuracy["checkpoints"]}
-    return Measured(name, accuracy["actual_s"], predicted, len(failures), naive_s(session))
+    uncorrected = plain.accuracy()
+    assert uncorrected is not None
+    plain_predicted = {c["at_percent"]: c["predicted_s"] for c in uncorrected["checkpoints"]}
+    return Measured(
+        name, accuracy["actual_s"], predicted, len(failures), naive_s(session), plain_predicted
+    )
 
 
 def naive_s(session: Session) -> float:
@@ -182,6 +194,12 @@ def main() -> None:
             parts.append(
                 f"at {c} %: mean |error| {statistics.fmean(errors):.1f} %, "
                 f"max {max(errors):.1f} %, {within}/{len(errors)} within 3 %"
+            )
+        for c in CHECKPOINTS[1:]:
+            plain = [abs(run.error_percent(c, False)) for run in chosen if c in run.uncorrected_s]
+            parts.append(
+                f"not corrected by achieved speed at {c} %: mean |error| "
+                f"{statistics.fmean(plain):.1f} %, max {max(plain):.1f} %"
             )
         naive_errors = [abs(run.naive_error_percent) for run in chosen]
         parts.append(

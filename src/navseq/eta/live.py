@@ -65,6 +65,8 @@ class EtaEstimator:
 
     prediction: MissionPrediction
     from_pose: Callable[[Pose2D], MissionPrediction] | None = None
+    # False: the prediction's driving times as they are (benchmarks compare the two).
+    correct_by_achieved_speed: bool = True
     eta_s: float | None = None
     eta_upper_s: float | None = None
     _start: float | None = None
@@ -153,7 +155,7 @@ class EtaEstimator:
         predicted = self._drive_done_s + (visit.drive_s - self._drive_left_s if visit else 0.0)
         driven = elapsed - self._waiting_s
         ratio = 1.0
-        if predicted >= RATIO_AFTER_S and driven > 0.0:
+        if self.correct_by_achieved_speed and predicted >= RATIO_AFTER_S and driven > 0.0:
             ratio = min(max(driven / predicted, RATIO_LIMITS[0]), RATIO_LIMITS[1])
         dwell_left = 0.0
         if self._dwell_until is not None:
