@@ -74,7 +74,8 @@ class EtaEstimator:
     _loop_index: tuple[int, int] | None = None
     _drive_done_s: float = 0.0  # predicted driving of the visits finished
     _drive_left_s: float = 0.0  # predicted driving still to go on the current leg
-    _waiting_s: float = 0.0  # dwell and pause time so far (not driving)
+    _waiting_s: float = 0.0  # dwell and pause time of the visits finished (not driving)
+    _dwell_from: float | None = None
     _dwell_until: float | None = None
     _paused_at: float | None = None
     _finished_at: float | None = None
@@ -90,11 +91,11 @@ class EtaEstimator:
             self._start = event.t
             self._resumed = event.resumed_from is not None
         elif isinstance(event, WaypointStarted):
+            self._dwell_from = self._dwell_until = None
             if (event.loop, event.index) != self._loop_index:
                 self._loop_index = (event.loop, event.index)
                 self._visit = self._visit_at(event.loop, event.index)
                 self._drive_left_s = self._visit.drive_s if self._visit else 0.0
-            self._dwell_until = None
             self._update(event.t)
         elif isinstance(event, WaypointProgress):
             if self.from_pose is not None:
@@ -108,14 +109,16 @@ class EtaEstimator:
             self._update(event.t)
         elif isinstance(event, WaypointDwelling):
             self._drive_left_s = 0.0
+            self._dwell_from = event.t
             self._dwell_until = event.t + event.seconds
-            self._waiting_s += event.seconds
             self._update(event.t)
         elif isinstance(event, WaypointFinished):
             if self._visit is not None:
                 self._drive_done_s += self._visit.drive_s
+            if self._dwell_from is not None:  # the dwell as it was (an operator may cut it)
+                self._waiting_s += event.t - self._dwell_from
             self._visit, self._loop_index, self._drive_left_s = None, None, 0.0
-            self._dwell_until = None
+            self._dwell_from = self._dwell_until = None
         elif isinstance(event, MissionPaused):
             self._paused_at = event.t
         elif isinstance(event, MissionResumed):
@@ -153,7 +156,8 @@ class EtaEstimator:
         elapsed = now - self._start
         # Driving achieved against predicted: the ground covered so far, both ways.
         predicted = self._drive_done_s + (visit.drive_s - self._drive_left_s if visit else 0.0)
-        driven = elapsed - self._waiting_s
+        dwelt = now - self._dwell_from if self._dwell_from is not None else 0.0
+        driven = elapsed - self._waiting_s - dwelt
         ratio = 1.0
         if self.correct_by_achieved_speed and predicted >= RATIO_AFTER_S and driven > 0.0:
             ratio = min(max(driven / predicted, RATIO_LIMITS[0]), RATIO_LIMITS[1])
