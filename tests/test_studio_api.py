@@ -165,7 +165,8 @@ def test_a_checked_draft_gets_validate_problems_and_planned_legs(client: TestCli
     assert len(answer["legs"]) == 7  # start -> 1, then 1 -> 2 ... 6 -> 7
     assert all(leg["length_m"] > 0 and len(leg["points"]) >= 2 for leg in answer["legs"])
     assert answer["total_length_m"] == pytest.approx(sum(leg["length_m"] for leg in answer["legs"]))
-    assert answer["estimated_duration"].endswith("at 0.22 m/s")
+    assert answer["estimated_duration"].startswith("~1 min")  # the ETA, as navseq plan says
+    assert answer["upper_bound_s"] >= answer["expected_duration_s"] > 50.0
 
     document["waypoints"][2].update(x=PILLAR[0], y=PILLAR[1])
     answer = client.post("/api/check", json={"mission": document}).json()
@@ -434,6 +435,8 @@ def test_a_run_writes_the_usual_output_folder(client: TestClient, workspace: Pat
     report = json.loads((folder / "report.json").read_text())
     assert report["totals"]["reached"] == 7 and report == state["report"]
     assert len(state["trail"]) > 50 and state["pose"] is not None
+    assert state["eta_s"] == 0.0  # over: nothing left to go
+    assert report["eta"]["actual_s"] == report["totals"]["duration_s"]  # the ETA was kept
     # The folder is navseq run's own: navseq report rebuilds from its journal.
     from navseq.journal.writer import read_journal
 

@@ -1,8 +1,9 @@
 """``navseq plan MISSION [--map MAP] [--order shortest] [--out FILE]``: the mission's route.
 
 Every leg planned on the robot's costmap (the planner the simulator drives with; the
-studio draws the same legs), with its length beside the straight line and the time it
-takes at the robot's top speed; the route's total. With ``--order shortest`` the
+studio draws the same legs), with its length beside the straight line and the time the
+robot takes to drive it (:mod:`navseq.eta`: speeds, accelerations, turns, stops); the
+route's total, and the mission's expected duration and upper bound. With ``--order shortest`` the
 waypoints are put in the order that drives the least (:mod:`navseq.route.order`) and
 the route is shown in that order; ``--out FILE`` writes the mission so ordered (navseq
 YAML, never over an existing file unless ``--force``).
@@ -23,6 +24,7 @@ from navseq.commands.common import add_robot_option
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
+    from navseq.route.legs import Legs
 
 ORDERS = ("file", "shortest")
 #: The ``--json`` output's version (docs/schemas/plan.schema.json).
@@ -111,12 +113,16 @@ def run(args: argparse.Namespace) -> int:
 
         write_mission(ordered, args.out, overwrite=args.force)
     result = _result(mission, order, route, in_file_order, map_path, robot, args.out)
+    result.update(_expected(ordered, route, result["legs"], legs, robot))
+    prediction = result.pop("prediction")
     if args.json:
         from navseq.sinks.report import report_json
 
         print(report_json(result))
     else:
-        _print(result, args)
+        from navseq.eta.text import prediction_lines
+
+        _print(result, args, prediction_lines(prediction, has_start=ordered.start is not None))
     return 0 if result["every_leg_has_a_path"] else 1
 
 
@@ -169,7 +175,32 @@ def _result(
     }
 
 
-def _print(result: dict[str, Any], args: argparse.Namespace) -> None:
+def _expected(
+    mission: Mission,
+    route: list[dict[str, Any]],
+    shown: list[dict[str, Any]],
+    legs: Legs,
+    robot: RobotProfile,
+) -> dict[str, Any]:
+    """The mission's expected duration and upper bound (:mod:`navseq.eta.predict`); each
+    leg of ``shown`` (the ``--json`` legs of ``route``) gets its driving time."""
+    from navseq.eta.predict import predict_legs
+
+    prediction = predict_legs(mission, legs, robot, mission.start)
+    for leg, row in zip(route, shown, strict=True):
+        visits = prediction.later_loop if leg["loop"] else prediction.first_loop
+        driven = visits[leg["to"]].leg
+        row["drive_s"] = round(driven.duration_s, 1) if driven is not None else None
+    expected, upper = prediction.expected_s, prediction.upper_s
+    return {
+        "expected_duration_s": round(expected, 1) if expected is not None else None,
+        "upper_bound_s": round(upper, 1) if upper is not None else None,
+        "loop_duration_s": round(prediction.loop_expected_s, 1),
+        "prediction": prediction,  # for the text; not in --json
+    }
+
+
+def _print(result: dict[str, Any], args: argparse.Namespace, durations: list[str]) -> None:
     from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
@@ -191,10 +222,9 @@ def _print(result: dict[str, Any], args: argparse.Namespace) -> None:
         ("to", "left"),
         ("planned [m]", "right"),
         ("straight [m]", "right"),
-        ("time [s]", "right"),
+        ("driving [s]", "right"),
     ):
         table.add_column(escape(header), justify=justify)  # type: ignore[arg-type]
-    speed = result["max_speed_m_s"]
     for leg in result["legs"]:
         length = leg["length_m"]
         back = " (back to the first)" if leg["back_to_first"] else ""
@@ -203,7 +233,7 @@ def _print(result: dict[str, Any], args: argparse.Namespace) -> None:
             escape(printable(leg["to_name"] or "")),
             "no path" if length is None else f"{length:.2f}",
             f"{leg['straight_m']:.2f}",
-            "" if length is None or not speed else f"~{length / speed:.0f}",
+            "" if leg.get("drive_s") is None else f"~{leg['drive_s']:.0f}",
         )
     print_table(table, console)
     count = len(result["order"])
@@ -213,10 +243,9 @@ def _print(result: dict[str, Any], args: argparse.Namespace) -> None:
             f"(navseq validate {printable(str(args.mission))} --map ... says why)"
         )
     else:
-        duration = (
-            f", ~{result['duration_s']:.0f} s at {speed:.2f} m/s" if result["duration_s"] else ""
-        )
-        say(f"route: {count} waypoints, {result['length_m']:.2f} m{duration}")
+        say(f"route: {count} waypoints, {result['length_m']:.2f} m")
+    for line in durations:
+        say(line)
     if args.order == "shortest":
         before, after = result["length_in_file_order_m"], result["length_m"]
         shown = " ".join(str(number) for number in result["order"])

@@ -301,7 +301,11 @@ def _execute(session: Session, args: argparse.Namespace, signals: SignalGuard) -
     from navseq.sinks.progress import make_progress
 
     progress = make_progress(
-        session.mission, json_lines=args.json, robot=session.robot, numbers=session.numbers
+        session.mission,
+        json_lines=args.json,
+        robot=session.robot,
+        numbers=session.numbers,
+        eta=session.eta(),
     )
     outcome = session.run([StdoutGuard(progress)], signals=signals, on_note=_say)
     return _show(session, outcome, progress)

@@ -93,6 +93,16 @@ def run(args: argparse.Namespace) -> int:
         f"loops {loops}, {checked}",
         file=sys.stdout,
     )
+    if map_path is not None:
+        from navseq.commands.common import legs_on_map
+        from navseq.eta.predict import predict_legs
+        from navseq.eta.text import prediction_lines
+
+        robot = choose_robot(args.robot, mission)
+        start = args.start if args.start is not None else mission.start
+        prediction = predict_legs(mission, legs_on_map(map_path, robot), robot, start)
+        for line in prediction_lines(prediction, has_start=start is not None):
+            print(line, file=sys.stdout)
     return 0
 
 

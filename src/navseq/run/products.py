@@ -42,6 +42,11 @@ def build_run_report(
     number_visits(report, session.part)
     # Not in a report rebuilt from the journal (navseq report): it keeps no wall time.
     report["clock"] = clock
+    # The ETA's predictions against the actual end (not in a rebuilt report either).
+    estimator = session.eta()
+    accuracy = estimator.accuracy() if estimator is not None else None
+    if accuracy is not None:
+        report["eta"] = accuracy
     return report
 
 

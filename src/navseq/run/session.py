@@ -38,6 +38,8 @@ from navseq.run.request import Outputs, RunRequest, UseNavigator
 from navseq.run.resume import DEFAULT_KIND, continue_as_journaled, known_kind, read_resume
 
 if TYPE_CHECKING:
+    from navseq.eta.live import EtaEstimator
+    from navseq.eta.predict import MissionPrediction
     from navseq.executor.control import MissionControl
     from navseq.executor.machine import MissionListener
     from navseq.executor.result import MissionResult
@@ -89,6 +91,8 @@ class Session:
     listeners: list[MissionListener] = field(default_factory=list)
     # A navigator is made ready for one run (a ROS connection is closed after it).
     _started: bool = field(default=False, init=False, repr=False)
+    _eta: EtaEstimator | None = field(default=None, init=False, repr=False)
+    _eta_made: bool = field(default=False, init=False, repr=False)
 
     @property
     def records(self) -> bool:
@@ -102,6 +106,29 @@ class Session:
     def numbers(self) -> list[int] | None:
         """The run's waypoints' numbers in the mission file, when it runs a part of it."""
         return list(self.part.numbers) if self.part is not None else None
+
+    def eta(self) -> EtaEstimator | None:
+        """The run's ETA (made once, before the robot moves): the mission predicted on the
+        session's map from its start, kept up to date by the run's events. None when it
+        cannot be predicted (see the notes)."""
+        if not self._eta_made:
+            self._eta_made = True
+            from navseq.eta.live import EtaEstimator
+            from navseq.eta.predict import predict_on_map
+
+            try:
+                prediction = predict_on_map(self.mission, self.grid, self.robot, self.start)
+            except Exception as error:  # an ETA is never worth a run
+                self.notes.append(f"no ETA for this run: {error}")
+            else:
+                from_pose = None
+                if self.start is None:  # counted from the robot's first pose instead
+
+                    def from_pose(pose: Pose2D) -> MissionPrediction:
+                        return predict_on_map(self.mission, self.grid, self.robot, pose)
+
+                self._eta = EtaEstimator(prediction, from_pose)
+        return self._eta
 
     def run(
         self,
@@ -333,7 +360,10 @@ class Session:
         navigator_start, wall_start = navigator.now(), time.monotonic()
         try:
             journal = open_journal()
-            mine = [sink for sink in (journal, recorder) if sink is not None]
+            # The ETA first: the face's sinks show the time to go the event leads to.
+            eta = self.eta()
+            mine = [sink for sink in (eta, journal, recorder) if sink is not None]
+            _show_eta_on_status_topics([*face, *self.listeners], eta)
             with contextlib.ExitStack() as entered:
                 for listener in face:
                     if isinstance(listener, contextlib.AbstractContextManager):
@@ -406,6 +436,15 @@ class _Ran:
     clock: dict[str, float | None]
     navigator: Navigator
     recorder: RunRecorder | None
+
+
+def _show_eta_on_status_topics(listeners: list[MissionListener], eta: EtaEstimator | None) -> None:
+    """The ROS status topics' progress messages carry the run's ETA."""
+    from navseq.sinks.mission_status import StatusPublisher
+
+    for listener in listeners:
+        if isinstance(listener, StatusPublisher):
+            listener.state.eta = eta
 
 
 def _ignore(note: str) -> None:

@@ -95,7 +95,7 @@ class RegulatedPurePursuit:
     def set_costmap(self, costmap: Costmap) -> None:
         """Use ``costmap`` for the obstacle slowdown (after a costmap is rebuilt)."""
         self.costmap = costmap
-        self._speed_factor_by_cost = _speed_factors_by_cost(self.params, costmap)
+        self._speed_factor_by_cost = speed_factors_by_cost(self.params, costmap)
 
     def set_path(self, points: np.ndarray, goal: Pose2D) -> None:
         """Start following ``points`` (N, 2) toward ``goal``; the last point should be the goal.
@@ -255,7 +255,7 @@ class RegulatedPurePursuit:
         return math.copysign(rate, angle)
 
 
-def _speed_factors_by_cost(params: ControllerParams, costmap: Costmap) -> list[float]:
+def speed_factors_by_cost(params: ControllerParams, costmap: Costmap) -> list[float]:
     """Speed multiplier for each cost byte: clearance / ``cost_slowdown_distance`` when short.
 
     The clearance is read back from the cost the way Nav2 does, by inverting the

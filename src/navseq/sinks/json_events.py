@@ -28,9 +28,9 @@ import json
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
-from typing import IO, Any
+from typing import IO, Any, Protocol
 
-from navseq.executor.events import MissionEvent, WaypointOutcome
+from navseq.executor.events import MissionEvent, WaypointOutcome, WaypointProgress
 
 #: Version of the record layout (``schema_version`` in every record).
 SCHEMA_VERSION = 3
@@ -164,6 +164,13 @@ def run_finished_record(
     }
 
 
+def _rounded(seconds: float | None) -> float | None:
+    """Seconds to go as a record has them: tenths, never negative, None when unknown."""
+    if seconds is None or not math.isfinite(seconds):
+        return None
+    return round(max(seconds, 0.0), 1)
+
+
 def _dumps(record: Mapping[str, Any]) -> str:
     return json.dumps(record, ensure_ascii=False, separators=(",", ":"))
 
@@ -173,15 +180,27 @@ def event_to_json(event: MissionEvent, numbers: Sequence[int] | None = None) -> 
     return _dumps(event_record(event, numbers))
 
 
+class Eta(Protocol):
+    """The run's time to go (:class:`navseq.eta.live.EtaEstimator`), as sinks read it."""
+
+    eta_s: float | None
+    eta_upper_s: float | None
+
+
 class JsonProgress:
     """One JSON object per event on ``stream`` (``navseq run --json``).
 
     ``numbers``: the waypoints' positions in the file when the mission is a part of it.
+    ``eta``: the run's ETA; each ``WaypointProgress`` record then carries ``eta_s`` and
+    ``eta_upper_s``.
     """
 
-    def __init__(self, stream: IO[str], numbers: Sequence[int] | None = None):
+    def __init__(
+        self, stream: IO[str], numbers: Sequence[int] | None = None, eta: Eta | None = None
+    ):
         self.stream = stream
         self.numbers = numbers
+        self.eta = eta
 
     def __enter__(self) -> JsonProgress:
         return self
@@ -190,7 +209,11 @@ class JsonProgress:
         self.stream.flush()
 
     def __call__(self, event: MissionEvent) -> None:
-        self.stream.write(event_to_json(event, self.numbers) + "\n")
+        record = event_record(event, self.numbers)
+        if self.eta is not None and isinstance(event, WaypointProgress):
+            record["eta_s"] = _rounded(self.eta.eta_s)
+            record["eta_upper_s"] = _rounded(self.eta.eta_upper_s)
+        self.stream.write(_dumps(record) + "\n")
         self.stream.flush()
 
     def run_finished(

@@ -34,6 +34,7 @@ from navseq.executor.events import (
     WaypointStarted,
 )
 from navseq.mission.model import Mission
+from navseq.sinks.json_events import Eta
 
 PROGRESS_PERIOD = 0.5  # s of mission time between two progress status messages
 ARROW_NS = "navseq_waypoints"
@@ -173,6 +174,9 @@ class MissionStatus:
 
     def __init__(self, mission: Mission, progress_period: float = PROGRESS_PERIOD) -> None:
         self.mission = mission
+        # The run's ETA, when the run service keeps one: progress messages then say
+        # ``eta_s`` and ``eta_upper_s``.
+        self.eta: Eta | None = None
         self.statuses: dict[int, MarkerStatus] = {}
         self.progress_period = progress_period
         self._last_progress = -math.inf
@@ -215,7 +219,14 @@ class MissionStatus:
             fields = {"event": type(event).__name__, **asdict(event)}
             fields["state"] = status_state(event)
             fields["waypoints"] = len(self.mission)
+            if self.eta is not None and isinstance(event, WaypointProgress):
+                fields["eta_s"] = _seconds(self.eta.eta_s)
+                fields["eta_upper_s"] = _seconds(self.eta.eta_upper_s)
             return StatusUpdate(markers_changed, fields)
+
+
+def _seconds(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else round(max(value, 0.0), 1)
 
 
 class StatusPublisher(abc.ABC):

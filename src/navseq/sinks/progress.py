@@ -48,7 +48,7 @@ from navseq.executor.events import (
 )
 from navseq.mission.model import Mission
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
-from navseq.sinks.json_events import JsonProgress
+from navseq.sinks.json_events import Eta, JsonProgress
 from navseq.text import printable
 
 OUTCOME_STYLE = {
@@ -83,6 +83,19 @@ def _why(reason: str, text: str) -> str:
     if not text or text == reason:
         return reason
     return f"{reason}: {text}" if reason else text
+
+
+def mission_eta_text(eta: Eta | None) -> str:
+    """`` · mission ends in ~1 min 05 s (at most 1 min 35 s)`` from the run's ETA, or ``""``."""
+    from navseq.eta.text import format_duration
+
+    if eta is None or eta.eta_s is None:
+        return ""
+    text = f"mission ends in ~{format_duration(eta.eta_s)}"
+    upper = eta.eta_upper_s
+    if upper is not None and upper > eta.eta_s + 0.5:
+        text += f" ({format_duration(upper)} if every task takes its timeout)"
+    return text
 
 
 def eta_text(remaining: float, robot: RobotProfile) -> str:
@@ -203,9 +216,11 @@ class LiveProgress:
         recent_lines: int = 4,
         robot: RobotProfile = DEFAULT_PROFILE,
         numbers: Sequence[int] | None = None,
+        eta: Eta | None = None,
     ):
         self.view = RunView(mission, numbers)
         self.robot = robot
+        self.eta = eta
         self.console = console
         self.recent: deque[str] = deque(maxlen=recent_lines)
         self._live = Live(
@@ -269,6 +284,8 @@ class LiveProgress:
                 rows.append(bar)
         else:
             rows.append(Text(view.status))
+        if view.finished is None and (ends := mission_eta_text(self.eta)):
+            rows.append(Text(ends))
         if view.count <= 40:
             marks = Text()
             for index in range(view.count):
@@ -405,9 +422,11 @@ class LogProgress:
         progress_period: float = 10.0,
         robot: RobotProfile = DEFAULT_PROFILE,
         numbers: Sequence[int] | None = None,
+        eta: Eta | None = None,
     ):
         self.view = RunView(mission, numbers)
         self.robot = robot
+        self.eta = eta
         self.stream = None if callable(out) else out
         self._emit = out if callable(out) else self._write
         self.progress_period = progress_period
@@ -443,9 +462,11 @@ class LogProgress:
                     and math.isfinite(event.distance_remaining)
                     else ""
                 )
+                ends = mission_eta_text(self.eta)
                 self._log(
                     f"{view.waypoint_label(event.index)}: {to_go}"
-                    f"{event.distance_driven:.2f} m driven{recoveries_text(event.recoveries)}",
+                    f"{event.distance_driven:.2f} m driven{recoveries_text(event.recoveries)}"
+                    + (f"; {ends}" if ends else ""),
                     event,
                 )
             return
@@ -464,17 +485,19 @@ def make_progress(
     stream: IO[str] | None = None,
     robot: RobotProfile = DEFAULT_PROFILE,
     numbers: Sequence[int] | None = None,
+    eta: Eta | None = None,
 ) -> ProgressSink:
     """JSON lines if asked, a live panel on a terminal, plain log lines otherwise.
 
     ``robot``'s top speed gives the time still to go (at least) shown with the distance.
     ``numbers``: the waypoints' positions in the file when ``mission`` is a part of it.
+    ``eta``: the run's ETA (the session's), shown and written with the progress.
     """
     stream = stream if stream is not None else sys.stdout
     numbers = numbers if numbers is not None else mission.numbers
     if json_lines:
-        return JsonProgress(stream, numbers)
+        return JsonProgress(stream, numbers, eta)
     console = Console(file=stream)
     if console.is_terminal:
-        return LiveProgress(mission, console, robot=robot, numbers=numbers)
-    return LogProgress(mission, stream, robot=robot, numbers=numbers)
+        return LiveProgress(mission, console, robot=robot, numbers=numbers, eta=eta)
+    return LogProgress(mission, stream, robot=robot, numbers=numbers, eta=eta)

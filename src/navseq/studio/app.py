@@ -318,6 +318,7 @@ class Studio:
             legs = legs_of(mission, planner)
             answer["legs"] = legs
             answer.update(route_summary(legs, robot))
+            answer.update(_expected_duration(mission, planner, robot))
         return answer
 
     def save(self, body: dict[str, Any]) -> dict[str, Any]:
@@ -850,3 +851,22 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     app.state.studio = studio
     app.add_middleware(TokenGate, token=config.token, hosts=config.hosts)
     return app
+
+
+def _expected_duration(mission: Mission, planner: Legs, robot: RobotProfile) -> dict[str, Any]:
+    """The mission's expected duration and upper bound (navseq.eta), as ``navseq plan``
+    says them; the legs come from the planner's cache, so an edit costs the driving."""
+    from navseq.eta.predict import predict_legs
+    from navseq.eta.text import format_duration
+
+    prediction = predict_legs(mission, planner, robot, mission.start)
+    expected, upper = prediction.expected_s, prediction.upper_s
+    if expected is None:  # a patrol that loops forever
+        text = f"~{format_duration(prediction.loop_expected_s)} a loop"
+    else:
+        text = f"~{format_duration(expected)} expected, upper bound {format_duration(upper)}"
+    return {
+        "estimated_duration": text,
+        "expected_duration_s": None if expected is None else round(expected, 1),
+        "upper_bound_s": None if upper is None else round(upper, 1),
+    }

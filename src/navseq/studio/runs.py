@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from navseq.mission.model import Mission
     from navseq.navigators.base import Navigator
     from navseq.run.session import Session
+    from navseq.sinks.json_events import Eta
 
 #: Trail points kept for the page (older ones are thinned to every other one).
 MAX_TRAIL_POINTS = 4000
@@ -70,6 +71,7 @@ class LiveView:
         self.folder: str | None = None
         self.error: str | None = None
         self.navigator: Navigator | None = None
+        self.eta: Eta | None = None  # the run's ETA (the session's), for the time to go
         self._start_t: float | None = None
         # The clock shows the mission's running time: a pause holds it, as it holds every
         # deadline of the run, so that it does not jump by the pause on Resume.
@@ -168,6 +170,7 @@ class LiveView:
                 "status": self.status,
                 "reason": self.reason,
                 "clock_s": round(self.clock_s, 2),
+                "eta_s": _seconds(self.eta.eta_s) if self.eta is not None else None,
                 "current": self.current,
                 "loop": self.loop,
                 "waypoints": list(self.waypoints),
@@ -248,6 +251,7 @@ class StudioRun:
         error: str | None = None
         code: int | None = None
         try:
+            self.view.eta = session.eta()
             outcome = session.run([self.view], control=self.control)
             code = outcome.exit_status
             if outcome.error is not None:
@@ -304,6 +308,10 @@ def _shown_outcome(event: WaypointFinished) -> str:
     if event.outcome is WaypointOutcome.FAILED and ended_from_outside(event.reason):
         return "stopped"
     return event.outcome.value
+
+
+def _seconds(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else round(max(value, 0.0), 1)
 
 
 def _latest_report(folder: Path | None) -> dict[str, Any] | None:

@@ -715,7 +715,8 @@ function drawRun(run, before) {
   $("run").disabled = busy;
   const at = run.current !== null ? ` · waypoint ${run.current + 1} ${run.waypoints[run.current]}` : "";
   const loop = run.loop ? ` · loop ${run.loop + 1}` : "";
-  let text = `${run.status} · ${run.clock_s.toFixed(1)} s${at}${loop}`;
+  const eta = busy && run.eta_s != null ? ` · ends in ~${Math.round(run.eta_s)} s` : "";
+  let text = `${run.status} · ${run.clock_s.toFixed(1)} s${at}${loop}${eta}`;
   if (run.done && run.report) text = `${run.status} · ${run.report.totals.reached}/${run.report.totals.visits} reached · ${run.report.totals.duration_s} s`;
   if (run.error) text += ` · ${run.error}`;
   setStatus(run.status, text);
