@@ -52,10 +52,18 @@ The executor believes the robot, not only the navigation stack:
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from navseq.errors import NavseqError
 from navseq.executor.arrival import arrival_miss, goal_tolerance
-from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.commands import (
+    CancelGoal,
+    CancelTask,
+    ClearCostmaps,
+    Command,
+    SendGoal,
+    StartTask,
+)
 from navseq.executor.events import (
     AttemptFailed,
     LoopStarted,
@@ -65,6 +73,8 @@ from navseq.executor.events import (
     MissionResumed,
     MissionStarted,
     ServerStatusChanged,
+    TaskFinished,
+    TaskStarted,
     WaypointDwelling,
     WaypointFinished,
     WaypointOutcome,
@@ -74,13 +84,14 @@ from navseq.executor.events import (
 )
 from navseq.executor.monitor import AttemptMonitor
 from navseq.executor.odometer import Odometer
-from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.result import MissionResult, TaskResult, WaypointResult
 from navseq.executor.resume import ResumePoint, check_resume_point, visit_log
 from navseq.executor.states import ExecutorState, Trigger, next_state
 from navseq.executor.visit import Visit, next_position
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction, Mission, Policy
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
+from navseq.mission.tasks import Task
 from navseq.navigators.base import (
     Goal,
     GoalDone,
@@ -91,6 +102,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.tasks.base import TaskDone, TaskOutcome
 from navseq.track import simplify_path
 
 #: Pause between a failed attempt and the next one, so a failing stack is not hammered.
@@ -107,6 +119,15 @@ _GOES_ON = {
 }
 
 MissionListener = Callable[[MissionEvent], None]
+
+
+@dataclass(frozen=True)
+class _RunningTask:
+    """The task a StartTask went out for, and when (its timeout runs from then)."""
+
+    task_id: int
+    task: Task
+    started_at: float
 
 
 class MissionExecutor:
@@ -143,6 +164,8 @@ class MissionExecutor:
         self._visit: Visit | None = None
         self._monitor: AttemptMonitor | None = None  # the goal out for the current visit
         self._next_goal_id = 1
+        self._next_task_id = 1
+        self._task: _RunningTask | None = None  # the task out, in RUNNING_TASK
         self._deadline = 0.0  # end of dwell or back-off, by state
         self._clear_costmaps_before_send = False
         self._server_up = True
@@ -310,6 +333,26 @@ class MissionExecutor:
                 return commands
         return self._check_clock(now)
 
+    def on_task_done(self, done: TaskDone, now: float) -> list[Command]:
+        """A task the executor started ended by itself (success or failure).
+
+        Reports about any other task than the one running (cancelled, timed out) are
+        ignored.
+        """
+        self._now = max(self._now, now)
+        task = self._task
+        if self._state is not ExecutorState.RUNNING_TASK or task is None:
+            return []
+        if done.task_id != task.task_id:
+            return []
+        if not done.succeeded:
+            return self._task_failed(now, TaskOutcome.FAILED, done, cancel=False)
+        visit = self._current
+        self._record_task(now, TaskOutcome.SUCCEEDED, done)
+        visit.next_task += 1
+        visit.task_attempt = 1
+        return self._tasks_or_finish(now)
+
     def skip(self, now: float, reason: str = "skipped by operator") -> list[Command]:
         """Give up the current visit (outcome SKIPPED) and go on with the next one.
 
@@ -324,11 +367,12 @@ class MissionExecutor:
         interrupted: ExecutorState = self._state
         if interrupted is ExecutorState.PAUSED:
             interrupted = self._end_pause(now)
+        stopped = self._stop_task(now, reason)
         if interrupted is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
         else:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
-        commands = self._advance(now)
+        commands = [*stopped, *self._advance(now)]
         if self.finished:
             return [CancelGoal(), *commands]  # no next goal replaces the active one
         return commands
@@ -345,6 +389,9 @@ class MissionExecutor:
         commands: list[Command] = []
         if self._state is ExecutorState.ACTIVE:
             commands.append(CancelGoal())
+        if self._task is not None:  # run again from its start on resume
+            commands.append(CancelTask(self._task.task_id))
+            self._task = None
         paused_from = self._paused_from = self._state
         self._paused_at = now
         self._paused_monitor = self._monitor
@@ -369,6 +416,8 @@ class MissionExecutor:
         if interrupted in _GOES_ON:
             self._move(_GOES_ON[interrupted])
             return self._check_clock(now)
+        if interrupted is ExecutorState.RUNNING_TASK:
+            return self._start_task(now)
         # ACTIVE: the same attempt, a fresh goal id (late events of the cancelled goal
         # are ignored). WAITING_SERVER: sent if the server came back while paused.
         commands = self._send_goal(now)
@@ -402,9 +451,10 @@ class MissionExecutor:
             self._started_at = now
             self._finish_mission(now, reason)
             return []
+        stopped = self._stop_task(now, reason)
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, reason)
-        return [CancelGoal()]
+        return [CancelGoal(), *stopped]
 
     def _end_pause(self, now: float) -> ExecutorState:
         """Move the interrupted state's deadlines on by the pause; the state to go back to.
@@ -484,8 +534,133 @@ class MissionExecutor:
             self._deadline = now + visit.policy.dwell_s
             self._emit(WaypointDwelling(t=now, index=visit.index, seconds=visit.policy.dwell_s))
             return []
-        self._finish_visit(now, WaypointOutcome.REACHED, "", passed_through=passed_through)
+        if passed_through:
+            self._finish_visit(now, WaypointOutcome.REACHED, "", passed_through=True)
+            return self._advance(now)
+        return self._tasks_or_finish(now)
+
+    # ------------------------------------------------------------------ tasks
+
+    def _tasks_or_finish(self, now: float) -> list[Command]:
+        """At a reached waypoint: start its next task, or end the visit when none is left."""
+        visit = self._current
+        if visit.next_task < len(visit.policy.tasks):
+            return self._start_task(now)
+        self._finish_visit(now, WaypointOutcome.REACHED, "")
         return self._advance(now)
+
+    def _start_task(self, now: float) -> list[Command]:
+        visit = self._current
+        task = visit.policy.tasks[visit.next_task]
+        running = self._task = _RunningTask(self._next_task_id, task, now)
+        self._next_task_id += 1
+        self._move(Trigger.TASK)
+        self._emit(
+            TaskStarted(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                task=visit.next_task + 1,
+                kind=task.kind,
+                attempt=visit.task_attempt,
+                description=task.describe(),
+            )
+        )
+        return [StartTask(running.task_id, task, visit.index, visit.loop, visit.next_task + 1)]
+
+    def _record_task(
+        self, now: float, outcome: TaskOutcome, done: TaskDone | None, *, will_retry: bool = False
+    ) -> None:
+        """Put the running task's end into the visit's result and tell the sinks."""
+        visit, running = self._current, self._task
+        assert running is not None
+        self._task = None
+        detail = done.detail if done is not None else ""
+        files = done.files if done is not None else ()
+        output = done.output if done is not None else ()
+        duration = max(0.0, now - running.started_at)
+        number = visit.next_task + 1
+        visit.result.tasks.append(
+            TaskResult(
+                number=number,
+                kind=running.task.kind,
+                outcome=outcome.value,
+                attempt=visit.task_attempt,
+                duration=duration,
+                detail=detail,
+                files=list(files),
+                output=list(output),
+            )
+        )
+        self._emit(
+            TaskFinished(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                task=number,
+                kind=running.task.kind,
+                attempt=visit.task_attempt,
+                outcome=outcome.value,
+                duration=duration,
+                detail=detail,
+                files=files,
+                output=output,
+                will_retry=will_retry,
+            )
+        )
+
+    def _stop_task(self, now: float, reason: str) -> list[Command]:
+        """Cancel the running task, if any (skip, cancel, interrupt), recording why."""
+        running = self._task
+        if running is None:
+            return []
+        self._record_task(now, TaskOutcome.CANCELLED, TaskDone(running.task_id, False, reason))
+        return [CancelTask(running.task_id)]
+
+    def _task_failed(
+        self, now: float, outcome: TaskOutcome, done: TaskDone, *, cancel: bool
+    ) -> list[Command]:
+        """A task failed or timed out: run it again, or the waypoint's on_failure decides.
+
+        ``retries`` lets each task run again that many times (the goal is not sent
+        again: the robot is there); ``on_failure: retry`` runs it again without limit.
+        Each new run waits :data:`RETRY_BACKOFF` first.
+        """
+        visit = self._current
+        running = self._task
+        assert running is not None
+        policy = visit.policy
+        will_retry = (
+            policy.on_failure is FailureAction.RETRY or visit.task_attempt <= policy.retries
+        )
+        commands: list[Command] = [CancelTask(running.task_id)] if cancel else []
+        self._record_task(now, outcome, done, will_retry=will_retry)
+        if will_retry:
+            visit.task_attempt += 1
+            self._deadline = now + RETRY_BACKOFF  # _check_clock starts it again
+            return commands
+        words = "timed out" if outcome is TaskOutcome.TIMED_OUT else "failed"
+        reason = f"task {visit.next_task + 1} ({running.task.kind}) {words}"
+        if done.detail:
+            reason += f": {done.detail}"
+        if policy.on_failure is FailureAction.SKIP:
+            self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
+            return commands + self._advance(now)
+        label = self._mission.waypoint_label(visit.index)
+        self._finish_visit(now, WaypointOutcome.FAILED, reason)
+        self._finish_mission(now, f"stopped: {label} failed ({reason})")
+        return commands
+
+    def _check_task(self, now: float) -> list[Command]:
+        """A task's timeout, or the end of the back-off before a failed task runs again."""
+        running = self._task
+        if running is None:
+            return self._start_task(now) if now >= self._deadline else []
+        timeout = running.task.timeout_s
+        if timeout is not None and now - running.started_at >= timeout:
+            done = TaskDone(running.task_id, False, f"no end after {timeout:g} s")
+            return self._task_failed(now, TaskOutcome.TIMED_OUT, done, cancel=True)
+        return []
 
     def _advance(self, now: float) -> list[Command]:
         visit = self._current
@@ -647,8 +822,9 @@ class MissionExecutor:
                 return self._attempt_failed(now, overdue, cancel=True)
         elif state is ExecutorState.DWELLING:
             if now >= self._deadline:
-                self._finish_visit(now, WaypointOutcome.REACHED, "")
-                return self._advance(now)
+                return self._tasks_or_finish(now)
+        elif state is ExecutorState.RUNNING_TASK:
+            return self._check_task(now)
         elif state is ExecutorState.WAITING_RETRY:
             if now >= self._deadline:
                 return self._start_attempt(now)
