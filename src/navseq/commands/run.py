@@ -23,6 +23,7 @@ from navseq.commands.common import (
     parse_realtime,
     parse_waypoint_number,
 )
+from navseq.commands.task_options import add_task_options, task_options_of
 from navseq.errors import NavseqError
 from navseq.navigators import registry
 from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
@@ -119,6 +120,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         default=None,  # None: not given (a resume takes the journal's)
         help="do not draw mission.png",
     )
+    add_task_options(parser)
     add_robot_option(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
@@ -209,6 +211,7 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         ),
         resume=args.resume,
         realtime=args.realtime,
+        tasks=task_options_of(args),
     )
 
 

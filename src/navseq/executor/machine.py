@@ -483,7 +483,11 @@ class MissionExecutor:
     def _begin_visit(self, now: float, loop: int, index: int, *, new_loop: bool) -> list[Command]:
         if new_loop:
             self._emit(LoopStarted(t=now, loop=loop))
-        self._visit = Visit.of(self._mission, loop, index)
+        visit = self._visit = Visit.of(self._mission, loop, index)
+        resume = self._resume
+        if resume is not None and (loop, index) == (resume.loop, resume.index):
+            # The visit a crash interrupted: its tasks that succeeded are not run again.
+            visit.next_task = min(resume.tasks_done, len(visit.policy.tasks))
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:

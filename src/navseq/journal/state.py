@@ -26,10 +26,11 @@ from typing import Any, NamedTuple, overload
 
 from navseq.errors import NavseqError
 from navseq.executor import events as ev
-from navseq.executor.result import AttemptResult, VisitLog, WaypointResult
+from navseq.executor.result import AttemptResult, TaskResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
 from navseq.journal.reader import Damaged, Event, JournalReader, Resumed
 from navseq.sinks.recorder import RunRecorder
+from navseq.tasks.base import TaskOutcome
 
 #: The most waypoints a journaled mission may claim: a visit log for that many is
 #: built as the journal is read. Far above what a mission file can hold (a 10 MiB
@@ -94,6 +95,7 @@ class _VisitTrail:
     # The stack's recovery count last journaled for the latest attempt (the journal
     # keeps every progress event whose count changed).
     recoveries: int | None = None
+    tasks: list[TaskResult] = field(default_factory=list)  # every task run, in order
 
 
 @dataclass
@@ -110,6 +112,9 @@ class VisitHistory:
     frontier: tuple[int, int] = (0, 0)
     unfinished: WaypointResult | None = None
     _trail: _VisitTrail | None = None
+    # The tasks of a visit that succeeded, in order, over every segment: (loop, index)
+    # and how many. A resume does not run them again.
+    tasks_done: tuple[tuple[int, int], int] = ((0, 0), 0)
 
     @property
     def waypoint_count(self) -> int | None:
@@ -168,6 +173,21 @@ class VisitHistory:
     def see_progress(self, event: ev.WaypointProgress) -> None:
         if self._trail is not None and event.recoveries is not None:
             self._trail.recoveries = event.recoveries
+
+    def finish_task(self, event: ev.TaskFinished) -> None:
+        key = (event.loop, event.index)
+        if self._trail is not None and self._trail.key == key:
+            self._trail.tasks.append(_task_of(event))
+        if event.outcome != TaskOutcome.SUCCEEDED.value:
+            return
+        done_key, done = self.tasks_done
+        done = done if done_key == key else 0
+        self.tasks_done = (key, max(done, event.task))  # tasks run in order
+
+    def tasks_done_at(self, key: tuple[int, int]) -> int:
+        """How many tasks of visit ``key`` succeeded (0 when none, or another visit)."""
+        done_key, done = self.tasks_done
+        return done if done_key == key else 0
 
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
@@ -297,6 +317,8 @@ def _fold(state: JournalState, reader: JournalReader) -> None:
             visits.start_visit(event)
         elif isinstance(event, ev.AttemptFailed):
             visits.fail_attempt(event)
+        elif isinstance(event, ev.TaskFinished):
+            visits.finish_task(event)
         elif isinstance(event, ev.WaypointFinished):
             visits.finish_visit(event, f"{path}:{entry.line}")
         elif isinstance(event, ev.MissionFinished):
@@ -340,6 +362,7 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
         index=index,
         earlier=state.visits.log,
         previous_duration=state.previous_duration,
+        tasks_done=state.visits.tasks_done_at((loop, index)),
     )
 
 
@@ -406,6 +429,20 @@ def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> W
         reason=event.reason,
         passed_through=event.passed_through,
         attempt_results=_attempts_of(event, trail),
+        tasks=list(trail.tasks) if trail is not None else [],
+    )
+
+
+def _task_of(event: ev.TaskFinished) -> TaskResult:
+    return TaskResult(
+        number=event.task,
+        kind=event.kind,
+        outcome=event.outcome,
+        attempt=event.attempt,
+        duration=event.duration,
+        detail=event.detail,
+        files=list(event.files),
+        output=list(event.output),
     )
 
 

@@ -49,7 +49,9 @@ def _loops(loops: Any) -> Any:
 
 
 def _outcome(outcome: Any) -> Any:
-    return WaypointOutcome(outcome).value
+    if isinstance(outcome, WaypointOutcome):
+        return outcome.value
+    return outcome  # a task's outcome is its text already (TaskFinished)
 
 
 def _points(path: Any) -> Any:
