@@ -109,7 +109,8 @@ class TaskStarted:
     index: int
     loop: int
     task: int
-    kind: str  # wait, run, input ...
+    # wait, run, input ... (not ``kind``: the journal's records have their own ``kind``)
+    task_kind: str
     attempt: int  # 1-based: a failed task runs again under retries / on_failure: retry
     description: str = ""
 
@@ -126,7 +127,7 @@ class TaskFinished:
     index: int
     loop: int
     task: int
-    kind: str
+    task_kind: str
     attempt: int
     outcome: str
     duration: float

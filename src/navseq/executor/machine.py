@@ -565,7 +565,7 @@ class MissionExecutor:
                 index=visit.index,
                 loop=visit.loop,
                 task=visit.next_task + 1,
-                kind=task.kind,
+                task_kind=task.kind,
                 attempt=visit.task_attempt,
                 description=task.describe(),
             )
@@ -602,7 +602,7 @@ class MissionExecutor:
                 index=visit.index,
                 loop=visit.loop,
                 task=number,
-                kind=running.task.kind,
+                task_kind=running.task.kind,
                 attempt=visit.task_attempt,
                 outcome=outcome.value,
                 duration=duration,

@@ -436,7 +436,7 @@ def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> W
 def _task_of(event: ev.TaskFinished) -> TaskResult:
     return TaskResult(
         number=event.task,
-        kind=event.kind,
+        kind=event.task_kind,
         outcome=event.outcome,
         attempt=event.attempt,
         duration=event.duration,

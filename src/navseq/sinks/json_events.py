@@ -72,6 +72,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "loops": ("loops", _loops),
     "outcome": ("outcome", _outcome),
     "path": ("path", _points),
+    "task_kind": ("kind", None),  # TaskStarted / TaskFinished, as the report's tasks say
 }
 
 

@@ -335,7 +335,7 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
         )
     if isinstance(event, TaskFinished):
         return (
-            f"{view.waypoint_label(event.index)}: task {event.task} ({event.kind}) "
+            f"{view.waypoint_label(event.index)}: task {event.task} ({event.task_kind}) "
             f"{_task_outcome(event)} after {event.duration:.1f} s"
         )
     if isinstance(event, WaypointFinished):

@@ -234,15 +234,19 @@ class OperatorInput:
     """Confirmations of ``input`` tasks: from :meth:`confirm`, or a line on ``stdin``.
 
     ``stdin`` is read only when it is a terminal or a pipe (a file or /dev/null would
-    confirm at once or never), by one daemon thread started at the first prompt.
-    Each prompt is a ticket; only the latest one can be answered.
+    confirm at once or never), by one daemon thread started at the first prompt; lines
+    typed before a prompt do not count. Each prompt is a ticket. :meth:`confirm` answers
+    the open prompt, or, when none is open, the next one: a listener that confirms on
+    ``TaskStarted`` does so before the runner has asked.
     """
 
     def __init__(self, stdin: IO[str] | None = None) -> None:
         self._stdin = stdin if stdin is not None else sys.stdin
         self._lock = threading.Lock()
         self._ticket = 0
-        self._answers: dict[int, tuple[bool, str]] = {}
+        self._open = False  # a prompt waits for its answer
+        self._answer: tuple[bool, str] | None = None  # the open prompt's
+        self._early: tuple[bool, str] | None = None  # for the next prompt
         self._lines: queue.Queue[str | None] = queue.Queue()
         self._reader: threading.Thread | None = None
         self._reads = _reads_lines(self._stdin)
@@ -251,10 +255,11 @@ class OperatorInput:
         return "press Enter to go on" if self._reads else "waiting for confirmation"
 
     def ask(self) -> int:
-        """A new prompt: earlier lines and answers no longer count."""
+        """A new prompt: lines typed before it do not count."""
         with self._lock:
             self._ticket += 1
-            self._answers.clear()
+            self._open = True
+            self._answer, self._early = self._early, None
             while not self._lines.empty():
                 if self._lines.get_nowait() is None:  # stdin ended: say so again
                     self._lines.put(None)
@@ -275,30 +280,41 @@ class OperatorInput:
         self._lines.put(None)
 
     def confirm(self, confirmed: bool = True, detail: str = "") -> bool:
-        """Answer the open prompt; False when none is open."""
+        """Answer the open prompt, or the next one; False when one is already answered."""
+        answer = (confirmed, detail or ("confirmed" if confirmed else "refused"))
         with self._lock:
-            if self._ticket == 0 or self._ticket in self._answers:
+            if self._open:
+                if self._answer is not None:
+                    return False
+                self._answer = answer
+                return True
+            if self._early is not None:
                 return False
-            self._answers[self._ticket] = (confirmed, detail or "confirmed")
+            self._early = answer
             return True
 
     def answer(self, ticket: int) -> tuple[bool, str] | None:
+        """The answer to prompt ``ticket``, once there is one (the prompt then closes)."""
         with self._lock:
-            if ticket != self._ticket:
+            if ticket != self._ticket or not self._open:
                 return None
-            if ticket not in self._answers and not self._lines.empty():
+            if self._answer is None and not self._lines.empty():
                 line = self._lines.get_nowait()
                 if line is None:
                     self._lines.put(None)
-                    self._answers[ticket] = (False, "no operator: standard input ended")
+                    self._answer = (False, "no operator: standard input ended")
                 else:
-                    self._answers[ticket] = (True, "confirmed in the terminal")
-            return self._answers.get(ticket)
+                    self._answer = (True, "confirmed in the terminal")
+            answer = self._answer
+            if answer is not None:
+                self._open, self._answer = False, None
+            return answer
 
     def withdraw(self, ticket: int) -> None:
+        """Prompt ``ticket`` was cancelled: a confirmation now goes to the next one."""
         with self._lock:
             if ticket == self._ticket:
-                self._ticket += 1  # a confirmation now answers nothing
+                self._open, self._answer = False, None
 
 
 def _reads_lines(stream: IO[str]) -> bool:
