@@ -331,3 +331,40 @@ def _kill(pid_file: Path) -> None:
 def test_task_options_refuse_a_negative_simulated_time() -> None:
     with pytest.raises(NavseqError, match="simulate_ros_s"):
         TaskOptions(simulate_ros_s=-1.0)
+
+
+def test_the_example_mission_runs_on_the_simulator(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    process = subprocess.Popen(
+        [
+            NAVSEQ,
+            "run",
+            str(REPO / "examples" / "tasks.yaml"),
+            "--allow-run",
+            "--simulate-tasks",
+            "--json",
+            "--no-picture",
+            "--out",
+            str(out),
+        ],
+        cwd=tmp_path,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert process.stdin is not None and process.stdout is not None
+    for line in process.stdout:
+        if '"TaskStarted"' in line and '"input"' in line:
+            break
+    process.stdin.write("\n")
+    process.stdin.flush()
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 0, stderr
+    kinds = [[t["kind"] for t in visit["tasks"]] for visit in report(out)["visits"]]
+    assert kinds == [["call", "run"], ["wait"], ["input"]]
+    # The report rebuilt from the journal lists the same tasks.
+    written = report(out)
+    (out / "report.json").unlink()
+    assert navseq("report", out, cwd=tmp_path).returncode == 0
+    assert [v["tasks"] for v in report(out)["visits"]] == [v["tasks"] for v in written["visits"]]
