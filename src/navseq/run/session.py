@@ -130,7 +130,7 @@ class Session:
         if outputs is None:
             for note in self.notes:
                 say(note)
-            ran = self._drive(face, control, guard, lambda: None, None, say, folder=None)
+            ran = self._drive(face, control, guard, lambda: None, None, say)
             return RunOutcome(
                 ran.result,
                 ran.exit_status,
@@ -211,7 +211,6 @@ class Session:
                 lambda: fresh if fresh is not None else self._continued_journal(journal_path),
                 self._new_recorder(),
                 say,
-                folder=folder,
             )
         except BaseException:
             # No result to report (e.g. no navigation server, or a signal before the run
@@ -281,15 +280,13 @@ class Session:
         open_journal: Callable[[], JournalWriter | None],
         recorder: RunRecorder | None,
         say: NoteSink,
-        *,
-        folder: Path | None,
     ) -> _Ran:
         """Run the mission; from the moment it ends, shutdown signals are only counted."""
         from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
         from navseq.sinks.json_events import clock_record
         from navseq.tasks.runner import TaskRunner
 
-        tasks = self.task_runner or TaskRunner(self.request.tasks, say=say, folder=folder)
+        tasks = self.task_runner or TaskRunner(self.request.tasks, say=say)
 
         navigator = self.make_navigator()
         error: NavseqError | None = None

@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
+import signal
 import stat
 import subprocess
 import sys
@@ -28,7 +29,6 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
-from pathlib import Path
 from typing import IO, Protocol
 
 from navseq.executor.commands import StartTask
@@ -158,7 +158,7 @@ class _RunJob:
         if process is None or process.poll() is not None:
             return
         with contextlib.suppress(OSError):
-            os.killpg(process.pid, 9)  # its children too: it runs in a session of its own
+            os.killpg(process.pid, signal.SIGKILL)  # its children too: its own session
         with contextlib.suppress(subprocess.TimeoutExpired):
             process.wait(timeout=5.0)
 
@@ -331,7 +331,7 @@ class TaskRunner:
     """Runs the tasks a mission's executor starts; see the module docstring.
 
     ``say`` gets the lines an operator should see (a prompt, a simulated task);
-    ``folder`` is the run folder (files a task writes go there).
+    ``stdin`` is where an operator's Enter comes from (default: the process's).
     """
 
     def __init__(
@@ -339,10 +339,8 @@ class TaskRunner:
         options: TaskOptions | None = None,
         *,
         say: Say | None = None,
-        folder: Path | None = None,
         stdin: IO[str] | None = None,
     ) -> None:
-        self.folder = folder
         self.operator = OperatorInput(stdin)
         self._context = _Context(options or TaskOptions(), say or _to_stderr, self.operator)
         self._jobs: dict[int, Job] = {}
