@@ -487,7 +487,7 @@ class MissionExecutor:
         resume = self._resume
         if resume is not None and (loop, index) == (resume.loop, resume.index):
             # The visit a crash interrupted: its tasks that succeeded are not run again.
-            visit.next_task = min(resume.tasks_done, len(visit.policy.tasks))
+            visit.next_task = max(0, min(resume.tasks_done, len(visit.policy.tasks)))
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:
