@@ -133,3 +133,14 @@ def test_a_line_typed_before_the_prompt_does_not_confirm_it() -> None:
         typed.write("\n")
         typed.flush()
         assert until_done(runner) == TaskDone(2, True, "confirmed in the terminal")
+
+
+def test_a_programs_long_lines_are_cut_and_only_the_last_20_kept() -> None:
+    runner = TaskRunner(TaskOptions(allow_run=True), say=lambda line: None)
+    code = "print('x' * 100000); [print(i) for i in range(30)]; print('tail', end='')"
+    start(runner, RunTask((sys.executable, "-c", code)))
+    done = until_done(runner)
+    assert done.output == (*[str(i) for i in range(11, 30)], "tail")
+    start(runner, RunTask((sys.executable, "-c", "print('y' * 100000)")), task_id=2)
+    (line,) = until_done(runner).output
+    assert line == "y" * 500

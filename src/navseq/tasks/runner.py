@@ -132,10 +132,15 @@ class _RunJob:
         self._reader.start()
 
     def _read(self) -> None:
+        """Keep the last lines, each cut short: a program printing a gigabyte without a
+        newline takes no more memory than one piece of it."""
         assert self._process is not None and self._process.stdout is not None
-        for raw in self._process.stdout:
-            text = raw.decode("utf-8", "replace").rstrip("\r\n")
-            self._lines.append(text[:LINE_CHARACTERS])
+        stdout, continued = self._process.stdout, False
+        while raw := stdout.readline(LINE_CHARACTERS * 4):
+            if not continued:
+                text = raw.decode("utf-8", "replace").rstrip("\r\n")
+                self._lines.append(text[:LINE_CHARACTERS])
+            continued = not raw.endswith(b"\n")
 
     def poll(self, now: float) -> TaskDone | None:
         if self._failed is not None:
