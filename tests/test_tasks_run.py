@@ -320,6 +320,12 @@ def test_a_task_running_at_a_crash_runs_again_on_resume_a_finished_one_does_not(
     assert [r["task"] for r in after if r.get("type") == "TaskStarted"] == [2]
     assert (tmp_path / "marker").read_text() == "xx"  # ran twice: killed, then again
     assert report(out)["success"] is True
+    # The report tells of the task before the crash too.
+    tasks = report(out)["visits"][0]["tasks"]
+    assert [(t["number"], t["kind"], t["outcome"]) for t in tasks] == [
+        (1, "wait", "succeeded"),
+        (2, "run", "succeeded"),
+    ]
 
 
 def _kill(pid_file: Path) -> None:

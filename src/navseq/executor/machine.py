@@ -52,7 +52,7 @@ The executor believes the robot, not only the navigation stack:
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from navseq.errors import NavseqError
 from navseq.executor.arrival import arrival_miss, goal_tolerance
@@ -488,6 +488,7 @@ class MissionExecutor:
         if resume is not None and (loop, index) == (resume.loop, resume.index):
             # The visit a crash interrupted: its tasks that succeeded are not run again.
             visit.next_task = max(0, min(resume.tasks_done, len(visit.policy.tasks)))
+            visit.result.tasks.extend(replace(task) for task in resume.tasks)
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:

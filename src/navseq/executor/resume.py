@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from navseq.errors import NavseqError
-from navseq.executor.result import VisitLog, WaypointResult
+from navseq.executor.result import TaskResult, VisitLog, WaypointResult
 from navseq.mission.model import Mission
 
 
@@ -33,6 +33,7 @@ class ResumePoint:
     previous_duration: float = 0.0
     earlier: VisitLog | None = None
     tasks_done: int = 0
+    tasks: tuple[TaskResult, ...] = ()  # the visit's task runs before, for its result
 
 
 def check_resume_point(mission: Mission, resume: ResumePoint) -> None:

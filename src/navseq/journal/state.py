@@ -95,7 +95,6 @@ class _VisitTrail:
     # The stack's recovery count last journaled for the latest attempt (the journal
     # keeps every progress event whose count changed).
     recoveries: int | None = None
-    tasks: list[TaskResult] = field(default_factory=list)  # every task run, in order
 
 
 @dataclass
@@ -112,9 +111,10 @@ class VisitHistory:
     frontier: tuple[int, int] = (0, 0)
     unfinished: WaypointResult | None = None
     _trail: _VisitTrail | None = None
-    # The tasks of a visit that succeeded, in order, over every segment: (loop, index)
-    # and how many. A resume does not run them again.
-    tasks_done: tuple[tuple[int, int], int] = ((0, 0), 0)
+    # The task runs of the latest visit that ran tasks, over every segment (a resume
+    # does not run the ones that succeeded again), and which visit that is.
+    _task_visit: tuple[int, int] | None = None
+    _task_runs: list[TaskResult] = field(default_factory=list)
 
     @property
     def waypoint_count(self) -> int | None:
@@ -176,18 +176,19 @@ class VisitHistory:
 
     def finish_task(self, event: ev.TaskFinished) -> None:
         key = (event.loop, event.index)
-        if self._trail is not None and self._trail.key == key:
-            self._trail.tasks.append(_task_of(event))
-        if event.outcome != TaskOutcome.SUCCEEDED.value:
-            return
-        done_key, done = self.tasks_done
-        done = done if done_key == key else 0
-        self.tasks_done = (key, max(done, event.task))  # tasks run in order
+        if key != self._task_visit:
+            self._task_visit, self._task_runs = key, []
+        self._task_runs.append(_task_of(event))
+
+    def tasks_of(self, key: tuple[int, int]) -> list[TaskResult]:
+        """Every task run the journal records for visit ``key``, in order."""
+        return list(self._task_runs) if key == self._task_visit else []
 
     def tasks_done_at(self, key: tuple[int, int]) -> int:
-        """How many tasks of visit ``key`` succeeded (0 when none, or another visit)."""
-        done_key, done = self.tasks_done
-        return done if done_key == key else 0
+        """How many tasks of visit ``key`` succeeded: they run in order, so the highest
+        number that succeeded (0 when none)."""
+        succeeded = TaskOutcome.SUCCEEDED.value
+        return max((t.number for t in self.tasks_of(key) if t.outcome == succeeded), default=0)
 
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
@@ -220,7 +221,7 @@ class VisitHistory:
                 source=where,
             )
         trail = self._trail if self._trail is not None and self._trail.key == key else None
-        visit = _visit_of(event, trail)
+        visit = _visit_of(event, trail, self.tasks_of(key))
         if event.outcome not in _DONE_OUTCOMES:
             self.unfinished = visit  # run again on resume, unless a later segment did
             return
@@ -363,6 +364,7 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
         earlier=state.visits.log,
         previous_duration=state.previous_duration,
         tasks_done=state.visits.tasks_done_at((loop, index)),
+        tasks=tuple(state.visits.tasks_of((loop, index))),
     )
 
 
@@ -413,7 +415,11 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
     return attempts
 
 
-def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> WaypointResult:
+def _visit_of(
+    event: ev.WaypointFinished,
+    trail: _VisitTrail | None = None,
+    tasks: list[TaskResult] | None = None,
+) -> WaypointResult:
     """A finished visit as the result lists it (the waypoint's pose comes from the mission)."""
     return WaypointResult(
         index=event.index,
@@ -429,7 +435,7 @@ def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> W
         reason=event.reason,
         passed_through=event.passed_through,
         attempt_results=_attempts_of(event, trail),
-        tasks=list(trail.tasks) if trail is not None else [],
+        tasks=tasks or [],
     )
 
 
