@@ -184,25 +184,35 @@ def test_a_program_over_its_timeout_is_killed_and_retried(tmp_path: Path) -> Non
     assert "task 1 (run) timed out" in report(out)["visits"][0]["reason"]
 
 
+def confirm_when_asked(args: list[str], cwd: Path, prompt: str) -> str:
+    """Run ``navseq ARGS`` and press Enter once ``prompt`` shows on stderr (what was
+    typed before it would not count); the rest of its stderr."""
+    with (cwd / "stdout.txt").open("w") as stdout:
+        process = subprocess.Popen(
+            [NAVSEQ, *args],
+            cwd=cwd,
+            stdin=subprocess.PIPE,
+            stdout=stdout,  # a file: the progress lines never fill a pipe meanwhile
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert process.stdin is not None and process.stderr is not None
+        seen = []
+        for line in process.stderr:
+            seen.append(line)
+            if prompt in line:
+                break
+        process.stdin.write("\n")
+        process.stdin.flush()
+        _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 0, "".join(seen) + stderr
+    return "".join(seen) + stderr
+
+
 def test_input_is_confirmed_by_a_line_on_stdin(tmp_path: Path) -> None:
     path = mission(tmp_path, "  - {x: -1.0, y: -0.5, tasks: [{input: {prompt: Load it}}]}\n")
     out = tmp_path / "out"
-    process = subprocess.Popen(
-        [NAVSEQ, "run", str(path), "--json", "--out", str(out)],
-        cwd=tmp_path,
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert process.stdin is not None and process.stdout is not None
-    for line in process.stdout:  # a line typed before the prompt would not count
-        if '"TaskStarted"' in line:
-            break
-    process.stdin.write("\n")
-    process.stdin.flush()
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 0, stderr
+    stderr = confirm_when_asked(["run", str(path), "--out", str(out)], tmp_path, "Load it")
     assert "Load it — press Enter to go on" in stderr
     (task,) = report(out)["visits"][0]["tasks"]
     assert (task["kind"], task["outcome"], task["detail"]) == (
@@ -341,32 +351,9 @@ def test_task_options_refuse_a_negative_simulated_time() -> None:
 
 def test_the_example_mission_runs_on_the_simulator(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    process = subprocess.Popen(
-        [
-            NAVSEQ,
-            "run",
-            str(REPO / "examples" / "tasks.yaml"),
-            "--allow-run",
-            "--simulate-tasks",
-            "--json",
-            "--no-picture",
-            "--out",
-            str(out),
-        ],
-        cwd=tmp_path,
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert process.stdin is not None and process.stdout is not None
-    for line in process.stdout:
-        if '"TaskStarted"' in line and '"input"' in line:
-            break
-    process.stdin.write("\n")
-    process.stdin.flush()
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 0, stderr
+    example = str(REPO / "examples" / "tasks.yaml")
+    args = ["run", example, "--allow-run", "--simulate-tasks", "--no-picture", "--out", str(out)]
+    confirm_when_asked(args, tmp_path, "Unload the tray")
     kinds = [[t["kind"] for t in visit["tasks"]] for visit in report(out)["visits"]]
     assert kinds == [["call", "run"], ["wait"], ["input"]]
     # The report rebuilt from the journal lists the same tasks.

@@ -144,3 +144,13 @@ def test_a_programs_long_lines_are_cut_and_only_the_last_20_kept() -> None:
     start(runner, RunTask((sys.executable, "-c", "print('y' * 100000)")), task_id=2)
     (line,) = until_done(runner).output
     assert line == "y" * 500
+
+
+def test_an_enter_pressed_before_the_first_prompt_does_not_confirm_it() -> None:
+    read, write = os.pipe()
+    os.write(write, b"\n")  # pressed while the robot drove
+    os.close(write)  # and then nobody is left to confirm
+    with os.fdopen(read) as stdin:
+        runner = TaskRunner(say=lambda line: None, stdin=stdin)
+        start(runner, InputTask("first"))
+        assert until_done(runner) == TaskDone(1, False, "no operator: standard input ended")

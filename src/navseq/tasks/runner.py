@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
+import select
 import signal
 import stat
 import subprocess
@@ -270,6 +271,7 @@ class OperatorInput:
                     self._lines.put(None)
                     break
             if self._reads and self._reader is None:
+                _discard_pending(self._stdin)  # typed before the first prompt
                 self._reader = threading.Thread(
                     target=self._read, name="navseq-operator-input", daemon=True
                 )
@@ -320,6 +322,17 @@ class OperatorInput:
         with self._lock:
             if ticket == self._ticket:
                 self._open, self._answer = False, None
+
+
+def _discard_pending(stream: IO[str]) -> None:
+    """Throw away what waits to be read on ``stream`` now (not its end, if it ended)."""
+    try:
+        descriptor = stream.fileno()
+        while select.select([descriptor], [], [], 0)[0]:
+            if not os.read(descriptor, 65536):
+                return  # the end: the reader thread will see it too
+    except (OSError, ValueError):
+        pass
 
 
 def _reads_lines(stream: IO[str]) -> bool:
