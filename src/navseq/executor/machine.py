@@ -15,7 +15,11 @@ navigator's clock):
   :meth:`~MissionExecutor.resume` and :meth:`~MissionExecutor.cancel`: operator
   requests (one path for the ROS nodes and the CLI, see
   :class:`~navseq.executor.control.MissionControl`);
-* :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash).
+* :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash);
+* :meth:`~MissionExecutor.on_task_done` when a task it started (``StartTask``) ended
+  by itself: a reached waypoint's tasks run in order, after its dwell, each timed out
+  from ``now`` by the executor (``CancelTask``) and its failure handled by the
+  waypoint's ``retries`` / ``on_failure``.
 
 Its states and the only ways between them are the table in
 :mod:`navseq.executor.states`; every state change goes through it.
@@ -24,7 +28,8 @@ Pausing cancels the active goal (the robot stops) and holds the run in
 :attr:`ExecutorState.PAUSED`, where no deadline runs: on resume the goal timeout, the
 stall timeout, a dwell, a retry back-off and the server wait all move on by the time
 spent paused, and an interrupted goal is sent again (a fresh goal id, the same
-attempt). Durations in the result stay what they were on the clock, pauses included.
+attempt). A running task is cancelled and runs again from its start on resume.
+Durations in the result stay what they were on the clock, pauses included.
 
 Each input returns the commands (:mod:`navseq.executor.commands`) the caller must
 apply to the navigator, in order. What happened is told to listeners as mission
