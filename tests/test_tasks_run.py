@@ -361,3 +361,17 @@ def test_the_example_mission_runs_on_the_simulator(tmp_path: Path) -> None:
     (out / "report.json").unlink()
     assert navseq("report", out, cwd=tmp_path).returncode == 0
     assert [v["tasks"] for v in report(out)["visits"]] == [v["tasks"] for v in written["visits"]]
+
+
+@pytest.mark.parametrize("kind", ["ros1", "nav2"])
+def test_a_ros_navigator_refuses_ros_tasks_before_connecting(tmp_path: Path, kind: str) -> None:
+    path = write_mission(
+        tmp_path / "m.yaml",
+        "  - {x: 1, y: 0, tasks: [{publish: {topic: /a, type: std_msgs/Empty}}]}\n",
+    )
+    done = navseq("run", path, "--navigator", kind, "--simulate-tasks", cwd=tmp_path)
+    assert_clean_error(done)
+    assert (
+        f"m.yaml:3, waypoint 1, task 1 (publish): publish tasks are not supported on the "
+        f"{kind} navigator yet" in done.stderr
+    )

@@ -506,7 +506,7 @@ def _refuse_tasks(mission: Mission, request: RunRequest, kind: NavigatorKind | N
         name, simulated = str(request.navigator.info["kind"]), False
     else:
         assert kind is not None
-        name, simulated = kind.name, kind.places_robot  # a real stack places no robot
+        name, simulated = kind.name, not kind.ros
     problems = task_problems(mission, request.tasks, name, simulated=simulated)
     if len(problems) == 1:
         raise problems[0]
