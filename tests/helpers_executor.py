@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any, TypeVar
 
 from navseq.executor import CancelGoal, ClearCostmaps, Command, MissionExecutor, SendGoal
+from navseq.executor.commands import CancelTask, StartTask
 from navseq.executor.events import MissionEvent
 from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D
@@ -17,6 +18,7 @@ from navseq.navigators.base import (
     ServerLost,
 )
 from navseq.navigators.scripted import scripted_done
+from navseq.tasks.base import TaskDone
 
 E = TypeVar("E")
 
@@ -118,6 +120,19 @@ class Harness:
 
     def interrupt(self, t: float, reason: str) -> list[Command]:
         return self._keep(self.executor.interrupt(t, reason))
+
+    def started_tasks(self) -> list[StartTask]:
+        return [c for c in self.commands if isinstance(c, StartTask)]
+
+    def cancelled_tasks(self) -> list[CancelTask]:
+        return [c for c in self.commands if isinstance(c, CancelTask)]
+
+    def task_done(
+        self, t: float, succeeded: bool = True, detail: str = "", task_id: int | None = None
+    ) -> list[Command]:
+        """The last task started ends by itself (or the task ``task_id``)."""
+        tid = self.started_tasks()[-1].task_id if task_id is None else task_id
+        return self._keep(self.executor.on_task_done(TaskDone(tid, succeeded, detail), t))
 
     def of_type(self, cls: type[E]) -> list[E]:
         return [e for e in self.events if isinstance(e, cls)]

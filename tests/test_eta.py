@@ -252,3 +252,23 @@ def test_without_a_start_pose_the_first_leg_is_counted_from_the_robot_s_first_po
     assert startless.expected_s is not None and estimator.eta_s is not None
     assert estimator.eta_s > startless.expected_s + 5.0  # the way to waypoint 1 counts
     assert estimator.prediction.first_loop[0].drive_s > 5.0
+
+
+def test_a_missions_own_tasks_count_wait_as_expected_and_timeouts_as_the_bound() -> None:
+    """``wait: 2`` is two seconds expected; a run with ``timeout: 20`` may take twenty;
+    an operator's input without timeout leaves no upper bound."""
+    from navseq.eta.predict import time_of_tasks
+    from navseq.mission.tasks import InputTask, RunTask, WaitTask
+
+    assert time_of_tasks([]) == TaskTime(0.0, 0.0)
+    timed = time_of_tasks([WaitTask(2.0), RunTask(argv=("true",), timeout_s=20.0)])
+    assert timed == TaskTime(2.0, 22.0)
+    assert time_of_tasks([InputTask(prompt="ok?")]).upper_s == float("inf")
+
+
+def test_plan_counts_the_example_missions_tasks(tmp_path: Path) -> None:
+    done = navseq("plan", str(EXAMPLES / "tasks.yaml"), "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    plan = json.loads(done.stdout)
+    # 2 s of wait at north-dock expected; 60 + 20 + 2 + 300 s of task timeouts at most.
+    assert plan["upper_bound_s"] - plan["expected_duration_s"] == pytest.approx(380.0, abs=1.0)

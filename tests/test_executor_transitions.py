@@ -24,6 +24,7 @@ from navseq.executor.states import (
 )
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction
+from navseq.mission.tasks import InputTask, WaitTask
 
 S, T = ExecutorState, Trigger
 AT_P1 = Pose2D(1.0, 0.0, 0.0)  # line_mission's first waypoint
@@ -200,6 +201,62 @@ def stop_on_failure() -> Harness:
     return h
 
 
+TWO_TASKS = (WaitTask(1.0), InputTask("go on?"))
+
+
+def running_task(count: int = 2) -> Harness:
+    h = Harness(line_mission(count, tasks=TWO_TASKS))
+    h.start(0.0)
+    reached_p1(h)
+    assert h.executor.state is S.RUNNING_TASK
+    return h
+
+
+def dwell_then_task() -> Harness:
+    h = Harness(line_mission(2, dwell_s=2.0, tasks=TWO_TASKS))
+    h.start(0.0)
+    reached_p1(h)
+    h.tick(8.0)
+    assert len(h.started_tasks()) == 1
+    return h
+
+
+def next_task() -> Harness:
+    h = running_task()
+    h.task_done(6.0)
+    assert [c.number for c in h.started_tasks()] == [1, 2]
+    return h
+
+
+def tasks_done_then_next() -> Harness:
+    h = next_task()
+    h.task_done(7.0)
+    assert len(h.goals()) == 2
+    return h
+
+
+def tasks_done_then_server_gone() -> Harness:
+    h = next_task()
+    h.server_lost(6.5)
+    h.task_done(7.0)
+    assert len(h.goals()) == 1 and h.executor.state is S.WAITING_SERVER
+    return h
+
+
+def interrupt_task() -> Harness:
+    h = running_task()
+    h.interrupt(6.0, "interrupted: SIGINT")
+    assert len(h.cancelled_tasks()) == 1
+    return h
+
+
+def resume_task() -> Harness:
+    h = paused(running_task(), t=6.0)
+    h.resume(9.0)
+    assert [c.number for c in h.started_tasks()] == [1, 1]
+    return h
+
+
 #: One scenario per table entry; each must take its entry at least once.
 SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.IDLE, T.GOAL_SENT): started,
@@ -208,6 +265,7 @@ SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.ACTIVE, T.GOAL_SENT): reach_first_of_two,
     (S.ACTIVE, T.SERVER_AWAY): waiting_for_server,
     (S.ACTIVE, T.DWELL): dwelling,
+    (S.ACTIVE, T.TASK): running_task,
     (S.ACTIVE, T.RETRY_LATER): backing_off,
     (S.ACTIVE, T.PAUSE): lambda: paused(started()),
     (S.ACTIVE, T.END): stop_on_failure,
@@ -215,6 +273,12 @@ SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.DWELLING, T.SERVER_AWAY): dwell_then_server_gone,
     (S.DWELLING, T.PAUSE): lambda: paused(dwelling(), t=6.0),
     (S.DWELLING, T.END): interrupt_dwell,
+    (S.DWELLING, T.TASK): dwell_then_task,
+    (S.RUNNING_TASK, T.TASK): next_task,
+    (S.RUNNING_TASK, T.GOAL_SENT): tasks_done_then_next,
+    (S.RUNNING_TASK, T.SERVER_AWAY): tasks_done_then_server_gone,
+    (S.RUNNING_TASK, T.PAUSE): lambda: paused(running_task(), t=6.0),
+    (S.RUNNING_TASK, T.END): interrupt_task,
     (S.WAITING_RETRY, T.GOAL_SENT): backoff_then_retry,
     (S.WAITING_RETRY, T.SERVER_AWAY): backoff_then_server_gone,
     (S.WAITING_RETRY, T.PAUSE): lambda: paused(backing_off(), t=2.5),
@@ -228,6 +292,7 @@ SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.PAUSED, T.DWELL_GOES_ON): resume_dwell,
     (S.PAUSED, T.BACKOFF_GOES_ON): resume_backoff,
     (S.PAUSED, T.END): interrupt_pause,
+    (S.PAUSED, T.TASK): resume_task,
 }
 
 Taken = list[tuple[ExecutorState, Trigger, ExecutorState]]

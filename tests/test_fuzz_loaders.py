@@ -433,6 +433,8 @@ EVENT_TYPES = [
     "WaypointPlan",
     "AttemptFailed",
     "WaypointDwelling",
+    "TaskStarted",
+    "TaskFinished",
     "WaypointFinished",
     "ServerStatusChanged",
     "MissionFinished",
@@ -460,6 +462,11 @@ FIELDS = [
     "available",
     "success",
     "resumed",
+    "task",
+    "task_kind",
+    "detail",
+    "files",
+    "output",
 ]
 HOSTILE_JSON = [
     None,

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 ORDERS = ("file", "shortest")
 #: The ``--json`` output's version (docs/schemas/plan.schema.json).
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 def configure(parser: argparse.ArgumentParser) -> None:

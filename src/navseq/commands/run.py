@@ -23,6 +23,7 @@ from navseq.commands.common import (
     parse_realtime,
     parse_waypoint_number,
 )
+from navseq.commands.task_options import add_task_options, task_options_of
 from navseq.errors import NavseqError
 from navseq.navigators import registry
 from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
@@ -143,6 +144,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "publishes them (any type, e.g. /scan); a topic navseq records itself (/map, /odom, "
         "/tf, /plan ...) is then the stack's own",
     )
+    add_task_options(parser)
     add_robot_option(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
@@ -245,6 +247,7 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         ),
         resume=args.resume,
         realtime=args.realtime,
+        tasks=task_options_of(args),
     )
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from navseq.commands.common import add_robot_option, parse_pose
+from navseq.commands.task_options import add_task_options, task_options_of
 from navseq.errors import NavseqError
 from navseq.text import printable
 
@@ -23,6 +24,7 @@ if TYPE_CHECKING:
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
+    from navseq.tasks.options import TaskOptions
 
 #: Gives the costmap of a map file for a robot. A long-lived caller (the studio, which
 #: checks a mission on every edit) passes one that keeps costmaps it already built, so
@@ -45,6 +47,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         help="start pose to check (metres, metres, degrees; default: the mission's start:)",
     )
     add_robot_option(parser)
+    add_task_options(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -73,7 +76,11 @@ def run(args: argparse.Namespace) -> int:
         errors = [*problems.errors, *option_errors]
     else:
         mission, errors = mission_file_problems(
-            args.mission, map_path=args.map, start=args.start, robot=args.robot
+            args.mission,
+            map_path=args.map,
+            start=args.start,
+            robot=args.robot,
+            tasks=task_options_of(args),
         )
     if errors:
         raise MissionErrors(errors)
@@ -113,6 +120,7 @@ def mission_file_problems(
     start: Pose2D | None = None,
     robot: str | RobotProfile | None = None,
     costmaps: CostmapSource | None = None,
+    tasks: TaskOptions | None = None,
 ) -> tuple[Mission | None, list[NavseqError]]:
     """The mission in ``path`` (None if it cannot be read) and every problem found.
 
@@ -120,7 +128,9 @@ def mission_file_problems(
     ``map:``), the pre-flight problems of every waypoint that did read, in one list.
     ``robot`` is a profile, or a built-in name or file as ``--robot`` takes (default:
     the mission's ``robot:``). ``costmaps`` builds (or recalls) the costmap of a map for
-    a robot; by default the map file is read and inflated on each call. ``navseq
+    a robot; by default the map file is read and inflated on each call. ``tasks``: also
+    the tasks a simulator run with these options would refuse (``run`` without
+    ``--allow-run``, ROS tasks without ``--simulate-tasks``); None: not checked. ``navseq
     validate``, :func:`navseq.validate_file` and the studio's checks all call this.
     """
     from navseq.mission import inspect_mission_file
@@ -133,6 +143,10 @@ def mission_file_problems(
         salvage = problems.salvage
         errors += _map_problems(salvage.mission, map_path, start, robot, salvage.numbers, costmaps)
     elif mission is not None:
+        if tasks is not None:
+            from navseq.tasks.permissions import task_problems
+
+            errors += task_problems(mission, tasks, "sim", simulated=True)
         errors += _map_problems(mission, map_path, start, robot, costmaps=costmaps)
     elif map_path is not None:  # no waypoints to check, but the map can still be read
         errors += _map_problems(None, map_path, start, robot, costmaps=costmaps)

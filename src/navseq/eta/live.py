@@ -31,6 +31,8 @@ from navseq.executor.events import (
     MissionPaused,
     MissionResumed,
     MissionStarted,
+    TaskFinished,
+    TaskStarted,
     WaypointDwelling,
     WaypointFinished,
     WaypointProgress,
@@ -77,6 +79,10 @@ class EtaEstimator:
     _waiting_s: float = 0.0  # dwell and pause time of the visits finished (not driving)
     _dwell_from: float | None = None
     _dwell_until: float | None = None
+    # The visit's tasks: time spent in them so far (not driving), and since when the
+    # one running runs.
+    _tasks_done_s: float = 0.0
+    _task_from: float | None = None
     _paused_at: float | None = None
     _finished_at: float | None = None
     _resumed = False  # a resumed run: its actual duration is only what was left
@@ -112,13 +118,29 @@ class EtaEstimator:
             self._dwell_from = event.t
             self._dwell_until = event.t + event.seconds
             self._update(event.t)
+        elif isinstance(event, TaskStarted):
+            self._drive_left_s = 0.0
+            if self._dwell_from is not None:  # the dwell is over once a task starts
+                self._waiting_s += event.t - self._dwell_from
+                self._dwell_from = self._dwell_until = None
+            self._task_from = event.t
+            self._update(event.t)
+        elif isinstance(event, TaskFinished):
+            if self._task_from is not None:
+                self._tasks_done_s += event.t - self._task_from
+                self._waiting_s += event.t - self._task_from
+                self._task_from = None
+            self._update(event.t)
         elif isinstance(event, WaypointFinished):
             if self._visit is not None:
                 self._drive_done_s += self._visit.drive_s
             if self._dwell_from is not None:  # the dwell as it was (an operator may cut it)
                 self._waiting_s += event.t - self._dwell_from
+            if self._task_from is not None:  # a task cut short by the visit's end
+                self._waiting_s += event.t - self._task_from
             self._visit, self._loop_index, self._drive_left_s = None, None, 0.0
             self._dwell_from = self._dwell_until = None
+            self._tasks_done_s, self._task_from = 0.0, None
         elif isinstance(event, MissionPaused):
             self._paused_at = event.t
         elif isinstance(event, MissionResumed):
@@ -157,18 +179,21 @@ class EtaEstimator:
         # Driving achieved against predicted: the ground covered so far, both ways.
         predicted = self._drive_done_s + (visit.drive_s - self._drive_left_s if visit else 0.0)
         dwelt = now - self._dwell_from if self._dwell_from is not None else 0.0
-        driven = elapsed - self._waiting_s - dwelt
+        in_task = now - self._task_from if self._task_from is not None else 0.0
+        driven = elapsed - self._waiting_s - dwelt - in_task
         ratio = 1.0
         if self.correct_by_achieved_speed and predicted >= RATIO_AFTER_S and driven > 0.0:
             ratio = min(max(driven / predicted, RATIO_LIMITS[0]), RATIO_LIMITS[1])
         dwell_left = 0.0
+        tasks_begun = self._tasks_done_s > 0.0 or self._task_from is not None
         if self._dwell_until is not None:
             dwell_left = max(self._dwell_until - now, 0.0)
-        elif visit is not None:
+        elif visit is not None and not tasks_begun:
             dwell_left = visit.dwell_s
         tasks = visit.tasks if visit is not None else None
-        task_s = tasks.expected_s if tasks is not None else 0.0
-        task_upper_s = max(tasks.upper_s, task_s) if tasks is not None else 0.0
+        spent = self._tasks_done_s + in_task
+        task_s = max(tasks.expected_s - spent, 0.0) if tasks is not None else 0.0
+        task_upper_s = max(tasks.upper_s - spent, task_s) if tasks is not None else 0.0
         later_drive = self.prediction.after(loop, index, "drive") or 0.0
         drive_left = (self._drive_left_s + later_drive) * ratio
         here = dwell_left + task_s

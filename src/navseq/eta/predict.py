@@ -16,13 +16,13 @@ and its tasks' time.
   a goal timeout is no bound on a leg that goes well, and retries, recovery behaviours
   or a blocked door have no bound the mission states.
 
-Tasks at waypoints plug in through :data:`TaskTimes`; the default is no tasks.
+Tasks at waypoints count by :func:`time_of_tasks` (or a :data:`TaskTimes` given).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Literal
 
@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission, Waypoint
     from navseq.mission.robot import RobotProfile
+    from navseq.mission.tasks import Task
     from navseq.route.legs import Legs
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
@@ -54,6 +55,24 @@ TaskTimes = Callable[[int, "Waypoint"], TaskTime]
 def no_tasks(index: int, waypoint: Waypoint) -> TaskTime:
     """A mission without tasks at its waypoints."""
     return TaskTime()
+
+
+def time_of_tasks(tasks: Iterable[Task]) -> TaskTime:
+    """The mission's own tasks at a waypoint: a ``wait`` is expected to take its seconds,
+    any other task nothing beyond its start (no figure says more); at most, each takes
+    its timeout (a ``wait`` its seconds). A task without timeout that can wait for ever
+    (``input``, ``wait_for`` ...) makes the upper bound infinite."""
+    from navseq.mission.tasks import WaitTask
+
+    expected = upper = 0.0
+    for task in tasks:
+        if isinstance(task, WaitTask):
+            expected += task.seconds
+            limit = task.seconds if task.timeout_s is None else min(task.seconds, task.timeout_s)
+            upper += limit
+        else:
+            upper += math.inf if task.timeout_s is None else task.timeout_s
+    return TaskTime(expected, upper)
 
 
 @dataclass(frozen=True)
@@ -169,7 +188,7 @@ def predict_mission(
     start: Pose2D | None,
     *,
     speed_cap: SpeedCap | None = None,
-    task_times: TaskTimes = no_tasks,
+    task_times: TaskTimes | None = None,
     planned_visits: int = PLANNED_VISITS,
 ) -> MissionPrediction:
     """The mission's visits predicted; ``start`` None: the first leg starts at the first
@@ -228,11 +247,12 @@ def predict_mission(
                 where, heading, speed = driven.end_point, driven.end_heading, driven.end_speed
             else:
                 where, heading, speed = goal, waypoint.yaw_rad, 0.0
-            visits.append(
-                VisitPrediction(
-                    loop, index, driven, visit.policy.dwell_s, task_times(index, waypoint)
-                )
+            tasks = (
+                task_times(index, waypoint)
+                if task_times is not None
+                else time_of_tasks(visit.policy.tasks)
             )
+            visits.append(VisitPrediction(loop, index, driven, visit.policy.dwell_s, tasks))
         return tuple(visits)
 
     first = loop_of(0) if count else ()
@@ -278,7 +298,7 @@ def predict_on_map(
     robot: RobotProfile,
     start: Pose2D | None,
     *,
-    task_times: TaskTimes = no_tasks,
+    task_times: TaskTimes | None = None,
 ) -> MissionPrediction:
     """``mission`` predicted for ``robot`` on ``grid`` (legs planned on its costmap, the
     slowdown near obstacles read from it), or on straight lines when there is no map."""
@@ -300,7 +320,7 @@ def predict_legs(
     robot: RobotProfile,
     start: Pose2D | None,
     *,
-    task_times: TaskTimes = no_tasks,
+    task_times: TaskTimes | None = None,
 ) -> MissionPrediction:
     """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls)."""
     model = DriveModel.of(robot)

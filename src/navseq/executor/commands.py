@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from navseq.mission.tasks import Task
 from navseq.navigators.base import Goal
 
 
@@ -30,4 +31,23 @@ class ClearCostmaps:
     """Forget transient obstacles before a retry."""
 
 
-Command = SendGoal | CancelGoal | ClearCostmaps
+@dataclass(frozen=True)
+class StartTask:
+    """Start ``task`` (number ``number``, 1-based, of waypoint ``index``'s list); its end
+    comes back as :class:`~navseq.tasks.base.TaskDone` with ``task_id``."""
+
+    task_id: int
+    task: Task
+    index: int
+    loop: int
+    number: int
+
+
+@dataclass(frozen=True)
+class CancelTask:
+    """Stop the task ``task_id`` (timeout, skip, pause, cancel); no TaskDone is expected."""
+
+    task_id: int
+
+
+Command = SendGoal | CancelGoal | ClearCostmaps | StartTask | CancelTask

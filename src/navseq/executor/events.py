@@ -102,6 +102,42 @@ class WaypointDwelling:
 
 
 @dataclass(frozen=True)
+class TaskStarted:
+    """A task of the waypoint began (``task``: its 1-based number in the list)."""
+
+    t: float
+    index: int
+    loop: int
+    task: int
+    # wait, run, input ... (not ``kind``: the journal's records have their own ``kind``)
+    task_kind: str
+    attempt: int  # 1-based: a failed task runs again under retries / on_failure: retry
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class TaskFinished:
+    """A task ended; ``outcome`` a :class:`~navseq.tasks.base.TaskOutcome` value.
+
+    ``will_retry``: the same task runs again. ``files``: what it wrote; ``output``: the
+    last lines a ``run`` program printed.
+    """
+
+    t: float
+    index: int
+    loop: int
+    task: int
+    task_kind: str
+    attempt: int
+    outcome: str
+    duration: float
+    detail: str = ""
+    files: tuple[str, ...] = ()
+    output: tuple[str, ...] = ()
+    will_retry: bool = False
+
+
+@dataclass(frozen=True)
 class WaypointFinished:
     t: float
     index: int
@@ -159,6 +195,8 @@ MissionEvent = (
     | WaypointPlan
     | AttemptFailed
     | WaypointDwelling
+    | TaskStarted
+    | TaskFinished
     | WaypointFinished
     | ServerStatusChanged
     | MissionPaused

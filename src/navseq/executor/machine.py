@@ -15,7 +15,11 @@ navigator's clock):
   :meth:`~MissionExecutor.resume` and :meth:`~MissionExecutor.cancel`: operator
   requests (one path for the ROS nodes and the CLI, see
   :class:`~navseq.executor.control.MissionControl`);
-* :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash).
+* :meth:`~MissionExecutor.interrupt` when the run must end now (signal, crash);
+* :meth:`~MissionExecutor.on_task_done` when a task it started (``StartTask``) ended
+  by itself: a reached waypoint's tasks run in order, after its dwell, each timed out
+  from ``now`` by the executor (``CancelTask``) and its failure handled by the
+  waypoint's ``retries`` / ``on_failure``.
 
 Its states and the only ways between them are the table in
 :mod:`navseq.executor.states`; every state change goes through it.
@@ -24,7 +28,8 @@ Pausing cancels the active goal (the robot stops) and holds the run in
 :attr:`ExecutorState.PAUSED`, where no deadline runs: on resume the goal timeout, the
 stall timeout, a dwell, a retry back-off and the server wait all move on by the time
 spent paused, and an interrupted goal is sent again (a fresh goal id, the same
-attempt). Durations in the result stay what they were on the clock, pauses included.
+attempt). A running task is cancelled and runs again from its start on resume.
+Durations in the result stay what they were on the clock, pauses included.
 
 Each input returns the commands (:mod:`navseq.executor.commands`) the caller must
 apply to the navigator, in order. What happened is told to listeners as mission
@@ -52,10 +57,18 @@ The executor believes the robot, not only the navigation stack:
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 from navseq.errors import NavseqError
 from navseq.executor.arrival import arrival_miss, goal_tolerance
-from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.commands import (
+    CancelGoal,
+    CancelTask,
+    ClearCostmaps,
+    Command,
+    SendGoal,
+    StartTask,
+)
 from navseq.executor.events import (
     AttemptFailed,
     LoopStarted,
@@ -65,6 +78,8 @@ from navseq.executor.events import (
     MissionResumed,
     MissionStarted,
     ServerStatusChanged,
+    TaskFinished,
+    TaskStarted,
     WaypointDwelling,
     WaypointFinished,
     WaypointOutcome,
@@ -74,13 +89,14 @@ from navseq.executor.events import (
 )
 from navseq.executor.monitor import AttemptMonitor
 from navseq.executor.odometer import Odometer
-from navseq.executor.result import MissionResult, WaypointResult
+from navseq.executor.result import MissionResult, TaskResult, WaypointResult
 from navseq.executor.resume import ResumePoint, check_resume_point, visit_log
 from navseq.executor.states import ExecutorState, Trigger, next_state
 from navseq.executor.visit import Visit, next_position
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction, Mission, Policy
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
+from navseq.mission.tasks import Task
 from navseq.navigators.base import (
     Goal,
     GoalDone,
@@ -91,6 +107,7 @@ from navseq.navigators.base import (
     ServerBack,
     ServerLost,
 )
+from navseq.tasks.base import TaskDone, TaskOutcome
 from navseq.track import simplify_path
 
 #: Pause between a failed attempt and the next one, so a failing stack is not hammered.
@@ -107,6 +124,15 @@ _GOES_ON = {
 }
 
 MissionListener = Callable[[MissionEvent], None]
+
+
+@dataclass(frozen=True)
+class _RunningTask:
+    """The task a StartTask went out for, and when (its timeout runs from then)."""
+
+    task_id: int
+    task: Task
+    started_at: float
 
 
 class MissionExecutor:
@@ -143,6 +169,8 @@ class MissionExecutor:
         self._visit: Visit | None = None
         self._monitor: AttemptMonitor | None = None  # the goal out for the current visit
         self._next_goal_id = 1
+        self._next_task_id = 1
+        self._task: _RunningTask | None = None  # the task out, in RUNNING_TASK
         self._deadline = 0.0  # end of dwell or back-off, by state
         self._clear_costmaps_before_send = False
         self._server_up = True
@@ -310,6 +338,26 @@ class MissionExecutor:
                 return commands
         return self._check_clock(now)
 
+    def on_task_done(self, done: TaskDone, now: float) -> list[Command]:
+        """A task the executor started ended by itself (success or failure).
+
+        Reports about any other task than the one running (cancelled, timed out) are
+        ignored.
+        """
+        self._now = max(self._now, now)
+        task = self._task
+        if self._state is not ExecutorState.RUNNING_TASK or task is None:
+            return []
+        if done.task_id != task.task_id:
+            return []
+        if not done.succeeded:
+            return self._task_failed(now, TaskOutcome.FAILED, done, cancel=False)
+        visit = self._current
+        self._record_task(now, TaskOutcome.SUCCEEDED, done)
+        visit.next_task += 1
+        visit.task_attempt = 1
+        return self._tasks_or_finish(now)
+
     def skip(self, now: float, reason: str = "skipped by operator") -> list[Command]:
         """Give up the current visit (outcome SKIPPED) and go on with the next one.
 
@@ -324,11 +372,12 @@ class MissionExecutor:
         interrupted: ExecutorState = self._state
         if interrupted is ExecutorState.PAUSED:
             interrupted = self._end_pause(now)
+        stopped = self._stop_task(now, reason)
         if interrupted is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
         else:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
-        commands = self._advance(now)
+        commands = [*stopped, *self._advance(now)]
         if self.finished:
             return [CancelGoal(), *commands]  # no next goal replaces the active one
         return commands
@@ -345,6 +394,9 @@ class MissionExecutor:
         commands: list[Command] = []
         if self._state is ExecutorState.ACTIVE:
             commands.append(CancelGoal())
+        if self._task is not None:  # run again from its start on resume
+            commands.append(CancelTask(self._task.task_id))
+            self._task = None
         paused_from = self._paused_from = self._state
         self._paused_at = now
         self._paused_monitor = self._monitor
@@ -369,6 +421,8 @@ class MissionExecutor:
         if interrupted in _GOES_ON:
             self._move(_GOES_ON[interrupted])
             return self._check_clock(now)
+        if interrupted is ExecutorState.RUNNING_TASK:
+            return self._start_task(now)
         # ACTIVE: the same attempt, a fresh goal id (late events of the cancelled goal
         # are ignored). WAITING_SERVER: sent if the server came back while paused.
         commands = self._send_goal(now)
@@ -402,9 +456,10 @@ class MissionExecutor:
             self._started_at = now
             self._finish_mission(now, reason)
             return []
+        stopped = self._stop_task(now, reason)
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, reason)
-        return [CancelGoal()]
+        return [CancelGoal(), *stopped]
 
     def _end_pause(self, now: float) -> ExecutorState:
         """Move the interrupted state's deadlines on by the pause; the state to go back to.
@@ -433,7 +488,12 @@ class MissionExecutor:
     def _begin_visit(self, now: float, loop: int, index: int, *, new_loop: bool) -> list[Command]:
         if new_loop:
             self._emit(LoopStarted(t=now, loop=loop))
-        self._visit = Visit.of(self._mission, loop, index)
+        visit = self._visit = Visit.of(self._mission, loop, index)
+        resume = self._resume
+        if resume is not None and (loop, index) == (resume.loop, resume.index):
+            # The visit a crash interrupted: its tasks that succeeded are not run again.
+            visit.next_task = max(0, min(resume.tasks_done, len(visit.policy.tasks)))
+            visit.result.tasks.extend(replace(task) for task in resume.tasks)
         return self._start_attempt(now)
 
     def _start_attempt(self, now: float) -> list[Command]:
@@ -484,8 +544,133 @@ class MissionExecutor:
             self._deadline = now + visit.policy.dwell_s
             self._emit(WaypointDwelling(t=now, index=visit.index, seconds=visit.policy.dwell_s))
             return []
-        self._finish_visit(now, WaypointOutcome.REACHED, "", passed_through=passed_through)
+        if passed_through:
+            self._finish_visit(now, WaypointOutcome.REACHED, "", passed_through=True)
+            return self._advance(now)
+        return self._tasks_or_finish(now)
+
+    # ------------------------------------------------------------------ tasks
+
+    def _tasks_or_finish(self, now: float) -> list[Command]:
+        """At a reached waypoint: start its next task, or end the visit when none is left."""
+        visit = self._current
+        if visit.next_task < len(visit.policy.tasks):
+            return self._start_task(now)
+        self._finish_visit(now, WaypointOutcome.REACHED, "")
         return self._advance(now)
+
+    def _start_task(self, now: float) -> list[Command]:
+        visit = self._current
+        task = visit.policy.tasks[visit.next_task]
+        running = self._task = _RunningTask(self._next_task_id, task, now)
+        self._next_task_id += 1
+        self._move(Trigger.TASK)
+        self._emit(
+            TaskStarted(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                task=visit.next_task + 1,
+                task_kind=task.kind,
+                attempt=visit.task_attempt,
+                description=task.describe(),
+            )
+        )
+        return [StartTask(running.task_id, task, visit.index, visit.loop, visit.next_task + 1)]
+
+    def _record_task(
+        self, now: float, outcome: TaskOutcome, done: TaskDone | None, *, will_retry: bool = False
+    ) -> None:
+        """Put the running task's end into the visit's result and tell the sinks."""
+        visit, running = self._current, self._task
+        assert running is not None
+        self._task = None
+        detail = done.detail if done is not None else ""
+        files = done.files if done is not None else ()
+        output = done.output if done is not None else ()
+        duration = max(0.0, now - running.started_at)
+        number = visit.next_task + 1
+        visit.result.tasks.append(
+            TaskResult(
+                number=number,
+                kind=running.task.kind,
+                outcome=outcome.value,
+                attempt=visit.task_attempt,
+                duration=duration,
+                detail=detail,
+                files=list(files),
+                output=list(output),
+            )
+        )
+        self._emit(
+            TaskFinished(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                task=number,
+                task_kind=running.task.kind,
+                attempt=visit.task_attempt,
+                outcome=outcome.value,
+                duration=duration,
+                detail=detail,
+                files=files,
+                output=output,
+                will_retry=will_retry,
+            )
+        )
+
+    def _stop_task(self, now: float, reason: str) -> list[Command]:
+        """Cancel the running task, if any (skip, cancel, interrupt), recording why."""
+        running = self._task
+        if running is None:
+            return []
+        self._record_task(now, TaskOutcome.CANCELLED, TaskDone(running.task_id, False, reason))
+        return [CancelTask(running.task_id)]
+
+    def _task_failed(
+        self, now: float, outcome: TaskOutcome, done: TaskDone, *, cancel: bool
+    ) -> list[Command]:
+        """A task failed or timed out: run it again, or the waypoint's on_failure decides.
+
+        ``retries`` lets each task run again that many times (the goal is not sent
+        again: the robot is there); ``on_failure: retry`` runs it again without limit.
+        Each new run waits :data:`RETRY_BACKOFF` first.
+        """
+        visit = self._current
+        running = self._task
+        assert running is not None
+        policy = visit.policy
+        will_retry = (
+            policy.on_failure is FailureAction.RETRY or visit.task_attempt <= policy.retries
+        )
+        commands: list[Command] = [CancelTask(running.task_id)] if cancel else []
+        self._record_task(now, outcome, done, will_retry=will_retry)
+        if will_retry:
+            visit.task_attempt += 1
+            self._deadline = now + RETRY_BACKOFF  # _check_clock starts it again
+            return commands
+        words = "timed out" if outcome is TaskOutcome.TIMED_OUT else "failed"
+        reason = f"task {visit.next_task + 1} ({running.task.kind}) {words}"
+        if done.detail:
+            reason += f": {done.detail}"
+        if policy.on_failure is FailureAction.SKIP:
+            self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
+            return commands + self._advance(now)
+        label = self._mission.waypoint_label(visit.index)
+        self._finish_visit(now, WaypointOutcome.FAILED, reason)
+        self._finish_mission(now, f"stopped: {label} failed ({reason})")
+        return commands
+
+    def _check_task(self, now: float) -> list[Command]:
+        """A task's timeout, or the end of the back-off before a failed task runs again."""
+        running = self._task
+        if running is None:
+            return self._start_task(now) if now >= self._deadline else []
+        timeout = running.task.timeout_s
+        if timeout is not None and now - running.started_at >= timeout:
+            done = TaskDone(running.task_id, False, f"no end after {timeout:g} s")
+            return self._task_failed(now, TaskOutcome.TIMED_OUT, done, cancel=True)
+        return []
 
     def _advance(self, now: float) -> list[Command]:
         visit = self._current
@@ -647,8 +832,9 @@ class MissionExecutor:
                 return self._attempt_failed(now, overdue, cancel=True)
         elif state is ExecutorState.DWELLING:
             if now >= self._deadline:
-                self._finish_visit(now, WaypointOutcome.REACHED, "")
-                return self._advance(now)
+                return self._tasks_or_finish(now)
+        elif state is ExecutorState.RUNNING_TASK:
+            return self._check_task(now)
         elif state is ExecutorState.WAITING_RETRY:
             if now >= self._deadline:
                 return self._start_attempt(now)

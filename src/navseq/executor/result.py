@@ -52,6 +52,20 @@ class AttemptResult:
 
 
 @dataclass
+class TaskResult:
+    """One run of one task at a visit (a retried task has one per run)."""
+
+    number: int  # 1-based position in the waypoint's task list
+    kind: str
+    outcome: str  # a navseq.tasks.base.TaskOutcome value
+    attempt: int = 1
+    duration: float = 0.0  # s, navigator clock
+    detail: str = ""
+    files: list[str] = field(default_factory=list)
+    output: list[str] = field(default_factory=list)
+
+
+@dataclass
 class WaypointResult:
     """One visit of one waypoint (a patrol visits each waypoint once per loop)."""
 
@@ -68,6 +82,7 @@ class WaypointResult:
     reason: str = ""
     passed_through: bool = False
     attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
+    tasks: list[TaskResult] = field(default_factory=list)  # every task run, in order
 
     @property
     def yaw_deg(self) -> float:
@@ -295,6 +310,7 @@ class VisitLog:
                 y=waypoint.y,
                 yaw_rad=waypoint.yaw_rad,
                 attempt_results=[replace(a) for a in visit.attempt_results],
+                tasks=[replace(t) for t in visit.tasks],
             )
 
         for index, total in self._totals.items():

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from navseq.errors import NavseqError
-from navseq.executor.result import VisitLog, WaypointResult
+from navseq.executor.result import TaskResult, VisitLog, WaypointResult
 from navseq.mission.model import Mission
 
 
@@ -22,7 +22,9 @@ class ResumePoint:
     kept in full, so that a patrol of weeks resumes in bounded memory; its waypoints
     are relabelled with the mission's), or listed one by one in ``done`` (added after
     ``earlier``'s). ``previous_duration`` is the mission time those runs took
-    (seconds), added to the result's duration.
+    (seconds), added to the result's duration. ``tasks_done``: how many of the visit's
+    tasks succeeded before (the robot is sent there again, then the task that was
+    running at the end runs again and those before it do not).
     """
 
     loop: int
@@ -30,6 +32,8 @@ class ResumePoint:
     done: tuple[WaypointResult, ...] = field(default=())
     previous_duration: float = 0.0
     earlier: VisitLog | None = None
+    tasks_done: int = 0
+    tasks: tuple[TaskResult, ...] = ()  # the visit's task runs before, for its result
 
 
 def check_resume_point(mission: Mission, resume: ResumePoint) -> None:

@@ -18,9 +18,17 @@ from __future__ import annotations
 import logging
 from collections import deque
 from collections.abc import Generator, Iterable, Iterator
+from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError
-from navseq.executor.commands import CancelGoal, ClearCostmaps, Command, SendGoal
+from navseq.executor.commands import (
+    CancelGoal,
+    CancelTask,
+    ClearCostmaps,
+    Command,
+    SendGoal,
+    StartTask,
+)
 from navseq.executor.control import MissionControl, OperatorRequest, StopRequested
 from navseq.executor.events import MissionEvent
 from navseq.executor.machine import MissionExecutor, MissionListener
@@ -31,6 +39,9 @@ from navseq.mission.model import Mission
 from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import Navigator
 from navseq.signals import SignalGuard, Terminated
+
+if TYPE_CHECKING:
+    from navseq.tasks.runner import TaskRunner
 
 _log = logging.getLogger(__name__)
 
@@ -75,6 +86,7 @@ def run_mission(
     control: MissionControl | None = None,
     signals: SignalGuard | None = None,
     robot: RobotProfile | None = None,
+    tasks: TaskRunner | None = None,
 ) -> MissionResult:
     """Drive ``mission`` through ``navigator`` until it ends, and return the result.
 
@@ -90,7 +102,9 @@ def run_mission(
     before it restores the handlers. Without one, a guard of the run's own is restored
     on return. ``robot`` gives the goal tolerance of the arrival check (see
     :class:`~navseq.executor.machine.MissionExecutor`; default: the mission's
-    ``robot:``, else the TurtleBot3 burger).
+    ``robot:``, else the TurtleBot3 burger). ``tasks`` runs the waypoints' tasks
+    (default: a :class:`~navseq.tasks.runner.TaskRunner` that refuses ``run`` tasks and
+    ROS ones); whatever ends the run stops the task still running.
 
     Raises :class:`~navseq.errors.NavseqError` when the server is not there,
     :class:`MissionInterrupted` on SIGINT/SIGTERM/SIGHUP,
@@ -105,34 +119,36 @@ def run_mission(
     executor = MissionExecutor(mission, resume=resume, robot=robot)
     for listener in listeners:
         executor.add_listener(listener)
+    tasks = tasks if tasks is not None else _default_tasks()
     guard = signals if signals is not None else SignalGuard()
     guard.arm()
     try:
         server_up = navigator.wait_for_server(server_wait)
         if server_up:
-            _drive(executor, navigator, tick, control)
+            _drive(executor, _Outside(navigator, tasks), tick, control)
     except KeyboardInterrupt:
         guard.defer()  # also for a KeyboardInterrupt not raised by the guard
-        result = _abort(executor, navigator, "interrupted: SIGINT")
+        result = _abort(executor, navigator, "interrupted: SIGINT", tasks)
         raise MissionInterrupted("SIGINT", result) from None
     except Terminated as signalled:
         name = signalled.signal_name
-        result = _abort(executor, navigator, f"interrupted: {name}")
+        result = _abort(executor, navigator, f"interrupted: {name}", tasks)
         raise MissionInterrupted(name, result) from None
     except StopRequested as stop:
         guard.defer()
-        _abort(executor, navigator, f"interrupted ({stop})")
+        _abort(executor, navigator, f"interrupted ({stop})", tasks)
         raise
     except NavseqError as error:
         # A sink could not do its job (the journal on a full disk): stop, then say why.
         guard.defer()
-        result = _abort(executor, navigator, f"stopped: {error}")
+        result = _abort(executor, navigator, f"stopped: {error}", tasks)
         raise MissionAborted(error, result) from None
     except BaseException as error:
         guard.defer()
-        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}", tasks)
         raise
     finally:
+        tasks.close()
         if control is not None:
             control.close("the mission has ended")
         if signals is None:
@@ -152,6 +168,7 @@ def iter_mission(
     server_wait: float = 10.0,
     control: MissionControl | None = None,
     robot: RobotProfile | None = None,
+    tasks: TaskRunner | None = None,
 ) -> Generator[MissionEvent, None, MissionResult]:
     """:func:`run_mission` as a generator of mission events, for a caller's own loop.
 
@@ -159,26 +176,30 @@ def iter_mission(
     It installs no signal handlers (a library's loop may not run in the main thread);
     whatever ends it early -- an exception, Ctrl-C, or the caller leaving the loop
     (``close()``) -- cancels the active goal first, as :func:`run_mission` does.
-    Raises :class:`~navseq.errors.NavseqError` when the server is not there.
+    Raises :class:`~navseq.errors.NavseqError` when the server is not there. ``tasks``
+    as for :func:`run_mission`.
     """
     executor = MissionExecutor(mission, robot=robot)
+    tasks = tasks if tasks is not None else _default_tasks()
     pending: deque[MissionEvent] = deque()
     executor.add_listener(pending.append)
     if not navigator.wait_for_server(server_wait):
         raise _no_server(server_wait)
     try:
-        for _ in _steps(executor, navigator, tick, control):
+        for _ in _steps(executor, _Outside(navigator, tasks), tick, control):
             while pending:
                 yield pending.popleft()
     except GeneratorExit:
-        _abort(executor, navigator, "interrupted: the caller stopped the run")
+        _abort(executor, navigator, "interrupted: the caller stopped the run", tasks)
         raise
     except KeyboardInterrupt:
-        _abort(executor, navigator, "interrupted: SIGINT")
+        _abort(executor, navigator, "interrupted: SIGINT", tasks)
         raise
     except BaseException as error:
-        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}")
+        _abort(executor, navigator, f"interrupted: {type(error).__name__}: {error}", tasks)
         raise
+    finally:
+        tasks.close()
     while pending:
         yield pending.popleft()
     return executor.result
@@ -192,20 +213,49 @@ def _no_server(server_wait: float) -> NavseqError:
     )
 
 
+def _default_tasks() -> TaskRunner:
+    from navseq.tasks.runner import TaskRunner
+
+    return TaskRunner()
+
+
+class _Outside:
+    """What the executor's commands act on: the navigator and the task runner."""
+
+    def __init__(self, navigator: Navigator, tasks: TaskRunner) -> None:
+        self.navigator = navigator
+        self.tasks = tasks
+
+    def apply(self, commands: list[Command]) -> None:
+        navigator = self.navigator
+        for command in commands:
+            if isinstance(command, SendGoal):
+                navigator.send_goal(command.goal)
+            elif isinstance(command, CancelGoal):
+                navigator.cancel_goal()
+            elif isinstance(command, ClearCostmaps):
+                navigator.clear_costmaps()
+            elif isinstance(command, StartTask):
+                self.tasks.start(command, navigator.now())
+            elif isinstance(command, CancelTask):
+                self.tasks.cancel(command.task_id)
+
+
 def _drive(
-    executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
+    executor: MissionExecutor, outside: _Outside, tick: float, control: MissionControl | None
 ) -> None:
     """The loop: navigator events, operator requests and the clock in; commands out."""
-    for _ in _steps(executor, navigator, tick, control):
+    for _ in _steps(executor, outside, tick, control):
         pass
 
 
 def _steps(
-    executor: MissionExecutor, navigator: Navigator, tick: float, control: MissionControl | None
+    executor: MissionExecutor, outside: _Outside, tick: float, control: MissionControl | None
 ) -> Iterator[None]:
     """The loop, one step (one look at the mission, then ``tick`` of navigator time) per
     item, so that :func:`iter_mission` can hand over the events between steps."""
-    _apply(navigator, executor.start(navigator.now(), navigator.robot_pose()))
+    navigator, _apply = outside.navigator, outside.apply
+    _apply(executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
         events = navigator.poll()
         if control is not None and control.stop_reason is not None:
@@ -215,15 +265,18 @@ def _steps(
             if stop is not None:
                 raise StopRequested(stop)
         for event in events:
-            _apply(navigator, executor.on_event(event, navigator.now(), navigator.robot_pose()))
+            _apply(executor.on_event(event, navigator.now(), navigator.robot_pose()))
+        for done in outside.tasks.poll(navigator.now()):
+            _apply(executor.on_task_done(done, navigator.now()))
         if control is not None:
             for request in control.take_requests():
-                _apply(navigator, _operate(executor, request, navigator.now()))
+                _apply(_operate(executor, request, navigator.now()))
         pose, odom_pose = navigator.robot_pose(), _odometry_pose(navigator)
-        _apply(navigator, executor.on_tick(navigator.now(), pose, odom_pose))
+        _apply(executor.on_tick(navigator.now(), pose, odom_pose))
         yield
         if not executor.finished:
             navigator.spin(tick)
+            outside.tasks.pace(navigator.now())
 
 
 def _operate(executor: MissionExecutor, request: OperatorRequest, now: float) -> list[Command]:
@@ -258,18 +311,10 @@ def _odometry_pose(navigator: Navigator) -> Pose2D | None:
     return odometry_pose() if odometry_pose is not None else None
 
 
-def _apply(navigator: Navigator, commands: list[Command]) -> None:
-    for command in commands:
-        if isinstance(command, SendGoal):
-            navigator.send_goal(command.goal)
-        elif isinstance(command, CancelGoal):
-            navigator.cancel_goal()
-        elif isinstance(command, ClearCostmaps):
-            navigator.clear_costmaps()
-
-
-def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> MissionResult:
-    """Stop the robot first, then close the books; never raise from here.
+def _abort(
+    executor: MissionExecutor, navigator: Navigator, reason: str, tasks: TaskRunner
+) -> MissionResult:
+    """Stop the robot and the running task first, then close the books; never raise.
 
     Called with the run's signal guard deferring: a second Ctrl-C cannot cut it short.
     """
@@ -277,6 +322,10 @@ def _abort(executor: MissionExecutor, navigator: Navigator, reason: str) -> Miss
         navigator.cancel_goal()
     except Exception:
         _log.exception("cancelling the active goal failed")
+    try:
+        tasks.close()
+    except Exception:
+        _log.exception("stopping the running task failed")
     try:
         now = navigator.now()
     except Exception:

@@ -22,6 +22,7 @@ class ExecutorState(enum.Enum):
     IDLE = "idle"  # start() not called yet
     ACTIVE = "active"  # a goal is out; waiting for its result, a timeout or pass-through
     DWELLING = "dwelling"  # goal reached; waiting the waypoint's dwell time
+    RUNNING_TASK = "running_task"  # goal reached; a task runs (or waits to run again)
     WAITING_RETRY = "waiting_retry"  # attempt failed; back-off before the next attempt
     WAITING_SERVER = "waiting_server"  # server gone; the goal is resent when it is back
     PAUSED = "paused"  # the operator paused: no goal out, no deadline running
@@ -34,6 +35,7 @@ class Trigger(enum.Enum):
     GOAL_SENT = "goal sent"  # the current visit's goal went out (first, next or again)
     SERVER_AWAY = "server away"  # the server is gone: the goal waits for it to come back
     DWELL = "dwell"  # the goal was reached; the waypoint's dwell time runs
+    TASK = "task"  # a task of the reached waypoint starts (the first, next, or again)
     RETRY_LATER = "retry later"  # the attempt failed; back off before the next one
     PAUSE = "pause"  # the operator paused the run
     DWELL_GOES_ON = "dwell goes on"  # a pause during a dwell ended
@@ -45,7 +47,8 @@ _S, _T = ExecutorState, Trigger
 
 #: Every allowed state change: (state, trigger) → next state. Nothing leaves FINISHED.
 #: A pause ends by going back to what it interrupted: a goal sent again (or held for
-#: the server), or the dwell or back-off going on with its deadline moved.
+#: the server), the dwell or back-off going on with its deadline moved, or the
+#: interrupted task started again.
 TRANSITIONS: dict[tuple[ExecutorState, Trigger], ExecutorState] = {
     (_S.IDLE, _T.GOAL_SENT): _S.ACTIVE,
     (_S.IDLE, _T.SERVER_AWAY): _S.WAITING_SERVER,
@@ -53,13 +56,20 @@ TRANSITIONS: dict[tuple[ExecutorState, Trigger], ExecutorState] = {
     (_S.ACTIVE, _T.GOAL_SENT): _S.ACTIVE,  # the next visit's goal replaces this one
     (_S.ACTIVE, _T.SERVER_AWAY): _S.WAITING_SERVER,
     (_S.ACTIVE, _T.DWELL): _S.DWELLING,
+    (_S.ACTIVE, _T.TASK): _S.RUNNING_TASK,
     (_S.ACTIVE, _T.RETRY_LATER): _S.WAITING_RETRY,
     (_S.ACTIVE, _T.PAUSE): _S.PAUSED,
     (_S.ACTIVE, _T.END): _S.FINISHED,
     (_S.DWELLING, _T.GOAL_SENT): _S.ACTIVE,
     (_S.DWELLING, _T.SERVER_AWAY): _S.WAITING_SERVER,
     (_S.DWELLING, _T.PAUSE): _S.PAUSED,
+    (_S.DWELLING, _T.TASK): _S.RUNNING_TASK,
     (_S.DWELLING, _T.END): _S.FINISHED,
+    (_S.RUNNING_TASK, _T.TASK): _S.RUNNING_TASK,  # the next task, or a failed one again
+    (_S.RUNNING_TASK, _T.GOAL_SENT): _S.ACTIVE,  # the tasks are done: the next visit
+    (_S.RUNNING_TASK, _T.SERVER_AWAY): _S.WAITING_SERVER,
+    (_S.RUNNING_TASK, _T.PAUSE): _S.PAUSED,
+    (_S.RUNNING_TASK, _T.END): _S.FINISHED,
     (_S.WAITING_RETRY, _T.GOAL_SENT): _S.ACTIVE,
     (_S.WAITING_RETRY, _T.SERVER_AWAY): _S.WAITING_SERVER,
     (_S.WAITING_RETRY, _T.PAUSE): _S.PAUSED,
@@ -70,6 +80,7 @@ TRANSITIONS: dict[tuple[ExecutorState, Trigger], ExecutorState] = {
     (_S.WAITING_SERVER, _T.END): _S.FINISHED,
     (_S.PAUSED, _T.GOAL_SENT): _S.ACTIVE,
     (_S.PAUSED, _T.SERVER_AWAY): _S.WAITING_SERVER,
+    (_S.PAUSED, _T.TASK): _S.RUNNING_TASK,  # the interrupted task runs again from its start
     (_S.PAUSED, _T.DWELL_GOES_ON): _S.DWELLING,
     (_S.PAUSED, _T.BACKOFF_GOES_ON): _S.WAITING_RETRY,
     (_S.PAUSED, _T.END): _S.FINISHED,

@@ -31,6 +31,10 @@ class Visit:
     # The stack's count of recovery behaviours for the current attempt's goal, when the
     # stack gives one (Nav2's number_of_recoveries); None: not known.
     attempt_recoveries: int | None = None
+    # The waypoint's tasks: the 0-based position of the one to run next (tasks before it
+    # have succeeded), and which run of it this is (1 + its failures so far).
+    next_task: int = 0
+    task_attempt: int = 1
 
     @classmethod
     def of(cls, mission: Mission, loop: int, index: int) -> Visit:
@@ -49,8 +53,12 @@ class Visit:
     @property
     def passes_through(self) -> bool:
         """Whether the visit ends when the robot comes near, without stopping there."""
+        policy = self.policy
         return (
-            self.policy.pass_through_m is not None and self.policy.dwell_s == 0 and not self.is_last
+            policy.pass_through_m is not None
+            and policy.dwell_s == 0
+            and not policy.tasks
+            and not self.is_last
         )
 
     def start_attempt(self, now: float) -> None:

@@ -53,6 +53,8 @@ EVENT_TYPES: dict[str, type] = {
         ev.WaypointPlan,
         ev.AttemptFailed,
         ev.WaypointDwelling,
+        ev.TaskStarted,
+        ev.TaskFinished,
         ev.WaypointFinished,
         ev.MissionPaused,
         ev.MissionResumed,

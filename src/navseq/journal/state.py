@@ -26,10 +26,11 @@ from typing import Any, NamedTuple, overload
 
 from navseq.errors import NavseqError
 from navseq.executor import events as ev
-from navseq.executor.result import AttemptResult, VisitLog, WaypointResult
+from navseq.executor.result import AttemptResult, TaskResult, VisitLog, WaypointResult
 from navseq.executor.resume import ResumePoint
 from navseq.journal.reader import Damaged, Entry, Event, JournalHeader, JournalReader, Resumed
 from navseq.sinks.recorder import RunRecorder
+from navseq.tasks.base import TaskOutcome
 
 #: The most waypoints a journaled mission may claim: a visit log for that many is
 #: built as the journal is read. Far above what a mission file can hold (a 10 MiB
@@ -110,6 +111,10 @@ class VisitHistory:
     frontier: tuple[int, int] = (0, 0)
     unfinished: WaypointResult | None = None
     _trail: _VisitTrail | None = None
+    # The task runs of the latest visit that ran tasks, over every segment (a resume
+    # does not run the ones that succeeded again), and which visit that is.
+    _task_visit: tuple[int, int] | None = None
+    _task_runs: list[TaskResult] = field(default_factory=list)
 
     @property
     def waypoint_count(self) -> int | None:
@@ -169,6 +174,22 @@ class VisitHistory:
         if self._trail is not None and event.recoveries is not None:
             self._trail.recoveries = event.recoveries
 
+    def finish_task(self, event: ev.TaskFinished) -> None:
+        key = (event.loop, event.index)
+        if key != self._task_visit:
+            self._task_visit, self._task_runs = key, []
+        self._task_runs.append(_task_of(event))
+
+    def tasks_of(self, key: tuple[int, int]) -> list[TaskResult]:
+        """Every task run the journal records for visit ``key``, in order."""
+        return list(self._task_runs) if key == self._task_visit else []
+
+    def tasks_done_at(self, key: tuple[int, int]) -> int:
+        """How many tasks of visit ``key`` succeeded: they run in order, so the highest
+        number that succeeded (0 when none)."""
+        succeeded = TaskOutcome.SUCCEEDED.value
+        return max((t.number for t in self.tasks_of(key) if t.outcome == succeeded), default=0)
+
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
         if self._trail is not None:
@@ -200,7 +221,7 @@ class VisitHistory:
                 source=where,
             )
         trail = self._trail if self._trail is not None and self._trail.key == key else None
-        visit = _visit_of(event, trail)
+        visit = _visit_of(event, trail, self.tasks_of(key))
         if event.outcome not in _DONE_OUTCOMES:
             self.unfinished = visit  # run again on resume, unless a later segment did
             return
@@ -316,6 +337,8 @@ def _fold(state: JournalState, entries: Iterable[Entry]) -> None:
             visits.start_visit(event)
         elif isinstance(event, ev.AttemptFailed):
             visits.fail_attempt(event)
+        elif isinstance(event, ev.TaskFinished):
+            visits.finish_task(event)
         elif isinstance(event, ev.WaypointFinished):
             visits.finish_visit(event, f"{path}:{entry.line}")
         elif isinstance(event, ev.MissionFinished):
@@ -359,6 +382,8 @@ def resume_point(state: JournalState, *, mission_digest: str | None = None) -> R
         index=index,
         earlier=state.visits.log,
         previous_duration=state.previous_duration,
+        tasks_done=state.visits.tasks_done_at((loop, index)),
+        tasks=tuple(state.visits.tasks_of((loop, index))),
     )
 
 
@@ -409,7 +434,11 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
     return attempts
 
 
-def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> WaypointResult:
+def _visit_of(
+    event: ev.WaypointFinished,
+    trail: _VisitTrail | None = None,
+    tasks: list[TaskResult] | None = None,
+) -> WaypointResult:
     """A finished visit as the result lists it (the waypoint's pose comes from the mission)."""
     return WaypointResult(
         index=event.index,
@@ -425,6 +454,20 @@ def _visit_of(event: ev.WaypointFinished, trail: _VisitTrail | None = None) -> W
         reason=event.reason,
         passed_through=event.passed_through,
         attempt_results=_attempts_of(event, trail),
+        tasks=tasks or [],
+    )
+
+
+def _task_of(event: ev.TaskFinished) -> TaskResult:
+    return TaskResult(
+        number=event.task,
+        kind=event.task_kind,
+        outcome=event.outcome,
+        attempt=event.attempt,
+        duration=event.duration,
+        detail=event.detail,
+        files=list(event.files),
+        output=list(event.output),
     )
 
 

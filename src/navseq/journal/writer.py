@@ -275,7 +275,13 @@ _PROGRESS_DEFAULT_NONE = tuple(
     spec.name for spec in dataclasses.fields(ev.WaypointProgress) if spec.default is None
 )
 #: Events before which the latest pose is journaled, so the path ends where the robot was.
-_ARRIVALS = (ev.WaypointDwelling, ev.WaypointFinished, ev.MissionPaused, ev.MissionFinished)
+_ARRIVALS = (
+    ev.WaypointDwelling,
+    ev.TaskStarted,
+    ev.WaypointFinished,
+    ev.MissionPaused,
+    ev.MissionFinished,
+)
 
 
 def _rounded(value: float | None) -> float | None:

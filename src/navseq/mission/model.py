@@ -17,6 +17,7 @@ from typing import Any, NoReturn
 
 from navseq.geometry import Pose2D
 from navseq.mission.robot import RobotProfile
+from navseq.mission.tasks import Task
 
 
 class FailureAction(str, enum.Enum):
@@ -61,6 +62,9 @@ class Policy:
     # Arrival check on SUCCEEDED: None takes the robot profile's goal tolerance.
     xy_tolerance_m: float | None = None
     yaw_tolerance_rad: float | None = None
+    # Run in order once the waypoint is reached (after the dwell); a waypoint's list
+    # replaces the defaults' list as a whole.
+    tasks: tuple[Task, ...] = ()
 
     def __init__(
         self,
@@ -75,6 +79,7 @@ class Policy:
         xy_tolerance_m: float | None = None,
         yaw_tolerance_deg: float | None = None,
         yaw_tolerance_rad: float | None = None,
+        tasks: tuple[Task, ...] = (),
         **unknown: NoReturn,
     ) -> None:
         if ambiguous:
@@ -101,6 +106,7 @@ class Policy:
             ("dwell_s", dwell_s),
             ("xy_tolerance_m", xy_tolerance_m),
             ("yaw_tolerance_rad", yaw_tolerance_rad),
+            ("tasks", tuple(tasks)),
         ):
             object.__setattr__(self, name_, value)
 

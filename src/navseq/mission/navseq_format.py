@@ -34,6 +34,7 @@ from navseq.mission.located import Located, describe
 from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.problems import Problems, Salvage
 from navseq.mission.robot_format import read_robot
+from navseq.mission.task_format import read_tasks
 
 FORMAT_VERSION = 1
 FOREVER = "forever"
@@ -44,7 +45,8 @@ OPTIONAL_SETTINGS = ("map", "start", "robot")  # null: none, like leaving the ke
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
 POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
-WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_KEYS)
+TASKS_KEY = "tasks"  # a waypoint's (or the defaults') list, read by navseq.mission.task_format
+WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_KEYS, TASKS_KEY)
 
 
 def mission_from_document(
@@ -73,6 +75,7 @@ def mission_from_document(
     defaults = read_defaults(doc.get("defaults"), problems)
     waypoints_node = doc.get("waypoints")
     waypoints: tuple[Waypoint, ...] = ()
+    numbers: tuple[int, ...] = ()
     if waypoints_node is None:
         # A misspelt 'waypoints' key is already reported with its correction.
         if not any(difflib.get_close_matches(key, ["waypoints"], cutoff=0.6) for key in doc.value):
@@ -84,6 +87,7 @@ def mission_from_document(
     else:
         waypoints, numbers = read_numbered_waypoints(waypoints_node, problems)
     settings = read_settings(doc, base_dir, problems)
+    check_tasks_stop(waypoints, numbers, defaults, problems)
     if len(problems) > before:
         if waypoints:
             problems.salvage = Salvage(
@@ -98,8 +102,36 @@ def read_defaults(node: Located | None, problems: Problems) -> Policy:
         return Policy()
     if fields.attempt(problems, lambda: fields.mapping(node, "field defaults")) is None:
         return Policy()
-    fields.check_keys(node, tuple(POLICY_KEYS), "defaults", problems)
-    return Policy(**fields.policy_values(node, "defaults", problems))
+    fields.check_keys(node, (*POLICY_KEYS, TASKS_KEY), "defaults", problems)
+    values = fields.policy_values(node, "defaults", problems)
+    tasks = _tasks(node, "defaults", problems)
+    if tasks is not None:
+        values["tasks"] = tasks
+    return Policy(**values)
+
+
+def _tasks(node: Located, owner: str, problems: Problems) -> tuple[Any, ...] | None:
+    """The mapping's ``tasks:`` list, checked; None when absent or faulty."""
+    entry = node.get(TASKS_KEY)
+    return None if entry is None else read_tasks(entry, owner, problems)
+
+
+def check_tasks_stop(
+    waypoints: Sequence[Waypoint], numbers: Sequence[int], defaults: Policy, problems: Problems
+) -> None:
+    """A waypoint the robot only passes through cannot run tasks: it does not stop there.
+
+    ``numbers``: each waypoint's index in the file, for the message.
+    """
+    for index, waypoint in zip(numbers, waypoints, strict=True):
+        policy = defaults.with_overrides(waypoint.overrides)
+        if policy.tasks and policy.pass_through_m is not None and policy.dwell_s == 0:
+            problems.add(
+                "has tasks but passes through (pass_through) without stopping; tasks run "
+                "only where the robot stops: remove pass_through (or the tasks)",
+                source=waypoint.where,
+                subject=waypoint.label(index),
+            )
 
 
 def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> dict[str, Any]:
@@ -279,6 +311,9 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
     z = _optional_number(node, "z", label, problems, fields.coordinate)
     yaw = read_yaw(node, label, problems)
     overrides = fields.policy_values(node, label, problems)
+    tasks = _tasks(node, label, problems)
+    if tasks is not None:
+        overrides["tasks"] = tasks
     if len(problems) > before or x is None or y is None or yaw is None:
         return None
     return Waypoint(

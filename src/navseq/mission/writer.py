@@ -23,6 +23,7 @@ from navseq.geometry import Pose2D
 from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
 from navseq.mission.robot import BUILTIN_PROFILES, RobotProfile
+from navseq.mission.task_format import task_document
 from navseq.mission.yaml_doc import EXPONENT_FLOAT
 
 HEADER = "# navseq mission (format reference: docs/mission-format.md)\n"
@@ -112,6 +113,8 @@ def _settings(mission: Mission, base_dir: Path | None) -> dict[str, Any]:
     if mission.record:
         doc["record"] = True
     doc["defaults"] = _policy_values(mission.defaults, POLICY_KEYS)
+    if mission.defaults.tasks:
+        doc["defaults"]["tasks"] = [task_document(t) for t in mission.defaults.tasks]
     return doc
 
 
@@ -330,6 +333,8 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
                 [key for key, name in POLICY_KEYS.items() if name in waypoint.overrides],
             )
         )
+    if "tasks" in waypoint.overrides:
+        entry["tasks"] = [task_document(t) for t in waypoint.overrides["tasks"]]
     return entry
 
 

@@ -125,7 +125,9 @@ class NavigatorKind:
     a missing dependency becomes; ``hidden`` kinds (test doubles) stay out of ``--help``.
     ``places_robot`` is False for a real robot's stack: the robot is where it is, so a
     start pose is refused; ``paced`` is True for the simulator, the only kind whose time
-    a run may pace (``realtime``)."""
+    a run may pace (``realtime``). ``ros``: the kind drives a ROS stack, so a mission's
+    ROS tasks are ROS's business there (not run yet), and are only rehearsed
+    (``--simulate-tasks``) on the kinds without."""
 
     name: str
     help: str
@@ -135,6 +137,7 @@ class NavigatorKind:
     hidden: bool = False
     places_robot: bool = True
     paced: bool = False
+    ros: bool = False
 
     def create(self, settings: NavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
         from navseq.errors import NavseqError
@@ -182,6 +185,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         Ros1NavigatorSettings,
         requires="ROS 1's Python packages (rospy, actionlib, move_base_msgs)",
         places_robot=False,
+        ros=True,
     ),
     NavigatorKind(
         "nav2",
@@ -191,6 +195,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         requires="ROS 2's Python packages (rclpy, nav2_msgs): source ROS 2 first "
         "(e.g. source /opt/ros/jazzy/setup.bash), then start navseq from that shell",
         places_robot=False,
+        ros=True,
     ),
     # A deterministic stand-in for the plumbing's tests; its options are hidden too.
     NavigatorKind(

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from navseq.errors import NavseqError
+from navseq.tasks.options import TaskOptions
 
 if TYPE_CHECKING:
     from navseq.geometry import Pose2D
@@ -103,7 +104,9 @@ class RunRequest:
     ``map``, ``start``, ``robot``, ``loops``: None takes the mission's (on a resume the
     journal's). ``first``/``last``/``only``: run a part of the mission (1-based numbers,
     ``only`` names or numbers, comma-separated). ``outputs`` None writes no file at all.
-    ``realtime``: the simulator's pace (None: as fast as it goes).
+    ``realtime``: the simulator's pace (None: as fast as it goes). ``tasks``: what the
+    waypoints' tasks may do (``run`` programs, simulated ROS tasks); not journaled: a
+    resume asks again.
     """
 
     mission: Path | Mission | None = None
@@ -122,6 +125,7 @@ class RunRequest:
     realtime: float | None = None
     server_wait: float = 10.0
     tick: float = 0.1
+    tasks: TaskOptions = field(default_factory=TaskOptions)
 
     def __post_init__(self) -> None:
         if self.mission is None and self.resume is None:

@@ -55,6 +55,7 @@ if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.recorder import RunRecorder
     from navseq.sinks.recording.sink import RecordingSink
+    from navseq.tasks.runner import TaskRunner
 
 #: Called with each note on the run (one line) at the moment a face should show it.
 NoteSink = Callable[[str], None]
@@ -89,6 +90,9 @@ class Session:
     part: MissionPart | None = None  # the waypoints run, when not all of them
     # Extra mission listeners the navigator's setup made (ROS markers and status).
     listeners: list[MissionListener] = field(default_factory=list)
+    # Runs the waypoints' tasks; None: one made for the run from ``request.tasks``. A
+    # face that confirms input tasks itself (the API, the studio) gives its own.
+    task_runner: TaskRunner | None = None
     # A navigator is made ready for one run (a ROS connection is closed after it).
     _started: bool = field(default=False, init=False, repr=False)
     _eta: EtaEstimator | None = field(default=None, init=False, repr=False)
@@ -162,7 +166,7 @@ class Session:
         if outputs is None:
             for note in self.notes:
                 say(note)
-            ran = self._drive(face, control, guard, lambda: None, recorder=None)
+            ran = self._drive(face, control, guard, lambda: None, None, say)
             return RunOutcome(
                 ran.result,
                 ran.exit_status,
@@ -245,6 +249,7 @@ class Session:
                 # does not answer leaves the journal as it was.
                 lambda: fresh if fresh is not None else self._continued_journal(journal_path),
                 self._new_recorder(),
+                say,
             )
         except BaseException:
             # No result to report (e.g. no navigation server, or a signal before the run
@@ -350,10 +355,14 @@ class Session:
         guard: SignalGuard,
         open_journal: Callable[[], JournalWriter | None],
         recorder: RunRecorder | None,
+        say: NoteSink,
     ) -> _Ran:
         """Run the mission; from the moment it ends, shutdown signals are only counted."""
         from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
         from navseq.sinks.json_events import clock_record
+        from navseq.tasks.runner import TaskRunner
+
+        tasks = self.task_runner or TaskRunner(self.request.tasks, say=say)
 
         navigator = self.make_navigator()
         error: NavseqError | None = None
@@ -387,6 +396,7 @@ class Session:
                         control=control,
                         tick=self.request.tick,
                         server_wait=self.request.server_wait,
+                        tasks=tasks,
                     )
                     exit_status, interrupted = result.exit_code, None
                 except MissionInterrupted as stop:
@@ -494,6 +504,7 @@ def prepare(request: RunRequest) -> Session:
     part = None if spec.whole else spec.select(mission)
     if part is not None:
         mission = part.apply(mission)
+    _refuse_tasks(mission, request, kind)
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
@@ -609,6 +620,24 @@ def _refuse_simulator_options(kind: NavigatorKind, request: RunRequest, start_gi
             "time. Leave --realtime out",
             source="--realtime",
         )
+
+
+def _refuse_tasks(mission: Mission, request: RunRequest, kind: NavigatorKind | None) -> None:
+    """Tasks this run may not start (a program without --allow-run, a ROS task where
+    there is no ROS), every one with its file:line, before anything moves."""
+    from navseq.errors import MissionErrors
+    from navseq.tasks.permissions import task_problems
+
+    if isinstance(request.navigator, UseNavigator):
+        name, simulated = str(request.navigator.info["kind"]), False
+    else:
+        assert kind is not None
+        name, simulated = kind.name, not kind.ros
+    problems = task_problems(mission, request.tasks, name, simulated=simulated)
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        raise MissionErrors(problems)
 
 
 def _navigator_setup(

@@ -1,6 +1,6 @@
 """Mission events as JSON records: ``navseq run --json``, and the public API's records.
 
-One record per event, one line each: ``{"event": "<type>", "schema_version": 3,
+One record per event, one line each: ``{"event": "<type>", "schema_version": 4,
 "t_s": ..., ...}``. The record is the event's fields under the names the run report
 uses, with the unit in the name: ``t_s``, ``duration_s``, ``distance_m``,
 ``distance_remaining_m``, ``navigation_time_s``, ``dwell_s``, ``yaw_deg`` (degrees, like
@@ -33,7 +33,7 @@ from typing import IO, Any, Protocol
 from navseq.executor.events import MissionEvent, WaypointOutcome, WaypointProgress
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 
 
 #: Decimals kept in every number of a record.
@@ -49,7 +49,9 @@ def _loops(loops: Any) -> Any:
 
 
 def _outcome(outcome: Any) -> Any:
-    return WaypointOutcome(outcome).value
+    if isinstance(outcome, WaypointOutcome):
+        return outcome.value
+    return outcome  # a task's outcome is its text already (TaskFinished)
 
 
 def _points(path: Any) -> Any:
@@ -70,6 +72,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "loops": ("loops", _loops),
     "outcome": ("outcome", _outcome),
     "path": ("path", _points),
+    "task_kind": ("kind", None),  # TaskStarted / TaskFinished, as the report's tasks say
 }
 
 

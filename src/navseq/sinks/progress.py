@@ -40,6 +40,8 @@ from navseq.executor.events import (
     MissionResumed,
     MissionStarted,
     ServerStatusChanged,
+    TaskFinished,
+    TaskStarted,
     WaypointDwelling,
     WaypointFinished,
     WaypointOutcome,
@@ -175,6 +177,11 @@ class RunView:
         elif isinstance(event, WaypointDwelling):
             self.status = f"dwelling {event.seconds:g} s"
             self.distance_remaining = 0.0
+        elif isinstance(event, TaskStarted):
+            self.status = f"task {event.task}: {printable(event.description)}"
+            self.distance_remaining = 0.0
+        elif isinstance(event, TaskFinished):
+            self.status = f"task {event.task} {_task_outcome(event)}"
         elif isinstance(event, WaypointFinished):
             outcome = WaypointOutcome(event.outcome)
             self.loop_outcomes[event.index] = outcome
@@ -337,6 +344,17 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
         )
     if isinstance(event, WaypointDwelling):
         return f"{view.waypoint_label(event.index)}: dwelling {event.seconds:g} s"
+    if isinstance(event, TaskStarted):
+        again = f", attempt {event.attempt}" if event.attempt > 1 else ""
+        return (
+            f"{view.waypoint_label(event.index)}: task {event.task} "
+            f"{printable(event.description)}{again}"
+        )
+    if isinstance(event, TaskFinished):
+        return (
+            f"{view.waypoint_label(event.index)}: task {event.task} ({event.task_kind}) "
+            f"{_task_outcome(event)} after {event.duration:.1f} s"
+        )
     if isinstance(event, WaypointFinished):
         outcome = WaypointOutcome(event.outcome)
         how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
@@ -362,6 +380,14 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     return None  # WaypointProgress, WaypointPlan
 
 
+def _task_outcome(event: TaskFinished) -> str:
+    """``succeeded``, ``failed (exit status 1), will retry`` ..."""
+    text = event.outcome.replace("_", " ")
+    if event.detail and event.outcome != "succeeded":
+        text += f" ({printable(event.detail)})"
+    return text + (", will retry" if event.will_retry else "")
+
+
 def needs_attention(event: MissionEvent) -> bool:
     """Whether the line about ``event`` tells of something that went wrong.
 
@@ -372,6 +398,8 @@ def needs_attention(event: MissionEvent) -> bool:
         return WaypointOutcome(event.outcome) in (WaypointOutcome.SKIPPED, WaypointOutcome.FAILED)
     if isinstance(event, AttemptFailed):
         return True
+    if isinstance(event, TaskFinished):
+        return event.outcome != "succeeded"
     if isinstance(event, ServerStatusChanged):
         return not event.available
     if isinstance(event, MissionFinished):

@@ -28,7 +28,9 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
                   "attempts": [{"number", "reached", "status", "reason", "text",
                                 "duration_s", "distance_m", "recoveries"}],
-                  "duration_s", "distance_m", "reason", "passed_through"}],
+                  "duration_s", "distance_m", "reason", "passed_through",
+                  "tasks": [{"number", "kind", "attempt", "outcome", "duration_s",
+                             "detail", "files", "output"}]}],
       "files": {"journal", "picture", ...},
       "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
       "clock": {"navigator_s", "wall_s", "real_time_factor"}   # (not navseq report)
@@ -78,6 +80,7 @@ from navseq.executor.result import (
     KEEP_NOT_REACHED_VISITS,
     AttemptResult,
     MissionResult,
+    TaskResult,
     WaypointResult,
     WaypointTotals,
 )
@@ -93,7 +96,7 @@ try:  # a dependency, but a ROS install of the package may not have it (see repo
 except ImportError:  # pragma: no cover - the tests run with it installed
     orjson = None  # type: ignore[assignment]
 
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -154,6 +157,22 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "distance_m": _rounded(visit.distance_driven),
         "reason": visit.reason,
         "passed_through": visit.passed_through,
+        "tasks": [_task_dict(task) for task in visit.tasks],
+    }
+
+
+def _task_dict(task: TaskResult) -> dict[str, Any]:
+    """One run of a waypoint's task: ``outcome`` succeeded, failed, timed_out or
+    cancelled; ``files`` what it wrote; ``output`` a program's last lines."""
+    return {
+        "number": task.number,
+        "kind": task.kind,
+        "attempt": task.attempt,
+        "outcome": task.outcome,
+        "duration_s": _rounded(task.duration, 2),
+        "detail": task.detail,
+        "files": list(task.files),
+        "output": list(task.output),
     }
 
 
