@@ -482,3 +482,30 @@ def test_closing_the_tab_with_unsaved_edits_asks_first_and_not_once_saved(
     with page.expect_event("close", timeout=5_000):
         page.close(run_before_unload=True)
     assert "beforeunload" not in seen  # saved: nothing to lose, nothing asked
+
+
+def test_typing_in_a_field_keeps_the_focus_and_every_value(page: Any) -> None:
+    """Enter or Tab in a field commits it without rebuilding the form under the user: the
+    value typed next lands in the next field, as typed (the form was rebuilt at every
+    change, dropping the focus and the following keys)."""
+    page.get_by_test_id("waypoint-row").nth(1).click()
+    x = page.locator("#fields input[name^='x ']")
+    x.click()
+    page.keyboard.press("Control+a")
+    checked_after(page, lambda: (page.keyboard.type(str(FREE_SPOT[0])), page.keyboard.press("Tab")))
+    assert page.evaluate("document.activeElement.id") == "fields-y"
+    checked_after(
+        page, lambda: (page.keyboard.type(str(FREE_SPOT[1])), page.keyboard.press("Enter"))
+    )
+    # Both values landed (the row and the form say so) and the focus stayed in y.
+    row = page.get_by_test_id("waypoint-row").nth(1).locator(".label").inner_text()
+    assert f"({FREE_SPOT[0]:.2f}, {FREE_SPOT[1]:.2f}," in row
+    assert page.evaluate("document.activeElement.id") == "fields-y"
+    assert x.input_value() == str(FREE_SPOT[0])
+    # Typing on goes on in y: the next value lands too.
+    page.keyboard.press("Control+a")
+    checked_after(page, lambda: (page.keyboard.type("-1.1"), page.keyboard.press("Enter")))
+    row = page.get_by_test_id("waypoint-row").nth(1).locator(".label").inner_text()
+    assert f"({FREE_SPOT[0]:.2f}, -1.10," in row
+    assert page.evaluate("document.activeElement.id") == "fields-y"
+    assert page.errors == []  # type: ignore[attr-defined]

@@ -297,7 +297,26 @@ function renderList() {
     list.appendChild(li);
   });
 }
-function field(form, label, value, kind, onChange, placeholder) {
+// The forms are built once for their set of fields and then updated in place: rebuilding
+// them at every edit replaced the input being typed in, so Enter or Tab dropped the focus
+// and the next value typed went nowhere. The input that has the focus keeps what the user
+// typed; the others show the mission.
+function fillForm(form, specs) {
+  const shape = specs.map((s) => s.label).join("|");
+  if (form.dataset.shape !== shape) {
+    form.textContent = "";
+    form.dataset.shape = shape;
+    form.onChange = {};
+    for (const s of specs) field(form, s);
+  }
+  for (const s of specs) {
+    const input = $(`${form.id}-${s.key}`);
+    form.onChange[s.key] = s.onChange;  // closes over the current document (undo replaces it)
+    if (input !== document.activeElement) input.value = s.value ?? "";
+    if (s.placeholder !== undefined) input.placeholder = s.placeholder;
+  }
+}
+function field(form, { key, label, kind }) {
   const l = document.createElement("label");
   l.textContent = label;
   let input;
@@ -308,17 +327,18 @@ function field(form, label, value, kind, onChange, placeholder) {
       o.value = option; o.textContent = option || "(default)";
       input.appendChild(o);
     }
-    input.value = value ?? "";
   } else {
     input = document.createElement("input");
     input.type = kind; if (kind === "number") input.step = "any";
-    input.value = value ?? "";
-    if (placeholder !== undefined) input.placeholder = placeholder;
   }
   input.name = label;
-  input.addEventListener("change", () => onChange(input.value));
+  input.id = `${form.id}-${key}`;
+  l.htmlFor = input.id;  // every input named by its visible label
+  input.addEventListener("change", () => form.onChange[key](input.value));
   form.append(l, input);
 }
+// Enter commits a field (its change event); it never submits a form (nothing to send).
+for (const id of ["fields", "settings", "defaults"]) $(id).addEventListener("submit", (e) => e.preventDefault());
 function fieldValue(kind, text) {
   if (text === "") return undefined;
   if (kind === "number") { const n = Number(text); return Number.isFinite(n) ? n : text; }
@@ -329,49 +349,46 @@ function renderEditor() {
   $("editor").hidden = !w;
   if (!w) return;
   $("editor-title").textContent = `${S.selected + 1}`;
-  const form = $("fields");
-  form.textContent = "";
   const defaults = S.doc.defaults || {};
-  for (const [key, kind] of WP_FIELDS) {
+  fillForm($("fields"), WP_FIELDS.map(([key, kind]) => {
     const unit = S.units[key] ? ` [${S.units[key]}]` : "";
     const inherited = defaults[key] === undefined || defaults[key] === null ? "" : `default ${defaults[key]}`;
-    field(form, key + unit, w[key], kind, (text) => edit(() => {
-      const value = fieldValue(kind, text);
-      if (value === undefined) delete w[key]; else w[key] = value;
-    }), ["x", "y", "yaw", "name"].includes(key) ? "" : inherited);
-  }
+    return { key, label: key + unit, kind, value: w[key], placeholder: ["x", "y", "yaw", "name"].includes(key) ? "" : inherited,
+      onChange: (text) => edit(() => {
+        const value = fieldValue(kind, text);
+        if (value === undefined) delete w[key]; else w[key] = value;
+      }) };
+  }));
 }
 function renderSettings() {
-  const form = $("settings");
-  if (form.contains(document.activeElement)) return;
-  form.textContent = "";
-  field(form, "loops", S.doc.loops, "text", (t) => edit(() => {
-    S.doc.loops = t === "forever" ? "forever" : fieldValue("number", t) ?? 1;
-  }));
-  field(form, "frame", S.doc.frame, "text", (t) => edit(() => { S.doc.frame = t; }));
-  field(form, "map", S.doc.map, "text", (t) => edit(() => { S.doc.map = t || null; }));
   const st = S.doc.start;
-  field(form, "start x,y,yaw", okPoint(st) ? `${st.x}, ${st.y}, ${st.yaw ?? 0}` : "", "text", (t) => edit(() => {
-    const parts = t.split(",").map((v) => Number(v.trim()));
-    if (!t.trim()) delete S.doc.start;
-    else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
-  }), "none: the simulator's");
+  fillForm($("settings"), [
+    { key: "loops", label: "loops", kind: "text", value: S.doc.loops, onChange: (t) => edit(() => {
+      S.doc.loops = t === "forever" ? "forever" : fieldValue("number", t) ?? 1;
+    }) },
+    { key: "frame", label: "frame", kind: "text", value: S.doc.frame, onChange: (t) => edit(() => { S.doc.frame = t; }) },
+    { key: "map", label: "map", kind: "text", value: S.doc.map, onChange: (t) => edit(() => { S.doc.map = t || null; }) },
+    { key: "start", label: "start x,y,yaw", kind: "text", value: okPoint(st) ? `${st.x}, ${st.y}, ${st.yaw ?? 0}` : "",
+      placeholder: "none: the simulator's", onChange: (t) => edit(() => {
+        const parts = t.split(",").map((v) => Number(v.trim()));
+        if (!t.trim()) delete S.doc.start;
+        else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
+      }) },
+  ]);
 }
 function renderDefaults() {
-  const form = $("defaults");
-  if (form.contains(document.activeElement)) return;
-  form.textContent = "";
   const defaults = S.doc.defaults || {};
-  for (const [key, kind] of DEFAULT_FIELDS) {
+  fillForm($("defaults"), DEFAULT_FIELDS.map(([key, kind]) => {
     const unit = S.units[key] ? ` [${S.units[key]}]` : "";
-    const shown = typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key];
-    field(form, key + unit, shown, kind, (text) => edit(() => {
-      const d = { ...(S.doc.defaults || {}) };
-      const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
-      if (value === undefined) delete d[key]; else d[key] = value;
-      S.doc.defaults = d;
-    }), "loader's default");
-  }
+    return { key, label: key + unit, kind, placeholder: "loader's default",
+      value: typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key],
+      onChange: (text) => edit(() => {
+        const d = { ...(S.doc.defaults || {}) };
+        const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
+        if (value === undefined) delete d[key]; else d[key] = value;
+        S.doc.defaults = d;
+      }) };
+  }));
 }
 function placeStart(on) {
   S.placingStart = on;
