@@ -509,3 +509,78 @@ def test_typing_in_a_field_keeps_the_focus_and_every_value(page: Any) -> None:
     assert f"({FREE_SPOT[0]:.2f}, -1.10," in row
     assert page.evaluate("document.activeElement.id") == "fields-y"
     assert page.errors == []  # type: ignore[attr-defined]
+
+
+def _row_xy(page: Any, i: int) -> tuple[float, float]:
+    """The (x, y) a waypoint's row shows."""
+    label = page.get_by_test_id("waypoint-row").nth(i).locator(".label").inner_text()
+    x, y = label.split("(")[1].split(",")[:2]
+    return float(x), float(y)
+
+
+def _focused(page: Any) -> str:
+    return str(page.evaluate("document.activeElement.getAttribute('aria-label') || ''"))
+
+
+def test_the_mission_is_edited_with_the_keyboard_alone(page: Any) -> None:
+    """Rows and markers take the focus and Enter selects; the arrows move the selected
+    waypoint (5 cm, Shift 50 cm), each press one undoable edit; ▲ ▼ ✕ say what they do;
+    the focus stays where the user is through every redraw."""
+    rows = page.get_by_test_id("waypoint-row")
+    x0, y0 = _row_xy(page, 2)
+    rows.nth(2).locator("button.pick").focus()
+    page.keyboard.press("Enter")
+    assert page.locator("#editor-title").inner_text() == "3"
+    checked_after(page, lambda: page.keyboard.press("ArrowRight"))
+    checked_after(page, lambda: page.keyboard.press("Shift+ArrowUp"))
+    assert _row_xy(page, 2) == pytest.approx((x0 + 0.05, y0 + 0.5), abs=1e-9)
+    assert page.evaluate("document.activeElement.dataset.focus") == "row-2"
+    checked_after(page, lambda: page.keyboard.press("Control+z"))  # one press, one step
+    assert _row_xy(page, 2) == pytest.approx((x0 + 0.05, y0), abs=1e-9)
+    checked_after(page, lambda: page.keyboard.press("Control+Shift+z"))
+    assert _row_xy(page, 2) == pytest.approx((x0 + 0.05, y0 + 0.5), abs=1e-9)
+
+    # A marker: focused, Enter selects it, the arrows move it, it keeps the focus.
+    marker = page.get_by_test_id("waypoint-marker").nth(3)
+    assert (marker.get_attribute("aria-label") or "").startswith("waypoint 4")
+    marker.focus()
+    page.keyboard.press("Enter")
+    assert page.locator("#editor-title").inner_text() == "4"
+    x3, y3 = _row_xy(page, 3)
+    checked_after(page, lambda: page.keyboard.press("ArrowDown"))
+    assert _row_xy(page, 3) == pytest.approx((x3, y3 - 0.05), abs=1e-9)
+    assert _focused(page).startswith("waypoint 4") and "selected" in _focused(page)
+
+    # ▲ ▼ ✕ are named by what they do; the focus follows the moved waypoint.
+    up = rows.nth(3).get_by_role("button", name="move waypoint 4 up")
+    assert rows.nth(3).get_by_role("button", name="delete waypoint 4").count() == 1
+    name = rows.nth(3).locator(".label").inner_text()
+    up.focus()
+    checked_after(page, lambda: page.keyboard.press("Enter"))
+    assert rows.nth(2).locator(".label").inner_text() == name
+    assert _focused(page) == "move waypoint 3 up"
+    # Delete removes the selected waypoint; the focus goes to the row in its place.
+    rows.nth(2).locator("button.pick").focus()
+    checked_after(page, lambda: page.keyboard.press("Delete"))
+    assert rows.count() == 6 and name not in rows.all_inner_texts()
+    assert page.evaluate("document.activeElement.dataset.focus") == "row-2"
+
+    # Every input and choice on the page has a name (its label, or aria-label).
+    unnamed = page.evaluate(
+        "[...document.querySelectorAll('input, select')]"
+        ".filter((el) => !el.labels.length && !el.getAttribute('aria-label')).map((el) => el.id)"
+    )
+    assert unnamed == []
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_the_run_status_is_announced(page: Any) -> None:
+    live = page.get_by_test_id("run-live")
+    assert live.get_attribute("aria-live") == "polite"
+    page.get_by_test_id("run").click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'completed'",
+        timeout=60_000,
+    )
+    assert "completed" in live.inner_text() and "7/7 reached" in live.inner_text()
+    assert page.errors == []  # type: ignore[attr-defined]

@@ -139,25 +139,53 @@ map.on("click", (e) => {
     S.selected = S.doc.waypoints.length - 1;
   });
 });
+// Keys of the page (docs/studio.md, Keyboard). In a field (input, select) the field keeps
+// its own keys: Ctrl+Z there is the browser's undo of the typed text, and the arrows step
+// a number or a choice; the mission's undo is one Tab away (↶ ↷) or after Esc. On the map
+// itself the arrows pan (Leaflet's); on a waypoint's row or marker they move it.
+// Listened to in the capture phase: a focused marker's keys would otherwise reach
+// Leaflet's keyboard handler, which pans the map with the same arrows.
+const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] };
+const STEP_M = 0.05, BIG_STEP_M = 0.5;
 document.addEventListener("keydown", (e) => {
-  if (e.target.closest("input, select")) return;
+  if (e.target.closest("input, select, textarea, dialog")) {
+    if (e.key === "Escape" && e.target.closest("#fields, #settings, #defaults")) e.target.blur();
+    return;
+  }
   const z = e.key.toLowerCase() === "z" && (e.ctrlKey || e.metaKey);
+  const busy = (S.run && !S.run.done) || S.replay;
   if (z && !e.shiftKey) { e.preventDefault(); restore(S.undo, S.redo); }
   else if ((z && e.shiftKey) || (e.key.toLowerCase() === "y" && e.ctrlKey)) { e.preventDefault(); restore(S.redo, S.undo); }
-  else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null) {
+  else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null && !busy) {
     e.preventDefault();
     if (S.selected === "start") edit(() => { delete S.doc.start; S.selected = null; });
     else removeWaypoint(S.selected);
   }
+  else if (e.key in ARROWS && !e.ctrlKey && !e.altKey && !e.metaKey && e.target !== $("map") && !busy) {
+    const p = selectedPoint();
+    if (!p || !okPoint(p)) return;
+    e.preventDefault();
+    e.stopPropagation();
+    const [dx, dy] = ARROWS[e.key], step = e.shiftKey ? BIG_STEP_M : STEP_M;
+    // One edit per key press: each Ctrl+Z takes one step back.
+    edit(() => { p.x = round(p.x + dx * step, 2); p.y = round(p.y + dy * step, 2); });
+    say(`${S.selected === "start" ? "start pose" : `waypoint ${S.selected + 1}`} at (${p.x.toFixed(2)}, ${p.y.toFixed(2)})`);
+  }
   else if (e.key === "Escape") placeStart(false);
-});
+}, true);
 $("undo").onclick = () => restore(S.undo, S.redo);
 $("redo").onclick = () => restore(S.redo, S.undo);
 function removeWaypoint(i) {
+  // The focus goes to the row that takes the removed one's place (else the one before).
+  const n = S.doc.waypoints.length - 1;
+  S.focusNext = n > 0 ? `row-${Math.min(i, n - 1)}` : null;
   edit(() => { S.doc.waypoints.splice(i, 1); S.selected = null; });
 }
 function moveWaypoint(from, to) {
   if (to < 0 || to >= S.doc.waypoints.length || from === to) return;
+  // The focus follows the moved waypoint (its ▲ or ▼ again: press on to move it on).
+  const part = (document.activeElement?.dataset?.focus || "").split("-")[2];
+  S.focusNext = part ? `row-${to}-${part}` : `row-${to}`;
   edit(() => {
     const [w] = S.doc.waypoints.splice(from, 1);
     S.doc.waypoints.splice(to, 0, w);
@@ -178,7 +206,26 @@ function wpIcon(w, i, extra) {
     html: `<div class="arrow" style="transform: rotate(${-yaw}deg)"></div><div class="dot">${i === null ? "S" : i + 1}</div>`,
   });
 }
+// The element with the focus is rebuilt by render (a row, a marker): the focus goes to the
+// new one in its place (data-focus), as a keyboard user would lose it otherwise.
 function render() {
+  const focused = S.focusNext !== undefined ? S.focusNext : document.activeElement?.dataset?.focus;
+  S.focusNext = undefined;
+  renderAll();
+  if (!focused) return;
+  const el = document.querySelector(`[data-focus="${focused}"]`);
+  if (el && el !== document.activeElement) el.focus({ preventScroll: true });
+}
+// Enter or Space on a focused marker selects it, as a click does.
+function keySelects(marker, select) {
+  marker.getElement().addEventListener("keydown", (e) => {
+    if (e.key !== "Enter" && e.key !== " ") return;
+    e.preventDefault();
+    e.stopPropagation();
+    select();
+  });
+}
+function renderAll() {
   S.layers.markers.forEach((m) => m.remove());
   S.layers.markers = [];
   if (S.layers.start) S.layers.start.remove();
@@ -188,6 +235,9 @@ function render() {
     S.layers.start = L.marker(ll(start.x, start.y), { icon: wpIcon(start, null, "start"), draggable: true,
       title: "start pose", zIndexOffset: -100 }).addTo(map);
     S.layers.start.getElement().dataset.testid = "start-marker";
+    S.layers.start.getElement().dataset.focus = "marker-start";
+    S.layers.start.getElement().setAttribute("aria-label", `start pose${S.selected === "start" ? ", selected" : ""}`);
+    keySelects(S.layers.start, () => { S.selected = "start"; render(); });
     S.layers.start.on("dragstart", () => { S.selected = "start"; drawHandle(); });
     S.layers.start.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, start.yaw || 0); });
     S.layers.start.on("dragend", (e) => {
@@ -203,6 +253,9 @@ function render() {
     const el = m.getElement();
     el.dataset.testid = "waypoint-marker";
     el.dataset.index = String(i);
+    el.dataset.focus = `marker-${i}`;
+    el.setAttribute("aria-label", `waypoint ${i + 1}${w.name ? ` ${w.name}` : ""}${i === S.selected ? ", selected" : ""}`);
+    keySelects(m, () => { S.selected = i; render(); });
     m.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = i; render(); });
     m.on("dragstart", () => { S.selected = i; drawHandle(); });
     m.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, w.yaw || 0); });
@@ -280,12 +333,21 @@ function renderList() {
     if (problemsOf(i).length) li.classList.add("bad");
     const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
     const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
-    li.innerHTML = `<span class="num"></span><span class="label"></span><span class="state"></span>
-      <button title="move up">▲</button><button title="move down">▼</button><button title="delete">✕</button>`;
+    // The row's waypoint is a button (Tab reaches it, Enter or Space selects it); ▲ ▼ ✕
+    // are named for a screen reader by what they do, not by their glyph.
+    li.innerHTML = `<button type="button" class="pick"><span class="num"></span><span class="label"></span><span class="state"></span></button>
+      <button type="button" class="up">▲</button><button type="button" class="down">▼</button><button type="button" class="del">✕</button>`;
     li.querySelector(".num").textContent = i + 1;
     li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
     li.querySelector(".state").textContent = state;
-    const [up, down, del] = li.querySelectorAll("button");
+    const [pick, up, down, del] = li.querySelectorAll("button");
+    pick.dataset.focus = `row-${i}`;
+    if (i === S.selected) pick.setAttribute("aria-current", "true");
+    for (const [button, part, what] of [[up, "up", "move waypoint # up"], [down, "down", "move waypoint # down"], [del, "del", "delete waypoint #"]]) {
+      button.dataset.focus = `row-${i}-${part}`;
+      button.setAttribute("aria-label", what.replace("#", String(i + 1)));
+      button.title = what.replace(" #", "");
+    }
     up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
     down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
     del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
@@ -403,8 +465,13 @@ function renderProblems() {
   for (const p of S.problems) {
     const li = document.createElement("li");
     li.dataset.testid = "problem";
-    li.textContent = p.text;
-    if (p.waypoint !== null) li.onclick = () => { S.selected = p.waypoint; render(); };
+    if (p.waypoint !== null) {
+      // A button: the keyboard reaches it and Enter selects the waypoint concerned.
+      const b = document.createElement("button");
+      b.type = "button"; b.className = "problem-link"; b.textContent = p.text;
+      b.onclick = () => { S.selected = p.waypoint; render(); };
+      li.appendChild(b);
+    } else li.textContent = p.text;
     list.appendChild(li);
   }
   $("problem-count").textContent = S.problems.length ? `(${S.problems.length})` : "";
@@ -668,10 +735,15 @@ function drawReplay(t) {
 }
 
 // ---- running -----------------------------------------------------------------------------
-function setStatus(status, text) {
+// The visible status holds the clock (20 updates a second); the live region, read out by
+// screen readers, says only what changed: the status and the waypoint driven to.
+function setStatus(status, text, spoken) {
   const el = $("run-status");
   el.dataset.status = status;
   el.textContent = text;
+  const live = $("run-live");
+  const words = spoken ?? text;
+  if (live.textContent !== words) live.textContent = words;
 }
 $("run").onclick = async () => {
   const speed = $("speed").value;
@@ -735,7 +807,7 @@ function drawRun(run, before) {
   let text = `${run.status} · ${run.clock_s.toFixed(1)} s${at}${loop}`;
   if (run.done && run.report) text = `${run.status} · ${run.report.totals.reached}/${run.report.totals.visits} reached · ${run.report.totals.duration_s} s`;
   if (run.error) text += ` · ${run.error}`;
-  setStatus(run.status, text);
+  setStatus(run.status, text, run.done ? text : `${run.status}${at}${loop}`);
   updateRowStates(run.waypoints, before);
   if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); loadRuns(); }
 }
