@@ -26,6 +26,8 @@ from navseq.mission import load_mission
 
 REPO = Path(__file__).resolve().parents[1]
 CHROMIUM = os.environ.get("NAVSEQ_CHROMIUM", "/usr/bin/chromium")
+#: axe-core, from npm (tests/browser-deps, installed by scripts/install-browser.sh).
+AXE = REPO / "tests/browser-deps/node_modules/axe-core/axe.min.js"
 PILLAR = (1.0, 0.0)  # an occupied cell: the west face of the arena's middle east pillar
 FREE_SPOT = (0.55, -1.2)
 
@@ -583,4 +585,65 @@ def test_the_run_status_is_announced(page: Any) -> None:
         timeout=60_000,
     )
     assert "completed" in live.inner_text() and "7/7 reached" in live.inner_text()
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def _axe_or_skip() -> None:
+    if not AXE.exists():
+        reason = (
+            f"no axe-core at {AXE.relative_to(REPO)} "
+            "(scripts/install-browser.sh runs npm ci in tests/browser-deps)"
+        )
+        if os.environ.get("NAVSEQ_EXPECT_BROWSER") == "1":  # CI installed it: must not skip
+            pytest.fail(reason)
+        pytest.skip(reason)
+
+
+def serious_violations(page: Any) -> list[str]:
+    """axe-core's violations of impact serious or critical on the page as it is now, one
+    line each: the rule, what it asks, and the elements concerned."""
+    if not page.evaluate("typeof window.axe !== 'undefined'"):
+        page.add_script_tag(path=str(AXE))  # the harness's contexts bypass the CSP
+    found = page.evaluate(
+        """async () => (await axe.run(document, { resultTypes: ["violations"] })).violations
+            .filter((v) => v.impact === "serious" || v.impact === "critical")
+            .map((v) => `${v.id} (${v.impact}): ${v.help}: `
+                + v.nodes.slice(0, 5).map((n) => n.target.join(" ")).join(", "))"""
+    )
+    return list(found)
+
+
+def test_no_serious_accessibility_violation_in_the_editor_a_run_and_a_replay(
+    page: Any,
+) -> None:
+    """axe-core finds no serious or critical violation on the opened editor (a waypoint
+    selected, its form shown), during a run and after it, and during a replay."""
+    _axe_or_skip()
+    page.get_by_test_id("waypoint-row").nth(1).click()
+    assert serious_violations(page) == []
+
+    page.locator("#speed").select_option("1")
+    page.get_by_test_id("run").click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'running'",
+        timeout=30_000,
+    )
+    page.locator("#pause").click()  # held still while it is looked at
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'paused'",
+        timeout=10_000,
+    )
+    assert serious_violations(page) == []
+    page.get_by_test_id("stop").click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'stopped'",
+        timeout=30_000,
+    )
+    assert "stopped" in page.get_by_test_id("run-live").inner_text()
+    assert serious_violations(page) == []
+
+    page.wait_for_function("document.getElementById('runs').options.length > 1")
+    page.get_by_test_id("runs").select_option(index=1)
+    page.wait_for_selector("[data-testid=replay-waypoint]")
+    assert serious_violations(page) == []
     assert page.errors == []  # type: ignore[attr-defined]
