@@ -347,9 +347,27 @@ def test_import_the_tutorials_launch_file_and_export_one(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:
     _, workspace, _ = studio
-    prompts = accept_dialogs(page, ["tutorial_params.yaml", "tour.launch"])
-    checked_after(page, lambda: page.locator("#import").click())
-    assert "tutorial_move_base_seq.launch" in prompts[0]  # the choice lists every format
+    accept_dialogs(page, ["tour.launch"])
+    page.get_by_test_id("import").click()
+    dialog = page.get_by_test_id("import-dialog")
+    dialog.wait_for(state="visible")
+    about = dialog.inner_text()
+    for kind in ("navseq YAML", "tutorial launch file", "rosparam YAML", "CSV"):
+        assert kind in about  # each format said
+    files = page.get_by_test_id("import-file")
+    launch = files.and_(page.locator("[data-path='tutorial_move_base_seq.launch']"))
+    assert "launch file" in launch.inner_text()  # the choice lists every format, by its kind
+    assert "CSV" in files.and_(page.locator("[data-path='recorded.csv']")).inner_text()
+    # Escape closes it and gives the focus back to Import; Enter on a file imports it.
+    assert page.evaluate("document.activeElement.dataset.testid") == "import-file"
+    page.keyboard.press("Escape")
+    assert not dialog.is_visible()
+    assert page.evaluate("document.activeElement.id") == "import"
+    page.keyboard.press("Enter")
+    dialog.wait_for(state="visible")
+    page.locator("[data-testid=import-file][data-path='tutorial_params.yaml']").focus()
+    checked_after(page, lambda: page.keyboard.press("Enter"))
+    assert not dialog.is_visible()
     assert page.get_by_test_id("waypoint-marker").count() == 4
     assert "imported 4 waypoints" in page.locator("#message").inner_text()
     # Still on the arena's map: its pre-flight runs on the imported points.
@@ -617,10 +635,15 @@ def test_no_serious_accessibility_violation_in_the_editor_a_run_and_a_replay(
     page: Any,
 ) -> None:
     """axe-core finds no serious or critical violation on the opened editor (a waypoint
-    selected, its form shown), during a run and after it, and during a replay."""
+    selected, its form shown; the Import dialog open), during a run and after it, and
+    during a replay."""
     _axe_or_skip()
     page.get_by_test_id("waypoint-row").nth(1).click()
     assert serious_violations(page) == []
+    page.get_by_test_id("import").click()  # the Import dialog, open
+    page.get_by_test_id("import-dialog").wait_for(state="visible")
+    assert serious_violations(page) == []
+    page.keyboard.press("Escape")
 
     page.locator("#speed").select_option("1")
     page.get_by_test_id("run").click()
@@ -646,4 +669,26 @@ def test_no_serious_accessibility_violation_in_the_editor_a_run_and_a_replay(
     page.get_by_test_id("runs").select_option(index=1)
     page.wait_for_selector("[data-testid=replay-waypoint]")
     assert serious_violations(page) == []
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_a_dropped_file_opens_the_import_list_on_it(page: Any) -> None:
+    """The studio imports files by their path under its folders, which a dropped file
+    does not give: the drop opens the Import list, focused on the file of that name,
+    and the page stays (the browser would otherwise leave it to show the file)."""
+    page.evaluate(
+        """() => {
+            const dt = new DataTransfer();
+            dt.items.add(new File(["x,y,z,qx,qy,qz,qw"], "recorded.csv", { type: "text/csv" }));
+            document.getElementById("waypoints").dispatchEvent(
+                new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
+        }"""
+    )
+    dialog = page.get_by_test_id("import-dialog")
+    dialog.wait_for(state="visible")
+    assert "recorded.csv was dropped" in dialog.inner_text()
+    page.wait_for_function("document.activeElement.dataset.path === 'recorded.csv'")
+    checked_after(page, lambda: page.keyboard.press("Enter"))
+    assert "imported" in page.locator("#message").inner_text()
+    assert page.get_by_test_id("waypoint-row").count() > 0
     assert page.errors == []  # type: ignore[attr-defined]

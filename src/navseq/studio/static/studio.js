@@ -540,11 +540,49 @@ $("save-as").onclick = () => {
 };
 
 // ---- import / export ---------------------------------------------------------------------
-async function importFile() {
+// Import: a dialog listing the files the studio may read (GET /api/files), each with its
+// format, chosen with the keyboard (Tab, Enter) or the mouse. The format is told by the
+// file's ending: a .yaml is a navseq mission or the tutorial's rosparam file, which only
+// the loader tells apart when it reads it.
+function formatOf(path) {
+  const ext = path.slice(path.lastIndexOf(".")).toLowerCase();
+  if (ext === ".launch" || ext === ".xml") return "launch file";
+  if (ext === ".csv") return "CSV";
+  return "YAML: navseq or rosparam";
+}
+async function openImport(note, preferred) {
+  const dialog = $("import-dialog");
+  const list = $("import-files");
+  $("import-note").textContent = note || "";
+  list.textContent = "";
   const files = await api("GET", "/api/files");
-  const names = files.ok ? files.data.missions : [];
-  const path = window.prompt(`Import the waypoints of (navseq YAML, the tutorial's launch file, rosparam YAML or CSV):\n${names.join("\n")}`, names[0] || "");
-  if (!path) return;
+  if (!files.ok) { say(files.data.error, true); return; }
+  const names = files.data.missions;
+  if (!names.length) $("import-note").textContent = "No file the loader reads under the studio's folders.";
+  for (const path of names) {
+    const li = document.createElement("li");
+    const b = document.createElement("button");
+    b.type = "button";
+    b.dataset.testid = "import-file";
+    b.dataset.path = path;
+    const name = document.createElement("span");
+    name.textContent = path;
+    const format = document.createElement("span");
+    format.className = "format";
+    format.textContent = formatOf(path);
+    b.append(name, format);
+    b.onclick = () => { dialog.close(); importFile(path); };
+    li.appendChild(b);
+    list.appendChild(li);
+  }
+  if (!dialog.open) dialog.showModal();
+  // The first file (or the one named by a dropped file) has the focus: Enter imports it.
+  const first = list.querySelector(preferred ? `button[data-path$="/${CSS.escape(preferred)}"], button[data-path="${CSS.escape(preferred)}"]` : "button")
+    || list.querySelector("button");
+  if (first) first.focus();
+}
+async function importFile(path) {
+  if ((S.run && !S.run.done) || S.replay) return;
   const answer = await api("POST", "/api/import", { path });
   if (!answer.ok) {
     const first = (answer.data.problems || [])[0];
@@ -593,7 +631,21 @@ async function exportLaunch() {
   const left = answer.data.left_out;
   say(`exported ${answer.data.path}${left.length ? `; the tutorial's format has no place for: ${left.join("; ")}` : ""}`);
 }
-$("import").onclick = importFile;
+$("import").onclick = () => openImport();
+// A file dropped on the page: the studio imports only files it reads itself, by their path
+// under its folders (POST /api/import takes a path, not a file's text), and the browser
+// does not tell a dropped file's path. The drop opens the Import list instead (the file of
+// the same name, if listed, has the focus), and the browser does not leave the page to
+// show the file.
+const dropsFile = (e) => e.dataTransfer && [...e.dataTransfer.types].includes("Files");
+document.addEventListener("dragover", (e) => { if (dropsFile(e)) e.preventDefault(); });
+document.addEventListener("drop", (e) => {
+  if (!dropsFile(e)) return;
+  e.preventDefault();
+  const file = e.dataTransfer.files[0];
+  if (!file) return;
+  openImport(`${file.name} was dropped: the studio reads files only under its folders, by their path; choose it below if it is there.`, file.name);
+});
 $("export").onclick = exportLaunch;
 
 // ---- past runs: replay with a time slider ------------------------------------------------
