@@ -585,6 +585,14 @@ def test_the_mission_is_edited_with_the_keyboard_alone(page: Any) -> None:
     assert rows.count() == 6 and name not in rows.all_inner_texts()
     assert page.evaluate("document.activeElement.dataset.focus") == "row-2"
 
+    # A waypoint added with a click on the map moves with the arrows at once (the click
+    # focused the map, whose own arrows pan it: not while a waypoint is selected).
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    checked_after(page, lambda: page.keyboard.press("ArrowLeft"))
+    assert _row_xy(page, 6) == pytest.approx((FREE_SPOT[0] - 0.05, FREE_SPOT[1]), abs=1e-9)
+    page.keyboard.press("Escape")  # deselects: the form closes
+    assert page.locator("#editor").is_hidden()
+
     # Every input and choice on the page has a name (its label, or aria-label).
     unnamed = page.evaluate(
         "[...document.querySelectorAll('input, select')]"

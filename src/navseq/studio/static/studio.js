@@ -141,10 +141,11 @@ map.on("click", (e) => {
 });
 // Keys of the page (docs/studio.md, Keyboard). In a field (input, select) the field keeps
 // its own keys: Ctrl+Z there is the browser's undo of the typed text, and the arrows step
-// a number or a choice; the mission's undo is one Tab away (↶ ↷) or after Esc. On the map
-// itself the arrows pan (Leaflet's); on a waypoint's row or marker they move it.
-// Listened to in the capture phase: a focused marker's keys would otherwise reach
-// Leaflet's keyboard handler, which pans the map with the same arrows.
+// a number or a choice; the mission's undo is one Tab away (↶ ↷) or after Esc. With a
+// waypoint selected the arrows move it, wherever the focus is (a click on the map that
+// adds one focuses the map); with none, the focused map pans (Leaflet's keys); Esc
+// deselects. Listened to in the capture phase, so that Leaflet's keyboard handler (on
+// the document while the map has the focus) does not pan the map with the same arrows.
 const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] };
 const STEP_M = 0.05, BIG_STEP_M = 0.5;
 document.addEventListener("keydown", (e) => {
@@ -161,7 +162,7 @@ document.addEventListener("keydown", (e) => {
     if (S.selected === "start") edit(() => { delete S.doc.start; S.selected = null; });
     else removeWaypoint(S.selected);
   }
-  else if (e.key in ARROWS && !e.ctrlKey && !e.altKey && !e.metaKey && e.target !== $("map") && !busy) {
+  else if (e.key in ARROWS && !e.ctrlKey && !e.altKey && !e.metaKey && !busy) {
     const p = selectedPoint();
     if (!p || !okPoint(p)) return;
     e.preventDefault();
@@ -171,14 +172,19 @@ document.addEventListener("keydown", (e) => {
     edit(() => { p.x = round(p.x + dx * step, 2); p.y = round(p.y + dy * step, 2); });
     say(`${S.selected === "start" ? "start pose" : `waypoint ${S.selected + 1}`} at (${p.x.toFixed(2)}, ${p.y.toFixed(2)})`);
   }
-  else if (e.key === "Escape") placeStart(false);
+  else if (e.key === "Escape") {
+    if (S.placingStart) placeStart(false);
+    else if (S.selected !== null) { S.selected = null; render(); }
+  }
 }, true);
 $("undo").onclick = () => restore(S.undo, S.redo);
 $("redo").onclick = () => restore(S.redo, S.undo);
 function removeWaypoint(i) {
-  // The focus goes to the row that takes the removed one's place (else the one before).
+  // The focus goes to the row (or the marker, from a marker) that takes the removed one's
+  // place, else the one before.
   const n = S.doc.waypoints.length - 1;
-  S.focusNext = n > 0 ? `row-${Math.min(i, n - 1)}` : null;
+  const kind = (document.activeElement?.dataset?.focus || "").startsWith("marker-") ? "marker" : "row";
+  S.focusNext = n > 0 ? `${kind}-${Math.min(i, n - 1)}` : null;
   edit(() => { S.doc.waypoints.splice(i, 1); S.selected = null; });
 }
 function moveWaypoint(from, to) {
