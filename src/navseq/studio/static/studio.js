@@ -306,6 +306,9 @@ function drawHandle() {
   S.layers.handle = L.marker(ll(w.x + r * Math.cos(yaw), w.y + r * Math.sin(yaw)), {
     icon: L.divIcon({ className: "yaw-handle", iconSize: [12, 12] }), draggable: true, zIndexOffset: 1000,
     title: "drag to set the heading",
+    // Not a Tab stop: it is worked by dragging only; the keyboard sets the heading in the
+    // form's yaw field.
+    keyboard: false,
   }).addTo(map);
   S.layers.handle.getElement().dataset.testid = "yaw-handle";
   S.layers.handle.on("click", (e) => L.DomEvent.stopPropagation(e));
