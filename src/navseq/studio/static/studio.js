@@ -139,25 +139,59 @@ map.on("click", (e) => {
     S.selected = S.doc.waypoints.length - 1;
   });
 });
+// Keys of the page (docs/studio.md, Keyboard). In a field (input, select) the field keeps
+// its own keys: Ctrl+Z there is the browser's undo of the typed text, and the arrows step
+// a number or a choice; the mission's undo is one Tab away (↶ ↷) or after Esc. With a
+// waypoint selected the arrows move it, wherever the focus is (a click on the map that
+// adds one focuses the map); with none, the focused map pans (Leaflet's keys); Esc
+// deselects. Listened to in the capture phase, so that Leaflet's keyboard handler (on
+// the document while the map has the focus) does not pan the map with the same arrows.
+const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowDown: [0, -1] };
+const STEP_M = 0.05, BIG_STEP_M = 0.5;
 document.addEventListener("keydown", (e) => {
-  if (e.target.closest("input, select")) return;
+  if (e.target.closest("input, select, textarea, dialog")) {
+    if (e.key === "Escape" && e.target.closest("#fields, #settings, #defaults")) e.target.blur();
+    return;
+  }
   const z = e.key.toLowerCase() === "z" && (e.ctrlKey || e.metaKey);
+  const busy = (S.run && !S.run.done) || S.replay;
   if (z && !e.shiftKey) { e.preventDefault(); restore(S.undo, S.redo); }
   else if ((z && e.shiftKey) || (e.key.toLowerCase() === "y" && e.ctrlKey)) { e.preventDefault(); restore(S.redo, S.undo); }
-  else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null) {
+  else if ((e.key === "Delete" || e.key === "Backspace") && S.selected !== null && !busy) {
     e.preventDefault();
     if (S.selected === "start") edit(() => { delete S.doc.start; S.selected = null; });
     else removeWaypoint(S.selected);
   }
-  else if (e.key === "Escape") placeStart(false);
-});
+  else if (e.key in ARROWS && !e.ctrlKey && !e.altKey && !e.metaKey && !busy) {
+    const p = selectedPoint();
+    if (!p || !okPoint(p)) return;
+    e.preventDefault();
+    e.stopPropagation();
+    const [dx, dy] = ARROWS[e.key], step = e.shiftKey ? BIG_STEP_M : STEP_M;
+    // One edit per key press: each Ctrl+Z takes one step back.
+    edit(() => { p.x = round(p.x + dx * step, 2); p.y = round(p.y + dy * step, 2); });
+    say(`${S.selected === "start" ? "start pose" : `waypoint ${S.selected + 1}`} at (${p.x.toFixed(2)}, ${p.y.toFixed(2)})`);
+  }
+  else if (e.key === "Escape") {
+    if (S.placingStart) placeStart(false);
+    else if (S.selected !== null) { S.selected = null; render(); }
+  }
+}, true);
 $("undo").onclick = () => restore(S.undo, S.redo);
 $("redo").onclick = () => restore(S.redo, S.undo);
 function removeWaypoint(i) {
+  // The focus goes to the row (or the marker, from a marker) that takes the removed one's
+  // place, else the one before.
+  const n = S.doc.waypoints.length - 1;
+  const kind = (document.activeElement?.dataset?.focus || "").startsWith("marker-") ? "marker" : "row";
+  S.focusNext = n > 0 ? `${kind}-${Math.min(i, n - 1)}` : null;
   edit(() => { S.doc.waypoints.splice(i, 1); S.selected = null; });
 }
 function moveWaypoint(from, to) {
   if (to < 0 || to >= S.doc.waypoints.length || from === to) return;
+  // The focus follows the moved waypoint (its ▲ or ▼ again: press on to move it on).
+  const part = (document.activeElement?.dataset?.focus || "").split("-")[2];
+  S.focusNext = part ? `row-${to}-${part}` : `row-${to}`;
   edit(() => {
     const [w] = S.doc.waypoints.splice(from, 1);
     S.doc.waypoints.splice(to, 0, w);
@@ -178,7 +212,26 @@ function wpIcon(w, i, extra) {
     html: `<div class="arrow" style="transform: rotate(${-yaw}deg)"></div><div class="dot">${i === null ? "S" : i + 1}</div>`,
   });
 }
+// The element with the focus is rebuilt by render (a row, a marker): the focus goes to the
+// new one in its place (data-focus), as a keyboard user would lose it otherwise.
 function render() {
+  const focused = S.focusNext !== undefined ? S.focusNext : document.activeElement?.dataset?.focus;
+  S.focusNext = undefined;
+  renderAll();
+  if (!focused) return;
+  const el = document.querySelector(`[data-focus="${focused}"]`);
+  if (el && el !== document.activeElement) el.focus({ preventScroll: true });
+}
+// Enter or Space on a focused marker selects it, as a click does.
+function keySelects(marker, select) {
+  marker.getElement().addEventListener("keydown", (e) => {
+    if (e.key !== "Enter" && e.key !== " ") return;
+    e.preventDefault();
+    e.stopPropagation();
+    select();
+  });
+}
+function renderAll() {
   S.layers.markers.forEach((m) => m.remove());
   S.layers.markers = [];
   if (S.layers.start) S.layers.start.remove();
@@ -188,6 +241,9 @@ function render() {
     S.layers.start = L.marker(ll(start.x, start.y), { icon: wpIcon(start, null, "start"), draggable: true,
       title: "start pose", zIndexOffset: -100 }).addTo(map);
     S.layers.start.getElement().dataset.testid = "start-marker";
+    S.layers.start.getElement().dataset.focus = "marker-start";
+    S.layers.start.getElement().setAttribute("aria-label", `start pose${S.selected === "start" ? ", selected" : ""}`);
+    keySelects(S.layers.start, () => { S.selected = "start"; render(); });
     S.layers.start.on("dragstart", () => { S.selected = "start"; drawHandle(); });
     S.layers.start.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, start.yaw || 0); });
     S.layers.start.on("dragend", (e) => {
@@ -203,6 +259,9 @@ function render() {
     const el = m.getElement();
     el.dataset.testid = "waypoint-marker";
     el.dataset.index = String(i);
+    el.dataset.focus = `marker-${i}`;
+    el.setAttribute("aria-label", `waypoint ${i + 1}${w.name ? ` ${w.name}` : ""}${i === S.selected ? ", selected" : ""}`);
+    keySelects(m, () => { S.selected = i; render(); });
     m.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = i; render(); });
     m.on("dragstart", () => { S.selected = i; drawHandle(); });
     m.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, w.yaw || 0); });
@@ -247,6 +306,9 @@ function drawHandle() {
   S.layers.handle = L.marker(ll(w.x + r * Math.cos(yaw), w.y + r * Math.sin(yaw)), {
     icon: L.divIcon({ className: "yaw-handle", iconSize: [12, 12] }), draggable: true, zIndexOffset: 1000,
     title: "drag to set the heading",
+    // Not a Tab stop: it is worked by dragging only; the keyboard sets the heading in the
+    // form's yaw field.
+    keyboard: false,
   }).addTo(map);
   S.layers.handle.getElement().dataset.testid = "yaw-handle";
   S.layers.handle.on("click", (e) => L.DomEvent.stopPropagation(e));
@@ -280,12 +342,21 @@ function renderList() {
     if (problemsOf(i).length) li.classList.add("bad");
     const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
     const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
-    li.innerHTML = `<span class="num"></span><span class="label"></span><span class="state"></span>
-      <button title="move up">▲</button><button title="move down">▼</button><button title="delete">✕</button>`;
+    // The row's waypoint is a button (Tab reaches it, Enter or Space selects it); ▲ ▼ ✕
+    // are named for a screen reader by what they do, not by their glyph.
+    li.innerHTML = `<button type="button" class="pick"><span class="num"></span><span class="label"></span><span class="state"></span></button>
+      <button type="button" class="up">▲</button><button type="button" class="down">▼</button><button type="button" class="del">✕</button>`;
     li.querySelector(".num").textContent = i + 1;
     li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
     li.querySelector(".state").textContent = state;
-    const [up, down, del] = li.querySelectorAll("button");
+    const [pick, up, down, del] = li.querySelectorAll("button");
+    pick.dataset.focus = `row-${i}`;
+    if (i === S.selected) pick.setAttribute("aria-current", "true");
+    for (const [button, part, what] of [[up, "up", "move waypoint # up"], [down, "down", "move waypoint # down"], [del, "del", "delete waypoint #"]]) {
+      button.dataset.focus = `row-${i}-${part}`;
+      button.setAttribute("aria-label", what.replace("#", String(i + 1)));
+      button.title = what.replace(" #", "");
+    }
     up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
     down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
     del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
@@ -297,7 +368,26 @@ function renderList() {
     list.appendChild(li);
   });
 }
-function field(form, label, value, kind, onChange, placeholder) {
+// The forms are built once for their set of fields and then updated in place: rebuilding
+// them at every edit replaced the input being typed in, so Enter or Tab dropped the focus
+// and the next value typed went nowhere. The input that has the focus keeps what the user
+// typed; the others show the mission.
+function fillForm(form, specs) {
+  const shape = specs.map((s) => s.label).join("|");
+  if (form.dataset.shape !== shape) {
+    form.textContent = "";
+    form.dataset.shape = shape;
+    form.onChange = {};
+    for (const s of specs) field(form, s);
+  }
+  for (const s of specs) {
+    const input = $(`${form.id}-${s.key}`);
+    form.onChange[s.key] = s.onChange;  // closes over the current document (undo replaces it)
+    if (input !== document.activeElement) input.value = s.value ?? "";
+    if (s.placeholder !== undefined) input.placeholder = s.placeholder;
+  }
+}
+function field(form, { key, label, kind }) {
   const l = document.createElement("label");
   l.textContent = label;
   let input;
@@ -308,17 +398,18 @@ function field(form, label, value, kind, onChange, placeholder) {
       o.value = option; o.textContent = option || "(default)";
       input.appendChild(o);
     }
-    input.value = value ?? "";
   } else {
     input = document.createElement("input");
     input.type = kind; if (kind === "number") input.step = "any";
-    input.value = value ?? "";
-    if (placeholder !== undefined) input.placeholder = placeholder;
   }
   input.name = label;
-  input.addEventListener("change", () => onChange(input.value));
+  input.id = `${form.id}-${key}`;
+  l.htmlFor = input.id;  // every input named by its visible label
+  input.addEventListener("change", () => form.onChange[key](input.value));
   form.append(l, input);
 }
+// Enter commits a field (its change event); it never submits a form (nothing to send).
+for (const id of ["fields", "settings", "defaults"]) $(id).addEventListener("submit", (e) => e.preventDefault());
 function fieldValue(kind, text) {
   if (text === "") return undefined;
   if (kind === "number") { const n = Number(text); return Number.isFinite(n) ? n : text; }
@@ -329,49 +420,46 @@ function renderEditor() {
   $("editor").hidden = !w;
   if (!w) return;
   $("editor-title").textContent = `${S.selected + 1}`;
-  const form = $("fields");
-  form.textContent = "";
   const defaults = S.doc.defaults || {};
-  for (const [key, kind] of WP_FIELDS) {
+  fillForm($("fields"), WP_FIELDS.map(([key, kind]) => {
     const unit = S.units[key] ? ` [${S.units[key]}]` : "";
     const inherited = defaults[key] === undefined || defaults[key] === null ? "" : `default ${defaults[key]}`;
-    field(form, key + unit, w[key], kind, (text) => edit(() => {
-      const value = fieldValue(kind, text);
-      if (value === undefined) delete w[key]; else w[key] = value;
-    }), ["x", "y", "yaw", "name"].includes(key) ? "" : inherited);
-  }
+    return { key, label: key + unit, kind, value: w[key], placeholder: ["x", "y", "yaw", "name"].includes(key) ? "" : inherited,
+      onChange: (text) => edit(() => {
+        const value = fieldValue(kind, text);
+        if (value === undefined) delete w[key]; else w[key] = value;
+      }) };
+  }));
 }
 function renderSettings() {
-  const form = $("settings");
-  if (form.contains(document.activeElement)) return;
-  form.textContent = "";
-  field(form, "loops", S.doc.loops, "text", (t) => edit(() => {
-    S.doc.loops = t === "forever" ? "forever" : fieldValue("number", t) ?? 1;
-  }));
-  field(form, "frame", S.doc.frame, "text", (t) => edit(() => { S.doc.frame = t; }));
-  field(form, "map", S.doc.map, "text", (t) => edit(() => { S.doc.map = t || null; }));
   const st = S.doc.start;
-  field(form, "start x,y,yaw", okPoint(st) ? `${st.x}, ${st.y}, ${st.yaw ?? 0}` : "", "text", (t) => edit(() => {
-    const parts = t.split(",").map((v) => Number(v.trim()));
-    if (!t.trim()) delete S.doc.start;
-    else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
-  }), "none: the simulator's");
+  fillForm($("settings"), [
+    { key: "loops", label: "loops", kind: "text", value: S.doc.loops, onChange: (t) => edit(() => {
+      S.doc.loops = t === "forever" ? "forever" : fieldValue("number", t) ?? 1;
+    }) },
+    { key: "frame", label: "frame", kind: "text", value: S.doc.frame, onChange: (t) => edit(() => { S.doc.frame = t; }) },
+    { key: "map", label: "map", kind: "text", value: S.doc.map, onChange: (t) => edit(() => { S.doc.map = t || null; }) },
+    { key: "start", label: "start x,y,yaw", kind: "text", value: okPoint(st) ? `${st.x}, ${st.y}, ${st.yaw ?? 0}` : "",
+      placeholder: "none: the simulator's", onChange: (t) => edit(() => {
+        const parts = t.split(",").map((v) => Number(v.trim()));
+        if (!t.trim()) delete S.doc.start;
+        else S.doc.start = { x: parts[0], y: parts[1], yaw: parts[2] || 0 };
+      }) },
+  ]);
 }
 function renderDefaults() {
-  const form = $("defaults");
-  if (form.contains(document.activeElement)) return;
-  form.textContent = "";
   const defaults = S.doc.defaults || {};
-  for (const [key, kind] of DEFAULT_FIELDS) {
+  fillForm($("defaults"), DEFAULT_FIELDS.map(([key, kind]) => {
     const unit = S.units[key] ? ` [${S.units[key]}]` : "";
-    const shown = typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key];
-    field(form, key + unit, shown, kind, (text) => edit(() => {
-      const d = { ...(S.doc.defaults || {}) };
-      const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
-      if (value === undefined) delete d[key]; else d[key] = value;
-      S.doc.defaults = d;
-    }), "loader's default");
-  }
+    return { key, label: key + unit, kind, placeholder: "loader's default",
+      value: typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key],
+      onChange: (text) => edit(() => {
+        const d = { ...(S.doc.defaults || {}) };
+        const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
+        if (value === undefined) delete d[key]; else d[key] = value;
+        S.doc.defaults = d;
+      }) };
+  }));
 }
 function placeStart(on) {
   S.placingStart = on;
@@ -386,8 +474,13 @@ function renderProblems() {
   for (const p of S.problems) {
     const li = document.createElement("li");
     li.dataset.testid = "problem";
-    li.textContent = p.text;
-    if (p.waypoint !== null) li.onclick = () => { S.selected = p.waypoint; render(); };
+    if (p.waypoint !== null) {
+      // A button: the keyboard reaches it and Enter selects the waypoint concerned.
+      const b = document.createElement("button");
+      b.type = "button"; b.className = "problem-link"; b.textContent = p.text;
+      b.onclick = () => { S.selected = p.waypoint; render(); };
+      li.appendChild(b);
+    } else li.textContent = p.text;
     list.appendChild(li);
   }
   $("problem-count").textContent = S.problems.length ? `(${S.problems.length})` : "";
@@ -456,11 +549,49 @@ $("save-as").onclick = () => {
 };
 
 // ---- import / export ---------------------------------------------------------------------
-async function importFile() {
+// Import: a dialog listing the files the studio may read (GET /api/files), each with its
+// format, chosen with the keyboard (Tab, Enter) or the mouse. The format is told by the
+// file's ending: a .yaml is a navseq mission or the tutorial's rosparam file, which only
+// the loader tells apart when it reads it.
+function formatOf(path) {
+  const ext = path.slice(path.lastIndexOf(".")).toLowerCase();
+  if (ext === ".launch" || ext === ".xml") return "launch file";
+  if (ext === ".csv") return "CSV";
+  return "YAML: navseq or rosparam";
+}
+async function openImport(note, preferred) {
+  const dialog = $("import-dialog");
+  const list = $("import-files");
+  $("import-note").textContent = note || "";
+  list.textContent = "";
   const files = await api("GET", "/api/files");
-  const names = files.ok ? files.data.missions : [];
-  const path = window.prompt(`Import the waypoints of (navseq YAML, the tutorial's launch file, rosparam YAML or CSV):\n${names.join("\n")}`, names[0] || "");
-  if (!path) return;
+  if (!files.ok) { say(files.data.error, true); return; }
+  const names = files.data.missions;
+  if (!names.length) $("import-note").textContent = "No file the loader reads under the studio's folders.";
+  for (const path of names) {
+    const li = document.createElement("li");
+    const b = document.createElement("button");
+    b.type = "button";
+    b.dataset.testid = "import-file";
+    b.dataset.path = path;
+    const name = document.createElement("span");
+    name.textContent = path;
+    const format = document.createElement("span");
+    format.className = "format";
+    format.textContent = formatOf(path);
+    b.append(name, format);
+    b.onclick = () => { dialog.close(); importFile(path); };
+    li.appendChild(b);
+    list.appendChild(li);
+  }
+  if (!dialog.open) dialog.showModal();
+  // The first file (or the one named by a dropped file) has the focus: Enter imports it.
+  const first = list.querySelector(preferred ? `button[data-path$="/${CSS.escape(preferred)}"], button[data-path="${CSS.escape(preferred)}"]` : "button")
+    || list.querySelector("button");
+  if (first) first.focus();
+}
+async function importFile(path) {
+  if ((S.run && !S.run.done) || S.replay) return;
   const answer = await api("POST", "/api/import", { path });
   if (!answer.ok) {
     const first = (answer.data.problems || [])[0];
@@ -509,7 +640,21 @@ async function exportLaunch() {
   const left = answer.data.left_out;
   say(`exported ${answer.data.path}${left.length ? `; the tutorial's format has no place for: ${left.join("; ")}` : ""}`);
 }
-$("import").onclick = importFile;
+$("import").onclick = () => openImport();
+// A file dropped on the page: the studio imports only files it reads itself, by their path
+// under its folders (POST /api/import takes a path, not a file's text), and the browser
+// does not tell a dropped file's path. The drop opens the Import list instead (the file of
+// the same name, if listed, has the focus), and the browser does not leave the page to
+// show the file.
+const dropsFile = (e) => e.dataTransfer && [...e.dataTransfer.types].includes("Files");
+document.addEventListener("dragover", (e) => { if (dropsFile(e)) e.preventDefault(); });
+document.addEventListener("drop", (e) => {
+  if (!dropsFile(e)) return;
+  e.preventDefault();
+  const file = e.dataTransfer.files[0];
+  if (!file) return;
+  openImport(`${file.name} was dropped: the studio reads files only under its folders, by their path; choose it below if it is there.`, file.name);
+});
 $("export").onclick = exportLaunch;
 
 // ---- past runs: replay with a time slider ------------------------------------------------
@@ -651,10 +796,15 @@ function drawReplay(t) {
 }
 
 // ---- running -----------------------------------------------------------------------------
-function setStatus(status, text) {
+// The visible status holds the clock (20 updates a second); the live region, read out by
+// screen readers, says only what changed: the status and the waypoint driven to.
+function setStatus(status, text, spoken) {
   const el = $("run-status");
   el.dataset.status = status;
   el.textContent = text;
+  const live = $("run-live");
+  const words = spoken ?? text;
+  if (live.textContent !== words) live.textContent = words;
 }
 $("run").onclick = async () => {
   const speed = $("speed").value;
@@ -719,7 +869,7 @@ function drawRun(run, before) {
   let text = `${run.status} · ${run.clock_s.toFixed(1)} s${at}${loop}${eta}`;
   if (run.done && run.report) text = `${run.status} · ${run.report.totals.reached}/${run.report.totals.visits} reached · ${run.report.totals.duration_s} s`;
   if (run.error) text += ` · ${run.error}`;
-  setStatus(run.status, text);
+  setStatus(run.status, text, run.done ? text : `${run.status}${at}${loop}`);
   updateRowStates(run.waypoints, before);
   if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); loadRuns(); }
 }
