@@ -184,7 +184,7 @@ def test_the_global_map_is_taken_when_nobody_publishes_the_namespaced_one() -> N
     catch.offer("/map", "global")
     began = time.monotonic()
     assert catch.wait(5.0, lambda topic: topic == "/map") == ("/map", "global")
-    assert time.monotonic() - began < 1.0
+    assert time.monotonic() - began < 4.0  # not the 5 s timeout: nobody was waited for
 
 
 def test_a_published_namespaced_map_is_waited_for_then_the_global_one_is_taken() -> None:
