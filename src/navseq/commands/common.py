@@ -99,14 +99,19 @@ def costmap_for_robot(grid: OccupancyGrid, robot: RobotProfile | None = None) ->
     return Costmap.from_grid(grid, costmap_params_of(robot or DEFAULT_PROFILE))
 
 
-def legs_on_map(map_path: Path | None, robot: RobotProfile) -> Legs:
+def legs_on_map(
+    map_path: Path | None,
+    robot: RobotProfile,
+    costmaps: Callable[[Path, RobotProfile], Costmap] | None = None,
+) -> Legs:
     """The legs a mission's route is made of: planned on ``map_path``'s costmap for
-    ``robot``, or straight lines when there is no map."""
+    ``robot``, or straight lines when there is no map. ``costmaps`` builds (or recalls)
+    the costmap; by default the map is read and inflated here."""
     from navseq.route.legs import LegPlanner, StraightLegs
 
     if map_path is None:
         return StraightLegs()
-    return LegPlanner(costmap_for_map(map_path, robot))
+    return LegPlanner((costmaps or costmap_for_map)(map_path, robot))
 
 
 def add_robot_option(parser: argparse.ArgumentParser) -> None:

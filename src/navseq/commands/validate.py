@@ -9,6 +9,7 @@ others in the file have problems. Exit 0 when there is nothing to report, 2 othe
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -51,10 +52,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from navseq.commands.common import choose_robot, require_file
+    from navseq.commands.common import choose_robot, costmap_for_map, require_file
     from navseq.errors import MissionErrors
     from navseq.mission.robot_format import robot_from_option
 
+    # The pre-flight and the ETA's plans use one costmap: inflating a large map is
+    # most of what validate --map costs.
+    costmaps = functools.cache(costmap_for_map)
     # Every problem of every input, in one list: a bad --map or --robot does not hide
     # the mission's problems, nor the other way round.
     option_errors: list[NavseqError] = []
@@ -80,6 +84,7 @@ def run(args: argparse.Namespace) -> int:
             map_path=args.map,
             start=args.start,
             robot=args.robot,
+            costmaps=costmaps,
             tasks=task_options_of(args),
         )
     if errors:
@@ -107,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
 
         robot = choose_robot(args.robot, mission)
         start = args.start if args.start is not None else mission.start
-        prediction = predict_legs(mission, legs_on_map(map_path, robot), robot, start)
+        legs = legs_on_map(map_path, robot, costmaps)
+        prediction = predict_legs(mission, legs, robot, start)
         for line in prediction_lines(prediction, has_start=start is not None):
             print(line, file=sys.stdout)
     return 0
