@@ -9,6 +9,10 @@ and prints one JSON object on its last stdout line: what it saw. Verbs:
 - ``waypoints X,Y,YAW ...``: a ``follow_waypoints`` goal;
 - ``path X,Y,YAW``: ``compute_path_to_pose`` from the robot;
 - ``map``: subscribes to ``map`` late, transient local, like RViz or a costmap;
+- ``behavior KIND``: a goal to the behaviour server's ``spin`` (``--value`` radians),
+  ``backup`` / ``drive_on_heading`` (``--value`` metres at ``--speed``, ``--target-y``),
+  or ``wait`` (``--value`` seconds), ``--allowance`` seconds of time allowance; says how
+  far the robot turned and moved (its ``odom -> base`` transform on ``/tf``);
 - ``ready``: the lifecycle ``get_state`` of bt_navigator and amcl, then an
   ``initialpose`` and the ``amcl_pose`` that follows, then a clear-costmap call — what
   nav2_simple_commander's ``waitUntilNav2Active`` and ``clearAllCostmaps`` do.
@@ -30,16 +34,21 @@ from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from lifecycle_msgs.srv import GetState
 from nav2_msgs.action import (
+    BackUp,
     ComputePathToPose,
+    DriveOnHeading,
     FollowWaypoints,
     NavigateThroughPoses,
     NavigateToPose,
+    Spin,
+    Wait,
 )
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from tf2_msgs.msg import TFMessage
 
 STATUS = {
     GoalStatus.STATUS_SUCCEEDED: "SUCCEEDED",
@@ -92,6 +101,8 @@ def run_goal(node: Node, args: argparse.Namespace, action: Any, name_: str, goal
             "number_of_recoveries",
             "number_of_poses_remaining",
             "current_waypoint",
+            "angular_distance_traveled",
+            "distance_traveled",
         ):
             if hasattr(fb, field):
                 entry[field] = getattr(fb, field)
@@ -119,7 +130,7 @@ def run_goal(node: Node, args: argparse.Namespace, action: Any, name_: str, goal
             lambda m: speeds.append((time.monotonic(), abs(m.twist.twist.linear.x))),
             50,
         )
-        moving = feedback[-1]["x"] if feedback else None
+        moving = feedback[-1].get("x") if feedback else None
         response = wait(node, handle.cancel_goal_async(), args.timeout)
         canceled_at = time.monotonic()
         out["cancel_accepted"] = len(response.goals_canceling) == 1
@@ -193,6 +204,53 @@ def late_map(node: Node, args: argparse.Namespace) -> dict:
     }
 
 
+def behavior(node: Node, args: argparse.Namespace) -> dict:
+    """One behaviour goal (see the module doc) and the robot's motion in ``odom``."""
+    from builtin_interfaces.msg import Duration
+
+    kind = args.poses[0]
+    allowance = Duration(sec=int(args.allowance), nanosec=int(args.allowance % 1 * 1e9))
+    if kind == "spin":
+        action, goal = Spin, Spin.Goal(target_yaw=args.value, time_allowance=allowance)
+    elif kind == "wait":
+        seconds = Duration(sec=int(args.value), nanosec=int(args.value % 1 * 1e9))
+        action, goal = Wait, Wait.Goal(time=seconds)
+    else:
+        action = BackUp if kind == "backup" else DriveOnHeading
+        goal = action.Goal(speed=args.speed, time_allowance=allowance)
+        goal.target.x, goal.target.y = args.value, args.target_y
+    poses: list[tuple[float, float, float]] = []
+
+    def on_tf(message: TFMessage) -> None:
+        # odom -> base: Nav2's loopback simulator publishes odom only while moving.
+        for transform in message.transforms:
+            if transform.header.frame_id.endswith("odom") and "base" in transform.child_frame_id:
+                t, q = transform.transform.translation, transform.transform.rotation
+                poses.append((t.x, t.y, 2 * math.atan2(q.z, q.w)))
+
+    node.create_subscription(TFMessage, "/tf", on_tf, 100)
+    end = time.monotonic() + args.timeout
+    while not poses and time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    if not poses:
+        raise SystemExit("no odom -> base transform on /tf")
+    before = poses[-1]
+    started = time.monotonic()
+    out = run_goal(node, args, action, kind, goal)
+    out["took"] = time.monotonic() - started
+    settle = time.monotonic() + 1.0
+    while time.monotonic() < settle:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    after = poses[-1]
+    out["moved"] = math.hypot(after[0] - before[0], after[1] - before[1])
+    # Forward (+) or backward (-) along the heading the robot started with.
+    out["advanced"] = (after[0] - before[0]) * math.cos(before[2]) + (
+        after[1] - before[1]
+    ) * math.sin(before[2])
+    out["turned"] = math.remainder(after[2] - before[2], math.tau)
+    return out
+
+
 def ready(node: Node, args: argparse.Namespace) -> dict:
     out: dict[str, Any] = {}
     for server in ("bt_navigator", "amcl"):
@@ -236,6 +294,7 @@ VERBS = {
     "path": path,
     "map": late_map,
     "ready": ready,
+    "behavior": behavior,
 }
 
 
@@ -248,6 +307,10 @@ def main() -> int:
     parser.add_argument("--delay", type=float, default=0.0)
     parser.add_argument("--cancel-after", type=float)
     parser.add_argument("--timeout", type=float, default=60.0)
+    parser.add_argument("--value", type=float, default=0.0)
+    parser.add_argument("--speed", type=float, default=0.0)
+    parser.add_argument("--target-y", type=float, default=0.0)
+    parser.add_argument("--allowance", type=float, default=10.0)
     args = parser.parse_args()
     rclpy.init()
     node = Node(f"navseq_test_{args.verb}")

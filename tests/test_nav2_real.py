@@ -23,7 +23,9 @@ from typing import Any
 import pytest
 
 from cli_support import NAVSEQ, TURTLEBOT3_MAP, write_mission
+from nav2_behavior_cases import CASES, BehaviorCase
 from nav2_real_support import RealNav2, nav2_missing_reason
+from test_ros2_sim import client_command
 
 pytestmark = [pytest.mark.ros2, pytest.mark.slow]
 
@@ -265,3 +267,23 @@ def test_preflight_checks_the_map_nav2_publishes_before_anything_moves(
     # The arena's pillars are unknown inside (as the map file says): not a place to drive to.
     assert "1 problem found" in result.stderr and "waypoint 2 'pillar'" in result.stderr
     assert not (tmp_path / "out").exists()  # nothing written, nothing moved
+
+
+@pytest.mark.parametrize("case", CASES, ids=[case.name for case in CASES])
+def test_the_real_behaviour_server_answers_as_the_stand_in_does(
+    placed: RealNav2, case: BehaviorCase
+) -> None:
+    """``tests/nav2_behavior_cases.py`` against Nav2's own behaviour server: the stand-in's
+    tests hold the same table, so a difference fails one side."""
+    done = subprocess.run(
+        client_command("behavior", (case.kind,), {"timeout": 60, **case.options}),
+        env=placed.env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout.strip().splitlines()[-1])
+    shown = {key: value for key, value in seen.items() if key != "feedback"}
+    assert (seen["status"], seen["error_code"]) == (case.status, case.error_code), shown
+    assert case.check(seen), shown

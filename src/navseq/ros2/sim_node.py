@@ -16,6 +16,10 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   preempts the running one, which ends ABORTED, as in Nav2;
 - ``follow_waypoints`` (result ``missed_waypoints``; parameter ``stop_on_failure``,
   default true as in Nav2) and ``compute_path_to_pose``;
+- the behaviour server's ``spin``, ``backup``, ``drive_on_heading`` and ``wait``, acting
+  on the simulated robot with Nav2's collision check ahead, time allowance and error
+  codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
+  runs, a navigation goal's controller waits;
 - topics ``odom`` (``nav_msgs/Odometry``), ``/tf`` (``map -> odom -> base_footprint``),
   ``/tf_static`` (``base_footprint -> base_link``), ``map`` (transient local, as
   map_server), ``plan`` (``nav_msgs/Path``), ``cmd_vel`` (the velocity the controller
@@ -109,6 +113,7 @@ from navseq.commands.sim_options import add_arguments, config_from_args
 from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
+from navseq.ros2.behavior_actions import BehaviorActions
 from navseq.ros2.messages import (
     duration_msg,
     grid_msg,
@@ -285,6 +290,7 @@ class SimNode:
                 callback_group=group,
             ),
         ]
+        self._behaviors = BehaviorActions(node, self.standin, self._lock, group)
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.

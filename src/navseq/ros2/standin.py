@@ -55,6 +55,7 @@ import numpy.typing as npt
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.sim.behaviors import BehaviorServer
 from navseq.sim.navserver import CONTROL_FAILED, NavState
 from navseq.sim.world import SimWorld
 
@@ -201,6 +202,7 @@ class Nav2StandIn:
         # A robot driven from outside (teleop on cmd_vel) follows its commands for longer
         # than the world's two steps; while a goal runs a command comes every step.
         world.body.cmd_vel_timeout = max(world.body.cmd_vel_timeout, 0.5)
+        self.behaviors = BehaviorServer()
 
     # -- goals -----------------------------------------------------------------------
 
@@ -288,6 +290,7 @@ class Nav2StandIn:
             self.waypoints = None
         if self.active is not None:
             self.active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, why))
+        self.behaviors.abort_all(self.time, why)
         self._stop()
 
     # -- simulation ------------------------------------------------------------------
@@ -299,7 +302,12 @@ class Nav2StandIn:
         if task is not None and task.ending is None:
             self._replan_if_due(task)
             self._pass_through(task)
-        if world.server.state is NavState.ACTIVE:
+        if self.behaviors.running:
+            # A behaviour has the robot; a navigation goal's controller waits meanwhile.
+            body = world.body
+            body.command(*self.behaviors.step(self.time, body.pose, body.collides))
+            body.step(world.dt)
+        elif world.server.state is NavState.ACTIVE:
             world.step()
         else:
             world.body.step(world.dt)  # idle: a teleop command, or braking to rest
@@ -314,8 +322,9 @@ class Nav2StandIn:
             self._advance_waypoints(run)
 
     def command(self, v: float, w: float) -> bool:
-        """A velocity command from outside (teleop); ignored (False) while a goal runs."""
-        if self.world.server.state is NavState.ACTIVE:
+        """A velocity command from outside (teleop); ignored (False) while a goal or a
+        behaviour runs."""
+        if self.world.server.state is NavState.ACTIVE or self.behaviors.running:
             return False
         self.world.body.command(v, w)
         return True

@@ -1,0 +1,116 @@
+"""Nav2's behaviour server actions on the ROS 2 simulator node: spin, backup,
+drive_on_heading and wait (``nav2_msgs/action/...``), as nav2_bringup names them.
+
+The rules are :class:`navseq.sim.behaviors.BehaviorServer`'s (the stand-in steps it with
+the robot); this module only translates goals, feedback (every cycle: radians turned,
+metres driven, time left) and results (``total_elapsed_time``, ``error_code`` — the
+action's own constant for the error's name — and, as in Nav2, no ``error_msg``).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from nav2_msgs.action import BackUp, DriveOnHeading, Spin, Wait
+from rclpy.action import ActionServer, CancelResponse
+from rclpy.node import Node
+
+from navseq.ros2.messages import duration_msg
+from navseq.ros2.standin import Nav2StandIn
+from navseq.sim.behaviors import Behavior, BehaviorEnding, BehaviorGoal, Outcome
+
+#: Wall seconds between two feedback messages (Nav2's behaviours publish every cycle, 10 Hz).
+FEEDBACK_PERIOD = 0.1
+
+_ACTIONS: dict[Behavior, Any] = {
+    Behavior.SPIN: Spin,
+    Behavior.BACKUP: BackUp,
+    Behavior.DRIVE_ON_HEADING: DriveOnHeading,
+    Behavior.WAIT: Wait,
+}
+
+
+class BehaviorActions:
+    """The four behaviour action servers on ``node``, acting on ``standin`` under ``lock``."""
+
+    def __init__(self, node: Node, standin: Nav2StandIn, lock: threading.Lock, group: Any) -> None:
+        self._node = node
+        self._standin = standin
+        self._lock = lock
+        self._log = node.get_logger()
+        self.servers = [
+            ActionServer(
+                node,
+                action,
+                behavior.value,
+                execute_callback=self._executor(behavior, action),
+                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
+                callback_group=group,
+            )
+            for behavior, action in _ACTIONS.items()
+        ]
+
+    def _executor(self, behavior: Behavior, action: Any) -> Callable[[Any], Any]:
+        return lambda handle: self._execute(handle, behavior, action)
+
+    def _execute(self, handle: Any, behavior: Behavior, action: Any) -> Any:
+        with self._lock:
+            goal = self._start(behavior, handle.request)
+        self._log.info(f"Running {behavior.value}")
+        feedback = action.Feedback()
+        while not goal.done.wait(FEEDBACK_PERIOD):
+            if handle.is_cancel_requested:
+                with self._lock:
+                    self._standin.behaviors.cancel(goal, self._standin.time)
+                break
+            _set_feedback(feedback, behavior, goal.progress)
+            handle.publish_feedback(feedback)
+        ending = goal.ending
+        assert ending is not None
+        return self._result(handle, action, behavior, ending)
+
+    def _start(self, behavior: Behavior, request: Any) -> BehaviorGoal:
+        server, now = self._standin.behaviors, self._standin.time
+        if behavior is Behavior.SPIN:
+            allowance = _seconds(request.time_allowance)
+            return server.spin(now, float(request.target_yaw), allowance)
+        if behavior is Behavior.WAIT:
+            return server.wait(now, _seconds(request.time))
+        target = (float(request.target.x), float(request.target.y), float(request.target.z))
+        allowance = _seconds(request.time_allowance)
+        return server.drive(behavior, now, target, float(request.speed), allowance)
+
+    def _result(self, handle: Any, action: Any, behavior: Behavior, ending: BehaviorEnding) -> Any:
+        result = action.Result()
+        result.total_elapsed_time = duration_msg(ending.elapsed)
+        if ending.error:
+            result.error_code = int(getattr(action.Result, ending.error))
+        if ending.log:
+            self._log.warning(f"{behavior.value}: {ending.log}")
+        if ending.outcome is Outcome.SUCCEEDED:
+            handle.succeed()
+            self._log.info(f"{behavior.value} completed successfully")
+        elif ending.outcome is Outcome.CANCELED and handle.is_cancel_requested:
+            handle.canceled()
+        else:
+            handle.abort()
+            self._log.warning(f"{behavior.value} failed")
+        return result
+
+
+def _set_feedback(feedback: Any, behavior: Behavior, progress: float) -> None:
+    if behavior is Behavior.SPIN:
+        feedback.angular_distance_traveled = float(progress)
+    elif behavior is Behavior.WAIT:
+        feedback.time_left = duration_msg(progress)
+    else:
+        feedback.distance_traveled = float(progress)
+
+
+def _seconds(duration: Any) -> float:
+    return float(duration.sec) + float(duration.nanosec) * 1e-9
+
+
+__all__ = ["BehaviorActions"]
