@@ -241,3 +241,14 @@ def test_a_problem_without_a_spot_to_move_to_has_no_fix(client: TestClient) -> N
     document["waypoints"][0]["yaw"] = "north"
     problems = client.post("/api/check", json={"mission": document}).json()["problems"]
     assert problems and all(problem["fix"] is None for problem in problems)
+
+
+def test_a_task_without_a_time_limit_leaves_the_route_without_an_upper_bound(
+    client: TestClient,
+) -> None:
+    document = opened(client)["mission"]
+    document["waypoints"][1]["tasks"] = [{"input": {"prompt": "Load the tray"}}]
+    answer = client.post("/api/check", json={"mission": document})
+    assert answer.status_code == 200  # was a 500: an infinite bound is no JSON number
+    assert answer.json()["upper_bound_s"] is None
+    assert "no upper bound" in answer.json()["estimated_duration"]

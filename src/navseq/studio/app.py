@@ -897,10 +897,12 @@ def _expected_duration(mission: Mission, planner: Legs, robot: RobotProfile) -> 
     expected, upper = prediction.expected_s, prediction.upper_s
     if expected is None:  # a patrol that loops forever
         text = f"~{format_duration(prediction.loop_expected_s)} a loop"
+    elif upper is None or not math.isfinite(upper):  # a task waits without a time limit
+        text = f"~{format_duration(expected)} expected, no upper bound (a task has no timeout)"
     else:
         text = f"~{format_duration(expected)} expected, upper bound {format_duration(upper)}"
     return {
         "estimated_duration": text,
         "expected_duration_s": None if expected is None else round(expected, 1),
-        "upper_bound_s": None if upper is None else round(upper, 1),
+        "upper_bound_s": None if upper is None or not math.isfinite(upper) else round(upper, 1),
     }
