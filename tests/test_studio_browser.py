@@ -725,8 +725,10 @@ def test_tasks_edited_confirmed_in_a_run_and_reported_at_once(
     assert texts == ["1. wait 5 s", "2. input: Load the tray"]
     checked_after(page, lambda: tasks.get_by_label("remove task 1").click())
     assert tasks.locator(".task-text").all_inner_texts() == ["1. input: Load the tray"]
-    marker = page.locator("[data-testid=waypoint-marker][data-index='1'] .wp-icon, "
-                          "[data-testid=waypoint-marker][data-index='1']").first
+    marker = page.locator(
+        "[data-testid=waypoint-marker][data-index='1'] .wp-icon, "
+        "[data-testid=waypoint-marker][data-index='1']"
+    ).first
     assert "tasks" in (marker.get_attribute("class") or "")
     assert page.get_by_test_id("waypoint-row").nth(1).locator(".task-flag").count() == 1
     assert page.get_by_test_id("problem").all_inner_texts() == []
@@ -759,9 +761,12 @@ def test_tasks_edited_confirmed_in_a_run_and_reported_at_once(
     assert serious_violations(page) == []
     assert page.errors == []  # type: ignore[attr-defined]
     # The task is in the page's mission, not yet in the file: a save writes it.
-    assert load_mission(workspace / "examples/turtlebot3_world.yaml").waypoints[1].overrides.get(
-        "tasks"
-    ) is None
+    assert (
+        load_mission(workspace / "examples/turtlebot3_world.yaml")
+        .waypoints[1]
+        .overrides.get("tasks")
+        is None
+    )
 
 
 def test_a_misplaced_waypoint_is_moved_to_the_nearest_free_spot_in_one_click(page: Any) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import time
 from pathlib import Path
 from typing import Any
@@ -19,16 +20,19 @@ from navseq.mission.tasks import InputTask, WaitTask
 from navseq.studio.app import StudioConfig, create_app
 from navseq.studio.runs import LiveView
 from navseq.studio.security import FileRoots
-from test_studio_api import (
-    LOCAL,
-    PILLAR,
-    TOKEN,
-    client,  # noqa: F401  (a fixture)
-    make_client,
-    opened,
-    wait_for_run,
-    workspace,  # noqa: F401  (a fixture)
-)
+from test_studio_api import LOCAL, PILLAR, REPO, TOKEN, make_client, opened, wait_for_run
+
+
+@pytest.fixture
+def workspace(tmp_path: Path) -> Path:
+    shutil.copytree(REPO / "examples", tmp_path / "examples")
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    return tmp_path
+
+
+@pytest.fixture
+def client(workspace: Path) -> TestClient:
+    return make_client(workspace)
 
 
 def tasks_client(workspace: Path, *, allow_run: bool = False) -> TestClient:
@@ -140,7 +144,10 @@ def test_ros_tasks_run_on_the_simulator_only_when_simulated(client: TestClient) 
     refused = client.post("/api/run", json={"mission": document})
     assert refused.status_code == 422
     assert "--simulate-tasks" in refused.json()["problems"][0]["message"]
-    assert client.post("/api/run", json={"mission": document, "simulate_tasks": "on"}).status_code == 400
+    assert (
+        client.post("/api/run", json={"mission": document, "simulate_tasks": "on"}).status_code
+        == 400
+    )
     started = client.post("/api/run", json={"mission": document, "simulate_tasks": True})
     assert started.status_code == 200
     state = wait_for_run(client)

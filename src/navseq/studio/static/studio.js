@@ -1129,11 +1129,13 @@ function showReport(run) {
   const note = document.createElement("div");
   note.textContent = `${run.reason || run.status}; folder ${run.folder}${run.done ? "" : " (drawing the picture…)"}`;
   body.appendChild(note);
-  if (S.reportScrolled !== run.folder) {
+  if (r) body.appendChild(reportTable(r));
+  if (S.reportScrolled !== run.folder) {  // once the table is there: all of it in view
     S.reportScrolled = run.folder;
     $("report").scrollIntoView({ block: "start" });
   }
-  if (!r) return;
+}
+function reportTable(r) {
   const table = document.createElement("table");
   table.innerHTML = "<thead><tr><th>#</th><th>name</th><th>outcome</th><th>tries</th><th>time [s]</th><th>dist [m]</th></tr></thead><tbody></tbody>";
   const tbody = table.querySelector("tbody");
@@ -1152,7 +1154,7 @@ function showReport(run) {
   const tr = document.createElement("tr");
   tr.innerHTML = `<th></th><th>total</th><th>${t.reached} reached</th><th></th><th class="n">${t.duration_s}</th><th class="n">${t.distance_m}</th>`;
   tbody.appendChild(tr);
-  body.appendChild(table);
+  return table;
 }
 
 function reportTaskRow(t) {
