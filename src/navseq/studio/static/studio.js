@@ -503,8 +503,8 @@ function renderProblems() {
 // input's prompt and any task's timeout, adds wait and input tasks, removes and reorders
 // any: the other kinds' values are kept as they are (the server checks them all).
 const TASK_KINDS = ["wait", "wait_for", "input", "snapshot", "call", "publish", "run"];
-// Each kind's timeout when the file gives none (s); null: no limit.
-const TASK_DEFAULT_TIMEOUT = { wait: null, input: null };
+// The kinds without a time limit when the file gives no timeout (the others: 60 s).
+const UNLIMITED_KINDS = ["wait", "input"];
 const taskKind = (t) => (t && typeof t === "object" ? Object.keys(t).find((k) => TASK_KINDS.includes(k)) : undefined);
 // The task in a few words, as navseq says it ("wait 5 s", "input: Load the tray").
 function describeTask(t) {
@@ -643,8 +643,8 @@ function taskRow(box, t, k, count, problem) {
     });
   }
   if (kind) {
-    const fallback = kind in TASK_DEFAULT_TIMEOUT ? "no limit" : "60";
-    taskField(fields, box, k, "timeout [s]", "text", t.timeout === null ? "none" : t.timeout, `${fallback} (kind's default; none: no limit)`, (task, v) => {
+    const fallback = UNLIMITED_KINDS.includes(kind) ? "no limit" : "default 60; none: no limit";
+    taskField(fields, box, k, "timeout [s]", "text", t.timeout === null ? "none" : t.timeout, fallback, (task, v) => {
       if (v === undefined) delete task.timeout;
       else if (String(v).trim().toLowerCase() === "none") task.timeout = null;
       else task.timeout = fieldValue("number", String(v));
