@@ -700,3 +700,92 @@ def test_a_dropped_file_opens_the_import_list_on_it(page: Any) -> None:
     assert "imported" in page.locator("#message").inner_text()
     assert page.get_by_test_id("waypoint-row").count() > 0
     assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_tasks_edited_confirmed_in_a_run_and_reported_at_once(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    """A waypoint gets an input task in its editor (its marker and row show it has
+    tasks), the run stops there and says so, Confirm answers it, and the report is shown,
+    in view, with the task, as soon as the run has written it; axe finds nothing serious
+    on the task editor, the waiting task and the report."""
+    _axe_or_skip()
+    _, workspace, _ = studio
+    page.get_by_test_id("waypoint-row").nth(1).click()
+    tasks = page.get_by_test_id("wp-tasks")
+    checked_after(page, lambda: tasks.get_by_test_id("task-add").select_option("input"))
+    prompt = tasks.locator("input[id$='-prompt']")
+    assert prompt.evaluate("(input) => input === document.activeElement")  # typed at once
+    checked_after(page, lambda: (prompt.fill("Load the tray"), prompt.press("Enter")))
+    assert tasks.get_by_test_id("task").inner_text().startswith("1. input: Load the tray")
+    checked_after(page, lambda: tasks.get_by_test_id("task-add").select_option("wait"))
+    assert tasks.get_by_test_id("task").count() == 2
+    checked_after(page, lambda: tasks.get_by_label("move task 2 up").click())
+    texts = tasks.locator(".task-text").all_inner_texts()
+    assert texts == ["1. wait 5 s", "2. input: Load the tray"]
+    checked_after(page, lambda: tasks.get_by_label("remove task 1").click())
+    assert tasks.locator(".task-text").all_inner_texts() == ["1. input: Load the tray"]
+    marker = page.locator(
+        "[data-testid=waypoint-marker][data-index='1'] .wp-icon, "
+        "[data-testid=waypoint-marker][data-index='1']"
+    ).first
+    assert "tasks" in (marker.get_attribute("class") or "")
+    assert page.get_by_test_id("waypoint-row").nth(1).locator(".task-flag").count() == 1
+    assert page.get_by_test_id("problem").all_inner_texts() == []
+    page.get_by_test_id("legend").locator("summary").click()  # the legend, open
+    assert page.get_by_test_id("legend").locator("li").count() >= 13
+    assert serious_violations(page) == []
+
+    page.get_by_test_id("run").click()
+    confirm = page.get_by_test_id("task-confirm")
+    confirm.wait_for(state="visible", timeout=60_000)
+    assert page.get_by_test_id("run-task").inner_text() == (
+        "waypoint 2: input — Load the tray (Confirm or Refuse)"
+    )
+    assert "waypoint 2: input — Load the tray" in page.get_by_test_id("run-live").inner_text()
+    assert serious_violations(page) == []
+    confirm.click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=report-task]') !== null", timeout=60_000
+    )
+    report = page.locator("#report")
+    assert report.is_visible()
+    box, aside = report.bounding_box(), page.locator("aside").bounding_box()
+    assert aside["y"] <= box["y"] < aside["y"] + aside["height"]  # scrolled into view
+    task_row = page.get_by_test_id("report-task").inner_text()
+    assert "input" in task_row and "succeeded" in task_row and "confirmed in the studio" in task_row
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'completed'",
+        timeout=60_000,
+    )
+    assert serious_violations(page) == []
+    assert page.errors == []  # type: ignore[attr-defined]
+    # The task is in the page's mission, not yet in the file: a save writes it.
+    assert (
+        load_mission(workspace / "examples/turtlebot3_world.yaml")
+        .waypoints[1]
+        .overrides.get("tasks")
+        is None
+    )
+
+
+def test_a_misplaced_waypoint_is_moved_to_the_nearest_free_spot_in_one_click(page: Any) -> None:
+    start = screen_point(page, *FREE_SPOT)
+    checked_after(page, lambda: page.mouse.click(*start))
+    target = screen_point(page, *PILLAR)
+
+    def drag() -> None:
+        page.mouse.move(*start)
+        page.mouse.down()
+        page.mouse.move(*target, steps=12)
+        page.mouse.up()
+
+    checked_after(page, drag)
+    assert page.get_by_test_id("problem").count() == 1
+    checked_after(page, lambda: page.get_by_test_id("fix").click())
+    assert page.get_by_test_id("problem").count() == 0
+    x, y = page.evaluate("[S.doc.waypoints[7].x, S.doc.waypoints[7].y]")
+    assert math.dist((x, y), PILLAR) < 0.5
+    checked_after(page, lambda: page.keyboard.press("Control+z"))  # one undoable edit
+    assert page.get_by_test_id("problem").count() == 1
+    assert page.errors == []  # type: ignore[attr-defined]

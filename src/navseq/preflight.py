@@ -20,7 +20,9 @@ that clear every obstacle by the circumscribed radius, 8-connected as the planne
 moves), so it costs one labelling of the map instead of one plan per leg, and agrees
 with the planner on narrow gaps. Where a waypoint is merely too close to a wall the
 message suggests the nearest spot where the robot fits with ``clearance_margin_m`` to
-spare and that is reachable from the place the robot comes from.
+spare and that is reachable from the place the robot comes from; the problem is then a
+:class:`MisplacedError` carrying that spot (``suggested``), which a face can offer to
+apply in one click (the studio's "move to the nearest free spot").
 """
 
 from __future__ import annotations
@@ -40,6 +42,30 @@ from navseq.sim.footprint import Footprint, footprint_collides
 from navseq.sim.occupancy import OCCUPIED, UNKNOWN, blocked_values
 
 _EIGHT_CONNECTED = np.ones((3, 3), dtype=bool)
+
+
+class MisplacedError(NavseqError):
+    """A waypoint or start pose where the robot cannot stand and turn, with the nearest
+    spot where it can (``suggested``: map x, y in metres), when there is one."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        suggested: tuple[float, float] | None,
+        source: str | None = None,
+        subject: str | None = None,
+    ) -> None:
+        super().__init__(message, source=source, subject=subject)
+        self.suggested = suggested
+
+
+@dataclass(frozen=True)
+class _Placement:
+    """Why the robot cannot be at a point, and the nearest spot where it can (or None)."""
+
+    text: str
+    spot: tuple[float, float] | None = None
 
 
 def check_mission(
@@ -72,7 +98,12 @@ def check_mission(
         if problem:
             position = _format_position(start.x, start.y)
             problems.append(
-                NavseqError(f"{position} {problem}", source=mission.source, subject="start")
+                MisplacedError(
+                    f"{position} {problem.text}",
+                    suggested=problem.spot,
+                    source=mission.source,
+                    subject="start",
+                )
             )
         else:
             start_region = free.region_at(start.x, start.y)
@@ -95,10 +126,18 @@ def check_mission(
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
         if region is None:
-            problem = _placement_problem(
+            placement = _placement_problem(
                 free, waypoint.x, waypoint.y, "the robot cannot turn there", reference
             )
-            problems.append(NavseqError(f"{position} {problem}", source=source, subject=subject))
+            assert placement is not None  # region None: the robot cannot be there
+            problems.append(
+                MisplacedError(
+                    f"{position} {placement.text}",
+                    suggested=placement.spot,
+                    source=source,
+                    subject=subject,
+                )
+            )
             continue
         if previous is not None:
             before, reached = previous
@@ -129,23 +168,25 @@ def _most_common(regions: Sequence[int | None]) -> int | None:
     return max(counts, key=lambda region: counts[region]) if counts else None
 
 
-def _start_problem(free: _FreeRegions, start: Pose2D) -> str | None:
+def _start_problem(free: _FreeRegions, start: Pose2D) -> _Placement | None:
     """Why the robot cannot start at ``start``, or None if it can."""
     problem = _placement_problem(free, start.x, start.y, "the robot cannot turn there", None)
     costmap = free.costmap
     if problem is None or costmap.cost_at(start.x, start.y) in (LETHAL, NO_INFORMATION):
         return problem  # off the map, in an obstacle or in unknown space: said so already
     if footprint_collides(costmap.grid, free.footprint, start):
-        return (
+        hint, spot = free.nearest_hint(start.x, start.y, None)
+        return _Placement(
             "puts the robot's footprint over an obstacle, unknown space or the map edge: "
-            "the robot cannot be there" + free.nearest_hint(start.x, start.y, None)
+            "the robot cannot be there" + hint,
+            spot,
         )
     return problem
 
 
 def _placement_problem(
     free: _FreeRegions, x: float, y: float, consequence: str, from_region: int | None
-) -> str | None:
+) -> _Placement | None:
     """Why the robot centre cannot be at (x, y) and turn there, or None if it can.
 
     ``from_region``: where the robot comes from, so that a suggested spot is reachable.
@@ -153,24 +194,27 @@ def _placement_problem(
     costmap = free.costmap
     if not costmap.grid.contains(x, y):
         xmin, ymin, xmax, ymax = costmap.grid.bounds
-        return (
+        return _Placement(
             f"is outside the map (x {xmin:.2f} .. {xmax:.2f}, y {ymin:.2f} .. {ymax:.2f} m, "
             f"{costmap.grid.source})"
         )
     cost = costmap.cost_at(x, y)
     if cost == LETHAL:
-        return "is inside an obstacle" + free.nearest_hint(x, y, from_region)
-    if cost == NO_INFORMATION:
-        return "is in unmapped space (unknown cells)" + free.nearest_hint(x, y, from_region)
-    clearance = free.clearance_at(x, y)
-    radius = costmap.params.circumscribed_radius
-    if clearance < radius or not costmap.is_free(x, y):
-        return (
+        what = "is inside an obstacle"
+    elif cost == NO_INFORMATION:
+        what = "is in unmapped space (unknown cells)"
+    else:
+        clearance = free.clearance_at(x, y)
+        radius = costmap.params.circumscribed_radius
+        if clearance >= radius and costmap.is_free(x, y):
+            return None
+        what = (
             f"is {clearance:.3f} m from an obstacle, unknown space or the map edge, within "
             f"the robot's circumscribed radius ({radius:.3f} m, {free.robot.name}): "
-            f"{consequence}" + free.nearest_hint(x, y, from_region)
+            f"{consequence}"
         )
-    return None
+    hint, spot = free.nearest_hint(x, y, from_region)
+    return _Placement(what + hint, spot)
 
 
 def _format_position(x: float, y: float) -> str:
@@ -263,8 +307,11 @@ class _FreeRegions:
             nearest = min(nearest, float(np.hypot(d_col, d_row).min()))
         return min(cell_clearance, float(nearest) * resolution)
 
-    def nearest_hint(self, x: float, y: float, from_region: int | None) -> str:
-        """``"; the nearest free spot is at (x, y)"`` or an explanation why there is none.
+    def nearest_hint(
+        self, x: float, y: float, from_region: int | None
+    ) -> tuple[str, tuple[float, float] | None]:
+        """``"; the nearest free spot is at (x, y)"`` and that spot, or an explanation
+        why there is none and None.
 
         The spot leaves the robot room to turn with its clearance margin to spare and,
         when ``from_region`` is known, is reachable from where the robot comes from.
@@ -274,9 +321,14 @@ class _FreeRegions:
             cells = cells[self.labels[cells[:, 0], cells[:, 1]] == from_region]
         if len(cells) == 0:
             if from_region is not None:
-                return "; no spot reachable from the previous pose leaves the robot room to turn"
-            return "; the map has no spot where the robot has room to turn"
+                return (
+                    "; no spot reachable from the previous pose leaves the robot room to turn",
+                    None,
+                )
+            return "; the map has no spot where the robot has room to turn", None
         row, col = self.costmap.world_to_cell(x, y)
         nearest = np.argmin(((cells - (row, col)) ** 2).sum(axis=1))
         free_x, free_y = self.costmap.cell_to_world(*cells[nearest])
-        return f"; the nearest free spot is {_format_position(free_x, free_y)}"
+        # The cell's centre, to the millimetre: still inside the cell (>= 1 cm wide).
+        spot = (round(float(free_x), 3), round(float(free_y), 3))
+        return f"; the nearest free spot is {_format_position(free_x, free_y)}", spot

@@ -4,7 +4,9 @@ Serves the studio (``navseq.studio``) on 127.0.0.1 with a fresh token, prints
 ``navseq studio: http://127.0.0.1:PORT/?token=...`` as the first line on stdout and
 opens the browser (unless ``--no-browser``). The page may read and write files only
 under the mission's and the map's folders, or ``--root``. Ctrl-C stops it; a running
-simulation is cancelled first and its report written. See docs/studio.md.
+simulation is cancelled first and its report written. ``--allow-run``: runs started from
+the page may start the mission's ``run:`` tasks' programs (the page itself cannot allow
+that). See docs/studio.md.
 """
 
 from __future__ import annotations
@@ -43,6 +45,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="the only folder the studio may read and write files under "
         "(default: the mission's and the map's folders)",
+    )
+    parser.add_argument(
+        "--allow-run",
+        action="store_true",
+        help="let the runs started from the page start the mission's run: tasks' programs "
+        "(without it the page can never start a program)",
     )
 
 
@@ -99,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
         mission_path=mission.resolve() if mission is not None else None,
         map_path=map_path,
         hosts=allowed_hosts(args.host),
+        allow_run=args.allow_run,
     )
     return serve(config, args.host, args.port, open_browser=not args.no_browser)
 

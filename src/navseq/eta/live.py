@@ -235,7 +235,8 @@ class EtaEstimator:
         upper = self.prediction.upper_s
         return {
             "expected_s": round(expected, 1),
-            "upper_s": round(upper, 1) if upper is not None else None,
+            # None too when a task has no time limit (an input task): no upper bound.
+            "upper_s": round(upper, 1) if upper is not None and math.isfinite(upper) else None,
             "actual_s": round(actual, 1),
             "planned": self.prediction.planned,
             "checkpoints": checks,

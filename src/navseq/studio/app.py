@@ -53,6 +53,7 @@ from navseq.studio.security import (
     host_allowed,
     token_matches,
 )
+from navseq.tasks.options import DEFAULT_SIMULATED_SECONDS, TaskOptions
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -88,6 +89,7 @@ class StudioConfig:
     map_path: Path | None = None  # --map
     out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
     hosts: frozenset[str] = LOCAL_NAMES  # what a request's Host may say (allowed_hosts)
+    allow_run: bool = False  # --allow-run: runs may start the mission's run: programs
 
 
 class ApiError(Exception):
@@ -185,6 +187,7 @@ class Studio:
                 "units": UNITS,
                 "mission": empty_document(map_text),
                 "problems": [],
+                "allow_run": self.config.allow_run,
             }
         document, errors = open_document(path, self.base_dir)
         if document is None:
@@ -203,6 +206,7 @@ class Studio:
             "units": UNITS,
             "mission": document,
             "problems": [problem.as_json() for problem in problems_of(errors)],
+            "allow_run": self.config.allow_run,
         }
 
     def map_info(self, map_text: str | None) -> dict[str, Any]:
@@ -270,15 +274,22 @@ class Studio:
         return text, stamp
 
     def _checked(
-        self, document: Any, *, base_dir: Path | None = None, shown_as: str | None = None
+        self,
+        document: Any,
+        *,
+        base_dir: Path | None = None,
+        shown_as: str | None = None,
+        tasks: TaskOptions | None = None,
     ) -> CheckedDraft:
-        """The draft checked as ``navseq validate --map`` checks a file."""
+        """The draft checked as ``navseq validate --map`` checks a file (``tasks``: as
+        ``navseq validate`` with those task options checks it)."""
         return check_draft(
             document,
             roots=self.roots,
             base_dir=base_dir if base_dir is not None else self.base_dir,
             shown_as=shown_as if shown_as is not None else self.shown_name,
             costmaps=self.costmap,
+            tasks=tasks,
         )
 
     def _readable(self, document: Any, doing: str, **where: Any) -> tuple[CheckedDraft, Mission]:
@@ -513,10 +524,18 @@ class Studio:
             raise ApiError(
                 400, f"realtime: a factor above 0 and up to {MAX_REALTIME:g}, or null (fastest)"
             )
+        simulate = body.get("simulate_tasks", False)
+        if not isinstance(simulate, bool):
+            raise ApiError(400, "simulate_tasks: true or false")
+        # run: tasks only as the studio was started (--allow-run): never the page's call.
+        tasks = TaskOptions(
+            allow_run=self.config.allow_run,
+            simulate_ros_s=DEFAULT_SIMULATED_SECONDS if simulate else None,
+        )
         with self._lock:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
-        checked = self._checked(body.get("mission"))
+        checked = self._checked(body.get("mission"), tasks=tasks)
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
             raise ApiError(
@@ -527,7 +546,9 @@ class Studio:
         assert checked.mission is not None
         stem = self.config.mission_path.stem if self.config.mission_path else "mission"
         run = StudioRun(
-            StudioRunOrder(checked.mission, stem, None if realtime is None else float(realtime)),
+            StudioRunOrder(
+                checked.mission, stem, None if realtime is None else float(realtime), tasks
+            ),
             self.config.out_base,
         )
         run.start()  # NavseqError (pre-flight problems) -> 422 with them
@@ -808,6 +829,18 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         return JSONResponse({"ok": ok, "message": message}, status_code=200 if ok else 409)
 
     @api
+    async def confirm_task(request: Request) -> Response:
+        """The page's Confirm (``{"confirmed": true}``) or Refuse (false) of the input
+        task the run waits at; 409 when none waits."""
+        body = await read_json(request)
+        confirmed = body.get("confirmed", True)
+        if not isinstance(confirmed, bool):
+            raise ApiError(400, "confirmed: true (Confirm) or false (Refuse)")
+        run = studio.current_run()
+        ok, message = await run_in_threadpool(run.confirm, confirmed)
+        return JSONResponse({"ok": ok, "message": message}, status_code=200 if ok else 409)
+
+    @api
     async def run_events(request: Request) -> Response:
         run = studio.current_run()
 
@@ -844,6 +877,7 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/run", answer_body(studio.start_run), methods=["POST"]),
         Route("/api/run", get_run),
         Route("/api/run/events", run_events),
+        Route("/api/run/confirm", confirm_task, methods=["POST"]),
         Route("/api/run/{action}", run_request, methods=["POST"]),
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
@@ -863,10 +897,12 @@ def _expected_duration(mission: Mission, planner: Legs, robot: RobotProfile) -> 
     expected, upper = prediction.expected_s, prediction.upper_s
     if expected is None:  # a patrol that loops forever
         text = f"~{format_duration(prediction.loop_expected_s)} a loop"
+    elif upper is None or not math.isfinite(upper):  # a task waits without a time limit
+        text = f"~{format_duration(expected)} expected, no upper bound (a task has no timeout)"
     else:
         text = f"~{format_duration(expected)} expected, upper bound {format_duration(upper)}"
     return {
         "estimated_duration": text,
         "expected_duration_s": None if expected is None else round(expected, 1),
-        "upper_bound_s": None if upper is None else round(upper, 1),
+        "upper_bound_s": None if upper is None or not math.isfinite(upper) else round(upper, 1),
     }

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from navseq.commands.validate import CostmapSource
     from navseq.mission.model import Mission
     from navseq.studio.security import FileRoots
+    from navseq.tasks.options import TaskOptions
 
 #: The units of the document's numbers, sent with every mission so no client guesses.
 UNITS: dict[str, str] = {
@@ -147,6 +148,9 @@ class Problem:
     subject: str | None
     waypoint: int | None  # 0-based index of the waypoint concerned
     key: str | None  # the top-level key concerned (start, defaults, map ...)
+    # Where the waypoint (or start pose) concerned could go instead: the nearest spot where
+    # the robot has room to turn (pre-flight's suggestion), for a one-click fix.
+    fix: dict[str, float] | None = None
 
     def as_json(self) -> dict[str, Any]:
         return {
@@ -155,6 +159,7 @@ class Problem:
             "subject": self.subject,
             "waypoint": self.waypoint,
             "key": self.key,
+            "fix": self.fix,
         }
 
 
@@ -173,6 +178,8 @@ def problems_of(
     shown_as: str = "draft",
 ) -> list[Problem]:
     """``errors`` for the page; sources in the draft's temporary file become ``shown_as``."""
+    from navseq.preflight import MisplacedError
+
     problems: list[Problem] = []
     for error in flatten(errors):
         source, waypoint, key = error.source, None, None
@@ -186,7 +193,10 @@ def problems_of(
         if error.subject == "start":
             key = "start"
         shown = NavseqError(error.message, source=source, subject=error.subject)
-        problems.append(Problem(str(shown), error.message, error.subject, waypoint, key))
+        fix = None
+        if isinstance(error, MisplacedError) and error.suggested is not None:
+            fix = {"x": error.suggested[0], "y": error.suggested[1]}
+        problems.append(Problem(str(shown), error.message, error.subject, waypoint, key, fix))
     return problems
 
 
@@ -206,6 +216,7 @@ def check_draft(
     base_dir: Path,
     shown_as: str,
     costmaps: CostmapSource | None = None,
+    tasks: TaskOptions | None = None,
 ) -> CheckedDraft:
     """Every problem of a draft document (file problems and pre-flight), and its mission.
 
@@ -232,7 +243,7 @@ def check_draft(
     with tempfile.TemporaryDirectory(prefix="navseq-studio-") as folder:
         path = Path(folder) / "draft.yaml"
         path.write_text(drafted.text, encoding="utf-8")
-        mission, errors = mission_file_problems(path, costmaps=costmaps)
+        mission, errors = mission_file_problems(path, costmaps=costmaps, tasks=tasks)
         problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
     return CheckedDraft(mission, problems, map_path)
 

@@ -9,21 +9,29 @@ main thread: it asks for no signal handling (the studio's server has its own). T
 mission listener (:class:`LiveView`) that folds the mission events into what the page
 draws, and a :class:`~navseq.executor.control.MissionControl` through which the page's
 stop, pause and skip reach the run's thread as executor inputs (stop cancels the goal,
-as Ctrl-C does).
+as Ctrl-C does). The run's :class:`~navseq.tasks.runner.TaskRunner` is the studio's:
+the page's Confirm and Refuse answer an ``input`` task through it
+(:meth:`StudioRun.confirm`), and the view says which task runs at which waypoint.
+
+The report is shown as soon as it is written: ``navseq run`` writes it first and draws
+the picture after (seconds on a big map), so while the run is ``finishing`` the view
+looks for it in the run folder and hands it to the page at once.
 """
 
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import math
 import os
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
+from navseq.tasks.options import TaskOptions
 
 if TYPE_CHECKING:
     from navseq.executor.control import MissionControl
@@ -32,6 +40,7 @@ if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.run.session import Session
     from navseq.sinks.json_events import Eta
+    from navseq.tasks.runner import TaskRunner
 
 #: Trail points kept for the page (older ones are thinned to every other one).
 MAX_TRAIL_POINTS = 4000
@@ -41,11 +50,13 @@ TRAIL_STEP_M = 0.02
 
 @dataclass(frozen=True)
 class StudioRunOrder:
-    """What the page asked to run: the checked mission and the pace."""
+    """What the page asked to run: the checked mission, the pace and what its tasks may
+    do (``run`` programs only when the studio was started with ``--allow-run``)."""
 
     mission: Mission
     stem: str  # the mission file's name without extension, for the folder's name
     realtime: float | None  # None: as fast as the CPU goes
+    tasks: TaskOptions = field(default_factory=TaskOptions)
 
 
 class LiveView:
@@ -72,6 +83,12 @@ class LiveView:
         self.error: str | None = None
         self.navigator: Navigator | None = None
         self.eta: Eta | None = None  # the run's ETA (the session's), for the time to go
+        # The task running now ({index, number, kind, description, attempt, asks,
+        # answered}), the last one that ended, and the last line said to the operator.
+        self.task: dict[str, Any] | None = None
+        self.last_task: dict[str, Any] | None = None
+        self.note = ""
+        self.folder_path: Path | None = None  # where the report is looked for early
         self._start_t: float | None = None
         # The clock shows the mission's running time: a pause holds it, as it holds every
         # deadline of the run, so that it does not jump by the pause on Resume.
@@ -110,6 +127,27 @@ class LiveView:
                 self._set(event.index, "dwelling")
             elif isinstance(event, ev.WaypointFinished):
                 self._set(event.index, _shown_outcome(event))
+            elif isinstance(event, ev.TaskStarted):
+                self.task = {
+                    "index": event.index,
+                    "number": event.task,
+                    "kind": event.task_kind,
+                    "description": event.description,
+                    "attempt": event.attempt,
+                    "asks": event.task_kind == "input",  # waits for Confirm or Refuse
+                    "answered": False,
+                }
+            elif isinstance(event, ev.TaskFinished):
+                self.task = None
+                self.last_task = {
+                    "index": event.index,
+                    "number": event.task,
+                    "kind": event.task_kind,
+                    "outcome": event.outcome,
+                    "duration_s": round(event.duration, 2),
+                    "detail": event.detail,
+                    "files": list(event.files),
+                }
             elif isinstance(event, ev.MissionPaused):
                 self.status = "paused"
             elif isinstance(event, ev.MissionResumed):
@@ -118,6 +156,7 @@ class LiveView:
                 self.status = "finishing"  # the outputs are written next
                 self.reason = event.reason
                 self.current = None
+                self.task = None
             self.version += 1
 
     def _set(self, index: int, state: str) -> None:
@@ -144,9 +183,36 @@ class LiveView:
     def finished(self, status: str, report: dict[str, Any] | None, error: str | None) -> None:
         with self._lock:
             self.status = status
-            self.report = report
+            self.report = report if report is not None else self.report
             self.error = error
             self.current = None
+            self.task = None
+            self.version += 1
+
+    def say(self, line: str) -> None:
+        """A line for the operator from the task runner (a prompt, a simulated task)."""
+        with self._lock:
+            self.note = line
+            self.version += 1
+
+    def take_answer(self) -> bool:
+        """Mark the waiting ``input`` task answered; False when none waits (no task, not
+        an ``input``, or answered already)."""
+        with self._lock:
+            task = self.task
+            if task is None or not task["asks"] or task["answered"]:
+                return False
+            task["answered"] = True
+            self.version += 1
+            return True
+
+    def _early_report(self) -> None:
+        """While the outputs are written: the report, once it is (before the picture)."""
+        if self.status != "finishing" or self.report is not None:
+            return
+        report = _latest_report(self.folder_path)
+        if report is not None:
+            self.report = report
             self.version += 1
 
     # -- any thread --------------------------------------------------------------------
@@ -158,6 +224,7 @@ class LiveView:
     def snapshot(self) -> dict[str, Any]:
         """Everything the page draws; the robot's pose read from the simulator itself."""
         with self._lock:
+            self._early_report()
             pose = self.pose
             navigator = self.navigator
             if navigator is not None and not self.done:
@@ -183,6 +250,9 @@ class LiveView:
                 "folder": self.folder,
                 "report": self.report,
                 "error": self.error,
+                "task": dict(self.task) if self.task is not None else None,
+                "last_task": self.last_task,
+                "note": self.note,
             }
 
 
@@ -203,6 +273,7 @@ class StudioRun:
         self._thread: threading.Thread | None = None
         self.folder: Path | None = None
         self.stop_requested = False
+        self.tasks: TaskRunner | None = None  # made with the session
 
     def start(self) -> None:
         """Prepare as ``navseq run`` does (raises NavseqError), then run in a thread."""
@@ -226,6 +297,7 @@ class StudioRun:
                     mission=mission_file,
                     outputs=Outputs(folder=folder),
                     realtime=self.order.realtime,
+                    tasks=self.order.tasks,
                 )
             )
         except BaseException:
@@ -241,7 +313,14 @@ class StudioRun:
             return navigator
 
         session.make_navigator = watched_navigator
+        from navseq.tasks.runner import TaskRunner
+
+        # The studio's own runner: the page answers input tasks; the server's standard
+        # input is not the operator's (an empty text is read as no operator there).
+        self.tasks = TaskRunner(self.order.tasks, say=self.view.say, stdin=io.StringIO())
+        session.task_runner = self.tasks
         self.folder = folder
+        self.view.folder_path = folder
         # Shown as navseq run says it: relative to where the studio was started.
         self.view.folder = os.path.relpath(folder, self.out_base)
         return session
@@ -279,6 +358,15 @@ class StudioRun:
             self.stop_requested = True
         return self.control.request(kind, reason, timeout=5.0)
 
+    def confirm(self, confirmed: bool) -> tuple[bool, str]:
+        """Answer the ``input`` task waiting at the current waypoint (the page's Confirm
+        or Refuse); ``(False, why)`` when none waits."""
+        if self.tasks is None or not self.alive or not self.view.take_answer():
+            return False, "no input task waits for an answer"
+        detail = "confirmed in the studio" if confirmed else "refused in the studio"
+        self.tasks.confirm(confirmed, detail)
+        return True, detail
+
     def stop_and_wait(self, reason: str, timeout: float = 30.0) -> None:
         """Cancel the goal and end the run (as Ctrl-C does), then wait for its outputs."""
         if self._thread is None:
@@ -314,6 +402,10 @@ def _seconds(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else round(max(value, 0.0), 1)
 
 
+def _no_number(_constant: str) -> None:
+    return None
+
+
 def _latest_report(folder: Path | None) -> dict[str, Any] | None:
     """The report the run wrote (``report.json``, or ``report-N.json`` if that was taken)."""
     if folder is None:
@@ -322,7 +414,8 @@ def _latest_report(folder: Path | None) -> dict[str, Any] | None:
     if not reports:
         return None
     try:
-        loaded = json.loads(reports[-1].read_text(encoding="utf-8"))
+        # NaN or Infinity (which Python writes) as null: the page's JSON has no such number.
+        loaded = json.loads(reports[-1].read_text(encoding="utf-8"), parse_constant=_no_number)
     except (OSError, ValueError):
         return None
     return loaded if isinstance(loaded, dict) else None

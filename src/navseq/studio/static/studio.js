@@ -205,6 +205,7 @@ function wpIcon(w, i, extra) {
   const yaw = typeof w.yaw === "number" ? w.yaw : 0;
   const cls = ["wp-icon", extra || ""];
   if (w.pass_through) cls.push("pass");
+  if (i !== null && hasTasks(i)) cls.push("tasks");
   if (i !== null && problemsOf(i).length) cls.push("bad");
   if ((i !== null && i === S.selected) || (i === null && S.selected === "start")) cls.push("selected");
   return L.divIcon({
@@ -349,6 +350,7 @@ function renderList() {
     li.querySelector(".num").textContent = i + 1;
     li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
     li.querySelector(".state").textContent = state;
+    if (hasTasks(i)) li.querySelector(".state").before(taskFlag(i));
     const [pick, up, down, del] = li.querySelectorAll("button");
     pick.dataset.focus = `row-${i}`;
     if (i === S.selected) pick.setAttribute("aria-current", "true");
@@ -430,6 +432,7 @@ function renderEditor() {
         if (value === undefined) delete w[key]; else w[key] = value;
       }) };
   }));
+  renderTaskList($("wp-tasks"), waypointTasks(S.selected));
 }
 function renderSettings() {
   const st = S.doc.start;
@@ -460,6 +463,7 @@ function renderDefaults() {
         S.doc.defaults = d;
       }) };
   }));
+  renderTaskList($("default-tasks"), defaultTasks);
 }
 function placeStart(on) {
   S.placingStart = on;
@@ -481,6 +485,7 @@ function renderProblems() {
       b.onclick = () => { S.selected = p.waypoint; render(); };
       li.appendChild(b);
     } else li.textContent = p.text;
+    if (p.fix) li.appendChild(fixButton(p));
     list.appendChild(li);
   }
   $("problem-count").textContent = S.problems.length ? `(${S.problems.length})` : "";
@@ -491,6 +496,240 @@ function renderProblems() {
   $("route").textContent = r.total_length_m != null
     ? `${S.doc.waypoints.length} waypoints · ${r.total_length_m.toFixed(2)} m · ${r.estimated_duration}`
     : `${S.doc.waypoints.length} waypoints${!S.planned ? " · checking and planning…" : r.unplanned_legs ? " · some legs have no path" : ""}`;
+}
+
+// ---- tasks at waypoints (docs/mission-format.md, Tasks at waypoints) -------------------
+// A task is a document item {KIND: VALUE, timeout?}; the page edits wait's seconds,
+// input's prompt and any task's timeout, adds wait and input tasks, removes and reorders
+// any: the other kinds' values are kept as they are (the server checks them all).
+const TASK_KINDS = ["wait", "wait_for", "input", "snapshot", "call", "publish", "run"];
+// The kinds without a time limit when the file gives no timeout (the others: 60 s).
+const UNLIMITED_KINDS = ["wait", "input"];
+const taskKind = (t) => (t && typeof t === "object" ? Object.keys(t).find((k) => TASK_KINDS.includes(k)) : undefined);
+// The task in a few words, as navseq says it ("wait 5 s", "input: Load the tray").
+function describeTask(t) {
+  const kind = taskKind(t);
+  const v = kind ? t[kind] : null;
+  const o = v && typeof v === "object" ? v : {};
+  switch (kind) {
+    case "wait": return `wait ${v} s`;
+    case "input": return `input: ${o.prompt || "confirm to go on"}`;
+    case "wait_for": {
+      const relation = ["equals", "above", "below"].find((r) => r in o) || "?";
+      return `wait for ${o.topic} ${o.field} ${relation} ${JSON.stringify(o[relation])}`;
+    }
+    case "snapshot": return `snapshot of ${o.topic}`;
+    case "call": return `call ${o.service}`;
+    case "publish": return `publish on ${o.topic}`;
+    case "run": return `run ${Array.isArray(o.argv) ? o.argv.join(" ") : "?"}`;
+    default: return "unknown task (see Problems)";
+  }
+}
+// The tasks a waypoint runs: its own list, else the defaults' (an own [] runs none).
+function tasksOf(i) {
+  const w = S.doc.waypoints[i];
+  if (w && Array.isArray(w.tasks)) return w.tasks;
+  const d = (S.doc.defaults || {}).tasks;
+  return Array.isArray(d) ? d : [];
+}
+function hasTasks(i) { return tasksOf(i).length > 0; }
+// The small flag on a waypoint's row (the marker gets the class "tasks").
+function taskFlag(i) {
+  const span = document.createElement("span");
+  span.className = "task-flag";
+  const n = tasksOf(i).length;
+  span.title = `${n} task${n > 1 ? "s" : ""}: ${tasksOf(i).map(describeTask).join("; ")}`;
+  span.innerHTML = '<span aria-hidden="true"></span><span class="sr-only"></span>';
+  span.firstChild.textContent = `⚑${n}`;
+  span.lastChild.textContent = `, ${n} task${n > 1 ? "s" : ""}`;
+  return span;
+}
+// Whose list a task panel edits, looked up again at each change (undo replaces S.doc).
+function waypointTasks(i) {
+  return { id: `wp${i}`, name: `waypoint ${i + 1}`, own: () => S.doc.waypoints[i].tasks,
+    set: (list) => { if (list === undefined) delete S.doc.waypoints[i].tasks; else S.doc.waypoints[i].tasks = list; },
+    problems: () => S.problems.filter((p) => p.waypoint === i) };
+}
+const defaultTasks = {
+  id: "defaults", name: "defaults", own: () => (S.doc.defaults || {}).tasks,
+  set: (list) => {
+    const d = { ...(S.doc.defaults || {}) };
+    if (list === undefined || !list.length) delete d.tasks; else d.tasks = list;
+    S.doc.defaults = d;
+  },
+  problems: () => S.problems.filter((p) => p.key === "defaults"),
+};
+// The problem of task n (1-based) of a list, from its subject ("…, task 2 (wait)").
+function taskProblem(problems, n) {
+  return problems.find((p) => new RegExp(`(^|, )task ${n}( |$|,)`).test(p.subject || ""));
+}
+function renderTaskList(box, owner) {
+  const own = owner.own();
+  const problems = owner.problems();
+  // Rebuilt only when the list (or its problems) changed: a rebuild while a value is typed
+  // would drop it. Handlers find the list through box.owner, set at every render.
+  box.owner = owner;
+  const shape = JSON.stringify([owner.id, own, problems.map((p) => p.text), (S.doc.defaults || {}).tasks]);
+  if (box.dataset.shape === shape) return;
+  box.dataset.shape = shape;
+  box.textContent = "";
+  const list = Array.isArray(own) ? own : [];
+  if (!Array.isArray(own) && owner.id !== "defaults") {
+    const inherited = (S.doc.defaults || {}).tasks || [];
+    const p = document.createElement("p");
+    p.className = "none";
+    p.textContent = inherited.length ? `none of its own: the defaults' (${inherited.map(describeTask).join("; ")})` : "none";
+    box.appendChild(p);
+  } else if (!list.length) {
+    const p = document.createElement("p");
+    p.className = "none";
+    p.textContent = owner.id === "defaults" ? "none" : "none here (the defaults' tasks do not run here)";
+    box.appendChild(p);
+  }
+  const ol = document.createElement("ol");
+  list.forEach((t, k) => ol.appendChild(taskRow(box, t, k, list.length, taskProblem(problems, k + 1))));
+  if (list.length) box.appendChild(ol);
+  box.appendChild(taskAdder(box, own));
+}
+function changeTasks(box, change) {
+  const owner = box.owner;
+  edit(() => {
+    const list = JSON.parse(JSON.stringify(owner.own() || []));
+    owner.set(change(list));
+  });
+}
+function taskRow(box, t, k, count, problem) {
+  const id = `${box.id}-${k}`;
+  const kind = taskKind(t);
+  const li = document.createElement("li");
+  li.dataset.testid = "task";
+  li.dataset.kind = kind || "";
+  if (problem) li.classList.add("bad");
+  const head = document.createElement("div");
+  head.className = "task-head";
+  const text = document.createElement("span");
+  text.className = "task-text";
+  const timeout = t.timeout === undefined ? "" : t.timeout === null ? " (no time limit)" : ` (timeout ${t.timeout} s)`;
+  text.textContent = `${k + 1}. ${describeTask(t)}${timeout}`;
+  text.title = text.textContent;
+  head.appendChild(text);
+  const what = `task ${k + 1}`;
+  for (const [glyph, part, label, to] of [["▲", "up", `move ${what} up`, k - 1], ["▼", "down", `move ${what} down`, k + 1], ["✕", "del", `remove ${what}`, null]]) {
+    const b = document.createElement("button");
+    b.type = "button"; b.textContent = glyph; b.title = label;
+    b.setAttribute("aria-label", label);
+    b.dataset.focus = `${id}-${part}`;
+    if (to !== null && (to < 0 || to >= count)) b.disabled = true;
+    b.onclick = () => {
+      if (to === null) {
+        // The focus goes to the task taking its place, else the add choice.
+        S.focusNext = count > 1 ? `${box.id}-${Math.min(k, count - 2)}-del` : `${box.id}-add`;
+        changeTasks(box, (list) => { list.splice(k, 1); return list.length || box.owner.id === "defaults" ? list : undefined; });
+      } else {
+        S.focusNext = `${box.id}-${to}-${part}`;
+        changeTasks(box, (list) => { const [moved] = list.splice(k, 1); list.splice(to, 0, moved); return list; });
+      }
+    };
+    head.appendChild(b);
+  }
+  li.appendChild(head);
+  const fields = document.createElement("div");
+  fields.className = "task-fields";
+  if (kind === "wait") taskField(fields, box, k, "seconds", "number", t.wait, "", (task, v) => { task.wait = v; });
+  if (kind === "input") {
+    const prompt = t.input && typeof t.input === "object" ? t.input.prompt : "";
+    taskField(fields, box, k, "prompt", "text", prompt, "confirm to go on", (task, v) => {
+      if (v === undefined) task.input = null; else task.input = { ...(task.input || {}), prompt: String(v) };
+    });
+  }
+  if (kind) {
+    const fallback = UNLIMITED_KINDS.includes(kind) ? "no limit" : "default 60; none: no limit";
+    taskField(fields, box, k, "timeout [s]", "text", t.timeout === null ? "none" : t.timeout, fallback, (task, v) => {
+      if (v === undefined) delete task.timeout;
+      else if (String(v).trim().toLowerCase() === "none") task.timeout = null;
+      else task.timeout = fieldValue("number", String(v));
+    });
+  }
+  li.appendChild(fields);
+  if (problem) {
+    const p = document.createElement("div");
+    p.className = "task-problem";
+    p.textContent = problem.message;
+    li.appendChild(p);
+  }
+  return li;
+}
+function taskField(fields, box, k, label, kind, value, placeholder, apply) {
+  const id = `${box.id}-${k}-${label.split(" ")[0]}`;
+  const l = document.createElement("label");
+  l.textContent = label;
+  l.htmlFor = id;
+  const input = document.createElement("input");
+  input.id = id; input.type = kind === "number" ? "number" : "text";
+  if (kind === "number") input.step = "any";
+  input.dataset.focus = id;
+  input.value = value ?? "";
+  input.placeholder = placeholder;
+  input.addEventListener("change", () => {
+    const v = fieldValue(kind, input.value);
+    changeTasks(box, (list) => { apply(list[k], v); return list; });
+  });
+  input.addEventListener("keydown", (e) => { if (e.key === "Enter") input.blur(); });
+  fields.append(l, input);
+}
+// Add a wait or an input task (the other kinds are written in the file); for a waypoint,
+// "none here" too, which keeps the defaults' tasks from running there.
+function taskAdder(box, own) {
+  const wrap = document.createElement("div");
+  wrap.className = "task-add";
+  const select = document.createElement("select");
+  select.id = `${box.id}-add`;
+  select.dataset.focus = `${box.id}-add`;
+  select.dataset.testid = "task-add";
+  select.setAttribute("aria-label", `add a task (${box.owner.name})`);
+  const choices = [["", "add a task…"], ["wait", "wait 5 s"], ["input", "input: ask the operator to confirm"]];
+  if (box.owner.id !== "defaults") {
+    if (!Array.isArray(own) || own.length) choices.push(["none", "no tasks here (not the defaults')"]);
+    if (Array.isArray(own)) choices.push(["inherit", "the defaults' tasks (drop its own)"]);
+  }
+  for (const [value, text] of choices) {
+    const o = document.createElement("option");
+    o.value = value; o.textContent = text;
+    select.appendChild(o);
+  }
+  select.onchange = () => {
+    const choice = select.value;
+    select.value = "";
+    if (!choice) return;
+    const owner = box.owner;
+    if (choice === "none") { edit(() => owner.set([])); return; }
+    if (choice === "inherit") { edit(() => owner.set(undefined)); return; }
+    const task = choice === "wait" ? { wait: 5 } : { input: { prompt: "confirm to go on" } };
+    const n = (owner.own() || []).length;
+    S.focusNext = `${box.id}-${n}-${choice === "wait" ? "seconds" : "prompt"}`;
+    changeTasks(box, (list) => { list.push(task); return list; });
+  };
+  wrap.appendChild(select);
+  return wrap;
+}
+
+// A problem's one-click fix: the waypoint (or start pose) moved to pre-flight's nearest
+// free spot, one undoable edit.
+function fixButton(p) {
+  const b = document.createElement("button");
+  b.type = "button"; b.className = "fix"; b.dataset.testid = "fix";
+  const what = p.waypoint !== null ? `waypoint ${p.waypoint + 1}` : "the start pose";
+  b.textContent = "move to nearest free spot";
+  b.title = `move ${what} to (${p.fix.x.toFixed(2)}, ${p.fix.y.toFixed(2)}); undo: Ctrl+Z`;
+  b.setAttribute("aria-label", `move ${what} to the nearest free spot (${p.fix.x.toFixed(2)}, ${p.fix.y.toFixed(2)})`);
+  b.onclick = () => {
+    if ((S.run && !S.run.done) || S.replay) return;
+    const point = p.waypoint !== null ? S.doc.waypoints[p.waypoint] : p.key === "start" ? S.doc.start : null;
+    if (!okPoint(point)) return;
+    edit(() => { point.x = p.fix.x; point.y = p.fix.y; });
+    say(`${what} moved to (${p.fix.x.toFixed(2)}, ${p.fix.y.toFixed(2)}); undo: Ctrl+Z`);
+  };
+  return b;
 }
 
 // ---- checking (the same code as navseq validate --map) ----------------------------------
@@ -803,12 +1042,14 @@ function setStatus(status, text, spoken) {
   el.dataset.status = status;
   el.textContent = text;
   const live = $("run-live");
-  const words = spoken ?? text;
+  const task = runTaskWords(S.run && !S.run.done ? S.run : null);
+  const words = (spoken ?? text) + (task ? ` · ${task}` : "");
   if (live.textContent !== words) live.textContent = words;
 }
 $("run").onclick = async () => {
   const speed = $("speed").value;
-  const answer = await api("POST", "/api/run", { mission: S.doc, realtime: speed ? Number(speed) : null });
+  const answer = await api("POST", "/api/run", { mission: S.doc, realtime: speed ? Number(speed) : null,
+    simulate_tasks: $("simulate-tasks").checked });
   if (!answer.ok) {
     if (answer.data.problems) { S.problems = answer.data.problems; render(); }
     setStatus("error", "not started"); say(answer.data.error, true); return;
@@ -831,6 +1072,8 @@ function watchRun() {
     const before = S.run ? S.run.waypoints : null;
     S.run = run;
     drawRun(run, before);
+    showRunTask(run);
+    if (run.report && !run.done) showReport(run);  // written before the picture: shown now
     if (run.done) { S.events.close(); S.events = null; }
   };
   S.events.onerror = () => { if (S.events && S.run && S.run.done) S.events.close(); };
@@ -873,15 +1116,26 @@ function drawRun(run, before) {
   updateRowStates(run.waypoints, before);
   if (run.done) { showReport(run); say(`${run.status}; outputs in ${run.folder}`, run.status === "error"); loadRuns(); }
 }
+// The report as soon as the run wrote it (the picture is drawn after it), scrolled into
+// view once per run; each visit's tasks on lines of their own under it.
 function showReport(run) {
   const r = run.report;
+  const key = `${run.folder}|${run.done}`;
+  if (S.reportShown === key) return;  // the same report again (20 updates a second)
+  S.reportShown = key;
   $("report").hidden = false;
   const body = $("report-body");
   body.textContent = "";
   const note = document.createElement("div");
-  note.textContent = `${run.reason || run.status}; folder ${run.folder}`;
+  note.textContent = `${run.reason || run.status}; folder ${run.folder}${run.done ? "" : " (drawing the picture…)"}`;
   body.appendChild(note);
-  if (!r) return;
+  if (r) body.appendChild(reportTable(r));
+  if (S.reportScrolled !== run.folder) {  // once the table is there: all of it in view
+    S.reportScrolled = run.folder;
+    $("report").scrollIntoView({ block: "start" });
+  }
+}
+function reportTable(r) {
   const table = document.createElement("table");
   table.innerHTML = "<thead><tr><th>#</th><th>name</th><th>outcome</th><th>tries</th><th>time [s]</th><th>dist [m]</th></tr></thead><tbody></tbody>";
   const tbody = table.querySelector("tbody");
@@ -894,13 +1148,66 @@ function showReport(run) {
       tr.appendChild(td);
     }
     tbody.appendChild(tr);
+    for (const t of v.tasks || []) tbody.appendChild(reportTaskRow(t));
   }
   const t = r.totals;
   const tr = document.createElement("tr");
   tr.innerHTML = `<th></th><th>total</th><th>${t.reached} reached</th><th></th><th class="n">${t.duration_s}</th><th class="n">${t.distance_m}</th>`;
   tbody.appendChild(tr);
-  body.appendChild(table);
+  return table;
 }
+
+function reportTaskRow(t) {
+  const tr = document.createElement("tr");
+  tr.className = `task-row ${t.outcome}`;
+  tr.dataset.testid = "report-task";
+  const more = [t.detail, t.files && t.files.length ? `files: ${t.files.join(", ")}` : ""].filter(Boolean).join(" · ");
+  const cells = [["", false], [`↳ task ${t.number}: ${t.kind}${more ? ` · ${more}` : ""}`, false], [t.outcome, false],
+    [t.attempt, true], [t.duration_s, true], ["", false]];
+  for (const [value, numeric] of cells) {
+    const td = document.createElement("td");
+    td.textContent = value ?? ""; if (numeric) td.className = "n";
+    tr.appendChild(td);
+  }
+  return tr;
+}
+// The task the run is at ("waypoint 3: input — Load the tray"), for the status line and
+// the live region; "" when none runs.
+function runTaskWords(run) {
+  const t = run && run.task;
+  if (!t) return "";
+  const where = `waypoint ${t.index + 1}`;
+  if (t.kind === "input") {
+    const prompt = t.description.replace(/^input: /, "");
+    return `${where}: input — ${prompt}${t.asks && !t.answered ? " (Confirm or Refuse)" : ""}`;
+  }
+  return `${where}: ${t.description}`;
+}
+// The task shown beside the status, Confirm / Refuse while an input task waits, and how
+// the last task ended once it did.
+function showRunTask(run) {
+  const el = $("run-task");
+  const t = run.done ? null : run.task;
+  const waiting = !!(t && t.asks && !t.answered);
+  let text = t ? runTaskWords(run) : "";
+  const last = run.last_task;
+  if (!t && last && !run.done && last.index === run.current) {
+    text = `waypoint ${last.index + 1}: ${last.kind} ${last.outcome}${last.detail ? ` (${last.detail})` : ""}`;
+  }
+  el.hidden = !text;
+  if (el.textContent !== text) el.textContent = text;
+  el.dataset.asks = String(waiting);
+  $("task-confirm").hidden = !waiting;
+  $("task-refuse").hidden = !waiting;
+}
+async function answerTask(confirmed) {
+  $("task-confirm").hidden = true; $("task-refuse").hidden = true;  // one answer
+  const answer = await api("POST", "/api/run/confirm", { confirmed });
+  if (!answer.ok) say(answer.data.message || answer.data.error, true);
+  else say(answer.data.message);
+}
+$("task-confirm").onclick = () => answerTask(true);
+$("task-refuse").onclick = () => answerTask(false);
 
 // ---- start -------------------------------------------------------------------------------
 async function main() {
@@ -917,6 +1224,8 @@ async function main() {
   S.name = answer.data.name;
   S.exists = answer.data.exists;
   S.problems = answer.data.problems;
+  S.allowRun = answer.data.allow_run;
+  if (!S.allowRun) $("run").title = "run: tasks need the studio started with --allow-run";
   $("mission-name").textContent = answer.data.path || S.name;
   if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
   // The first check (pre-flight problems and every leg planned: a second or more on a
