@@ -13,6 +13,9 @@ and prints one JSON object on its last stdout line: what it saw. Verbs:
   ``backup`` / ``drive_on_heading`` (``--value`` metres at ``--speed``, ``--target-y``),
   or ``wait`` (``--value`` seconds), ``--allowance`` seconds of time allowance; says how
   far the robot turned and moved (its ``odom -> base`` transform on ``/tf``);
+- ``refusals``: goals the planner, smoother and controller servers refuse (no goals,
+  unknown plugin ids, an empty path, a pose in an unknown frame), each one's status and
+  error code;
 - ``ready``: the lifecycle ``get_state`` of bt_navigator and amcl, then an
   ``initialpose`` and the ``amcl_pose`` that follows, then a clear-costmap call — what
   nav2_simple_commander's ``waitUntilNav2Active`` and ``clearAllCostmaps`` do.
@@ -35,11 +38,14 @@ from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from lifecycle_msgs.srv import GetState
 from nav2_msgs.action import (
     BackUp,
+    ComputePathThroughPoses,
     ComputePathToPose,
     DriveOnHeading,
+    FollowPath,
     FollowWaypoints,
     NavigateThroughPoses,
     NavigateToPose,
+    SmoothPath,
     Spin,
     Wait,
 )
@@ -188,6 +194,51 @@ def path(node: Node, args: argparse.Namespace) -> dict:
     }
 
 
+def refusals(node: Node, args: argparse.Namespace) -> dict:
+    """Each refused goal's status and error code, by what it tried."""
+    from nav_msgs.msg import Path
+
+    somewhere = pose_stamped("-1.0,-0.5,0")
+    cases = {
+        "through no goals": (
+            ComputePathThroughPoses,
+            "compute_path_through_poses",
+            ComputePathThroughPoses.Goal(),
+        ),
+        "through unknown planner": (
+            ComputePathThroughPoses,
+            "compute_path_through_poses",
+            ComputePathThroughPoses.Goal(goals=[somewhere], planner_id="SmacHybrid"),
+        ),
+        "path unknown frame": (
+            ComputePathToPose,
+            "compute_path_to_pose",
+            ComputePathToPose.Goal(goal=pose_stamped("-1.0,-0.5,0", "nowhere")),
+        ),
+        "smooth empty path": (SmoothPath, "smooth_path", SmoothPath.Goal(path=Path())),
+        "smooth unknown smoother": (
+            SmoothPath,
+            "smooth_path",
+            SmoothPath.Goal(path=Path(poses=[somewhere]), smoother_id="savitzky_golay"),
+        ),
+        "follow unknown controller": (
+            FollowPath,
+            "follow_path",
+            FollowPath.Goal(path=Path(poses=[somewhere]), controller_id="DWB"),
+        ),
+        "follow empty path": (FollowPath, "follow_path", FollowPath.Goal(path=Path())),
+    }
+    out = {}
+    for what, (action, server, goal) in cases.items():
+        client = ActionClient(node, action, name(args.ns, server))
+        if not client.wait_for_server(timeout_sec=args.timeout):
+            raise SystemExit(f"no {server} server")
+        handle = wait(node, client.send_goal_async(goal), args.timeout)
+        result = wait(node, handle.get_result_async(), args.timeout)
+        out[what] = [STATUS.get(result.status, str(result.status)), int(result.result.error_code)]
+    return out
+
+
 def late_map(node: Node, args: argparse.Namespace) -> dict:
     got: list[OccupancyGrid] = []
     node.create_subscription(OccupancyGrid, name(args.ns, "map"), got.append, LATCHED)
@@ -295,6 +346,7 @@ VERBS = {
     "map": late_map,
     "ready": ready,
     "behavior": behavior,
+    "refusals": refusals,
 }
 
 

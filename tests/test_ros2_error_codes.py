@@ -216,6 +216,7 @@ STANDIN_CODES = {
     "START_OCCUPIED": ("ComputePathToPose", "START_OCCUPIED"),
     "GOAL_OCCUPIED": ("ComputePathToPose", "GOAL_OCCUPIED"),
     "NO_VALID_PATH": ("ComputePathToPose", "NO_VALID_PATH"),
+    "INVALID_PATH": ("FollowPath", "INVALID_PATH"),
 }
 
 INSTALLED = r"""

@@ -15,7 +15,10 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   planner or controller ``error_code`` and ``error_msg``) / CANCELED; a new goal
   preempts the running one, which ends ABORTED, as in Nav2;
 - ``follow_waypoints`` (result ``missed_waypoints``; parameter ``stop_on_failure``,
-  default true as in Nav2) and ``compute_path_to_pose``;
+  default true as in Nav2);
+- the planner's ``compute_path_to_pose`` and ``compute_path_through_poses``, the
+  smoother's ``smooth_path`` and the controller's ``follow_path``
+  (:mod:`navseq.ros2.path_actions`);
 - the behaviour server's ``spin``, ``backup``, ``drive_on_heading`` and ``wait``, acting
   on the simulated robot with Nav2's collision check ahead, time allowance and error
   codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
@@ -90,7 +93,6 @@ from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformS
 from lifecycle_msgs.msg import State, Transition
 from lifecycle_msgs.srv import ChangeState, GetState
 from nav2_msgs.action import (
-    ComputePathToPose,
     FollowWaypoints,
     NavigateThroughPoses,
     NavigateToPose,
@@ -124,6 +126,7 @@ from navseq.ros2.messages import (
     time_msg,
     transform_stamped,
 )
+from navseq.ros2.path_actions import PathActions
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
     Ending,
@@ -282,15 +285,17 @@ class SimNode:
                 cancel_callback=_accept_cancel,
                 callback_group=group,
             ),
-            ActionServer(
-                node,
-                ComputePathToPose,
-                "compute_path_to_pose",
-                execute_callback=self._execute_compute_path,
-                callback_group=group,
-            ),
         ]
         self._behaviors = BehaviorActions(node, self.standin, self._lock, group)
+        self._paths = PathActions(
+            node,
+            self.standin,
+            self._lock,
+            group,
+            in_map=self._in_map,
+            stamp=self._stamp,
+            frame=MAP_FRAME,
+        )
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.
@@ -598,34 +603,6 @@ class SimNode:
         result.error_code = int(ending.error_code)
         result.error_msg = ending.error_msg
         _finish(handle, ending)
-        return result
-
-    # -- compute_path_to_pose ----------------------------------------------------------
-
-    def _execute_compute_path(self, handle: Any) -> Any:
-        request = handle.request
-        result = ComputePathToPose.Result()
-        started = time.monotonic()
-        with self._lock:
-            goal = self._in_map(request.goal)
-            start = (
-                self._in_map(request.start) if request.use_start else self.standin.world.robot.pose
-            )
-            plan = None
-            if isinstance(goal, str) or isinstance(start, str):
-                result.error_code = ComputePathToPose.Result.UNKNOWN
-                result.error_msg = goal if isinstance(goal, str) else str(start)
-            else:
-                plan = self.standin.world.server.make_plan(start, goal)
-                if plan is None:
-                    result.error_code, result.error_msg = self.standin.no_plan_reason(start, goal)
-        result.planning_time = duration_msg(time.monotonic() - started)
-        if plan is None:
-            handle.abort()
-            return result
-        assert not isinstance(goal, str)
-        result.path = path_msg(plan, goal, MAP_FRAME, self._stamp())
-        handle.succeed()
         return result
 
     # -- topics and services -------------------------------------------------------------

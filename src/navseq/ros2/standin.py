@@ -67,10 +67,12 @@ NAV2_PLANNER_TOLERANCE = 0.5
 
 
 class Navigator(enum.Enum):
-    """bt_navigator's two navigators (the action each one serves)."""
+    """bt_navigator's two navigators (the action each one serves), and the controller
+    server's ``follow_path``, which drives a given path without a navigator."""
 
     TO_POSE = "navigate_to_pose"
     THROUGH_POSES = "navigate_through_poses"
+    FOLLOW_PATH = "follow_path"
 
 
 class Outcome(enum.Enum):
@@ -101,6 +103,7 @@ class ErrorCode(enum.IntEnum):
     START_OCCUPIED = 205
     GOAL_OCCUPIED = 206
     NO_VALID_PATH = 208
+    INVALID_PATH = 103  # FollowPath INVALID_PATH
 
 
 @dataclass(frozen=True)
@@ -213,7 +216,11 @@ class Nav2StandIn:
             task.end(Ending(Outcome.ABORTED, ErrorCode.PLANNER_UNKNOWN, "no poses in the goal"))
             return task
         active = self.active
-        if active is not None and active.navigator is not navigator:
+        if (
+            active is not None
+            and active.navigator is not navigator
+            and active.navigator is not Navigator.FOLLOW_PATH
+        ):
             task.end(
                 Ending(
                     Outcome.ABORTED,
@@ -242,6 +249,23 @@ class Nav2StandIn:
         self._replan_due = None
         self._planned_at = self.time
         server.set_goal(task.target)
+        return task
+
+    def follow_path(self, points: npt.NDArray[np.float64], goal: Pose2D) -> NavTask:
+        """Start a ``follow_path`` goal: ``points`` (N, 2) driven as given to ``goal``.
+
+        It takes the controller from whatever goal runs (that one ends ABORTED): the
+        stand-in has one controller, as Nav2's controller server has.
+        """
+        task = NavTask(Navigator.FOLLOW_PATH, (goal,), self.time)
+        if len(points) == 0:
+            task.end(Ending(Outcome.ABORTED, ErrorCode.INVALID_PATH, "the path has no poses"))
+            return task
+        if self.active is not None:
+            self.active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by follow_path"))
+        self.active = task
+        self._replan_due = None
+        self.world.server.follow_path(np.asarray(points, dtype=float), goal)
         return task
 
     def cancel(self, task: NavTask) -> None:
@@ -420,6 +444,10 @@ class Nav2StandIn:
         """The Nav2 code for the server's failure (see :class:`ErrorCode`)."""
         server = self.world.server
         text = server.status_text
+        if task.navigator is Navigator.FOLLOW_PATH:  # no planner: the controller's codes
+            if "another robot" in text:
+                return ErrorCode.FAILED_TO_MAKE_PROGRESS
+            return ErrorCode.NO_VALID_CONTROL
         # The pose the server pursued: a preempted goal's until the re-plan tick.
         goal = server.goal if server.goal is not None else task.target
         code, _ = self.no_plan_reason(self.world.robot.pose, goal)

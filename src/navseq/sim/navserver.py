@@ -144,6 +144,7 @@ class NavigationServer:
         self.plan_version = 0
         self.distance_remaining: float | None = None
         self._needs_plan = False
+        self._follows_given_path = False  # a FollowPath goal: no planning of our own
         self._since_plan = 0.0
         self._goal_time = 0.0
         self._blocked_since: float | None = None  # goal time the controller was first blocked
@@ -174,6 +175,7 @@ class NavigationServer:
         self.status_text = ""
         self.distance_remaining = None
         self._needs_plan = True
+        self._follows_given_path = False
         self._goal_time = 0.0
         self._blocked_since = None  # goal time the controller was first blocked
         self._remaining_when_blocked = math.inf
@@ -187,6 +189,20 @@ class NavigationServer:
         self._recovery = None
         self._remaining_at_recovery = math.inf
         self.recoveries_run = 0  # behaviours run for this goal (tests, reports)
+
+    def follow_path(self, points: np.ndarray, goal: Pose2D) -> None:
+        """Follow ``points`` (N, 2) to ``goal`` as given, as Nav2's controller server does
+        a ``FollowPath`` goal: no planning nor re-planning, no recovery behaviours; a
+        robot that cannot go on ends ABORTED. Replaces (preempts) any active goal."""
+        self.set_goal(goal)
+        self._follows_given_path = True
+        self._needs_plan = False
+        self._pending_recoveries = []
+        self._recovery_rounds_left = 0
+        steps = np.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
+        self.plan = Plan(points=points, length=float(steps.sum()), cost=float(steps.sum()))
+        self.plan_version += 1
+        self.controller.set_path(points, goal)
 
     def set_other_robots(self, others: Iterable[tuple[Pose2D, Footprint]]) -> None:
         """The other robots' poses (map frame) and footprints now; call every control step.
@@ -212,7 +228,7 @@ class NavigationServer:
         if self._recovery is not None:
             return self._run_recovery(pose, v, w, dt)
         period = self.params.replan_period
-        wants_plan = (
+        wants_plan = not self._follows_given_path and (
             self._needs_plan
             or controller.distance_to_path > self.params.stray_distance
             or (period is not None and self._since_plan >= period)
