@@ -132,3 +132,10 @@ def test_turtlebot3_world_costmap() -> None:
 def test_bad_params_are_refused(settings: dict) -> None:
     with pytest.raises(ValueError, match=next(iter(settings))):
         CostmapParams(**settings)
+
+
+def test_costs_become_occupancy_values_as_nav2s_costmap_publisher_makes_them() -> None:
+    from navseq.sim.costmap import occupancy_values
+
+    costs = np.array([0, 1, 128, 252, 253, 254, 255], dtype=np.uint8)
+    assert occupancy_values(costs).tolist() == [0, 1, 50, 98, 99, 100, -1]

@@ -39,9 +39,9 @@ def sim() -> Iterator[SimProcess]:
 
 
 def test_nav2_simple_commander_plans_smooths_follows_and_runs_behaviours_unchanged() -> None:
-    """example_follow_path's getPath -> smoothPath -> followPath, getPathThroughPoses and
-    demo_recoveries' spin / backup / driveOnHeading: each call returns (none hangs) and
-    succeeds."""
+    """example_follow_path's getPath -> smoothPath -> followPath, getPathThroughPoses,
+    both costmaps and demo_recoveries' spin / backup / driveOnHeading: each call returns
+    (none hangs) and succeeds."""
     reason = nav2_missing_reason()
     if reason is not None:
         pytest.skip(reason)
@@ -64,6 +64,10 @@ def test_nav2_simple_commander_plans_smooths_follows_and_runs_behaviours_unchang
     assert seen["smoothPath"] == seen["getPath"]
     assert seen["followPath"].startswith("SUCCEEDED")
     assert seen["getPathThroughPoses"] > seen["getPath"]
+    # The arena's map (384 x 384 cells at 5 cm) with its walls, and the 3 m window in odom.
+    assert seen["getGlobalCostmap"][:3] == [384, 384, 0.05]
+    assert seen["getGlobalCostmap"][3] > 500 and seen["getGlobalCostmap"][4] == "map"
+    assert seen["getLocalCostmap"][:3] == [60, 60, 0.05] and seen["getLocalCostmap"][4] == "odom"
     for behaviour in ("spin", "backup", "driveOnHeading"):
         assert seen[behaviour].startswith("SUCCEEDED"), seen
     assert "Traceback" not in err

@@ -5,9 +5,10 @@ usage: commander_paths.py  (run with the real Nav2 tree's ROS 2 environment)
 What ``example_follow_path.py`` and ``demo_recoveries.py`` do, with the poses moved onto
 the TurtleBot3 arena: an initial pose at (-2, -0.5), ``waitUntilNav2Active``, then
 ``getPath`` → ``smoothPath`` → ``followPath`` to (-0.6, -0.5), ``getPathThroughPoses``
-through two poses, ``spin``, ``backup`` and ``driveOnHeading``. Prints one JSON object: each call's
-``TaskResult`` name and what came back. Every call goes through ``BasicNavigator``
-unchanged: a call the server does not answer hangs, and the test's timeout says so.
+through two poses, ``getGlobalCostmap`` / ``getLocalCostmap``, ``spin``, ``backup`` and
+``driveOnHeading``. Prints one JSON object: each call's ``TaskResult`` name and what came
+back. Every call goes through ``BasicNavigator`` unchanged: a call the server does not
+answer hangs, and the test's timeout says so.
 """
 
 from __future__ import annotations
@@ -58,6 +59,19 @@ def main() -> int:
         goal, [pose(navigator, -0.6, 0.5), pose(navigator, -1.5, 0.5)]
     )
     out["getPathThroughPoses"] = len(through.poses) if through else None
+    for which, costmap in (
+        ("getGlobalCostmap", navigator.getGlobalCostmap()),
+        ("getLocalCostmap", navigator.getLocalCostmap()),
+    ):
+        specs = costmap.metadata
+        lethal = sum(1 for value in costmap.data if value == 254)
+        out[which] = [
+            specs.size_x,
+            specs.size_y,
+            round(specs.resolution, 3),
+            lethal,
+            costmap.header.frame_id,
+        ]
     navigator.spin(spin_dist=1.57)
     out["spin"] = finish(navigator)
     navigator.backup(backup_dist=0.15, backup_speed=0.05)

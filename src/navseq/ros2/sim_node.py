@@ -19,6 +19,9 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
 - the planner's ``compute_path_to_pose`` and ``compute_path_through_poses``, the
   smoother's ``smooth_path`` and the controller's ``follow_path``
   (:mod:`navseq.ros2.path_actions`);
+- both costmaps' topics (``global_costmap/costmap``, ``costmap_raw``,
+  ``published_footprint``, the local ones) and ``get_costmap`` services
+  (:mod:`navseq.ros2.costmap_topics`);
 - the behaviour server's ``spin``, ``backup``, ``drive_on_heading`` and ``wait``, acting
   on the simulated robot with Nav2's collision check ahead, time allowance and error
   codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
@@ -116,6 +119,7 @@ from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
+from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.messages import (
     duration_msg,
     grid_msg,
@@ -287,6 +291,15 @@ class SimNode:
             ),
         ]
         self._behaviors = BehaviorActions(node, self.standin, self._lock, group)
+        self._costmaps = CostmapTopics(
+            node,
+            self.standin,
+            self._lock,
+            group,
+            stamp=self._stamp,
+            map_frame=MAP_FRAME,
+            odom_frame=self.odom_frame,
+        )
         self._paths = PathActions(
             node,
             self.standin,

@@ -230,3 +230,14 @@ def cost_of_distance(distance: np.ndarray, params: CostmapParams) -> np.ndarray:
     cost = np.where(distance <= params.inscribed_radius, np.uint8(INSCRIBED), cost)
     cost = np.where(distance > params.inflation_radius, np.uint8(FREE), cost)
     return np.where(distance == 0, np.uint8(LETHAL), cost).astype(np.uint8)
+
+
+def occupancy_values(cost: np.ndarray) -> np.ndarray:
+    """Costs as a ``nav_msgs/OccupancyGrid``'s values, by Nav2's costmap publisher's
+    table: free 0, inscribed 99, lethal 100, unknown -1, the rest spread over 1..98."""
+    table = np.empty(256, dtype=np.int8)
+    table[0] = 0
+    middle = np.arange(1, INSCRIBED)
+    table[1:INSCRIBED] = 1 + (97 * (middle - 1)) // 251
+    table[INSCRIBED], table[LETHAL], table[NO_INFORMATION] = 99, 100, -1
+    return table[cost]
