@@ -106,7 +106,7 @@ CASES = [
     BehaviorCase(
         "a cancelled spin ends CANCELED",
         "spin",
-        {"value": 6.0, "cancel_after": 1.5},
+        {"value": 20.0, "allowance": 60, "cancel_after": 1.5},
         "CANCELED",
         0,
         lambda s: abs(s["turned"]) > 0.1,

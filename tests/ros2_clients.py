@@ -16,6 +16,9 @@ and prints one JSON object on its last stdout line: what it saw. Verbs:
 - ``refusals``: goals the planner, smoother and controller servers refuse (no goals,
   unknown plugin ids, an empty path, a pose in an unknown frame), each one's status and
   error code;
+- ``manage COMMAND``: ``lifecycle_manager_navigation/manage_nodes`` with COMMAND (pause,
+  resume, reset, startup, shutdown) as ``nav2_simple_commander``'s lifecycle calls make
+  it, then ``is_active``, bt_navigator's state, and whether a ``spin`` goal is accepted;
 - ``ready``: the lifecycle ``get_state`` of bt_navigator and amcl, then an
   ``initialpose`` and the ``amcl_pose`` that follows, then a clear-costmap call — what
   nav2_simple_commander's ``waitUntilNav2Active`` and ``clearAllCostmaps`` do.
@@ -239,6 +242,34 @@ def refusals(node: Node, args: argparse.Namespace) -> dict:
     return out
 
 
+def manage(node: Node, args: argparse.Namespace) -> dict:
+    from nav2_msgs.srv import ManageLifecycleNodes
+    from std_srvs.srv import Trigger
+
+    command = getattr(ManageLifecycleNodes.Request, args.poses[0].upper())
+    out: dict[str, Any] = {}
+    manager = "lifecycle_manager_navigation"
+    client = node.create_client(ManageLifecycleNodes, name(args.ns, f"{manager}/manage_nodes"))
+    if not client.wait_for_service(timeout_sec=args.timeout):
+        raise SystemExit("no manage_nodes")
+    request = ManageLifecycleNodes.Request(command=command)
+    out["success"] = wait(node, client.call_async(request), args.timeout).success
+    active = node.create_client(Trigger, name(args.ns, f"{manager}/is_active"))
+    active.wait_for_service(timeout_sec=args.timeout)
+    out["is_active"] = wait(node, active.call_async(Trigger.Request()), args.timeout).success
+    state = node.create_client(GetState, name(args.ns, "bt_navigator/get_state"))
+    state.wait_for_service(timeout_sec=args.timeout)
+    reply = wait(node, state.call_async(GetState.Request()), args.timeout)
+    out["bt_navigator"] = reply.current_state.label
+    spin = ActionClient(node, Spin, name(args.ns, "spin"))
+    spin.wait_for_server(timeout_sec=args.timeout)
+    handle = wait(node, spin.send_goal_async(Spin.Goal(target_yaw=0.1)), args.timeout)
+    out["spin_accepted"] = bool(handle.accepted)
+    if handle.accepted:
+        wait(node, handle.get_result_async(), args.timeout)
+    return out
+
+
 def late_map(node: Node, args: argparse.Namespace) -> dict:
     got: list[OccupancyGrid] = []
     node.create_subscription(OccupancyGrid, name(args.ns, "map"), got.append, LATCHED)
@@ -347,6 +378,7 @@ VERBS = {
     "ready": ready,
     "behavior": behavior,
     "refusals": refusals,
+    "manage": manage,
 }
 
 

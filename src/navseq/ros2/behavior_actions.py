@@ -17,6 +17,7 @@ from nav2_msgs.action import BackUp, DriveOnHeading, Spin, Wait
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
+from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import duration_msg
 from navseq.ros2.standin import Nav2StandIn
 from navseq.sim.behaviors import Behavior, BehaviorEnding, BehaviorGoal, Outcome
@@ -35,7 +36,14 @@ _ACTIONS: dict[Behavior, Any] = {
 class BehaviorActions:
     """The four behaviour action servers on ``node``, acting on ``standin`` under ``lock``."""
 
-    def __init__(self, node: Node, standin: Nav2StandIn, lock: threading.Lock, group: Any) -> None:
+    def __init__(
+        self,
+        node: Node,
+        standin: Nav2StandIn,
+        lock: threading.Lock,
+        group: Any,
+        lifecycle: Nav2Lifecycle,
+    ) -> None:
         self._node = node
         self._standin = standin
         self._lock = lock
@@ -46,6 +54,7 @@ class BehaviorActions:
                 action,
                 behavior.value,
                 execute_callback=self._executor(behavior, action),
+                goal_callback=lifecycle.gate(behavior.value, self._log.info),
                 cancel_callback=lambda _handle: CancelResponse.ACCEPT,
                 callback_group=group,
             )

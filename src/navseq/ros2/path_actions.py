@@ -35,6 +35,7 @@ from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
 from navseq.geometry import Pose2D
+from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import duration_msg, path_msg, pose_stamped, seconds_of
 from navseq.ros2.standin import Ending, Nav2StandIn, Outcome
 from navseq.sim.planner import Plan
@@ -65,6 +66,7 @@ class PathActions:
         in_map: InMap,
         stamp: Callable[[], Any],
         frame: str,
+        lifecycle: Nav2Lifecycle,
     ) -> None:
         self._standin = standin
         self._lock = lock
@@ -84,6 +86,7 @@ class PathActions:
                 action,
                 name,
                 execute_callback=execute,
+                goal_callback=lifecycle.gate(name, self._log.info),
                 cancel_callback=lambda _handle: CancelResponse.ACCEPT,
                 callback_group=group,
             )

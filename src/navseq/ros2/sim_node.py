@@ -34,10 +34,9 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1
   (subscribed instead with ``--follow-clock``);
 - services ``global_costmap/clear_entirely_global_costmap``,
-  ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``)
-  and ``get_state`` of the lifecycle nodes Nav2 clients wait for (``bt_navigator``,
-  ``amcl``, ...), answering *active*; every clear-costmap call is logged (``global_costmap:
-  cleared``), so a client's clearing can be checked against the goals that follow;
+  ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``);
+  every clear-costmap call is logged (``global_costmap: cleared``), so a client's
+  clearing can be checked against the goals that follow;
 - the robot's parameters where Nav2 keeps them, on nodes of Nav2's names
   (``planner_server``: ``GridBased.tolerance``;
   ``controller_server``: ``general_goal_checker.xy_goal_tolerance`` and
@@ -45,12 +44,12 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   ``rotate_to_heading_angular_vel``; ``global_costmap/global_costmap`` and
   ``local_costmap/local_costmap``: ``footprint``, ``inflation_layer.inflation_radius``
   and ``cost_scaling_factor``), so that a client reading the robot from Nav2 finds the
-  simulated one (:func:`nav2_parameter_nodes`);
-- ``bt_navigator/change_state`` (``lifecycle_msgs/srv/ChangeState``): *deactivate* and
-  *activate*, as Nav2's lifecycle manager does. While bt_navigator is inactive,
-  ``navigate_to_pose`` and ``navigate_through_poses`` reject new goals, as Nav2's action
-  servers do between configure and activate (they exist, so clients find them, but say
-  "Action server is inactive. Rejecting the goal."); goals already running go on.
+  simulated one (:func:`nav2_server_parameters`, :func:`nav2_costmap_nodes`);
+- Nav2's lifecycle: a lifecycle node per Nav2 server (``bt_navigator``, ``amcl``,
+  ``planner_server`` ...) and both lifecycle managers (``manage_nodes``, ``is_active``),
+  brought up at start (:mod:`navseq.ros2.lifecycle`). An action whose server is not
+  active rejects new goals, as Nav2's action servers do between configure and activate
+  ("Action server is inactive. Rejecting the goal."); goals already running go on.
 
 Several robots that see each other: with ``--other-robots robot2`` the node also listens
 to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
@@ -93,8 +92,6 @@ from typing import Any
 
 import rclpy
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformStamped, Twist
-from lifecycle_msgs.msg import State, Transition
-from lifecycle_msgs.srv import ChangeState, GetState
 from nav2_msgs.action import (
     FollowWaypoints,
     NavigateThroughPoses,
@@ -104,7 +101,7 @@ from nav2_msgs.msg import MissedWaypoint
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry, Path
-from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
@@ -120,6 +117,7 @@ from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
 from navseq.ros2.costmap_topics import CostmapTopics
+from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import (
     duration_msg,
     grid_msg,
@@ -159,15 +157,6 @@ OTHER_POSE_TOLERANCE = 1.0
 # in a burst of steps (the clock's node was busy, or restarted and went back in time).
 CLOCK_SKIP = 1.0
 # The Nav2 servers whose lifecycle state Nav2 clients (nav2_simple_commander, ...) ask.
-LIFECYCLE_NODES = (
-    "bt_navigator",
-    "amcl",
-    "map_server",
-    "planner_server",
-    "controller_server",
-    "behavior_server",
-    "waypoint_follower",
-)
 TRANSIENT_LOCAL = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
 )
@@ -181,9 +170,10 @@ class SimNode:
     that touches the stand-in holds ``self._lock``.
     """
 
-    def __init__(self, node: Node, config: SimConfig) -> None:
+    def __init__(self, node: Node, config: SimConfig, lifecycle: Nav2Lifecycle) -> None:
         self.node = node
         self.config = config
+        self.lifecycle = lifecycle
         grid = load_map(config.map_yaml)
         settings = SimSettings.of(config.robot)
         start = (
@@ -223,7 +213,6 @@ class SimNode:
         self._localized = False
         self._last_amcl = -float("inf")
         self._topic_goal: NavTask | None = None
-        self._navigator_active = True  # bt_navigator's lifecycle: inactive rejects goals
         self.log = node.get_logger()
         node.declare_parameter("stop_on_failure", True)
 
@@ -265,19 +254,6 @@ class SimNode:
                 self._clear_costmap_callback(service.partition("/")[0]),
                 callback_group=group,
             )
-        for lifecycle_node in LIFECYCLE_NODES:
-            node.create_service(
-                GetState,
-                f"{lifecycle_node}/get_state",
-                self._get_state_callback(lifecycle_node),
-                callback_group=group,
-            )
-        node.create_service(
-            ChangeState,
-            "bt_navigator/change_state",
-            self._on_change_navigator_state,
-            callback_group=group,
-        )
         self._servers = [
             self._nav_server(NavigateToPose, Navigator.TO_POSE, group),
             self._nav_server(NavigateThroughPoses, Navigator.THROUGH_POSES, group),
@@ -286,11 +262,12 @@ class SimNode:
                 FollowWaypoints,
                 "follow_waypoints",
                 execute_callback=self._execute_waypoints,
+                goal_callback=lifecycle.gate("follow_waypoints", self.log.info),
                 cancel_callback=_accept_cancel,
                 callback_group=group,
             ),
         ]
-        self._behaviors = BehaviorActions(node, self.standin, self._lock, group)
+        self._behaviors = BehaviorActions(node, self.standin, self._lock, group, lifecycle)
         self._costmaps = CostmapTopics(
             node,
             self.standin,
@@ -308,6 +285,7 @@ class SimNode:
             in_map=self._in_map,
             stamp=self._stamp,
             frame=MAP_FRAME,
+            lifecycle=lifecycle,
         )
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
@@ -503,17 +481,10 @@ class SimNode:
             action,
             navigator.value,
             execute_callback=lambda handle: self._execute_navigation(handle, action, navigator),
-            goal_callback=self._on_navigation_goal,
+            goal_callback=self.lifecycle.gate(navigator.value, self.log.info),
             cancel_callback=_accept_cancel,
             callback_group=group,
         )
-
-    def _on_navigation_goal(self, _request: Any) -> GoalResponse:
-        """Nav2's bt_navigator accepts every goal while active and none otherwise."""
-        if self._navigator_active:
-            return GoalResponse.ACCEPT
-        self.log.info("Action server is inactive. Rejecting the goal.")
-        return GoalResponse.REJECT
 
     def _execute_navigation(self, handle: Any, action: Any, navigator: Navigator) -> Any:
         request = handle.request
@@ -678,30 +649,6 @@ class SimNode:
 
         return clear
 
-    def _get_state_callback(self, lifecycle_node: str) -> Any:
-        def get_state(_request: Any, response: Any) -> Any:
-            active = lifecycle_node != "bt_navigator" or self._navigator_active
-            response.current_state = (
-                State(id=State.PRIMARY_STATE_ACTIVE, label="active")
-                if active
-                else State(id=State.PRIMARY_STATE_INACTIVE, label="inactive")
-            )
-            return response
-
-        return get_state
-
-    def _on_change_navigator_state(self, request: Any, response: Any) -> Any:
-        """Deactivate / activate bt_navigator; any other transition is refused."""
-        transition = request.transition.id
-        wanted = {Transition.TRANSITION_ACTIVATE: True, Transition.TRANSITION_DEACTIVATE: False}
-        if transition not in wanted or wanted[transition] == self._navigator_active:
-            response.success = False
-            return response
-        self._navigator_active = wanted[transition]
-        self.log.info(f"bt_navigator: {'active' if self._navigator_active else 'inactive'}")
-        response.success = True
-        return response
-
 
 def _accept_cancel(_handle: Any) -> CancelResponse:
     return CancelResponse.ACCEPT
@@ -738,15 +685,17 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
     try:
         overrides = [Parameter("use_sim_time", value=True)] if config.sim_time else []
         node = Node(NODE_NAME, namespace=config.namespace or None, parameter_overrides=overrides)
+        lifecycle = Nav2Lifecycle(config.namespace, nav2_server_parameters(config.robot))
+        helpers = [*lifecycle.nodes, *nav2_costmap_nodes(config.robot, config.namespace)]
         try:
-            sim = SimNode(node, config)
+            sim = SimNode(node, config, lifecycle)
         except NavseqError as error:
             print(f"navseq sim: {error_text(error)}", file=sys.stderr)
             return 2
         executor.add_node(node)
-        helpers = nav2_parameter_nodes(config.robot, config.namespace)
         for helper in helpers:
             executor.add_node(helper)
+        lifecycle.start()
         spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2")
         spinner.start()
         sim.start()
@@ -784,43 +733,46 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             signal.signal(number, handler)
 
 
-def nav2_parameter_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
-    """Nodes named as Nav2's that hold the robot's parameters where Nav2 keeps them
-    (``controller_server``, ``planner_server``, ``global_costmap/global_costmap``,
-    ``local_costmap/local_costmap``;
-    see :mod:`navseq.ros2.nav2_params`), so a client that reads the robot from Nav2 finds
-    the simulated one: its goal checker's tolerance, its controller's speeds, its outline
-    and inflation. rclpy serves every node's parameters by itself."""
-    ns = f"/{namespace.strip('/')}" if namespace and namespace.strip("/") else ""
+def nav2_server_parameters(robot: RobotProfile) -> dict[str, list[Parameter]]:
+    """The robot's parameters where Nav2's servers keep them (``controller_server``'s goal
+    checker and speeds, ``planner_server``'s tolerance; see :mod:`navseq.ros2.nav2_params`),
+    so a client that reads the robot from Nav2 finds the simulated one. rclpy serves
+    every node's parameters by itself."""
     tolerance = robot.goal_tolerance
-    controller = [
-        Parameter("goal_checker_plugins", value=["general_goal_checker"]),
-        Parameter("general_goal_checker.xy_goal_tolerance", value=tolerance.xy_m),
-        Parameter("general_goal_checker.yaw_goal_tolerance", value=tolerance.yaw_rad),
-        Parameter("controller_plugins", value=["FollowPath"]),
-        Parameter("FollowPath.desired_linear_vel", value=robot.max_linear_speed),
-        Parameter("FollowPath.rotate_to_heading_angular_vel", value=robot.max_angular_speed),
-    ]
+    return {
+        "controller_server": [
+            Parameter("goal_checker_plugins", value=["general_goal_checker"]),
+            Parameter("general_goal_checker.xy_goal_tolerance", value=tolerance.xy_m),
+            Parameter("general_goal_checker.yaw_goal_tolerance", value=tolerance.yaw_rad),
+            Parameter("controller_plugins", value=["FollowPath"]),
+            Parameter("FollowPath.desired_linear_vel", value=robot.max_linear_speed),
+            Parameter("FollowPath.rotate_to_heading_angular_vel", value=robot.max_angular_speed),
+        ],
+        "planner_server": [
+            Parameter("planner_plugins", value=["GridBased"]),
+            Parameter("GridBased.tolerance", value=NAV2_PLANNER_TOLERANCE),
+        ],
+    }
+
+
+def nav2_costmap_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
+    """``global_costmap/global_costmap`` and ``local_costmap/local_costmap``, holding the
+    robot's outline and inflation where Nav2's costmaps keep them."""
+    ns = f"/{namespace.strip('/')}" if namespace and namespace.strip("/") else ""
     outline = "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in robot.footprint) + "]"
     costmap = [
         Parameter("footprint", value=outline),
         Parameter("inflation_layer.inflation_radius", value=robot.inflation_radius),
         Parameter("inflation_layer.cost_scaling_factor", value=robot.cost_scaling_factor),
     ]
-    planner = [
-        Parameter("planner_plugins", value=["GridBased"]),
-        Parameter("GridBased.tolerance", value=NAV2_PLANNER_TOLERANCE),
-    ]
-    made = [("controller_server", ns or None, controller), ("planner_server", ns or None, planner)]
-    made += [(name, f"{ns}/{name}", costmap) for name in ("global_costmap", "local_costmap")]
     return [
         Node(
             name,
-            namespace=where,
-            parameter_overrides=overrides,
+            namespace=f"{ns}/{name}",
+            parameter_overrides=costmap,
             automatically_declare_parameters_from_overrides=True,
         )
-        for name, where, overrides in made
+        for name in ("global_costmap", "local_costmap")
     ]
 
 

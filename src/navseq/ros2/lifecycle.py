@@ -1,0 +1,216 @@
+"""Nav2's lifecycle surface for the ROS 2 simulator node: its managed nodes and managers.
+
+A default Jazzy bringup runs each server as a lifecycle node under its own name, brought
+up by two lifecycle managers. Clients depend on that: ``ros2 lifecycle get
+/bt_navigator``, ``nav2_simple_commander``'s ``waitUntilNav2Active()`` (``get_state``),
+``lifecycleStartup()`` / ``lifecycleShutdown()`` (every ``ManageLifecycleNodes``
+service). So the stand-in runs the same:
+
+- one rclpy ``LifecycleNode`` per Nav2 server, under nav2_bringup's names
+  (:data:`NAVIGATION_NODES`, :data:`LOCALIZATION_NODES`), with the real lifecycle
+  services (``get_state``, ``change_state``, ``get_available_states`` ...) and
+  transitions; configured and activated at start (nav2_bringup's ``autostart``);
+- ``lifecycle_manager_navigation`` and ``lifecycle_manager_localization`` with
+  ``manage_nodes`` (``nav2_msgs/srv/ManageLifecycleNodes``: STARTUP, PAUSE, RESUME, RESET,
+  SHUTDOWN, CONFIGURE, CLEANUP, in Nav2's order — bring-up in list order, tear-down in
+  reverse) and ``is_active`` (``std_srvs/srv/Trigger``).
+
+The simulator asks :meth:`Nav2Lifecycle.active` before it takes a goal: an action whose
+server is not active rejects new goals, as Nav2's action servers do between configure and
+activate (goals already running go on). After SHUTDOWN the nodes are finalized, and a
+later STARTUP fails, as in Nav2. The servers' own work (planning, costmaps) does not stop
+while inactive: only their action goals are refused.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from lifecycle_msgs.msg import State
+from nav2_msgs.srv import ManageLifecycleNodes
+from rclpy.action import GoalResponse
+from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_srvs.srv import Trigger
+
+#: nav2_bringup's navigation_launch.py lifecycle_nodes (Jazzy), in bring-up order.
+NAVIGATION_NODES = (
+    "controller_server",
+    "smoother_server",
+    "planner_server",
+    "behavior_server",
+    "velocity_smoother",
+    "collision_monitor",
+    "bt_navigator",
+    "waypoint_follower",
+    "docking_server",
+)
+#: nav2_bringup's localization_launch.py lifecycle_nodes.
+LOCALIZATION_NODES = ("map_server", "amcl")
+
+#: Which Nav2 server serves each action the simulator answers.
+ACTION_SERVERS = {
+    "navigate_to_pose": "bt_navigator",
+    "navigate_through_poses": "bt_navigator",
+    "follow_waypoints": "waypoint_follower",
+    "compute_path_to_pose": "planner_server",
+    "compute_path_through_poses": "planner_server",
+    "smooth_path": "smoother_server",
+    "follow_path": "controller_server",
+    "spin": "behavior_server",
+    "backup": "behavior_server",
+    "drive_on_heading": "behavior_server",
+    "wait": "behavior_server",
+}
+
+_ACTIVE = State.PRIMARY_STATE_ACTIVE
+_INACTIVE = State.PRIMARY_STATE_INACTIVE
+_UNCONFIGURED = State.PRIMARY_STATE_UNCONFIGURED
+_FINALIZED = State.PRIMARY_STATE_FINALIZED
+
+
+class _ManagedServer(LifecycleNode):
+    """A Nav2 server's lifecycle: every transition succeeds; the state is all it keeps."""
+
+    @property
+    def state_id(self) -> int:
+        # The state machine's own record (changed by change_state calls from outside too).
+        return int(self._state_machine.current_state[0])
+
+
+class Nav2Lifecycle:
+    """The managed nodes and both managers; see the module docstring.
+
+    ``parameters`` gives some nodes their parameters (the robot where Nav2 keeps it).
+    """
+
+    def __init__(
+        self, namespace: str | None, parameters: dict[str, list[Parameter]] | None = None
+    ) -> None:
+        given = parameters or {}
+        self._lock = threading.Lock()
+        self.servers = {
+            name: _ManagedServer(
+                name,
+                namespace=namespace or None,
+                parameter_overrides=given.get(name, []),
+                automatically_declare_parameters_from_overrides=True,
+            )
+            for name in (*NAVIGATION_NODES, *LOCALIZATION_NODES)
+        }
+        self.managers = [
+            self._manager("lifecycle_manager_navigation", NAVIGATION_NODES, namespace),
+            self._manager("lifecycle_manager_localization", LOCALIZATION_NODES, namespace),
+        ]
+
+    @property
+    def nodes(self) -> list[Node]:
+        return [*self.servers.values(), *self.managers]
+
+    def start(self) -> None:
+        """Configure and activate every server, as nav2_bringup's autostart does."""
+        for names in (LOCALIZATION_NODES, NAVIGATION_NODES):
+            self._startup(names)
+
+    def active(self, action: str) -> bool:
+        """Whether the server of ``action`` takes goals now."""
+        return self.servers[ACTION_SERVERS[action]].state_id == _ACTIVE
+
+    def gate(self, action: str, log: Callable[[str], None]) -> Callable[[Any], GoalResponse]:
+        """The goal callback of ``action``'s server: accept while it is active; a refusal
+        is logged with Nav2's words."""
+
+        def take(_request: Any) -> GoalResponse:
+            if self.active(action):
+                return GoalResponse.ACCEPT
+            log(f"{action}: Action server is inactive. Rejecting the goal.")
+            return GoalResponse.REJECT
+
+        return take
+
+    # -- managers ----------------------------------------------------------------------
+
+    def _manager(self, name: str, managed: Sequence[str], namespace: str | None) -> Node:
+        node = Node(
+            name,
+            namespace=namespace or None,
+            parameter_overrides=[
+                Parameter("node_names", value=list(managed)),
+                Parameter("autostart", value=True),
+            ],
+            automatically_declare_parameters_from_overrides=True,
+        )
+        commands: dict[int, Callable[[Sequence[str]], bool]] = {
+            ManageLifecycleNodes.Request.STARTUP: self._startup,
+            ManageLifecycleNodes.Request.PAUSE: self._pause,
+            ManageLifecycleNodes.Request.RESUME: self._resume,
+            ManageLifecycleNodes.Request.RESET: self._reset,
+            ManageLifecycleNodes.Request.SHUTDOWN: self._shutdown,
+            ManageLifecycleNodes.Request.CONFIGURE: self._configure,
+            ManageLifecycleNodes.Request.CLEANUP: self._cleanup,
+        }
+
+        def manage(request: Any, response: Any) -> Any:
+            command = commands.get(request.command)
+            response.success = command is not None and command(managed)
+            return response
+
+        def is_active(_request: Any, response: Any) -> Any:
+            response.success = all(self.servers[n].state_id == _ACTIVE for n in managed)
+            return response
+
+        node.create_service(ManageLifecycleNodes, f"{name}/manage_nodes", manage)
+        node.create_service(Trigger, f"{name}/is_active", is_active)
+        return node
+
+    def _each(self, names: Sequence[str], step: Callable[[_ManagedServer], bool]) -> bool:
+        with self._lock:
+            return all(step(self.servers[name]) for name in names)
+
+    def _startup(self, names: Sequence[str]) -> bool:
+        return self._configure(names) and self._resume(names)
+
+    def _configure(self, names: Sequence[str]) -> bool:
+        return self._each(names, lambda s: _move(s, _UNCONFIGURED, s.trigger_configure))
+
+    def _resume(self, names: Sequence[str]) -> bool:
+        return self._each(names, lambda s: _move(s, _INACTIVE, s.trigger_activate))
+
+    def _pause(self, names: Sequence[str]) -> bool:
+        return self._each(names[::-1], lambda s: _move(s, _ACTIVE, s.trigger_deactivate))
+
+    def _cleanup(self, names: Sequence[str]) -> bool:
+        return self._each(names[::-1], lambda s: _move(s, _INACTIVE, s.trigger_cleanup))
+
+    def _reset(self, names: Sequence[str]) -> bool:
+        return self._pause(names) and self._cleanup(names)
+
+    def _shutdown(self, names: Sequence[str]) -> bool:
+        return self._reset(names) and self._each(
+            names[::-1], lambda s: _move(s, _UNCONFIGURED, s.trigger_shutdown)
+        )
+
+
+def _move(server: _ManagedServer, source: int, trigger: Callable[[], Any]) -> bool:
+    """Take ``server`` out of state ``source`` with ``trigger``; a server already past it
+    (at the state the step leads to, or further on the same way) needs nothing. False
+    when it cannot: finalized, or the transition failed."""
+    state = server.state_id
+    if state == _FINALIZED:
+        return False
+    if state != source:
+        return True
+    try:
+        return _ok(trigger())
+    except Exception:  # rclpy's RCLError: the state machine has no such transition
+        return False
+
+
+def _ok(result: Any) -> bool:
+    return bool(result == TransitionCallbackReturn.SUCCESS)
+
+
+__all__ = ["ACTION_SERVERS", "LOCALIZATION_NODES", "NAVIGATION_NODES", "Nav2Lifecycle"]
