@@ -28,6 +28,9 @@ from ros_support import RosMaster, RosProcess
 TESTS = Path(__file__).resolve().parent
 ROS1_SERVER = TESTS / "ros_scripted_server.py"
 ROS2_SERVER = TESTS / "ros2_scripted_server.py"
+# The other side of a mission's ROS tasks (topics, a service): see the scripts.
+ROS1_TASK_PEER = TESTS / "ros_task_peer.py"
+ROS2_TASK_PEER = TESTS / "ros2_task_peer.py"
 # A killed process leaves the DDS graph after its lease: 10 s by default in Cyclone DDS.
 SHORT_LEASE = (
     "<CycloneDDS><Domain><Discovery><LeaseDuration>1s</LeaseDuration>"
@@ -47,6 +50,11 @@ class ScriptedStack(Protocol):
         ...
 
     def start_navseq(self, mission: Path, out: Path) -> None: ...
+
+    def start_task_peer(self, log: Path) -> None:
+        """Start the task peer (``ros_task_peer.py`` / ``ros2_task_peer.py``) logging to
+        ``log``; return once it is up."""
+        ...
 
     def server_events(self) -> list[str]:
         """The events the server logged so far (goal, cancel, cancel_ignored, jump ...)."""
@@ -81,6 +89,10 @@ class Ros1Stack:
         args += ["--cancel", cancel] + (["--clock"] if clock else [])
         server = self.master.start_python(ROS1_SERVER, *args)
         server.wait_for_output("scripted move_base ready", timeout=SERVER_READY_WAIT)
+
+    def start_task_peer(self, log: Path) -> None:
+        peer = self.master.start_python(ROS1_TASK_PEER, "--log", str(log))
+        peer.wait_for_output("task peer ready", timeout=SERVER_READY_WAIT)
 
     def start_navseq(self, mission: Path, out: Path) -> None:
         self.navseq = self.master.start(
@@ -118,6 +130,7 @@ class Ros2Stack:
         self.server: subprocess.Popen[str] | None = None
         self._server_lines: list[str] = []
         self.navseq: subprocess.Popen[str] | None = None
+        self.peer: subprocess.Popen[bytes] | None = None
         self._log = workdir / "navseq.log"
 
     def start_server(self, script: str, *, clock: bool = False, cancel: str = "answer") -> None:
@@ -132,6 +145,19 @@ class Ros2Stack:
         )
         threading.Thread(target=self._read_server, daemon=True).start()
         wait_for(lambda: "ready" in self.server_events(), SERVER_READY_WAIT, "the ROS 2 server")
+
+    def start_task_peer(self, log: Path) -> None:
+        self.peer = subprocess.Popen(
+            [sys.executable, str(ROS2_TASK_PEER), "--log", str(log)],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+
+        def up() -> bool:
+            return log.exists() and '"ready"' in log.read_text()
+
+        wait_for(up, SERVER_READY_WAIT, "the ROS 2 task peer")
 
     def _read_server(self) -> None:
         assert self.server is not None and self.server.stdout is not None
@@ -171,7 +197,7 @@ class Ros2Stack:
         return self._log.read_text(errors="replace") if self._log.exists() else ""
 
     def stop(self) -> None:
-        for process in (self.navseq, self.server):
+        for process in (self.navseq, self.server, self.peer):
             if process is not None and process.poll() is None:
                 process.send_signal(signal.SIGTERM)
                 try:

@@ -25,7 +25,8 @@ lost) and the distance to go every 10 s of mission time; trouble is a warning.
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
-and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``
+and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel``, ``~skip`` and
+``~confirm`` (confirms the ``input`` task waiting for an operator)
 (the active waypoint ends SKIPPED and the mission goes on with the next one).
 Ctrl-C, SIGTERM, ``rosnode kill`` and roslaunch's shutdown all cancel the active goal
 before the node exits, which logs ``interrupted (<signal or shutdown reason>)`` and
@@ -77,9 +78,10 @@ from navseq.ros1.navstack_params import read_navstack_profile
 from navseq.ros1.params import bool_param
 from navseq.roscore.navigator import CANCEL_WAIT
 from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
-from navseq.roscore.operator import OPERATOR_SERVICES, OperatorDesk
+from navseq.roscore.operator import CONFIRM_SERVICE, OPERATOR_SERVICES, OperatorDesk
 from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
+from navseq.tasks.runner import TaskRunner
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -185,8 +187,8 @@ class RospyFace:
 
 
 def offer_operator_services(desk: OperatorDesk) -> None:
-    """``~pause``, ``~resume``, ``~skip``, ``~cancel``; rospy serves each call on a thread
-    of its own, so a handler may wait (bounded) for the mission's answer."""
+    """``~pause``, ``~resume``, ``~skip``, ``~cancel`` and ``~confirm``; rospy serves each
+    call on a thread of its own, so a handler may wait (bounded) for the mission's answer."""
 
     def handler(kind: str) -> Callable[[Any], TriggerResponse]:
         def handle(_request: Any) -> TriggerResponse:
@@ -197,6 +199,12 @@ def offer_operator_services(desk: OperatorDesk) -> None:
 
     for kind in OPERATOR_SERVICES:
         rospy.Service(f"~{kind}", Trigger, handler(kind))
+
+    def confirm(_request: Any) -> TriggerResponse:
+        ok, message = desk.confirm()
+        return TriggerResponse(success=ok, message=message)
+
+    rospy.Service(f"~{CONFIRM_SERVICE}", Trigger, confirm)
 
 
 def run_node() -> int:
@@ -223,7 +231,8 @@ def run_node() -> int:
     face = RospyFace(navigator.resolved_action)
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
-    offer_operator_services(OperatorDesk(control, topics.state, face.service_name))
+    tasks = TaskRunner(say=face.info)
+    offer_operator_services(OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,
         mission,
@@ -234,6 +243,7 @@ def run_node() -> int:
         tick=float(settings["tick"]),
         log=lambda robot: LogProgress(mission, log_line, robot=robot),
         shutdowns=(rospy.ROSInterruptException,),
+        tasks=tasks,
     )
     if not run.ran_to_end:
         return run.code

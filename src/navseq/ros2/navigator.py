@@ -97,6 +97,7 @@ from navseq.ros2.messages import (
     terminal_status,
 )
 from navseq.ros2.session import Ros2Session
+from navseq.ros2.task_port import Ros2TaskPort
 from navseq.roscore.clock import CLOCK_WAIT
 from navseq.roscore.navigator import CANCEL_WAIT, NavigatorCore, rejected
 
@@ -201,6 +202,7 @@ class Nav2Navigator:
                 thread_name="navseq-nav2",
             )
         self._session = session
+        self._task_port: Ros2TaskPort | None = None  # made for the first ROS task
         self._context = session.context
         self._node = session.node
         try:
@@ -242,6 +244,12 @@ class Nav2Navigator:
             self._session.call_soon(callback, *args)
 
     # -- Navigator protocol -----------------------------------------------------------
+
+    def ros_tasks(self) -> Ros2TaskPort:
+        """The mission's ROS tasks on this navigator's node (:mod:`navseq.ros2.task_port`)."""
+        if self._task_port is None:
+            self._task_port = Ros2TaskPort(self._session)
+        return self._task_port
 
     def now(self) -> float:
         """The node's clock (ROS time under use_sim_time); after close, its last value."""
@@ -495,6 +503,8 @@ class Nav2Navigator:
         """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
         if self._closed:
             return
+        if self._task_port is not None:
+            self._task_port.close()
         self._core.cancel_and_wait()
         self.now()  # keep the clock's last value for after close
         self._closed = True
