@@ -287,3 +287,27 @@ def test_end_launch_outside_roslaunch_signals_nobody_and_exits_with_the_mission(
     assert node.wait(timeout=60) == 0, node.output()
     assert "~end_launch: the parent process" in node.output(), node.output()
     assert "is not roslaunch; the node just exits" in node.output(), node.output()
+
+
+def test_confirm_service_confirms_the_input_task_waiting(ros_master: RosMaster, tmp_path: Path):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - {x: 1, y: 0, tasks: [{input: {prompt: Load the tray}}]}\n"
+        "  - {x: 2, y: 0}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    ros_master.set_param("/navseq/server_wait", 30)
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    # No action server yet: nothing waits for a confirmation, and none is kept for later.
+    ros_master.wait_for_service("/navseq/confirm")
+    early = ros_master.call_service("/navseq/confirm")
+    assert early == {"success": False, "message": "no input task is waiting for a confirmation"}
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node.wait_for_output("Load the tray — call /navseq/confirm to go on", timeout=60)
+    assert len(events(log, "goal")) == 1  # the robot waits at the first waypoint
+    answer = ros_master.call_service("/navseq/confirm")
+    assert answer == {"success": True, "message": "input confirmed; going on"}
+    assert node.wait(timeout=60) == 0, node.output()
+    assert len(events(log, "goal")) == 2

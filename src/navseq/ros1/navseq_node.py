@@ -231,7 +231,7 @@ def run_node() -> int:
     face = RospyFace(navigator.resolved_action)
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
-    tasks = TaskRunner(say=face.info)
+    tasks = TaskRunner(say=face.info, confirm_hint=f"call {rospy.resolve_name('~confirm')}")
     offer_operator_services(OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,

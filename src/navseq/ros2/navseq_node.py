@@ -218,7 +218,8 @@ def run_node(session: Ros2Session) -> int:
     face = RclpyFace(session, navigator)
     topics = MissionTopics(node, mission)
     control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
-    tasks = TaskRunner(say=face.info)
+    confirm = node.resolve_service_name(f"~/{CONFIRM_SERVICE}", only_expand=True)
+    tasks = TaskRunner(say=face.info, confirm_hint=f"call {confirm}")
     OperatorServices(session, OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,

@@ -308,8 +308,9 @@ class OperatorInput:
     ``TaskStarted`` does so before the runner has asked.
     """
 
-    def __init__(self, stdin: IO[str] | None = None) -> None:
+    def __init__(self, stdin: IO[str] | None = None, hint: str | None = None) -> None:
         self._stdin = stdin if stdin is not None else sys.stdin
+        self._hint = hint  # how else to confirm (a node's ~confirm service)
         self._lock = threading.Lock()
         self._ticket = 0
         self._open = False  # a prompt waits for its answer
@@ -320,7 +321,9 @@ class OperatorInput:
         self._reads = _reads_lines(self._stdin)
 
     def how_to_confirm(self) -> str:
-        return "press Enter to go on" if self._reads else "waiting for confirmation"
+        ways = ["press Enter"] if self._reads else []
+        ways += [self._hint] if self._hint else []
+        return " or ".join(ways) + " to go on" if ways else "waiting for confirmation"
 
     def ask(self) -> int:
         """A new prompt: lines typed before it do not count."""
@@ -421,7 +424,9 @@ class TaskRunner:
     """Runs the tasks a mission's executor starts; see the module docstring.
 
     ``say`` gets the lines an operator should see (a prompt, a simulated task);
-    ``stdin`` is where an operator's Enter comes from (default: the process's).
+    ``stdin`` is where an operator's Enter comes from (default: the process's);
+    ``confirm_hint`` names another way to confirm, for the prompt ("call
+    /navseq/confirm").
     """
 
     def __init__(
@@ -430,8 +435,9 @@ class TaskRunner:
         *,
         say: Say | None = None,
         stdin: IO[str] | None = None,
+        confirm_hint: str | None = None,
     ) -> None:
-        self.operator = OperatorInput(stdin)
+        self.operator = OperatorInput(stdin, confirm_hint)
         self._context = _Context(options or TaskOptions(), say or _to_stderr, self.operator)
         self._jobs: dict[int, Job] = {}
         # (navigator time, wall time) when a real-time job started: see pace().
