@@ -63,8 +63,9 @@ def task_problems(
         elif task.uses_ros and options.simulate_ros_s is None:
             problems.append(
                 NavseqError(
-                    f"needs ROS, which the {navigator} navigator does not have: give "
-                    "--simulate-tasks to rehearse it (logged, succeeds after a set time)",
+                    f"needs ROS, which the {navigator} navigator does not have: run it with "
+                    "--navigator ros1 or nav2, or give --simulate-tasks to rehearse it "
+                    "(logged, succeeds after a set time)",
                     source=task.where,
                     subject=subject,
                 )
