@@ -311,3 +311,31 @@ def test_confirm_service_confirms_the_input_task_waiting(ros_master: RosMaster, 
     assert answer == {"success": True, "message": "input confirmed; going on"}
     assert node.wait(timeout=60) == 0, node.output()
     assert len(events(log, "goal")) == 2
+
+
+def test_skip_during_a_wait_for_ends_its_subscription_and_the_mission_goes_on(
+    ros_master: RosMaster, tmp_path: Path
+):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - x: 1\n    y: 0\n    tasks:\n"
+        "      - wait_for: {topic: /door/open, type: std_msgs/Bool, field: data, equals: true}\n"
+        "        timeout: null\n"
+        "  - {x: 2, y: 0}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    ros_master.set_param("/navseq/keep_alive", True)  # still up when the mission is over
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    ros_master.wait_for_subscriber("/door/open", timeout=60)  # the task waits
+    answer = ros_master.call_service("/navseq/skip")
+    assert answer["success"], answer
+    node.wait_for_output("staying up", timeout=60)
+    assert len(events(log, "goal")) == 2  # the mission went on
+    # The node is still up, and no longer listens to the task's topic.
+    wait_for(
+        lambda: "/door/open" not in ros_master.system_state()[1], 10, "the subscription to end"
+    )
+    assert node.stop(signal.SIGINT) == 1, node.output()  # waypoint 1 skipped
