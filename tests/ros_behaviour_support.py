@@ -49,7 +49,9 @@ class ScriptedStack(Protocol):
         """Start the server (``--script``, then ``succeed:0.5``); return once it is ready."""
         ...
 
-    def start_navseq(self, mission: Path, out: Path) -> None: ...
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
+        """``navseq run MISSION`` on this ROS, ``extra`` options added."""
+        ...
 
     def start_task_peer(self, log: Path) -> None:
         """Start the task peer (``ros_task_peer.py`` / ``ros2_task_peer.py``) logging to
@@ -94,9 +96,9 @@ class Ros1Stack:
         peer = self.master.start_python(ROS1_TASK_PEER, "--log", str(log))
         peer.wait_for_output("task peer ready", timeout=SERVER_READY_WAIT)
 
-    def start_navseq(self, mission: Path, out: Path) -> None:
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
         self.navseq = self.master.start(
-            [NAVSEQ, "run", mission, "--navigator", "ros1", *RUN_ARGS, "--out", out],
+            [NAVSEQ, "run", mission, "--navigator", "ros1", *RUN_ARGS, "--out", out, *extra],
             cwd=out.parent,
             label="navseq",
         )
@@ -164,10 +166,11 @@ class Ros2Stack:
         for line in self.server.stdout:
             self._server_lines.append(line)
 
-    def start_navseq(self, mission: Path, out: Path) -> None:
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
+        navigator = ("--navigator", "nav2", *RUN_ARGS)
         with self._log.open("w") as sink:
             self.navseq = subprocess.Popen(
-                [NAVSEQ, "run", str(mission), "--navigator", "nav2", *RUN_ARGS, "--out", str(out)],
+                [NAVSEQ, "run", str(mission), *navigator, "--out", str(out), *extra],
                 env=self.env,
                 cwd=out.parent,
                 stdout=sink,

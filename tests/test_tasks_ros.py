@@ -119,3 +119,41 @@ def test_a_type_the_running_ros_lacks_is_refused_before_anything_moves(
     assert "m.yaml:7, waypoint 1, task 2 (call): service type nowhere_srvs/Nothing" in said
     assert "Traceback" not in said
     assert not out.exists()
+
+
+def test_record_topics_records_what_the_stack_publishes(
+    stack: ScriptedStack, tmp_path: Path
+) -> None:
+    """``--record-topics`` on both ROS: the peer's messages as it published them, in the
+    recording's encoding of that ROS, with the type's full definition as schema."""
+    from mcap.reader import make_reader
+
+    stack.start_server("succeed:0.5")
+    stack.start_task_peer(tmp_path / "peer.jsonl")
+    out = tmp_path / "out"
+    record_format = "ros1" if stack.name == "ros1" else "ros2"
+    waypoints = "  - {x: 1.0, y: 0.0, tasks: [{wait: 1.5}]}\n"
+    stack.start_navseq(
+        write_mission(tmp_path / "m.yaml", waypoints),
+        out,
+        *("--record", "--record-format", record_format, "--record-topics", "/counter"),
+    )
+    assert stack.finish(RUN_TIMEOUT) == 0, stack.output()[-4000:]
+    if record_format == "ros1":
+        from mcap_ros1.decoder import DecoderFactory
+    else:
+        from mcap_ros2.decoder import DecoderFactory  # type: ignore[no-redef]
+    with (out / "run.mcap").open("rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        summary = reader.get_summary()
+        assert summary is not None
+        types = {
+            c.topic: summary.schemas[c.schema_id].name
+            for c in summary.channels.values()
+            if c.schema_id
+        }
+        counts = [m.data for _, _, _, m in reader.iter_decoded_messages(topics=["/counter"])]
+    expected = "std_msgs/Int32" if record_format == "ros1" else "std_msgs/msg/Int32"
+    assert types["/counter"] == expected, types
+    # The peer counts up every 0.1 s: the run's second and a half holds many, in order.
+    assert len(counts) >= 5 and counts == sorted(counts), counts

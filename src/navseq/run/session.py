@@ -580,16 +580,20 @@ def _check_recording(
     if not records:
         raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
     kind = kind_of_run.name if kind_of_run is not None else "a face's own navigator"
-    if kind != "ros1":
+    # Each stack's messages are recorded as published: in its own ROS's encoding.
+    encodings = {"ros1": "ros1", "nav2": "ros2"}
+    if kind not in encodings:
         raise NavseqError(
-            "records a ROS 1 navigation stack's topics as it publishes them, with "
-            f"--navigator ros1 only (not {kind}); the map, pose, odometry, /tf and plans "
-            "are recorded with any navigator",
+            "records a ROS navigation stack's topics as it publishes them, with "
+            f"--navigator ros1 or nav2 only (not {kind}); the map, pose, odometry, /tf and "
+            "plans are recorded with any navigator",
             source="--record-topics",
         )
-    if outputs.record_format != "ros1":
+    if (outputs.record_format or "ros2") != encodings[kind]:
+        ros = "ROS 1" if kind == "ros1" else "ROS 2"
         raise NavseqError(
-            "records the ROS 1 stack's messages as they are published: add --record-format ros1",
+            f"records the {ros} stack's messages as they are published: add "
+            f"--record-format {encodings[kind]}",
             source="--record-topics",
         )
 
