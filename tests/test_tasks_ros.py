@@ -110,6 +110,8 @@ def test_a_type_the_running_ros_lacks_is_refused_before_anything_moves(
         "  - x: 1.0\n    y: 0.0\n    tasks:\n"
         "      - wait_for: {topic: /x, type: std_msgs/NoSuchType, field: data, equals: 1}\n"
         "      - call: {service: /y, type: nowhere_srvs/Nothing}\n"
+        "      - publish: {topic: /z, type: std_msgs/String, message: {dta: x}}\n"
+        "      - call: {service: /y, type: std_srvs/SetBool, request: {flag: true}}\n"
     )
     out = tmp_path / "out"
     stack.start_navseq(write_mission(tmp_path / "m.yaml", waypoints), out)
@@ -117,6 +119,14 @@ def test_a_type_the_running_ros_lacks_is_refused_before_anything_moves(
     said = stack.output()
     assert "m.yaml:6, waypoint 1, task 1 (wait_for): message type std_msgs/NoSuchType" in said
     assert "m.yaml:7, waypoint 1, task 2 (call): service type nowhere_srvs/Nothing" in said
+    assert (
+        "m.yaml:8, waypoint 1, task 3 (publish): message does not fit a std_msgs/String "
+        "message: " in said
+    )
+    assert (
+        "m.yaml:9, waypoint 1, task 4 (call): request does not fit the request of "
+        "std_srvs/SetBool: " in said
+    )
     assert "Traceback" not in said
     assert not out.exists()
 

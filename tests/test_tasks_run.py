@@ -128,6 +128,9 @@ class _KnownTypes:
         known = {"std_srvs/Trigger"} if service else {"std_msgs/Bool"}
         return None if type_name in known else "not found"
 
+    def fields_problem(self, type_name: str, fields: Any, *, service: bool = False) -> str | None:
+        return next((f"no field {name!r}" for name in fields if name != "data"), None)
+
 
 def test_ros_tasks_on_a_ros_navigator_are_checked_against_its_types(tmp_path: Path) -> None:
     path = mission(
@@ -136,7 +139,9 @@ def test_ros_tasks_on_a_ros_navigator_are_checked_against_its_types(tmp_path: Pa
         "  - x: -1\n    y: 0\n    tasks:\n"
         "      - publish: {topic: /a, type: std_msgs/Missing}\n"
         "      - call: {service: /y, type: my_srvs/Nope}\n"
-        "      - snapshot: {topic: /b, type: std_msgs/Bool}\n",
+        "      - snapshot: {topic: /b, type: std_msgs/Bool}\n"
+        "      - publish: {topic: /c, type: std_msgs/Bool, message: {datum: true}}\n"
+        "      - call: {service: /d, request: {data: 1}}\n",
     )
     loaded = load_mission(path)
     problems = task_problems(loaded, TaskOptions(), "ros1", simulated=False, types=_KnownTypes())
@@ -145,12 +150,14 @@ def test_ros_tasks_on_a_ros_navigator_are_checked_against_its_types(tmp_path: Pa
         "loaded here: not found",
         f"{path}:10, waypoint 2, task 2 (call): service type my_srvs/Nope cannot be loaded "
         "here: not found",
+        f"{path}:12, waypoint 2, task 4 (publish): message does not fit a std_msgs/Bool "
+        "message: no field 'datum'",
     ]
     # A node writes no run folder: a snapshot has nowhere to go.
     without_folder = task_problems(
         loaded, TaskOptions(), "ros1", simulated=False, types=_KnownTypes(), has_folder=False
     )
-    assert str(without_folder[-1]) == (
+    assert str(without_folder[-2]) == (
         f"{path}:11, waypoint 2, task 3 (snapshot): a snapshot is saved into the run folder, "
         "and this run writes none"
     )

@@ -21,7 +21,7 @@ settings, and each kind applies its own default.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
@@ -189,6 +189,11 @@ class _AnyType:
     """Types where ROS is not there to ask: none is refused (the kind refuses the run)."""
 
     def type_problem(self, type_name: str, *, service: bool = False) -> str | None:
+        return None
+
+    def fields_problem(
+        self, type_name: str, fields: Mapping[str, Any], *, service: bool = False
+    ) -> str | None:
         return None
 
 

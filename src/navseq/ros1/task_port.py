@@ -9,6 +9,8 @@ thread of its own, which drops its answer once the task is cancelled.
 
 from __future__ import annotations
 
+import io
+import struct
 import threading
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -32,6 +34,18 @@ class Ros1Types:
         except ValueError as error:
             return str(error)
         return None if loaded is not None else "not found"
+
+    def fields_problem(
+        self, type_name: str, fields: Mapping[str, Any], *, service: bool = False
+    ) -> str | None:
+        try:
+            made = (
+                _service_class(type_name)._request_class if service else _message_class(type_name)
+            )
+            _serialised(_filled(made(), fields))
+        except ValueError as error:
+            return str(error)
+        return None
 
 
 def ros_types() -> Ros1Types:
@@ -73,6 +87,17 @@ def _filled(message: Any, fields: Mapping[str, Any]) -> Any:
     return message
 
 
+def _serialised(message: Any) -> bytes:
+    """The message's bytes; ValueError when a value is not of its field's type (genpy
+    fills fields without looking at their types: serialising does)."""
+    buffer = io.BytesIO()
+    try:
+        message.serialize(buffer)
+    except (genpy.SerializationError, struct.error, TypeError, ValueError, AttributeError) as error:
+        raise ValueError(f"a value does not fit its field: {error}") from None
+    return buffer.getvalue()
+
+
 class _Publisher:
     def __init__(self, topic: str, message_class: Any) -> None:
         self._class = message_class
@@ -83,7 +108,9 @@ class _Publisher:
         return int(self.publisher.get_num_connections())
 
     def publish(self, fields: Mapping[str, Any]) -> None:
-        self.publisher.publish(_filled(self._class(), fields))
+        message = _filled(self._class(), fields)
+        _serialised(message)  # a bad value: ValueError here, not rospy's error mid-run
+        self.publisher.publish(message)
 
 
 class Ros1TaskPort(Ros1Types):
@@ -131,7 +158,7 @@ class Ros1TaskPort(Ros1Types):
                 return
             try:
                 response = rospy.ServiceProxy(service, service_class)(request)
-            except (rospy.ServiceException, rospy.ROSException) as error:
+            except (rospy.ServiceException, rospy.ROSException, genpy.SerializationError) as error:
                 answer(None, f"{service} failed: {error}")
                 return
             answer(response, None)

@@ -56,6 +56,16 @@ class Ros2Types:
             return str(error)
         return None
 
+    def fields_problem(
+        self, type_name: str, fields: Mapping[str, Any], *, service: bool = False
+    ) -> str | None:
+        try:
+            loaded = _loaded(type_name, service=service)
+            _filled((loaded.Request if service else loaded)(), fields)
+        except ValueError as error:
+            return str(error)
+        return None
+
 
 def ros_types() -> Ros2Types:
     return Ros2Types()

@@ -14,7 +14,7 @@ from collections.abc import Iterator
 
 from navseq.errors import NavseqError
 from navseq.mission.model import Mission
-from navseq.mission.tasks import CallTask, SnapshotTask, Task
+from navseq.mission.tasks import CallTask, PublishTask, SnapshotTask, Task
 from navseq.tasks.options import TaskOptions
 from navseq.tasks.ros_port import RosTypes
 
@@ -83,6 +83,12 @@ def _ros_task_problems(task: Task, types: RosTypes, has_folder: bool) -> Iterato
         if why is not None:
             what = "service" if service else "message"
             yield f"{what} type {type_name} cannot be loaded here: {why}"
+        elif isinstance(task, PublishTask | CallTask):
+            fields = task.request if isinstance(task, CallTask) else task.message
+            why = types.fields_problem(type_name, fields, service=service)
+            if why is not None:
+                what = f"the request of {type_name}" if service else f"a {type_name} message"
+                yield f"{'request' if service else 'message'} does not fit {what}: {why}"
     if isinstance(task, SnapshotTask) and not has_folder:
         yield "a snapshot is saved into the run folder, and this run writes none"
 

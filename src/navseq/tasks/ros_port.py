@@ -27,6 +27,12 @@ class RosTypes(Protocol):
     def type_problem(self, type_name: str, *, service: bool = False) -> str | None:
         """None when ``type_name`` (``pkg/Type``) loads, else why not, in a few words."""
 
+    def fields_problem(
+        self, type_name: str, fields: Mapping[str, Any], *, service: bool = False
+    ) -> str | None:
+        """None when a message of ``type_name`` (a service's request, with ``service``)
+        takes ``fields``, else why not (a field it lacks, a value of the wrong kind)."""
+
 
 class RosPublisher(Protocol):
     """One topic advertised for ``publish`` tasks, kept until the port closes."""
