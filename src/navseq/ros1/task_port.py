@@ -21,6 +21,9 @@ import rospy
 
 from navseq.tasks.ros_port import Stop
 
+#: Bytes rospy reads a message into at once: an image's megabytes in one go (rospy's
+#: 64 KiB default takes many reads for one camera frame).
+RECEIVE_BUFFER = 1 << 24
 #: Seconds between looks for a service that is not there yet (a cancel is seen as soon).
 SERVICE_LOOK = 0.2
 
@@ -122,7 +125,9 @@ class Ros1TaskPort(Ros1Types):
         self._stops: set[Stop] = set()
 
     def subscribe(self, topic: str, type_name: str, on_message: Callable[[Any], None]) -> Stop:
-        subscriber = rospy.Subscriber(topic, _message_class(type_name), on_message)
+        subscriber = rospy.Subscriber(
+            topic, _message_class(type_name), on_message, buff_size=RECEIVE_BUFFER
+        )
         return self._keep(subscriber.unregister)
 
     def advertise(self, topic: str, type_name: str) -> _Publisher:

@@ -187,7 +187,7 @@ class CallJob:
         has, answer = self._answer.take()
         if not has:
             return None
-        self._stop = _never
+        self.cancel()  # the answer is in: the client goes
         response, error = answer
         if error is not None:
             return TaskDone(self._task_id, False, error)
