@@ -9,6 +9,7 @@ thread of its own, which drops its answer once the task is cancelled.
 
 from __future__ import annotations
 
+import importlib.util
 import io
 import struct
 import threading
@@ -58,21 +59,30 @@ def ros_types() -> Ros1Types:
 def _message_class(type_name: str) -> Any:
     found = roslib.message.get_message_class(type_name)
     if found is None:
-        package = type_name.split("/", 1)[0]
-        raise ValueError(
-            f"no such message (is {package} installed? Debian: python3-{package.replace('_', '-')})"
-        )
+        raise ValueError(_missing(type_name, "msg"))
     return found
 
 
 def _service_class(type_name: str) -> Any:
     found = roslib.message.get_service_class(type_name)
     if found is None:
-        package = type_name.split("/", 1)[0]
-        raise ValueError(
-            f"no such service (is {package} installed? Debian: python3-{package.replace('_', '-')})"
-        )
+        raise ValueError(_missing(type_name, "srv"))
     return found
+
+
+def _missing(type_name: str, kind: str) -> str:
+    """Why ``pkg/Type`` does not load: the package is not there, or has no such type."""
+    package, name = type_name.split("/", 1)
+    try:
+        installed = importlib.util.find_spec(f"{package}.{kind}") is not None
+    except (ImportError, ValueError):
+        installed = False
+    what = "message" if kind == "msg" else "service"
+    if installed:
+        return f"{package} has no {what} {name}"
+    return (
+        f"the package {package} is not installed (on Debian: python3-{package.replace('_', '-')})"
+    )
 
 
 def _filled(message: Any, fields: Mapping[str, Any]) -> Any:

@@ -11,6 +11,7 @@ subscription and client are destroyed on the executor's thread.
 
 from __future__ import annotations
 
+import importlib.util
 import threading
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -42,9 +43,15 @@ def _loaded(type_name: str, *, service: bool) -> Any:
     try:
         return get_service(full) if service else get_message(full)
     except (ValueError, ModuleNotFoundError, AttributeError, ImportError):
+        what = "service" if service else "message"
+        try:
+            installed = importlib.util.find_spec(package) is not None
+        except (ImportError, ValueError):
+            installed = False
+        if installed:
+            raise ValueError(f"{package} has no {what} {name}") from None
         raise ValueError(
-            f"no such {'service' if service else 'message'} in this ROS 2 "
-            f"(is {package} installed and sourced?)"
+            f"the package {package} is not in this ROS 2 (is it installed, and sourced?)"
         ) from None
 
 
