@@ -19,6 +19,8 @@ from ros_support import RosMaster, RosProcess, wait_for
 
 pytestmark = pytest.mark.ros
 
+TESTS = Path(__file__).resolve().parent
+
 # The tutorial's launch file contents.
 P_SEQ = [-1, -4, 0, 1, -4, 0, 1, -1, 0]
 YEA_SEQ = [90, 0, 180]
@@ -339,3 +341,28 @@ def test_skip_during_a_wait_for_ends_its_subscription_and_the_mission_goes_on(
         lambda: "/door/open" not in ros_master.system_state()[1], 10, "the subscription to end"
     )
     assert node.stop(signal.SIGINT) == 1, node.output()  # waypoint 1 skipped
+
+
+def test_snapshots_go_into_the_snapshot_dir_and_without_one_are_refused(
+    ros_master: RosMaster, tmp_path: Path
+):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - name: dock\n    x: 1\n    y: 0\n    tasks:\n"
+        "      - snapshot: {topic: /camera/image, type: sensor_msgs/Image}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    refused = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    assert refused.wait(timeout=60) == 2, refused.output()
+    assert "m.yaml:7, waypoint 1 'dock', task 1 (snapshot)" in refused.output()
+    assert "snapshot_dir" in refused.output()
+    assert events(log, "goal") == []  # refused before the robot moved
+
+    ros_master.start_python(TESTS / "ros_task_peer.py", "--log", str(tmp_path / "peer.jsonl"))
+    ros_master.set_param("/navseq/snapshot_dir", str(tmp_path / "shots"))
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    assert node.wait(timeout=60) == 0, node.output()
+    assert [p.name for p in (tmp_path / "shots" / "snapshots").iterdir()] == ["dock-task1.png"]

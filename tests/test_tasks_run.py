@@ -159,7 +159,7 @@ def test_ros_tasks_on_a_ros_navigator_are_checked_against_its_types(tmp_path: Pa
     )
     assert str(without_folder[-2]) == (
         f"{path}:11, waypoint 2, task 3 (snapshot): a snapshot is saved into the run folder, "
-        "and this run writes none"
+        "and this run writes none (a navseq node: give it a snapshot_dir parameter)"
     )
     # A navigator that is no simulator and offers no ROS cannot run them at all.
     (refused,) = task_problems(

@@ -60,6 +60,7 @@ from __future__ import annotations
 import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import rospy
@@ -81,6 +82,7 @@ from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
 from navseq.roscore.operator import CONFIRM_SERVICE, OPERATOR_SERVICES, OperatorDesk
 from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
+from navseq.tasks.options import TaskOptions
 from navseq.tasks.runner import TaskRunner
 
 NODE_NAME = "navseq"
@@ -98,6 +100,7 @@ NODE_PARAMS: dict[str, Any] = {
     "end_launch": False,
     "settle": 0.05,
     "odom_frame": "odom",
+    "snapshot_dir": "",  # where snapshot tasks write (its snapshots/); "": refused
 }
 # s to wait for rospy to name its shutdown reason: it does so only after the navigator's
 # shutdown hook has waited (up to CANCEL_WAIT) for the server to take the cancel in.
@@ -231,7 +234,11 @@ def run_node() -> int:
     face = RospyFace(navigator.resolved_action)
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
-    tasks = TaskRunner(say=face.info, confirm_hint=f"call {rospy.resolve_name('~confirm')}")
+    snapshot_dir = str(settings["snapshot_dir"] or "")
+    options = TaskOptions(snapshot_folder=Path(snapshot_dir).expanduser() if snapshot_dir else None)
+    tasks = TaskRunner(
+        options, say=face.info, confirm_hint=f"call {rospy.resolve_name('~confirm')}"
+    )
     offer_operator_services(OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,
@@ -244,6 +251,7 @@ def run_node() -> int:
         log=lambda robot: LogProgress(mission, log_line, robot=robot),
         shutdowns=(rospy.ROSInterruptException,),
         tasks=tasks,
+        task_options=options,
     )
     if not run.ran_to_end:
         return run.code

@@ -75,6 +75,7 @@ from navseq.roscore.operator import (
 )
 from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import RunView, describe
+from navseq.tasks.options import TaskOptions
 from navseq.tasks.runner import TaskRunner
 
 NODE_NAME = "navseq"
@@ -219,7 +220,8 @@ def run_node(session: Ros2Session) -> int:
     topics = MissionTopics(node, mission)
     control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
     confirm = node.resolve_service_name(f"~/{CONFIRM_SERVICE}", only_expand=True)
-    tasks = TaskRunner(say=face.info, confirm_hint=f"call {confirm}")
+    options = TaskOptions(snapshot_folder=settings.snapshot_dir)
+    tasks = TaskRunner(options, say=face.info, confirm_hint=f"call {confirm}")
     OperatorServices(session, OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,
@@ -231,6 +233,7 @@ def run_node(session: Ros2Session) -> int:
         tick=settings.tick,
         log=lambda _robot: WaypointLog(mission, logger),
         tasks=tasks,
+        task_options=options,
     )
     if run.ran_to_end and settings.keep_alive:
         return stay_up(face, run.code, "mission over; staying up (keep_alive) until shut down")

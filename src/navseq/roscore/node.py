@@ -42,6 +42,7 @@ from navseq.navigators.base import Navigator
 from navseq.run import RunRequest, UseNavigator, prepare
 from navseq.signals import SignalGuard, StopSignals
 from navseq.sinks.mission_status import StatusPublisher
+from navseq.tasks.options import TaskOptions
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -106,12 +107,14 @@ def run_node_mission(
     log: Callable[[RobotProfile], MissionListener],
     shutdowns: Sequence[type[BaseException]] = (),
     tasks: TaskRunner | None = None,
+    task_options: TaskOptions | None = None,
 ) -> NodeRun:
     """Run the node's mission (module doc). ``log(robot)`` makes the listener that logs
     the run (the robot known by then gives it the time still to go); ``shutdowns``
     are the client library's own "shutting down" exceptions, which end the run with
     :data:`EXIT_SHUT_DOWN`. ``tasks`` runs the waypoints' tasks (the one the node's
-    ``~/confirm`` service answers); None: one made for the run."""
+    ``~/confirm`` service answers); None: one made for the run. ``task_options``: what
+    the tasks may do (where snapshots go)."""
     state = topics.state
     try:
         face.info(
@@ -135,6 +138,7 @@ def run_node_mission(
                 outputs=None,  # a node's record is its topics and its log
                 server_wait=server_wait,
                 tick=tick,
+                tasks=task_options or TaskOptions(),
             )
         )
         session.task_runner = tasks

@@ -369,8 +369,10 @@ class Session:
         tasks = self.task_runner or TaskRunner(self.request.tasks, say=say)
 
         navigator = self.make_navigator()
-        # ROS tasks on the navigator's own node; snapshots into the run folder.
-        tasks.attach(ros_port_of(navigator), folder, self._waypoint_name)
+        # ROS tasks on the navigator's own node; snapshots into the run folder (a
+        # node's: the folder its parameters name).
+        snapshots = self.request.tasks.snapshot_folder or folder
+        tasks.attach(ros_port_of(navigator), snapshots, self._waypoint_name)
         error: NavseqError | None = None
         navigator_start, wall_start = navigator.now(), time.monotonic()
         try:
@@ -657,7 +659,7 @@ def _refuse_tasks(mission: Mission, request: RunRequest, kind: NavigatorKind | N
         name,
         simulated=simulated,
         types=types,
-        has_folder=request.outputs is not None,
+        has_folder=request.outputs is not None or request.tasks.snapshot_folder is not None,
     )
     if len(problems) == 1:
         raise problems[0]

@@ -90,7 +90,10 @@ def _ros_task_problems(task: Task, types: RosTypes, has_folder: bool) -> Iterato
                 what = f"the request of {type_name}" if service else f"a {type_name} message"
                 yield f"{'request' if service else 'message'} does not fit {what}: {why}"
     if isinstance(task, SnapshotTask) and not has_folder:
-        yield "a snapshot is saved into the run folder, and this run writes none"
+        yield (
+            "a snapshot is saved into the run folder, and this run writes none (a navseq "
+            "node: give it a snapshot_dir parameter)"
+        )
 
 
 def _every_task(mission: Mission) -> Iterator[tuple[str, int, Task]]:
