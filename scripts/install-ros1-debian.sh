@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   python3-rospy python3-actionlib python3-move-base-msgs python3-nav-msgs
   python3-geometry-msgs python3-visualization-msgs python3-std-srvs python3-tf2-msgs
+  python3-sensor-msgs
   python3-tf2-ros python3-rosmaster python3-roslaunch python3-rosparam python3-rostopic
   rosbash catkin python3-venv
   # What the nodes import besides ROS, for catkin installs run by /usr/bin/python3

@@ -28,6 +28,9 @@ from ros_support import RosMaster, RosProcess
 TESTS = Path(__file__).resolve().parent
 ROS1_SERVER = TESTS / "ros_scripted_server.py"
 ROS2_SERVER = TESTS / "ros2_scripted_server.py"
+# The other side of a mission's ROS tasks (topics, a service): see the scripts.
+ROS1_TASK_PEER = TESTS / "ros_task_peer.py"
+ROS2_TASK_PEER = TESTS / "ros2_task_peer.py"
 # A killed process leaves the DDS graph after its lease: 10 s by default in Cyclone DDS.
 SHORT_LEASE = (
     "<CycloneDDS><Domain><Discovery><LeaseDuration>1s</LeaseDuration>"
@@ -46,7 +49,14 @@ class ScriptedStack(Protocol):
         """Start the server (``--script``, then ``succeed:0.5``); return once it is ready."""
         ...
 
-    def start_navseq(self, mission: Path, out: Path) -> None: ...
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
+        """``navseq run MISSION`` on this ROS, ``extra`` options added."""
+        ...
+
+    def start_task_peer(self, log: Path) -> None:
+        """Start the task peer (``ros_task_peer.py`` / ``ros2_task_peer.py``) logging to
+        ``log``; return once it is up."""
+        ...
 
     def server_events(self) -> list[str]:
         """The events the server logged so far (goal, cancel, cancel_ignored, jump ...)."""
@@ -82,9 +92,13 @@ class Ros1Stack:
         server = self.master.start_python(ROS1_SERVER, *args)
         server.wait_for_output("scripted move_base ready", timeout=SERVER_READY_WAIT)
 
-    def start_navseq(self, mission: Path, out: Path) -> None:
+    def start_task_peer(self, log: Path) -> None:
+        peer = self.master.start_python(ROS1_TASK_PEER, "--log", str(log))
+        peer.wait_for_output("task peer ready", timeout=SERVER_READY_WAIT)
+
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
         self.navseq = self.master.start(
-            [NAVSEQ, "run", mission, "--navigator", "ros1", *RUN_ARGS, "--out", out],
+            [NAVSEQ, "run", mission, "--navigator", "ros1", *RUN_ARGS, "--out", out, *extra],
             cwd=out.parent,
             label="navseq",
         )
@@ -118,6 +132,7 @@ class Ros2Stack:
         self.server: subprocess.Popen[str] | None = None
         self._server_lines: list[str] = []
         self.navseq: subprocess.Popen[str] | None = None
+        self.peer: subprocess.Popen[bytes] | None = None
         self._log = workdir / "navseq.log"
 
     def start_server(self, script: str, *, clock: bool = False, cancel: str = "answer") -> None:
@@ -133,15 +148,29 @@ class Ros2Stack:
         threading.Thread(target=self._read_server, daemon=True).start()
         wait_for(lambda: "ready" in self.server_events(), SERVER_READY_WAIT, "the ROS 2 server")
 
+    def start_task_peer(self, log: Path) -> None:
+        self.peer = subprocess.Popen(
+            [sys.executable, str(ROS2_TASK_PEER), "--log", str(log)],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+
+        def up() -> bool:
+            return log.exists() and '"ready"' in log.read_text()
+
+        wait_for(up, SERVER_READY_WAIT, "the ROS 2 task peer")
+
     def _read_server(self) -> None:
         assert self.server is not None and self.server.stdout is not None
         for line in self.server.stdout:
             self._server_lines.append(line)
 
-    def start_navseq(self, mission: Path, out: Path) -> None:
+    def start_navseq(self, mission: Path, out: Path, *extra: str) -> None:
+        navigator = ("--navigator", "nav2", *RUN_ARGS)
         with self._log.open("w") as sink:
             self.navseq = subprocess.Popen(
-                [NAVSEQ, "run", str(mission), "--navigator", "nav2", *RUN_ARGS, "--out", str(out)],
+                [NAVSEQ, "run", str(mission), *navigator, "--out", str(out), *extra],
                 env=self.env,
                 cwd=out.parent,
                 stdout=sink,
@@ -171,7 +200,7 @@ class Ros2Stack:
         return self._log.read_text(errors="replace") if self._log.exists() else ""
 
     def stop(self) -> None:
-        for process in (self.navseq, self.server):
+        for process in (self.navseq, self.server, self.peer):
             if process is not None and process.poll() is None:
                 process.send_signal(signal.SIGTERM)
                 try:

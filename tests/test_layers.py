@@ -57,6 +57,7 @@ CORE_MODULES = [
     "navseq.navigators.scripted",
     "navseq.navigators.stack_map",
     "navseq.preflight",
+    *(f"navseq.tasks.{name}" for name in ("runner", "permissions", "ros_jobs", "snapshots")),
     "navseq.sim.world",
     "navseq.sim.base",
     "navseq.sinks.progress",

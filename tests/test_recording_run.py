@@ -182,13 +182,18 @@ def test_record_topics_is_refused_where_it_cannot_work(tmp_path: Path) -> None:
     assert "--record-topics: adds topics to a recording: add --record" in done.stderr
     done = navseq("run", MISSION, "--record", "--record-topics", "/scan", cwd=tmp_path)
     assert done.returncode == 2
-    assert "with --navigator ros1 only (not sim)" in done.stderr
+    assert "with --navigator ros1 or nav2 only (not sim)" in done.stderr
     # Refused before navseq looks for a ROS master (there is none here).
     ros1 = ("--navigator", "ros1", "--record", "--record-topics", "/scan")
     done = navseq("run", MISSION, *ros1, cwd=tmp_path)
     assert done.returncode == 2
     assert "records the ROS 1 stack's messages as they are published" in done.stderr
     assert "--record-format ros1" in done.stderr
+    nav2 = ("--navigator", "nav2", "--record", "--record-format", "ros1", "--record-topics", "/a")
+    done = navseq("run", MISSION, *nav2, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "records the ROS 2 stack's messages as they are published" in done.stderr
+    assert "--record-format ros2" in done.stderr
     assert not (tmp_path / "navseq-out").exists()
 
 

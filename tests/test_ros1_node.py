@@ -19,6 +19,8 @@ from ros_support import RosMaster, RosProcess, wait_for
 
 pytestmark = pytest.mark.ros
 
+TESTS = Path(__file__).resolve().parent
+
 # The tutorial's launch file contents.
 P_SEQ = [-1, -4, 0, 1, -4, 0, 1, -1, 0]
 YEA_SEQ = [90, 0, 180]
@@ -287,3 +289,80 @@ def test_end_launch_outside_roslaunch_signals_nobody_and_exits_with_the_mission(
     assert node.wait(timeout=60) == 0, node.output()
     assert "~end_launch: the parent process" in node.output(), node.output()
     assert "is not roslaunch; the node just exits" in node.output(), node.output()
+
+
+def test_confirm_service_confirms_the_input_task_waiting(ros_master: RosMaster, tmp_path: Path):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - {x: 1, y: 0, tasks: [{input: {prompt: Load the tray}}]}\n"
+        "  - {x: 2, y: 0}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    ros_master.set_param("/navseq/server_wait", 30)
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    # No action server yet: nothing waits for a confirmation, and none is kept for later.
+    ros_master.wait_for_service("/navseq/confirm")
+    early = ros_master.call_service("/navseq/confirm")
+    assert early == {"success": False, "message": "no input task is waiting for a confirmation"}
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node.wait_for_output("Load the tray — call /navseq/confirm to go on", timeout=60)
+    assert len(events(log, "goal")) == 1  # the robot waits at the first waypoint
+    answer = ros_master.call_service("/navseq/confirm")
+    assert answer == {"success": True, "message": "input confirmed; going on"}
+    assert node.wait(timeout=60) == 0, node.output()
+    assert len(events(log, "goal")) == 2
+
+
+def test_skip_during_a_wait_for_ends_its_subscription_and_the_mission_goes_on(
+    ros_master: RosMaster, tmp_path: Path
+):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - x: 1\n    y: 0\n    tasks:\n"
+        "      - wait_for: {topic: /door/open, type: std_msgs/Bool, field: data, equals: true}\n"
+        "        timeout: null\n"
+        "  - {x: 2, y: 0}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    ros_master.set_param("/navseq/keep_alive", True)  # still up when the mission is over
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    ros_master.wait_for_subscriber("/door/open", timeout=60)  # the task waits
+    answer = ros_master.call_service("/navseq/skip")
+    assert answer["success"], answer
+    node.wait_for_output("staying up", timeout=60)
+    assert len(events(log, "goal")) == 2  # the mission went on
+    # The node is still up, and no longer listens to the task's topic.
+    wait_for(
+        lambda: "/door/open" not in ros_master.system_state()[1], 10, "the subscription to end"
+    )
+    assert node.stop(signal.SIGINT) == 1, node.output()  # waypoint 1 skipped
+
+
+def test_snapshots_go_into_the_snapshot_dir_and_without_one_are_refused(
+    ros_master: RosMaster, tmp_path: Path
+):
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - name: dock\n    x: 1\n    y: 0\n    tasks:\n"
+        "      - snapshot: {topic: /camera/image, type: sensor_msgs/Image}\n"
+    )
+    ros_master.set_param("/navseq/mission", str(mission))
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log)
+    refused = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    assert refused.wait(timeout=60) == 2, refused.output()
+    assert "m.yaml:7, waypoint 1 'dock', task 1 (snapshot)" in refused.output()
+    assert "snapshot_dir" in refused.output()
+    assert events(log, "goal") == []  # refused before the robot moved
+
+    ros_master.start_python(TESTS / "ros_task_peer.py", "--log", str(tmp_path / "peer.jsonl"))
+    ros_master.set_param("/navseq/snapshot_dir", str(tmp_path / "shots"))
+    node = ros_master.start_python("-m", "navseq.ros1.navseq_node", label="navseq_node")
+    assert node.wait(timeout=60) == 0, node.output()
+    assert [p.name for p in (tmp_path / "shots" / "snapshots").iterdir()] == ["dock-task1.png"]

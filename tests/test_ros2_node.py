@@ -345,3 +345,21 @@ def test_the_same_mission_gives_the_same_visits_on_sim_ros1_and_nav2(
     assert on_sim == expected
     assert on_ros1 == expected
     assert on_nav2 == expected
+
+
+def test_confirm_service_confirms_the_input_task_waiting(
+    sim: SimNode, env: dict[str, str], tmp_path: Path
+):
+    mission = write_mission(
+        tmp_path / "m.yaml",
+        "  - {name: east, x: 1.75, y: -0.55, yaw: 0, tasks: [{input: {prompt: Load the tray}}]}\n",
+    )
+    node = NavseqNode(env, "-p", f"mission:={mission}")
+    try:
+        node.wait_for("Load the tray — call /navseq/confirm to go on")
+        (answer,) = rclpy_script(env, SERVICE_CALLER, "/navseq/confirm")
+        code = node.finish(60)
+    finally:
+        node.kill()
+    assert answer[1:] == [True, "input confirmed; going on"]
+    assert code == 0, node.log()

@@ -121,15 +121,54 @@ def test_run_and_ros_tasks_are_refused_before_the_robot_moves(tmp_path: Path) ->
     assert navseq("validate", path, "--allow-run", "--simulate-tasks", cwd=tmp_path).returncode == 0
 
 
-def test_ros_tasks_on_a_ros_navigator_are_refused_as_not_supported_yet(tmp_path: Path) -> None:
-    path = mission(tmp_path, "  - {x: -1, y: -0.5, tasks: [{call: {service: /x}}, {wait: 1}]}\n")
-    problems = task_problems(
-        load_mission(path), TaskOptions(simulate_ros_s=1.0), "ros1", simulated=False
+class _KnownTypes:
+    """The types a running ROS could load, as a navigator's port says (no ROS here)."""
+
+    def type_problem(self, type_name: str, *, service: bool = False) -> str | None:
+        known = {"std_srvs/Trigger"} if service else {"std_msgs/Bool"}
+        return None if type_name in known else "not found"
+
+    def fields_problem(self, type_name: str, fields: Any, *, service: bool = False) -> str | None:
+        return next((f"no field {name!r}" for name in fields if name != "data"), None)
+
+
+def test_ros_tasks_on_a_ros_navigator_are_checked_against_its_types(tmp_path: Path) -> None:
+    path = mission(
+        tmp_path,
+        "  - {x: -1, y: -0.5, tasks: [{call: {service: /x}}, {wait: 1}]}\n"
+        "  - x: -1\n    y: 0\n    tasks:\n"
+        "      - publish: {topic: /a, type: std_msgs/Missing}\n"
+        "      - call: {service: /y, type: my_srvs/Nope}\n"
+        "      - snapshot: {topic: /b, type: std_msgs/Bool}\n"
+        "      - publish: {topic: /c, type: std_msgs/Bool, message: {datum: true}}\n"
+        "      - call: {service: /d, request: {data: 1}}\n",
     )
+    loaded = load_mission(path)
+    problems = task_problems(loaded, TaskOptions(), "ros1", simulated=False, types=_KnownTypes())
     assert [str(p) for p in problems] == [
-        f"{path}:5, waypoint 1, task 1 (call): call tasks are not supported on the ros1 "
-        "navigator yet (wait, input and run are)"
+        f"{path}:9, waypoint 2, task 1 (publish): message type std_msgs/Missing cannot be "
+        "loaded here: not found",
+        f"{path}:10, waypoint 2, task 2 (call): service type my_srvs/Nope cannot be loaded "
+        "here: not found",
+        f"{path}:12, waypoint 2, task 4 (publish): message does not fit a std_msgs/Bool "
+        "message: no field 'datum'",
     ]
+    # A node writes no run folder: a snapshot has nowhere to go.
+    without_folder = task_problems(
+        loaded, TaskOptions(), "ros1", simulated=False, types=_KnownTypes(), has_folder=False
+    )
+    assert str(without_folder[-2]) == (
+        f"{path}:11, waypoint 2, task 3 (snapshot): a snapshot is saved into the run folder, "
+        "and this run writes none (a navseq node: give it a snapshot_dir parameter)"
+    )
+    # A navigator that is no simulator and offers no ROS cannot run them at all.
+    (refused,) = task_problems(
+        load_mission(mission(tmp_path, "  - {x: -1, y: -0.5, tasks: [{call: {service: /x}}]}\n")),
+        TaskOptions(simulate_ros_s=1.0),
+        "studio",
+        simulated=False,
+    )
+    assert "call tasks need ROS, and the studio navigator offers none" in str(refused)
 
 
 @pytest.mark.parametrize(
@@ -363,15 +402,17 @@ def test_the_example_mission_runs_on_the_simulator(tmp_path: Path) -> None:
     assert [v["tasks"] for v in report(out)["visits"]] == [v["tasks"] for v in written["visits"]]
 
 
-@pytest.mark.parametrize("kind", ["ros1", "nav2"])
-def test_a_ros_navigator_refuses_ros_tasks_before_connecting(tmp_path: Path, kind: str) -> None:
+@pytest.mark.ros
+def test_a_ros1_run_refuses_an_unknown_message_type_before_connecting(tmp_path: Path) -> None:
     path = write_mission(
         tmp_path / "m.yaml",
-        "  - {x: 1, y: 0, tasks: [{publish: {topic: /a, type: std_msgs/Empty}}]}\n",
+        "  - {x: 1, y: 0, tasks: [{publish: {topic: /a, type: std_msgs/Emptyish}}]}\n",
     )
-    done = navseq("run", path, "--navigator", kind, "--simulate-tasks", cwd=tmp_path)
+    # No rosmaster anywhere: the type is refused before navseq looks for one.
+    done = navseq("run", path, "--navigator", "ros1", "--out", tmp_path / "out", cwd=tmp_path)
     assert_clean_error(done)
     assert (
-        f"m.yaml:3, waypoint 1, task 1 (publish): publish tasks are not supported on the "
-        f"{kind} navigator yet" in done.stderr
+        "m.yaml:3, waypoint 1, task 1 (publish): message type std_msgs/Emptyish cannot be "
+        "loaded here" in done.stderr
     )
+    assert not (tmp_path / "out").exists()

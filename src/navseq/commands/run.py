@@ -140,7 +140,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         type=parse_topics,
         default=(),
         metavar="TOPIC[,TOPIC...]",
-        help="with --record and --navigator ros1: also record these topics as the stack "
+        help="with --record and --navigator ros1 or nav2: also record these topics as the stack "
         "publishes them (any type, e.g. /scan); a topic navseq records itself (/map, /odom, "
         "/tf, /plan ...) is then the stack's own",
     )

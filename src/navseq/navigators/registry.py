@@ -21,7 +21,7 @@ settings, and each kind applies its own default.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
     from navseq.navigators.base import Navigator
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
+    from navseq.tasks.ros_port import RosTypes
 
 
 @dataclass
@@ -126,8 +127,10 @@ class NavigatorKind:
     ``places_robot`` is False for a real robot's stack: the robot is where it is, so a
     start pose is refused; ``paced`` is True for the simulator, the only kind whose time
     a run may pace (``realtime``). ``ros``: the kind drives a ROS stack, so a mission's
-    ROS tasks are ROS's business there (not run yet), and are only rehearsed
-    (``--simulate-tasks``) on the kinds without."""
+    ROS tasks run there (on the navigator's node), and are only rehearsed
+    (``--simulate-tasks``) on the kinds without; ``task_types`` is then the module whose
+    ``ros_types()`` says which message types the running ROS can load (checked before
+    the run)."""
 
     name: str
     help: str
@@ -138,6 +141,18 @@ class NavigatorKind:
     places_robot: bool = True
     paced: bool = False
     ros: bool = False
+    task_types: str = ""
+
+    def ros_types(self) -> RosTypes:
+        """The running ROS's message types, for the check before the run. Where the
+        client library does not import, every type passes here: :meth:`create` then
+        says what is missing."""
+        try:
+            module = importlib.import_module(self.task_types)
+        except ImportError:
+            return _AnyType()
+        types: RosTypes = module.ros_types()
+        return types
 
     def create(self, settings: NavigatorSettings, draft: NavigatorDraft) -> NavigatorSetup:
         from navseq.errors import NavseqError
@@ -170,6 +185,18 @@ class NavigatorKind:
         return tuple(option.name for option in self.options() if option.info.journaled)
 
 
+class _AnyType:
+    """Types where ROS is not there to ask: none is refused (the kind refuses the run)."""
+
+    def type_problem(self, type_name: str, *, service: bool = False) -> str | None:
+        return None
+
+    def fields_problem(
+        self, type_name: str, fields: Mapping[str, Any], *, service: bool = False
+    ) -> str | None:
+        return None
+
+
 NAVIGATORS: tuple[NavigatorKind, ...] = (
     NavigatorKind(
         "sim",
@@ -186,6 +213,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         requires="ROS 1's Python packages (rospy, actionlib, move_base_msgs)",
         places_robot=False,
         ros=True,
+        task_types="navseq.ros1.task_port",
     ),
     NavigatorKind(
         "nav2",
@@ -196,6 +224,7 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         "(e.g. source /opt/ros/jazzy/setup.bash), then start navseq from that shell",
         places_robot=False,
         ros=True,
+        task_types="navseq.ros2.task_port",
     ),
     # A deterministic stand-in for the plumbing's tests; its options are hidden too.
     NavigatorKind(

@@ -83,6 +83,7 @@ from navseq.navigators.base import (
 )
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
+from navseq.ros1.task_port import Ros1TaskPort
 from navseq.roscore.clock import CLOCK_WAIT
 from navseq.roscore.navigator import CANCEL_WAIT, REJECTED_STATUS, NavigatorCore, rejected
 
@@ -216,6 +217,7 @@ class Ros1Navigator:
         self._feedback_pose: Pose2D | None = None
         self._closed = False
         self._taps: list[Any] = []  # subscribers of record_topics
+        self._task_port: Ros1TaskPort | None = None  # made for the first ROS task
         # Created after the state its callbacks read: they may run at once.
         self._client = _TimedActionClient(self.action, MoveBaseAction, self._on_status)
 
@@ -241,6 +243,12 @@ class Ros1Navigator:
         rospy.on_shutdown(self._on_rospy_shutdown)
 
     # -- Navigator protocol -----------------------------------------------------------
+
+    def ros_tasks(self) -> Ros1TaskPort:
+        """The mission's ROS tasks on this node (:mod:`navseq.ros1.task_port`)."""
+        if self._task_port is None:
+            self._task_port = Ros1TaskPort()
+        return self._task_port
 
     def now(self) -> float:
         if self._clock_time is not None:
@@ -469,6 +477,8 @@ class Ros1Navigator:
         self._closed = True
         for tap in self._taps:
             tap.unregister()
+        if self._task_port is not None:
+            self._task_port.close()
         self._core.cancel_and_wait()
 
     def record_topics(self, topics: Sequence[str], write: PublishedSink) -> None:

@@ -25,7 +25,8 @@ lost) and the distance to go every 10 s of mission time; trouble is a warning.
 
 It publishes, latched, ``~waypoints`` (visualization_msgs/MarkerArray: arrows and
 numbers coloured by status) and ``~status`` (std_msgs/String holding one JSON object),
-and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel`` and ``~skip``
+and offers std_srvs/Trigger services ``~pause``, ``~resume``, ``~cancel``, ``~skip`` and
+``~confirm`` (confirms the ``input`` task waiting for an operator)
 (the active waypoint ends SKIPPED and the mission goes on with the next one).
 Ctrl-C, SIGTERM, ``rosnode kill`` and roslaunch's shutdown all cancel the active goal
 before the node exits, which logs ``interrupted (<signal or shutdown reason>)`` and
@@ -59,6 +60,7 @@ from __future__ import annotations
 import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import rospy
@@ -77,9 +79,11 @@ from navseq.ros1.navstack_params import read_navstack_profile
 from navseq.ros1.params import bool_param
 from navseq.roscore.navigator import CANCEL_WAIT
 from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
-from navseq.roscore.operator import OPERATOR_SERVICES, OperatorDesk
+from navseq.roscore.operator import CONFIRM_SERVICE, OPERATOR_SERVICES, OperatorDesk
 from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import LogLine, LogProgress
+from navseq.tasks.options import TaskOptions
+from navseq.tasks.runner import TaskRunner
 
 NODE_NAME = "navseq"
 # Private parameters that configure the node itself rather than the mission.
@@ -96,6 +100,7 @@ NODE_PARAMS: dict[str, Any] = {
     "end_launch": False,
     "settle": 0.05,
     "odom_frame": "odom",
+    "snapshot_dir": "",  # where snapshot tasks write (its snapshots/); "": refused
 }
 # s to wait for rospy to name its shutdown reason: it does so only after the navigator's
 # shutdown hook has waited (up to CANCEL_WAIT) for the server to take the cancel in.
@@ -185,8 +190,8 @@ class RospyFace:
 
 
 def offer_operator_services(desk: OperatorDesk) -> None:
-    """``~pause``, ``~resume``, ``~skip``, ``~cancel``; rospy serves each call on a thread
-    of its own, so a handler may wait (bounded) for the mission's answer."""
+    """``~pause``, ``~resume``, ``~skip``, ``~cancel`` and ``~confirm``; rospy serves each
+    call on a thread of its own, so a handler may wait (bounded) for the mission's answer."""
 
     def handler(kind: str) -> Callable[[Any], TriggerResponse]:
         def handle(_request: Any) -> TriggerResponse:
@@ -197,6 +202,12 @@ def offer_operator_services(desk: OperatorDesk) -> None:
 
     for kind in OPERATOR_SERVICES:
         rospy.Service(f"~{kind}", Trigger, handler(kind))
+
+    def confirm(_request: Any) -> TriggerResponse:
+        ok, message = desk.confirm()
+        return TriggerResponse(success=ok, message=message)
+
+    rospy.Service(f"~{CONFIRM_SERVICE}", Trigger, confirm)
 
 
 def run_node() -> int:
@@ -223,7 +234,12 @@ def run_node() -> int:
     face = RospyFace(navigator.resolved_action)
     topics = MissionTopics(mission)
     control = MissionControl(stop_reason=ShutdownWatch())
-    offer_operator_services(OperatorDesk(control, topics.state, face.service_name))
+    snapshot_dir = str(settings["snapshot_dir"] or "")
+    options = TaskOptions(snapshot_folder=Path(snapshot_dir).expanduser() if snapshot_dir else None)
+    tasks = TaskRunner(
+        options, say=face.info, confirm_hint=f"call {rospy.resolve_name('~confirm')}"
+    )
+    offer_operator_services(OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,
         mission,
@@ -234,6 +250,8 @@ def run_node() -> int:
         tick=float(settings["tick"]),
         log=lambda robot: LogProgress(mission, log_line, robot=robot),
         shutdowns=(rospy.ROSInterruptException,),
+        tasks=tasks,
+        task_options=options,
     )
     if not run.ran_to_end:
         return run.code

@@ -86,6 +86,7 @@ from navseq.navigators.base import (
     GoalFeedback,
     GoalOutcome,
     NavEvent,
+    PublishedSink,
 )
 from navseq.navigators.catchup import ResultHold
 from navseq.navigators.stack_map import MAP_WAIT, MapCatch, StackMap, stack_map_from_message
@@ -96,7 +97,9 @@ from navseq.ros2.messages import (
     seconds_of,
     terminal_status,
 )
+from navseq.ros2.record import TopicTap
 from navseq.ros2.session import Ros2Session
+from navseq.ros2.task_port import Ros2TaskPort
 from navseq.roscore.clock import CLOCK_WAIT
 from navseq.roscore.navigator import CANCEL_WAIT, NavigatorCore, rejected
 
@@ -201,6 +204,8 @@ class Nav2Navigator:
                 thread_name="navseq-nav2",
             )
         self._session = session
+        self._task_port: Ros2TaskPort | None = None  # made for the first ROS task
+        self._tap: TopicTap | None = None  # --record-topics
         self._context = session.context
         self._node = session.node
         try:
@@ -242,6 +247,18 @@ class Nav2Navigator:
             self._session.call_soon(callback, *args)
 
     # -- Navigator protocol -----------------------------------------------------------
+
+    def record_topics(self, topics: Sequence[str], write: PublishedSink) -> None:
+        """Hand every message published on ``topics`` to ``write`` as it came (CDR),
+        with its type's full definition (:mod:`navseq.ros2.record`); stamped with the
+        clock the stack uses (:meth:`now`)."""
+        self._tap = TopicTap(self._session, topics, write, self.now, self.warn)
+
+    def ros_tasks(self) -> Ros2TaskPort:
+        """The mission's ROS tasks on this navigator's node (:mod:`navseq.ros2.task_port`)."""
+        if self._task_port is None:
+            self._task_port = Ros2TaskPort(self._session)
+        return self._task_port
 
     def now(self) -> float:
         """The node's clock (ROS time under use_sim_time); after close, its last value."""
@@ -495,6 +512,10 @@ class Nav2Navigator:
         """Cancel the tracked goal, wait (bounded) for Nav2's answer, end the node."""
         if self._closed:
             return
+        if self._task_port is not None:
+            self._task_port.close()
+        if self._tap is not None:
+            self._tap.close()
         self._core.cancel_and_wait()
         self.now()  # keep the clock's last value for after close
         self._closed = True

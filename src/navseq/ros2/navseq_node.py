@@ -19,7 +19,7 @@ soon as ``/clock`` is published).
 It drives Nav2 through :class:`~navseq.ros2.navigator.Nav2Navigator` on this node,
 publishes ``~/waypoints`` (``visualization_msgs/msg/MarkerArray``) and ``~/status``
 (``std_msgs/msg/String``, one JSON object per event), both transient local, offers
-``~/pause``, ``~/resume``, ``~/skip`` and ``~/cancel`` (``std_srvs/srv/Trigger``),
+``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel`` and ``~/confirm`` (``std_srvs/srv/Trigger``),
 and logs one line per waypoint event. SIGINT / SIGTERM (Ctrl-C, ``ros2 launch``'s
 shutdown) cancel the active goal and wait (bounded) for Nav2's answer before the node
 exits. Exit status: 0 all waypoints reached, 1 not, 2 bad parameters or no action
@@ -67,9 +67,16 @@ from navseq.ros2.navigator import Nav2Navigator
 from navseq.ros2.node_params import NodeSettings, read_node_params
 from navseq.ros2.session import Ros2Session
 from navseq.roscore.node import EXIT_BAD_SETUP, run_node_mission, stay_up
-from navseq.roscore.operator import OPERATOR_SERVICES, SERVICE_ANSWER_WAIT, OperatorDesk
+from navseq.roscore.operator import (
+    CONFIRM_SERVICE,
+    OPERATOR_SERVICES,
+    SERVICE_ANSWER_WAIT,
+    OperatorDesk,
+)
 from navseq.signals import ignore_until_exit
 from navseq.sinks.progress import RunView, describe
+from navseq.tasks.options import TaskOptions
+from navseq.tasks.runner import TaskRunner
 
 NODE_NAME = "navseq"
 
@@ -135,7 +142,7 @@ class RclpyFace:
 
 
 class OperatorServices:
-    """``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel``, answered by
+    """``~/pause``, ``~/resume``, ``~/skip``, ``~/cancel`` and ``~/confirm``, answered by
     :class:`~navseq.roscore.operator.OperatorDesk` without holding the executor."""
 
     def __init__(self, session: Ros2Session, desk: OperatorDesk) -> None:
@@ -149,6 +156,12 @@ class OperatorServices:
             session.node.create_service(
                 Trigger, f"~/{name}", self._handler(name), callback_group=group
             )
+        # Answered at once: the default group will do.
+        session.node.create_service(Trigger, f"~/{CONFIRM_SERVICE}", self._confirm)
+
+    def _confirm(self, _request: Any, response: Any) -> Any:
+        response.success, response.message = self.desk.confirm()
+        return response
 
     def _handler(self, name: str) -> Any:
         async def handle(_request: Any, response: Any) -> Any:
@@ -206,7 +219,10 @@ def run_node(session: Ros2Session) -> int:
     face = RclpyFace(session, navigator)
     topics = MissionTopics(node, mission)
     control = MissionControl(stop_reason=lambda: None if session.ok() else "ROS 2 shut down")
-    OperatorServices(session, OperatorDesk(control, topics.state, face.service_name))
+    confirm = node.resolve_service_name(f"~/{CONFIRM_SERVICE}", only_expand=True)
+    options = TaskOptions(snapshot_folder=settings.snapshot_dir)
+    tasks = TaskRunner(options, say=face.info, confirm_hint=f"call {confirm}")
+    OperatorServices(session, OperatorDesk(control, topics.state, face.service_name, tasks))
     run = run_node_mission(
         face,
         mission,
@@ -216,6 +232,8 @@ def run_node(session: Ros2Session) -> int:
         server_wait=settings.server_wait,
         tick=settings.tick,
         log=lambda _robot: WaypointLog(mission, logger),
+        tasks=tasks,
+        task_options=options,
     )
     if run.ran_to_end and settings.keep_alive:
         return stay_up(face, run.code, "mission over; staying up (keep_alive) until shut down")

@@ -18,6 +18,7 @@ import array
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from navseq.errors import NavseqError
@@ -35,6 +36,7 @@ NODE_PARAMS: dict[str, Any] = {
     "base_frames": ["base_footprint", "base_link"],
     "odom_topic": "odom",
     "plan_topic": "plan",
+    "snapshot_dir": "",  # where snapshot tasks write (its snapshots/); "": refused
 }
 # Parameters every rclpy node may carry that are not the mission's.
 RCLPY_PARAMS = ("use_sim_time", "start_type_description_service")
@@ -53,6 +55,7 @@ class NodeSettings:
     odom_topic: str
     plan_topic: str | None  # "" in the parameter: no plan topic
     use_sim_time: bool | None  # None: not given, follow /clock when it is published
+    snapshot_dir: Path | None = None  # where snapshot tasks write; None: refused
 
 
 def plain_value(value: Any) -> Any:
@@ -138,6 +141,9 @@ def _settings(values: Mapping[str, Any], prefix: str) -> NodeSettings:
         or not all(isinstance(f, str) and f.strip() for f in base_frames)
     ):
         raise error("base_frames", "expected a list of frame names")
+    snapshot_dir = get("snapshot_dir")
+    if not isinstance(snapshot_dir, str):
+        raise error("snapshot_dir", "expected a folder's path")
     sim_time = values.get("use_sim_time")
     if sim_time is not None and not isinstance(sim_time, bool):
         raise NavseqError(
@@ -152,4 +158,5 @@ def _settings(values: Mapping[str, Any], prefix: str) -> NodeSettings:
         odom_topic=name_param("odom_topic"),
         plan_topic=name_param("plan_topic", empty_ok=True) or None,
         use_sim_time=sim_time,
+        snapshot_dir=Path(snapshot_dir).expanduser() if snapshot_dir else None,
     )

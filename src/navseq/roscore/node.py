@@ -11,7 +11,8 @@ their parameters and services) to :func:`run_node_mission`, which:
    logs where it came from;
 3. runs the mission through the run service (:mod:`navseq.run`: the node's own
    navigator, its topics and log as the sinks, no files, SIGINT / SIGTERM cancel the
-   goal);
+   goal; the waypoints' tasks on the node's :class:`~navseq.tasks.runner.TaskRunner`,
+   whose ``input`` tasks the ``~/confirm`` service answers);
 4. ends it: cancelled by the operator (a warning naming the service), succeeded
    (info) or failed (a warning); the status topic and the services then say the
    mission is over;
@@ -29,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from navseq.errors import NavseqError, error_text
 from navseq.executor.control import MissionControl, StopRequested, cancelled_by_operator
@@ -41,7 +42,11 @@ from navseq.navigators.base import Navigator
 from navseq.run import RunRequest, UseNavigator, prepare
 from navseq.signals import SignalGuard, StopSignals
 from navseq.sinks.mission_status import StatusPublisher
+from navseq.tasks.options import TaskOptions
 from navseq.text import printable
+
+if TYPE_CHECKING:
+    from navseq.tasks.runner import TaskRunner
 
 EXIT_BAD_SETUP = 2  # bad parameters, no action server, no valid clock
 EXIT_SHUT_DOWN = 1  # ROS shut the node down (rosnode kill, the master, rclpy's context)
@@ -101,11 +106,15 @@ def run_node_mission(
     tick: float,
     log: Callable[[RobotProfile], MissionListener],
     shutdowns: Sequence[type[BaseException]] = (),
+    tasks: TaskRunner | None = None,
+    task_options: TaskOptions | None = None,
 ) -> NodeRun:
     """Run the node's mission (module doc). ``log(robot)`` makes the listener that logs
     the run (the robot known by then gives it the time still to go); ``shutdowns``
     are the client library's own "shutting down" exceptions, which end the run with
-    :data:`EXIT_SHUT_DOWN`."""
+    :data:`EXIT_SHUT_DOWN`. ``tasks`` runs the waypoints' tasks (the one the node's
+    ``~/confirm`` service answers); None: one made for the run. ``task_options``: what
+    the tasks may do (where snapshots go)."""
     state = topics.state
     try:
         face.info(
@@ -129,8 +138,10 @@ def run_node_mission(
                 outputs=None,  # a node's record is its topics and its log
                 server_wait=server_wait,
                 tick=tick,
+                tasks=task_options or TaskOptions(),
             )
         )
+        session.task_runner = tasks
         guard = SignalGuard()  # the node's main thread: a shutdown signal cancels the goal
         try:
             outcome = session.run([topics, log(robot)], control=control, signals=guard)

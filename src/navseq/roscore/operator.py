@@ -1,6 +1,6 @@
 """What the node's pause / resume / skip / cancel services answer, alike on both ROS.
 
-Each ROS node offers four ``std_srvs`` Trigger services (ROS 1 ``~pause``, ROS 2
+Each ROS node offers five ``std_srvs`` Trigger services (ROS 1 ``~pause``, ROS 2
 ``~/pause`` ...). Their answers are decided here:
 
 - once the mission is over for good, every request is refused with why
@@ -10,7 +10,10 @@ Each ROS node offers four ``std_srvs`` Trigger services (ROS 1 ``~pause``, ROS 2
   the next one";
 - ``pause``, ``resume`` and ``cancel`` are carried out by the mission's thread, which
   answers within one tick; a run that does not answer within
-  :data:`SERVICE_ANSWER_WAIT` seconds is said to, and the service returns.
+  :data:`SERVICE_ANSWER_WAIT` seconds is said to, and the service returns;
+- ``confirm`` answers the ``input`` task waiting for an operator (Nav2's
+  InputAtWaypoint), at once: refused when none waits (a confirmation is never kept
+  for a later prompt).
 
 How a request waits for its answer is the client library's business: rospy serves each
 call on a thread of its own and may block (:meth:`OperatorDesk.answer_blocking`); an
@@ -21,11 +24,17 @@ rclpy handler must not hold the node's executor, so it awaits a future woken by
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from navseq.executor.control import MissionControl, OperatorRequest, operator_reason
 from navseq.sinks.mission_status import MissionStatus
 
+if TYPE_CHECKING:
+    from navseq.tasks.runner import TaskRunner
+
 OPERATOR_SERVICES = ("pause", "resume", "skip", "cancel")
+#: The service confirming an ``input`` task (answered by :meth:`OperatorDesk.confirm`).
+CONFIRM_SERVICE = "confirm"
 SERVICE_ANSWER_WAIT = 5.0  # s of wall time a service waits for the mission's answer
 
 Answer = tuple[bool, str]
@@ -43,10 +52,21 @@ class OperatorDesk:
         control: MissionControl,
         state: MissionStatus,
         service_name: Callable[[str], str],
+        tasks: TaskRunner | None = None,
     ) -> None:
         self.control = control
         self.state = state
         self.service_name = service_name
+        self.tasks = tasks
+
+    def confirm(self) -> Answer:
+        """``confirm``: the ``input`` task waiting now is confirmed; refused when none waits."""
+        if self.state.over is not None:
+            return False, f"nothing to confirm: {self.state.over}"
+        service = self.service_name(CONFIRM_SERVICE)
+        if self.tasks is None or not self.tasks.confirm_waiting(f"confirmed by {service}"):
+            return False, "no input task is waiting for a confirmation"
+        return True, "input confirmed; going on"
 
     def answer_at_once(self, kind: str) -> Answer | None:
         """The answer when it needs no word from the mission's thread, else None."""

@@ -55,6 +55,7 @@ if TYPE_CHECKING:
     from navseq.sim.occupancy import OccupancyGrid
     from navseq.sinks.recorder import RunRecorder
     from navseq.sinks.recording.sink import RecordingSink
+    from navseq.tasks.ros_port import RosTypes
     from navseq.tasks.runner import TaskRunner
 
 #: Called with each note on the run (one line) at the moment a face should show it.
@@ -166,7 +167,7 @@ class Session:
         if outputs is None:
             for note in self.notes:
                 say(note)
-            ran = self._drive(face, control, guard, lambda: None, None, say)
+            ran = self._drive(face, control, guard, lambda: None, None, say, None)
             return RunOutcome(
                 ran.result,
                 ran.exit_status,
@@ -250,6 +251,7 @@ class Session:
                 lambda: fresh if fresh is not None else self._continued_journal(journal_path),
                 self._new_recorder(),
                 say,
+                folder,
             )
         except BaseException:
             # No result to report (e.g. no navigation server, or a signal before the run
@@ -356,15 +358,21 @@ class Session:
         open_journal: Callable[[], JournalWriter | None],
         recorder: RunRecorder | None,
         say: NoteSink,
+        folder: Path | None,
     ) -> _Ran:
         """Run the mission; from the moment it ends, shutdown signals are only counted."""
         from navseq.executor.runner import MissionAborted, MissionInterrupted, run_mission
         from navseq.sinks.json_events import clock_record
+        from navseq.tasks.ros_port import ros_port_of
         from navseq.tasks.runner import TaskRunner
 
         tasks = self.task_runner or TaskRunner(self.request.tasks, say=say)
 
         navigator = self.make_navigator()
+        # ROS tasks on the navigator's own node; snapshots into the run folder (a
+        # node's: the folder its parameters name).
+        snapshots = self.request.tasks.snapshot_folder or folder
+        tasks.attach(ros_port_of(navigator), snapshots, self._waypoint_name)
         error: NavseqError | None = None
         navigator_start, wall_start = navigator.now(), time.monotonic()
         try:
@@ -411,6 +419,10 @@ class Session:
                 navigator.close()
         clock = clock_record(navigator.now() - navigator_start, time.monotonic() - wall_start)
         return _Ran(result, exit_status, interrupted, error, clock, navigator, recorder)
+
+    def _waypoint_name(self, index: int) -> str | None:
+        waypoints = self.mission.waypoints
+        return waypoints[index].name if 0 <= index < len(waypoints) else None
 
     def _report_builder(self, ran: _Ran) -> Callable[[dict[str, str], int], dict[str, Any]]:
         from navseq.run.products import build_run_report
@@ -570,16 +582,20 @@ def _check_recording(
     if not records:
         raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
     kind = kind_of_run.name if kind_of_run is not None else "a face's own navigator"
-    if kind != "ros1":
+    # Each stack's messages are recorded as published: in its own ROS's encoding.
+    encodings = {"ros1": "ros1", "nav2": "ros2"}
+    if kind not in encodings:
         raise NavseqError(
-            "records a ROS 1 navigation stack's topics as it publishes them, with "
-            f"--navigator ros1 only (not {kind}); the map, pose, odometry, /tf and plans "
-            "are recorded with any navigator",
+            "records a ROS navigation stack's topics as it publishes them, with "
+            f"--navigator ros1 or nav2 only (not {kind}); the map, pose, odometry, /tf and "
+            "plans are recorded with any navigator",
             source="--record-topics",
         )
-    if outputs.record_format != "ros1":
+    if (outputs.record_format or "ros2") != encodings[kind]:
+        ros = "ROS 1" if kind == "ros1" else "ROS 2"
         raise NavseqError(
-            "records the ROS 1 stack's messages as they are published: add --record-format ros1",
+            f"records the {ros} stack's messages as they are published: add "
+            f"--record-format {encodings[kind]}",
             source="--record-topics",
         )
 
@@ -627,13 +643,24 @@ def _refuse_tasks(mission: Mission, request: RunRequest, kind: NavigatorKind | N
     there is no ROS), every one with its file:line, before anything moves."""
     from navseq.errors import MissionErrors
     from navseq.tasks.permissions import task_problems
+    from navseq.tasks.ros_port import ros_port_of
 
+    types: RosTypes | None
     if isinstance(request.navigator, UseNavigator):
         name, simulated = str(request.navigator.info["kind"]), False
+        types = ros_port_of(request.navigator.navigator)
     else:
         assert kind is not None
         name, simulated = kind.name, not kind.ros
-    problems = task_problems(mission, request.tasks, name, simulated=simulated)
+        types = kind.ros_types() if kind.ros else None
+    problems = task_problems(
+        mission,
+        request.tasks,
+        name,
+        simulated=simulated,
+        types=types,
+        has_folder=request.outputs is not None or request.tasks.snapshot_folder is not None,
+    )
     if len(problems) == 1:
         raise problems[0]
     if problems:

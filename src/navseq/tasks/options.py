@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 from navseq.errors import NavseqError
 
@@ -17,10 +18,13 @@ class TaskOptions:
     mission file must not run programs by itself). ``simulate_ros_s``: on a navigator
     without ROS (the simulator), ROS tasks (wait_for, snapshot, call, publish) are logged
     and succeed after that many seconds (``--simulate-tasks[=SECONDS]``); None refuses
-    them there."""
+    them there. ``snapshot_folder``: where ``snapshot`` tasks write (into its
+    ``snapshots/``) for a run that writes no run folder (a navseq node's
+    ``snapshot_dir``); None: the run folder."""
 
     allow_run: bool = False
     simulate_ros_s: float | None = None
+    snapshot_folder: Path | None = None
 
     def __post_init__(self) -> None:
         seconds = self.simulate_ros_s

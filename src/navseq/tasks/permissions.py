@@ -2,9 +2,10 @@
 
 A ``run`` task needs ``--allow-run``. A ROS task (wait_for, snapshot, call, publish)
 needs ROS: on a navigator without it (the embedded simulator, the scripted double) it
-is refused unless ``--simulate-tasks``; on a ROS navigator (ros1, nav2) this version
-does not run ROS tasks yet, and says so instead of pretending. Every refusal names
-the task's file:line, all of them at once.
+is refused unless ``--simulate-tasks``; on a ROS navigator (ros1, nav2) its message or
+service type must load on the running ROS (``types``, the navigator's
+:class:`~navseq.tasks.ros_port.RosTypes`), and a snapshot needs a run folder to go
+into. Every refusal names the task's file:line, all of them at once.
 """
 
 from __future__ import annotations
@@ -13,17 +14,25 @@ from collections.abc import Iterator
 
 from navseq.errors import NavseqError
 from navseq.mission.model import Mission
-from navseq.mission.tasks import Task
+from navseq.mission.tasks import CallTask, PublishTask, SnapshotTask, Task
 from navseq.tasks.options import TaskOptions
+from navseq.tasks.ros_port import RosTypes
 
 
 def task_problems(
-    mission: Mission, options: TaskOptions, navigator: str, *, simulated: bool
+    mission: Mission,
+    options: TaskOptions,
+    navigator: str,
+    *,
+    simulated: bool,
+    types: RosTypes | None = None,
+    has_folder: bool = True,
 ) -> list[NavseqError]:
     """Every task of ``mission`` that a run with ``options`` on ``navigator`` must refuse.
 
     ``simulated``: the navigator is a simulated world without ROS (the robot is placed
-    by navseq); otherwise it is a robot's ROS stack.
+    by navseq). ``types``: the running ROS's types, on a navigator that runs ROS tasks;
+    None on one that cannot. ``has_folder``: the run writes a folder (snapshots go there).
     """
     problems = []
     for owner, number, task in _every_task(mission):
@@ -37,11 +46,16 @@ def task_problems(
                     subject=subject,
                 )
             )
+        elif task.uses_ros and types is not None:
+            problems.extend(
+                NavseqError(problem, source=task.where, subject=subject)
+                for problem in _ros_task_problems(task, types, has_folder)
+            )
         elif task.uses_ros and not simulated:
             problems.append(
                 NavseqError(
-                    f"{task.kind} tasks are not supported on the {navigator} navigator yet "
-                    "(wait, input and run are)",
+                    f"{task.kind} tasks need ROS, and the {navigator} navigator offers none "
+                    "to run them (wait, input and run work everywhere)",
                     source=task.where,
                     subject=subject,
                 )
@@ -49,13 +63,37 @@ def task_problems(
         elif task.uses_ros and options.simulate_ros_s is None:
             problems.append(
                 NavseqError(
-                    f"needs ROS, which the {navigator} navigator does not have: give "
-                    "--simulate-tasks to rehearse it (logged, succeeds after a set time)",
+                    f"needs ROS, which the {navigator} navigator does not have: run it with "
+                    "--navigator ros1 or nav2, or give --simulate-tasks to rehearse it "
+                    "(logged, succeeds after a set time)",
                     source=task.where,
                     subject=subject,
                 )
             )
     return problems
+
+
+def _ros_task_problems(task: Task, types: RosTypes, has_folder: bool) -> Iterator[str]:
+    """Why the running ROS cannot run ``task``: its type does not load, or a snapshot
+    has no folder to go into."""
+    service = isinstance(task, CallTask)
+    type_name = getattr(task, "type", None)
+    if isinstance(type_name, str):
+        why = types.type_problem(type_name, service=service)
+        if why is not None:
+            what = "service" if service else "message"
+            yield f"{what} type {type_name} cannot be loaded here: {why}"
+        elif isinstance(task, PublishTask | CallTask):
+            fields = task.request if isinstance(task, CallTask) else task.message
+            why = types.fields_problem(type_name, fields, service=service)
+            if why is not None:
+                what = f"the request of {type_name}" if service else f"a {type_name} message"
+                yield f"{'request' if service else 'message'} does not fit {what}: {why}"
+    if isinstance(task, SnapshotTask) and not has_folder:
+        yield (
+            "a snapshot is saved into the run folder, and this run writes none (a navseq "
+            "node: give it a snapshot_dir parameter)"
+        )
 
 
 def _every_task(mission: Mission) -> Iterator[tuple[str, int, Task]]:

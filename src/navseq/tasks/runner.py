@@ -11,9 +11,10 @@ are a registry (:data:`JOBS`): a new kind is one job class and one entry.
   prompt do not count).
 - ``run``: the program without a shell, its output's last lines kept; cancelling kills
   it.
-- ROS kinds on a navigator without ROS: simulated (``--simulate-tasks``), logged and
-  successful after the set time. On ROS navigators they are refused before the run
-  (:mod:`navseq.tasks.permissions`).
+- ROS kinds (wait_for, snapshot, call, publish): on a ROS navigator, run through its
+  :class:`~navseq.tasks.ros_port.RosPort` (:meth:`TaskRunner.attach`;
+  :mod:`navseq.tasks.ros_jobs`); on a navigator without ROS, simulated
+  (``--simulate-tasks``), logged and successful after the set time.
 """
 
 from __future__ import annotations
@@ -30,12 +31,23 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import IO, Protocol
 
 from navseq.executor.commands import StartTask
-from navseq.mission.tasks import InputTask, RunTask, Task, WaitTask
+from navseq.mission.tasks import (
+    CallTask,
+    InputTask,
+    PublishTask,
+    RunTask,
+    SnapshotTask,
+    Task,
+    WaitForTask,
+    WaitTask,
+)
 from navseq.tasks.base import TaskDone
 from navseq.tasks.options import DEFAULT_SIMULATED_SECONDS, TaskOptions
+from navseq.tasks.ros_port import RosPort
 
 #: Lines of a ``run`` program's output kept for the report.
 OUTPUT_LINES = 20
@@ -60,12 +72,17 @@ class Job(Protocol):
 
 
 class _Context:
-    """What jobs share: the runner's options, how to tell the operator, stdin's lines."""
+    """What jobs share: the runner's options, how to tell the operator, stdin's lines;
+    once attached (:meth:`TaskRunner.attach`), the navigator's ROS port, the run folder
+    and the waypoints' names."""
 
     def __init__(self, options: TaskOptions, say: Say, operator: OperatorInput) -> None:
         self.options = options
         self.say = say
         self.operator = operator
+        self.port: RosPort | None = None
+        self.folder: Path | None = None
+        self.waypoint_name: Callable[[int], str | None] = lambda _index: None
 
 
 class _WaitJob:
@@ -210,6 +227,51 @@ def _simulated_job(command: StartTask, context: _Context, now: float) -> Job:
     return _SimulatedRosJob(command.task_id, context, command.task, now)
 
 
+def _wait_for_job(command: StartTask, context: _Context, port: RosPort) -> Job:
+    from navseq.tasks.ros_jobs import WaitForJob
+
+    assert isinstance(command.task, WaitForTask)
+    return WaitForJob(command.task_id, command.task, port)
+
+
+def _snapshot_job(command: StartTask, context: _Context, port: RosPort) -> Job:
+    from navseq.tasks.ros_jobs import SnapshotJob
+    from navseq.tasks.snapshots import snapshot_stem
+
+    assert isinstance(command.task, SnapshotTask)
+    stem = snapshot_stem(context.waypoint_name(command.index), command.index, command.number)
+    if command.loop > 0:  # a patrol's later loops (0-based): one file per visit
+        stem += f"-loop{command.loop + 1}"
+    return SnapshotJob(command.task_id, command.task, port, context.folder, stem)
+
+
+def _call_job(command: StartTask, context: _Context, port: RosPort) -> Job:
+    from navseq.tasks.ros_jobs import CallJob
+
+    assert isinstance(command.task, CallTask)
+    return CallJob(command.task_id, command.task, port)
+
+
+def _publish_job(command: StartTask, context: _Context, port: RosPort) -> Job:
+    from navseq.tasks.ros_jobs import PublishJob
+
+    assert isinstance(command.task, PublishTask)
+    return PublishJob(command.task_id, command.task, port)
+
+
+def _on_ros(
+    start: Callable[[StartTask, _Context, RosPort], Job],
+) -> Callable[[StartTask, _Context, float], Job]:
+    """A ROS kind: run through the navigator's ROS port, simulated where there is none."""
+
+    def start_job(command: StartTask, context: _Context, now: float) -> Job:
+        if context.port is None:
+            return _simulated_job(command, context, now)
+        return start(command, context, context.port)
+
+    return start_job
+
+
 class _Refused:
     real_time = False
 
@@ -223,16 +285,16 @@ class _Refused:
         pass
 
 
-#: Each task kind -> how to start its job. The ROS kinds are simulated: a navigator
-#: with ROS does not run them yet (refused before the run starts).
+#: Each task kind -> how to start its job. The ROS kinds run on the navigator's ROS
+#: port, and are simulated on a navigator without ROS.
 JOBS: Mapping[str, Callable[[StartTask, _Context, float], Job]] = {
     "wait": _wait_job,
     "input": _input_job,
     "run": _run_job,
-    "wait_for": _simulated_job,
-    "snapshot": _simulated_job,
-    "call": _simulated_job,
-    "publish": _simulated_job,
+    "wait_for": _on_ros(_wait_for_job),
+    "snapshot": _on_ros(_snapshot_job),
+    "call": _on_ros(_call_job),
+    "publish": _on_ros(_publish_job),
 }
 
 
@@ -246,8 +308,9 @@ class OperatorInput:
     ``TaskStarted`` does so before the runner has asked.
     """
 
-    def __init__(self, stdin: IO[str] | None = None) -> None:
+    def __init__(self, stdin: IO[str] | None = None, hint: str | None = None) -> None:
         self._stdin = stdin if stdin is not None else sys.stdin
+        self._hint = hint  # how else to confirm (a node's ~confirm service)
         self._lock = threading.Lock()
         self._ticket = 0
         self._open = False  # a prompt waits for its answer
@@ -258,7 +321,9 @@ class OperatorInput:
         self._reads = _reads_lines(self._stdin)
 
     def how_to_confirm(self) -> str:
-        return "press Enter to go on" if self._reads else "waiting for confirmation"
+        ways = ["press Enter"] if self._reads else []
+        ways += [self._hint] if self._hint else []
+        return " or ".join(ways) + " to go on" if ways else "waiting for confirmation"
 
     def ask(self) -> int:
         """A new prompt: lines typed before it do not count."""
@@ -317,6 +382,16 @@ class OperatorInput:
                 self._open, self._answer = False, None
             return answer
 
+    def confirm_waiting(self, detail: str) -> bool:
+        """Confirm the prompt open now; False when none is open or it is answered
+        already (unlike :meth:`confirm`, nothing is kept for a later prompt: a ROS
+        service's caller must learn that nobody was waiting)."""
+        with self._lock:
+            if not self._open or self._answer is not None:
+                return False
+            self._answer = (True, detail)
+            return True
+
     def withdraw(self, ticket: int) -> None:
         """Prompt ``ticket`` was cancelled: a confirmation now goes to the next one."""
         with self._lock:
@@ -349,7 +424,9 @@ class TaskRunner:
     """Runs the tasks a mission's executor starts; see the module docstring.
 
     ``say`` gets the lines an operator should see (a prompt, a simulated task);
-    ``stdin`` is where an operator's Enter comes from (default: the process's).
+    ``stdin`` is where an operator's Enter comes from (default: the process's);
+    ``confirm_hint`` names another way to confirm, for the prompt ("call
+    /navseq/confirm").
     """
 
     def __init__(
@@ -358,12 +435,27 @@ class TaskRunner:
         *,
         say: Say | None = None,
         stdin: IO[str] | None = None,
+        confirm_hint: str | None = None,
     ) -> None:
-        self.operator = OperatorInput(stdin)
+        self.operator = OperatorInput(stdin, confirm_hint)
         self._context = _Context(options or TaskOptions(), say or _to_stderr, self.operator)
         self._jobs: dict[int, Job] = {}
         # (navigator time, wall time) when a real-time job started: see pace().
         self._paced_from: tuple[float, float] | None = None
+
+    def attach(
+        self,
+        port: RosPort | None,
+        folder: Path | None,
+        waypoint_name: Callable[[int], str | None] | None = None,
+    ) -> None:
+        """Where ROS tasks run (the navigator's port; None: simulated) and where
+        snapshots go (the run folder; None: nowhere, a snapshot fails);
+        ``waypoint_name(index)`` names a snapshot's file."""
+        self._context.port = port
+        self._context.folder = folder
+        if waypoint_name is not None:
+            self._context.waypoint_name = waypoint_name
 
     def start(self, command: StartTask, now: float) -> None:
         job = self._jobs[command.task_id] = JOBS[command.task.kind](command, self._context, now)
@@ -405,6 +497,11 @@ class TaskRunner:
     def confirm(self, confirmed: bool = True, detail: str = "") -> bool:
         """Answer the ``input`` task waiting for an operator; False when none waits."""
         return self.operator.confirm(confirmed, detail)
+
+    def confirm_waiting(self, detail: str = "confirmed") -> bool:
+        """Confirm the ``input`` task waiting now; False when none waits (nothing is
+        kept for a later one)."""
+        return self.operator.confirm_waiting(detail)
 
     def close(self) -> None:
         """Stop every task still running (the run ended)."""
