@@ -147,6 +147,25 @@ def screen_point(page: Any, x: float, y: float) -> tuple[float, float]:
     return box["x"] + point[0], box["y"] + point[1]
 
 
+def drawn(page: Any) -> dict[str, Any]:
+    """What the map's canvas painted last (``missionLayer.drawn()``): each waypoint's
+    screen point in the map (``marks``), the start pose's, the replayed run's marks."""
+    return dict(page.evaluate("missionLayer.drawn()"))
+
+
+def marks(page: Any) -> int:
+    """How many waypoints the map shows."""
+    return len(drawn(page)["marks"])
+
+
+def mark_point(page: Any, index: int) -> tuple[float, float]:
+    """Where waypoint ``index``'s marker is on the screen."""
+    box = page.get_by_test_id("map").bounding_box()
+    mark = drawn(page)["marks"][index]
+    assert mark["index"] == index
+    return box["x"] + mark["x"], box["y"] + mark["y"]
+
+
 def checked_after(page: Any, action: Any) -> None:
     """Do ``action`` and wait until the page's check of the change has come back."""
     before = page.evaluate("Number(document.body.dataset.checked || 0)")
@@ -158,16 +177,15 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:
     _, workspace, process = studio
-    markers = page.get_by_test_id("waypoint-marker")
     assert page.get_by_test_id("map").is_visible()
     assert page.locator("[data-testid=map-image]").count() == 1
-    assert markers.count() == 7
+    assert marks(page) == 7
     assert page.get_by_test_id("waypoint-row").count() == 7
     assert page.get_by_test_id("problem").count() == 0
 
     # Click free space: an eighth waypoint, no problem.
     checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
-    assert markers.count() == 8
+    assert marks(page) == 8
     assert page.get_by_test_id("problem").count() == 0
 
     # Drag it onto a pillar: a problem names it, and saving is still allowed but marked.
@@ -208,7 +226,7 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     # Undo the drag and the click: back to the 7 waypoints, which run.
     checked_after(page, lambda: page.keyboard.press("Control+z"))
     checked_after(page, lambda: page.keyboard.press("Control+z"))
-    assert markers.count() == 7 and page.get_by_test_id("problem").count() == 0
+    assert marks(page) == 7 and page.get_by_test_id("problem").count() == 0
 
     page.get_by_test_id("run").click()
     status = page.get_by_test_id("run-status")
@@ -279,7 +297,7 @@ def test_the_page_is_ready_before_the_first_check_and_plans_come_after(
         page.goto(studio[0])
         page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
         assert page.get_by_test_id("map-image").count() == 1
-        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert marks(page) == 7
         assert len(held) == 1  # asked at once, not answered yet
         assert page.evaluate("document.body.dataset.planned") is None
         assert page.locator(".leg-label").count() == 0
@@ -304,7 +322,7 @@ def test_the_shortest_order_is_one_undoable_edit(page: Any, studio: tuple[str, P
     after = names()
     assert after != before and sorted(after) == sorted(before) and after[-1] == "home"
     assert "instead of" in page.locator("#message").inner_text()
-    assert page.get_by_test_id("waypoint-marker").count() == 7
+    assert marks(page) == 7
     checked_after(page, lambda: page.keyboard.press("Control+z"))
     assert names() == before
     assert page.errors == []
@@ -335,7 +353,7 @@ def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     assert len(saved.waypoints) == 8  # the first tab's mission, whole
     assert saved.waypoints[7].x == pytest.approx(FREE_SPOT[0], abs=0.03)
     # The second tab keeps its edits: they can still be saved under another name.
-    assert second.get_by_test_id("waypoint-marker").count() == 9
+    assert marks(second) == 9
     accept_dialogs(second, ["second-tab.yaml"])
     second.locator("#save-as").click()
     message_of(second, "saved second-tab.yaml")
@@ -368,7 +386,7 @@ def test_import_the_tutorials_launch_file_and_export_one(
     page.locator("[data-testid=import-file][data-path='tutorial_params.yaml']").focus()
     checked_after(page, lambda: page.keyboard.press("Enter"))
     assert not dialog.is_visible()
-    assert page.get_by_test_id("waypoint-marker").count() == 4
+    assert marks(page) == 4
     assert "imported 4 waypoints" in page.locator("#message").inner_text()
     # Still on the arena's map: its pre-flight runs on the imported points.
     assert page.locator("[data-testid=map-image]").count() == 1
@@ -382,7 +400,7 @@ def test_import_the_tutorials_launch_file_and_export_one(
     assert "no place for" in said and "map" in said
     # Undo brings the opened mission back.
     checked_after(page, lambda: page.keyboard.press("Control+z"))
-    assert page.get_by_test_id("waypoint-marker").count() == 7
+    assert marks(page) == 7
     assert page.errors == []  # type: ignore[attr-defined]
 
 
@@ -403,8 +421,7 @@ def test_defaults_loops_and_a_start_pose_placed_and_turned_on_the_map(
     # The start pose: placed with a click, then turned with its handle to face +y.
     page.locator("#place-start").click()
     checked_after(page, lambda: page.mouse.click(*screen_point(page, -1.2, -1.2)))
-    start = page.get_by_test_id("start-marker")
-    assert start.count() == 1
+    assert drawn(page)["start"] is not None
     handle = page.get_by_test_id("yaw-handle").bounding_box()
     centre = screen_point(page, -1.2, -1.2)
 
@@ -435,7 +452,7 @@ def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, P
     runs = page.get_by_test_id("runs")
     page.wait_for_function("document.getElementById('runs').options.length > 1")
     runs.select_option(index=1)
-    page.wait_for_selector("[data-testid=replay-waypoint]")
+    page.wait_for_function("missionLayer.drawn().replayed.length === 7")
     slider = page.get_by_test_id("replay-time")
     duration = float(slider.get_attribute("max") or 0)
     assert duration > 10
@@ -444,10 +461,7 @@ def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, P
         slider.evaluate(
             "(el, t) => { el.value = String(t); el.dispatchEvent(new Event('input')); }", t
         )
-        return [
-            str(marker.get_attribute("data-status"))
-            for marker in page.get_by_test_id("replay-waypoint").all()
-        ]
+        return [str(mark["status"]) for mark in drawn(page)["replayed"]]
 
     assert at(0)[1:] == ["pending"] * 6  # the first is driving from t = 0
     middle = at(duration / 2)
@@ -473,7 +487,7 @@ def test_the_page_works_under_its_content_security_policy(
         page.goto(studio[0])
         page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
         assert page.get_by_test_id("waypoint-row").count() == 7
-        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert marks(page) == 7
         assert errors == []
     finally:
         page.context.close()
@@ -560,16 +574,17 @@ def test_the_mission_is_edited_with_the_keyboard_alone(page: Any) -> None:
     checked_after(page, lambda: page.keyboard.press("Control+Shift+z"))
     assert _row_xy(page, 2) == pytest.approx((x0 + 0.05, y0 + 0.5), abs=1e-9)
 
-    # A marker: focused, Enter selects it, the arrows move it, it keeps the focus.
-    marker = page.get_by_test_id("waypoint-marker").nth(3)
-    assert (marker.get_attribute("aria-label") or "").startswith("waypoint 4")
-    marker.focus()
+    # The map: with the focus on it, the arrows move the selected waypoint, and it keeps
+    # the focus (the markers are painted on a canvas: the rows are their keyboard way).
+    rows.nth(3).locator("button.pick").focus()
     page.keyboard.press("Enter")
     assert page.locator("#editor-title").inner_text() == "4"
+    page.get_by_test_id("map").focus()
     x3, y3 = _row_xy(page, 3)
     checked_after(page, lambda: page.keyboard.press("ArrowDown"))
     assert _row_xy(page, 3) == pytest.approx((x3, y3 - 0.05), abs=1e-9)
-    assert _focused(page).startswith("waypoint 4") and "selected" in _focused(page)
+    assert page.evaluate("document.activeElement.dataset.testid") == "map"
+    assert drawn(page)["marks"][3]["selected"]
 
     # ▲ ▼ ✕ are named by what they do; the focus follows the moved waypoint.
     up = rows.nth(3).get_by_role("button", name="move waypoint 4 up")
@@ -675,7 +690,7 @@ def test_no_serious_accessibility_violation_in_the_editor_a_run_and_a_replay(
 
     page.wait_for_function("document.getElementById('runs').options.length > 1")
     page.get_by_test_id("runs").select_option(index=1)
-    page.wait_for_selector("[data-testid=replay-waypoint]")
+    page.wait_for_function("missionLayer.drawn().replayed.length === 7")
     assert serious_violations(page) == []
     assert page.errors == []  # type: ignore[attr-defined]
 
