@@ -715,3 +715,160 @@ def test_a_dropped_file_opens_the_import_list_on_it(page: Any) -> None:
     assert "imported" in page.locator("#message").inner_text()
     assert page.get_by_test_id("waypoint-row").count() > 0
     assert page.errors == []  # type: ignore[attr-defined]
+
+
+def _big_mission(folder: Path, count: int) -> Path:
+    """A mission of ``count`` waypoints spread over the arena's free space (seeded), in
+    serpentine order, with the start pose on the first waypoint's spot."""
+    import json
+
+    import numpy as np
+
+    from navseq.commands.common import costmap_for_map
+
+    map_yaml = folder / "maps/turtlebot3_world.yaml"
+    costmap = costmap_for_map(map_yaml)
+    cells = np.argwhere(costmap.free_mask() & (costmap.clearance >= 0.25))
+    picked = cells[np.random.default_rng(7).choice(len(cells), count, replace=False)]
+    points = [costmap.cell_to_world(int(row), int(col)) for row, col in picked]
+    band = lambda p: int((p[1] + 3) // 0.25)  # noqa: E731
+    points.sort(key=lambda p: (band(p), p[0] if band(p) % 2 == 0 else -p[0]))
+    mission = {
+        "navseq": 1,
+        "map": "../maps/turtlebot3_world.yaml",
+        "start": {"x": round(points[0][0], 2), "y": round(points[0][1], 2), "yaw": 0},
+        "waypoints": [{"x": round(x, 2), "y": round(y, 2), "yaw": 0} for x, y in points],
+    }
+    path = folder / "examples/big.yaml"
+    path.write_text(json.dumps(mission), encoding="utf-8")
+    return path
+
+
+def _overlaps(page: Any) -> list[str]:
+    """Leg labels shown that overlap another label or a marker (its plate, as painted)."""
+    return list(
+        page.evaluate(
+            """() => {
+            const map = document.getElementById("map").getBoundingClientRect();
+            const labels = [...document.querySelectorAll(".leg-label")].map((el) => {
+                const r = el.getBoundingClientRect();
+                return { text: el.textContent, x: r.left - map.left, y: r.top - map.top, w: r.width, h: r.height };
+            });
+            const hit = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+            const found = [];
+            labels.forEach((a, k) => labels.slice(k + 1).forEach((b) => {
+                if (hit(a, b)) found.push(`${a.text} over ${b.text}`);
+            }));
+            const drawn = missionLayer.drawn();
+            for (const m of drawn.marks) {
+                const plate = { x: m.x - m.half, y: m.y - m.r, w: 2 * m.half, h: 2 * m.r };
+                for (const a of labels) if (hit(a, plate)) found.push(`${a.text} over waypoint ${m.index + 1}`);
+            }
+            return found;
+        }"""
+        )
+    )
+
+
+def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anything(
+    chromium: Any, tmp_path: Path
+) -> None:
+    """2000 waypoints: the page opens with all of them on the map and a list that builds
+    only the rows in sight (the last one reached by scrolling); a drag moves one and its
+    legs are planned again; leg lengths are shown only where they cover no marker and
+    no other label, at the whole-mission view and zoomed in; 4-digit numbers fit their
+    plates; the start pose, on the first waypoint's spot, is still seen around it."""
+    _skip_unless_there()
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    (tmp_path / "examples").mkdir()
+    mission = _big_mission(tmp_path, 2000)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "navseq", "studio", str(mission), "--no-browser"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    page = new_page(chromium)
+    try:
+        assert process.stdout is not None
+        url = process.stdout.readline().split(": ", 1)[1].strip()
+        errors: list[str] = []
+        page.on("pageerror", lambda error: errors.append(str(error)))
+        page.goto(url)
+        page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
+        assert marks(page) == 2000
+        rows = page.get_by_test_id("waypoint-row")
+        assert 0 < rows.count() < 100  # the rows in sight, not 2000
+        assert rows.first.get_attribute("aria-setsize") == "2000"
+        page.wait_for_selector("body[data-planned=true]", state="attached", timeout=120_000)
+        assert page.evaluate("S.legs.length") == 2000  # the start's leg and 1999 more
+        assert _overlaps(page) == []
+
+        # Zoomed in on the middle: numbered plates, labels where they fit, none over anything.
+        page.evaluate(
+            "map.setView(map.getCenter(), map.getMaxZoom(), { animate: false }); missionLayer.draw()"
+        )
+        assert not drawn(page)["compact"], page.evaluate("[map.getZoom(), map.getSize()]")
+        assert page.locator(".leg-label").count() > 0
+        assert _overlaps(page) == []
+
+        # Waypoint 2000: its 4 digits fit its plate.
+        last = page.evaluate(
+            """() => { const w = S.doc.waypoints[1999];
+            map.setView([w.y, w.x], map.getZoom(), { animate: false }); missionLayer.draw();
+            const ctx = document.createElement("canvas").getContext("2d");
+            ctx.font = "bold 11px system-ui, sans-serif";
+            return [missionLayer.drawn().marks[1999].half, ctx.measureText("2000").width]; }"""
+        )
+        assert last[0] * 2 >= last[1] + 4
+
+        # The start pose, on waypoint 1's spot: its ring shows around waypoint 1's plate.
+        colours = page.evaluate(
+            """() => { const s = S.doc.start;
+            map.setView([s.y, s.x], map.getZoom(), { animate: false }); missionLayer.draw();
+            const d = missionLayer.drawn(), c = document.querySelector("[data-testid=mission-canvas]");
+            const ctx = c.getContext("2d"), k = c.width / c.clientWidth;
+            const at = (x, y) => [...ctx.getImageData(Math.round(x * k), Math.round(y * k), 1, 1).data];
+            return { ring: at(d.start[0] - 15, d.start[1]), plate: at(d.marks[0].x, d.marks[0].y + 7) }; }"""
+        )
+        assert max(colours["ring"][:3]) < 80 and colours["ring"][3] > 200  # #111827
+        assert colours["plate"][2] > 150 and colours["plate"][0] < 100  # #2563eb, waypoint 1
+
+        # Drag waypoint 10 a little: it moves, and its two legs are planned again.
+        page.evaluate(
+            "map.setView([S.doc.waypoints[9].y, S.doc.waypoints[9].x], map.getZoom(), { animate: false }); missionLayer.draw();"
+        )
+        before = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
+        start = mark_point(page, 9)
+        page.mouse.move(*start)
+        page.mouse.down()
+
+        def drop() -> None:
+            page.mouse.move(start[0] + 12, start[1] + 6, steps=4)
+            page.mouse.up()
+
+        checked_after(page, drop)
+        after = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
+        assert after != before and page.evaluate("S.doc.waypoints.length") == 2000
+        legs = page.evaluate("S.legs.filter((leg) => leg.to === 9 || leg.from === '9')")
+        assert len(legs) == 2
+        into = legs[0] if legs[0]["to"] == 9 else legs[1]
+        assert into["points"][-1] == pytest.approx(after, abs=0.06)
+        assert _overlaps(page) == []
+
+        # The list's last row is reached by scrolling its box.
+        page.locator("#waypoint-box").evaluate("(el) => { el.scrollTop = el.scrollHeight; }")
+        page.wait_for_function(
+            "[...document.querySelectorAll('#waypoints .num')].some((el) => el.textContent === '2000')"
+        )
+        assert rows.count() < 100
+        assert errors == []
+    finally:
+        page.context.close()
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()

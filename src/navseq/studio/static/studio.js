@@ -298,9 +298,9 @@ const MissionLayer = L.Layer.extend({
       if (x > -MARK_R && y > -MARK_R && x < this.size.x + MARK_R && y < this.size.y + MARK_R) inView++;
     }
     this.shown = shown;
-    // Numbered discs while they cover under a sixth of the view; dots beyond (zoom in
+    // Numbered plates while they cover under a third of the view; dots beyond (zoom in
     // to read the numbers): thousands of overlapping discs say nothing.
-    this.compact = inView * (2 * MARK_R) ** 2 > (this.size.x * this.size.y) / 6;
+    this.compact = inView * (2 * MARK_R) ** 2 > (this.size.x * this.size.y) / 3;
   },
   // Where a leg's ends are now: the start pose or a waypoint (the dragged one: the mouse).
   endOf(name) {
@@ -570,11 +570,13 @@ function noPathReason(leg) {
 // The element with the focus is rebuilt by render (a row): the focus goes to the new one
 // in its place (data-focus), as a keyboard user would lose it otherwise.
 function render() {
+  const began = performance.now();
   const focused = S.focusNext !== undefined ? S.focusNext : document.activeElement?.dataset?.focus;
   S.focusNext = undefined;
   const row = (focused || "").match(/^row-(\d+)/);
   if (row) showRow(Number(row[1]));  // built, so that it can have the focus
   renderAll();
+  S.renderMs = performance.now() - began;  // read by benchmarks/bench_studio.py
   if (!focused) return;
   const el = document.querySelector(`[data-focus="${focused}"]`);
   if (el && el !== document.activeElement) el.focus({ preventScroll: true });
@@ -694,14 +696,14 @@ map.on("zoomend", drawHandle);
 // builds the next ones. Each row says its place (aria-posinset of aria-setsize).
 const ROW_H = 24, ROW_SPARE = 8;
 function showRow(i) {
-  const list = $("waypoints");
+  const list = $("waypoint-box");
   const height = list.clientHeight || listHeight();
   if (i * ROW_H < list.scrollTop) list.scrollTop = i * ROW_H;
   else if ((i + 1) * ROW_H > list.scrollTop + height) list.scrollTop = (i + 1) * ROW_H - height;
 }
 const listHeight = () => Math.min(S.doc.waypoints.length * ROW_H, Math.max(window.innerHeight * 0.4, 8 * ROW_H));
 function rowsInSight() {
-  const list = $("waypoints"), n = S.doc.waypoints.length;
+  const list = $("waypoint-box"), n = S.doc.waypoints.length;
   const height = list.clientHeight || listHeight();
   const first = Math.max(0, Math.floor(list.scrollTop / ROW_H) - ROW_SPARE);
   const last = Math.min(n, Math.ceil((list.scrollTop + height) / ROW_H) + ROW_SPARE);
@@ -717,7 +719,7 @@ function renderList() {
   for (let i = first; i < last; i++) made.push(waypointRow(i, n));
   list.replaceChildren(...made);
 }
-$("waypoints").addEventListener("scroll", () => {
+$("waypoint-box").addEventListener("scroll", () => {
   if (S.listFrame) return;
   S.listFrame = requestAnimationFrame(() => {
     S.listFrame = 0;
