@@ -752,9 +752,11 @@ def _overlaps(page: Any) -> list[str]:
             const map = document.getElementById("map").getBoundingClientRect();
             const labels = [...document.querySelectorAll(".leg-label")].map((el) => {
                 const r = el.getBoundingClientRect();
-                return { text: el.textContent, x: r.left - map.left, y: r.top - map.top, w: r.width, h: r.height };
+                return { text: el.textContent, x: r.left - map.left, y: r.top - map.top,
+                         w: r.width, h: r.height };
             });
-            const hit = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+            const hit = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w
+                && a.y < b.y + b.h && b.y < a.y + a.h;
             const found = [];
             labels.forEach((a, k) => labels.slice(k + 1).forEach((b) => {
                 if (hit(a, b)) found.push(`${a.text} over ${b.text}`);
@@ -762,7 +764,9 @@ def _overlaps(page: Any) -> list[str]:
             const drawn = missionLayer.drawn();
             for (const m of drawn.marks) {
                 const plate = { x: m.x - m.half, y: m.y - m.r, w: 2 * m.half, h: 2 * m.r };
-                for (const a of labels) if (hit(a, plate)) found.push(`${a.text} over waypoint ${m.index + 1}`);
+                for (const a of labels) {
+                    if (hit(a, plate)) found.push(`${a.text} over waypoint ${m.index + 1}`);
+                }
             }
             return found;
         }"""
@@ -807,7 +811,8 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
 
         # Zoomed in on the middle: numbered plates, labels where they fit, none over anything.
         page.evaluate(
-            "map.setView(map.getCenter(), map.getMaxZoom(), { animate: false }); missionLayer.draw()"
+            "map.setView(map.getCenter(), map.getMaxZoom(), { animate: false });"
+            " missionLayer.draw()"
         )
         assert not drawn(page)["compact"], page.evaluate("[map.getZoom(), map.getSize()]")
         assert page.locator(".leg-label").count() > 0
@@ -827,17 +832,21 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         colours = page.evaluate(
             """() => { const s = S.doc.start;
             map.setView([s.y, s.x], map.getZoom(), { animate: false }); missionLayer.draw();
-            const d = missionLayer.drawn(), c = document.querySelector("[data-testid=mission-canvas]");
+            const d = missionLayer.drawn();
+            const c = document.querySelector("[data-testid=mission-canvas]");
             const ctx = c.getContext("2d"), k = c.width / c.clientWidth;
-            const at = (x, y) => [...ctx.getImageData(Math.round(x * k), Math.round(y * k), 1, 1).data];
-            return { ring: at(d.start[0] - 15, d.start[1]), plate: at(d.marks[0].x, d.marks[0].y + 7) }; }"""
+            const at = (x, y) => [
+                ...ctx.getImageData(Math.round(x * k), Math.round(y * k), 1, 1).data];
+            return { ring: at(d.start[0] - 15, d.start[1]),
+                     plate: at(d.marks[0].x, d.marks[0].y + 7) }; }"""
         )
         assert max(colours["ring"][:3]) < 80 and colours["ring"][3] > 200  # #111827
         assert colours["plate"][2] > 150 and colours["plate"][0] < 100  # #2563eb, waypoint 1
 
         # Drag waypoint 10 a little: it moves, and its two legs are planned again.
         page.evaluate(
-            "map.setView([S.doc.waypoints[9].y, S.doc.waypoints[9].x], map.getZoom(), { animate: false }); missionLayer.draw();"
+            "const w = S.doc.waypoints[9];"
+            " map.setView([w.y, w.x], map.getZoom(), { animate: false }); missionLayer.draw();"
         )
         before = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
         start = mark_point(page, 9)
@@ -860,7 +869,8 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         # The list's last row is reached by scrolling its box.
         page.locator("#waypoint-box").evaluate("(el) => { el.scrollTop = el.scrollHeight; }")
         page.wait_for_function(
-            "[...document.querySelectorAll('#waypoints .num')].some((el) => el.textContent === '2000')"
+            "[...document.querySelectorAll('#waypoints .num')]"
+            ".some((el) => el.textContent === '2000')"
         )
         assert rows.count() < 100
         assert errors == []

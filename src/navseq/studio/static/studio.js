@@ -643,6 +643,7 @@ document.addEventListener("mouseup", () => {
   setTimeout(() => { S.swallowClick = false; }, 0);
   const drag = S.drag;
   S.drag = null;
+  const began = performance.now();
   if (p.moved && drag) {
     edit(() => {
       const point = drag.target === "start" ? S.doc.start : S.doc.waypoints[drag.target];
@@ -650,6 +651,7 @@ document.addEventListener("mouseup", () => {
       S.selected = drag.target;
     });
   } else { S.selected = p.hit; render(); }
+  S.dragDropMs = performance.now() - began;  // the page's own part (benchmarks/bench_studio.py)
 }, true);
 mapBox.addEventListener("click", (e) => { if (S.swallowClick) { S.swallowClick = false; e.stopPropagation(); } }, true);
 
