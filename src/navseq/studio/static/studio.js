@@ -371,14 +371,17 @@ const MissionLayer = L.Layer.extend({
     const bad = new Set(S.problems.map((p) => p.waypoint));
     ctx.globalAlpha = S.replay ? 0.25 : 1;  // the replayed run's own waypoints go on top
     const inView = (i, r) => this.px[i] > -r - 20 && this.py[i] > -r - 20 && this.px[i] < size.x + r + 20 && this.py[i] < size.y + r + 20;
-    if (this.compact) {
+    if (this.compact) {  // one path per colour: thousands of dots in one fill each
+      const paths = new Map();
       for (let i = 0; i < n; i++) {
         if (Number.isNaN(this.px[i]) || !inView(i, DOT_R) || i === S.selected) continue;
-        ctx.beginPath();
-        ctx.arc(this.px[i], this.py[i], DOT_R, 0, 2 * Math.PI);
-        ctx.fillStyle = this.fillOf(i, wps[i], bad);
-        ctx.fill();
+        const colour = this.fillOf(i, wps[i], bad);
+        let path = paths.get(colour);
+        if (!path) { path = new Path2D(); paths.set(colour, path); }
+        path.moveTo(this.px[i] + DOT_R, this.py[i]);
+        path.arc(this.px[i], this.py[i], DOT_R, 0, 2 * Math.PI);
       }
+      for (const [colour, path] of paths) { ctx.fillStyle = colour; ctx.fill(path); }
     } else {
       for (let i = 0; i < n; i++) {
         if (Number.isNaN(this.px[i]) || !inView(i, 2 * MARK_R) || i === S.selected) continue;
@@ -459,28 +462,29 @@ const MissionLayer = L.Layer.extend({
     const box = this.labels;
     box.textContent = "";
     if (!S.planned || S.drag) return;
-    const CELL = 48, taken = new Map();
-    const cells = (r, visit) => {
-      for (let gx = Math.floor(r[0] / CELL); gx <= Math.floor((r[0] + r[2]) / CELL); gx++) {
-        for (let gy = Math.floor(r[1] / CELL); gy <= Math.floor((r[1] + r[3]) / CELL); gy++) {
-          if (visit(`${gx},${gy}`) === false) return false;
-        }
-      }
+    const CELL = 48, COLS = Math.ceil(size.x / CELL) + 2, taken = new Map();
+    const hits = (a, b) => a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
+    // Rectangles by grid cell (numbered row by row; the view's margin clamped to its edge).
+    const visit = (r, each) => {
+      const x0 = Math.max(-1, Math.floor(r[0] / CELL)), x1 = Math.min(COLS - 2, Math.floor((r[0] + r[2]) / CELL));
+      const y0 = Math.max(-1, Math.floor(r[1] / CELL)), y1 = Math.floor((r[1] + r[3]) / CELL);
+      for (let gy = y0; gy <= y1; gy++) for (let gx = x0; gx <= x1; gx++) if (each((gy + 1) * COLS + gx + 1) === false) return false;
       return true;
     };
-    const hits = (a, b) => a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
-    const free = (r) => cells(r, (key) => !(taken.get(key) || []).some((o) => hits(r, o)));
-    const take = (r) => cells(r, (key) => { if (!taken.has(key)) taken.set(key, []); taken.get(key).push(r); });
+    const free = (r) => visit(r, (key) => !(taken.get(key) || []).some((o) => hits(r, o)));
+    const take = (r) => visit(r, (key) => { const list = taken.get(key); if (list) list.push(r); else taken.set(key, [r]); });
     const markR = (this.compact ? DOT_R : MARK_R) + LABEL_GAP;
     for (let i = 0; i < this.px.length; i++) {
       const x = this.px[i], y = this.py[i];
       if (Number.isNaN(x) || x < -markR || y < -markR || x > size.x + markR || y > size.y + markR) continue;
-      const half = this.compact && i !== S.selected ? DOT_R : this.halfWidth(ctx, i) + 3;
-      take([x - half - LABEL_GAP, y - MARK_R - LABEL_GAP, 2 * (half + LABEL_GAP), 2 * (MARK_R + LABEL_GAP)]);
+      const compact = this.compact && i !== S.selected;
+      const half = compact ? DOT_R : this.halfWidth(ctx, i) + 3, high = compact ? DOT_R : MARK_R;
+      take([x - half - LABEL_GAP, y - high - LABEL_GAP, 2 * (half + LABEL_GAP), 2 * (high + LABEL_GAP)]);
     }
     if (this.start) take([this.start[0] - START_R - 8, this.start[1] - START_R - 8, 2 * START_R + 16, 2 * START_R + 16]);
     for (const r of this.replayed) take([r.x - MARK_R - 4, r.y - MARK_R - 4, 2 * MARK_R + 8, 2 * MARK_R + 8]);
     ctx.font = LABEL_FONT;
+    const shortest = 2 * MARK_R + 30;  // px: no label is narrower than 30 px
     const made = [];
     for (const leg of S.legs) {
       if (made.length >= MAX_LABELS) break;
@@ -490,7 +494,7 @@ const MissionLayer = L.Layer.extend({
         if (!a || !b) continue;
         pts = [a, b];
       }
-      const mid = this.midpoint(pts, f);
+      const mid = this.midpoint(pts, f, shortest, size);
       if (!mid) continue;
       const text = leg.points ? `${leg.length_m.toFixed(2)} m` : "no path";
       const w = Math.ceil(ctx.measureText(text).width) + 6;
@@ -509,16 +513,20 @@ const MissionLayer = L.Layer.extend({
     }
     box.append(...made);
   },
-  // The point halfway along a leg on the screen, and the leg's length there (px).
-  midpoint(pts, f) {
-    const xs = pts.map((p) => f.ox + p[0] * f.s), ys = pts.map((p) => f.oy - p[1] * f.s);
+  // The point halfway along a leg on the screen and the leg's length there (px); null
+  // when the leg is shorter than ``shortest`` or its middle is out of the view.
+  midpoint(pts, f, shortest, size) {
+    const sx = (k) => f.ox + pts[k][0] * f.s, sy = (k) => f.oy - pts[k][1] * f.s;
     let total = 0;
-    for (let k = 1; k < xs.length; k++) total += Math.hypot(xs[k] - xs[k - 1], ys[k] - ys[k - 1]);
-    if (!(total > 0)) return null;
+    for (let k = 1; k < pts.length; k++) total += Math.hypot(sx(k) - sx(k - 1), sy(k) - sy(k - 1));
+    if (!(total >= shortest)) return null;
     let left = total / 2;
-    for (let k = 1; k < xs.length; k++) {
-      const d = Math.hypot(xs[k] - xs[k - 1], ys[k] - ys[k - 1]);
-      if (left <= d) return { x: xs[k - 1] + ((xs[k] - xs[k - 1]) * left) / d, y: ys[k - 1] + ((ys[k] - ys[k - 1]) * left) / d, length_px: total };
+    for (let k = 1; k < pts.length; k++) {
+      const d = Math.hypot(sx(k) - sx(k - 1), sy(k) - sy(k - 1));
+      if (left <= d) {
+        const x = sx(k - 1) + ((sx(k) - sx(k - 1)) * left) / d, y = sy(k - 1) + ((sy(k) - sy(k - 1)) * left) / d;
+        return x < 0 || y < 0 || x > size.x || y > size.y ? null : { x, y, length_px: total };
+      }
       left -= d;
     }
     return null;
