@@ -30,7 +30,7 @@ const selectedPoint = () => (S.selected === "start" ? S.doc.start : S.selected !
 async function api(method, path, body, signal) {
   const response = await fetch(path, {
     method, headers: body ? { "content-type": "application/json" } : {},
-    body: body ? JSON.stringify(body) : undefined, credentials: "same-origin", signal,
+    body: typeof body === "string" ? body : body ? JSON.stringify(body) : undefined, credentials: "same-origin", signal,
   });
   let data = null;
   try { data = await response.json(); } catch (e) { data = { error: response.statusText }; }
@@ -930,8 +930,9 @@ async function check() {
   if (S.checkBusy) { S.checkAgain = true; return; }
   S.checkBusy = true;
   const seq = ++S.checkSeq;
-  const sent = JSON.parse(JSON.stringify(S.doc));
-  const answer = await api("POST", "/api/check", { mission: sent });
+  // Written out once, now: the draft as it is at this moment (edits may follow while
+  // the answer is on its way), and no second copy of a mission of thousands.
+  const answer = await api("POST", "/api/check", JSON.stringify({ mission: S.doc }));
   S.checkBusy = false;
   if (S.checkAgain) { S.checkAgain = false; check(); return; }
   if (seq !== S.checkSeq) return;
