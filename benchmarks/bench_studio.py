@@ -275,22 +275,24 @@ def check_latency(served: Served, moves: list[tuple[float, float]]) -> float:
 
 def order_time(page: Any, limit: float) -> float:
     """Seconds until the page drew the shortest order; ``inf`` when it took over
-    ``limit`` (Cancel pressed then: the page is given back)."""
+    ``limit`` (Cancel pressed then: the page is given back), NaN when the server
+    refused (its message printed)."""
     began = time.perf_counter()
     page.get_by_test_id("order").select_option("shortest")
-    done = (
-        "(() => { const m = document.getElementById('message').textContent;"
-        " return m.startsWith('waypoints put') || m.includes('already are'); })()"
-    )
     try:
-        page.wait_for_function(done, timeout=limit * 1e3, polling=20)
+        page.wait_for_function("!S.ordering", timeout=limit * 1e3, polling=20)
     except Exception:  # Playwright's timeout: cancel and say so
         page.get_by_test_id("order-cancel").click()
         page.wait_for_function(
             "document.getElementById('message').textContent.startsWith('ordering cancelled')"
         )
         return float("inf")
-    return time.perf_counter() - began
+    took = time.perf_counter() - began
+    said = str(page.locator("#message").inner_text())
+    if said.startswith("waypoints put") or "already are" in said:
+        return took
+    print(f"Order… answered after {took:.1f} s: {said}", file=sys.stderr)
+    return float("nan")
 
 
 def live_rate(page: Any, seconds: float) -> float:
@@ -423,7 +425,13 @@ def main() -> int:
             "order": (
                 "Order… shortest [s]",
                 "<= 3 (400), 30 (2000)",
-                lambda v: f"> {limit:.0f}, cancelled" if v == float("inf") else f"{v:.1f}",
+                lambda v: (
+                    f"> {limit:.0f}, cancelled"
+                    if v == float("inf")
+                    else "refused"
+                    if v != v
+                    else f"{v:.1f}"
+                ),
             ),
             "live": ("live updates/s at 1x", ">= 10", lambda v: f"{v:.1f}"),
         }

@@ -276,6 +276,7 @@ const MissionLayer = L.Layer.extend({
     const f = this.frame0 = this.frameOf();
     this.size = size;
     this.project(f);
+    this.replayed = [];
     this.drawLegs(ctx, f);
     this.drawMarks(ctx, size);
     if (S.replay) this.drawReplayed(ctx, f);
