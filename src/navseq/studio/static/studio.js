@@ -227,6 +227,9 @@ const COLOUR = {
   skipped: "#dc2626", failed: "#dc2626", stopped: "#92400e",
 };
 map.createPane("mission").style.zIndex = 450;  // over the map image (400), under the yaw handle (600)
+// The robot over the waypoints (seen where it stands on one); its trail and plan stay
+// under them (the numbers stay readable).
+map.createPane("run").style.zIndex = 460;
 const MissionLayer = L.Layer.extend({
   onAdd(m) {
     const pane = m.getPane("mission");
@@ -1237,7 +1240,7 @@ function drawReplay(t) {
     }
     const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
     const outline = R.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
-    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.replay);
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false, pane: "run" }).addTo(S.layers.replay);
     body.getElement().dataset.testid = "replay-robot";
   }
   const at = state.current !== null && state.current !== undefined ? ` · waypoint ${state.current + 1} ${statuses[state.current] || "pending"}` : "";
@@ -1309,9 +1312,9 @@ function drawRun(run, before) {
     const { x_m: x, y_m: y, yaw_deg: deg } = run.pose;
     const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
     const outline = run.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
-    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.run);
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false, pane: "run" }).addTo(S.layers.run);
     body.getElement().dataset.testid = "robot";
-    L.polyline([ll(x, y), ll(x + 0.25 * c, y + 0.25 * s)], { color: "#111827", weight: 2, interactive: false }).addTo(S.layers.run);
+    L.polyline([ll(x, y), ll(x + 0.25 * c, y + 0.25 * s)], { color: "#111827", weight: 2, interactive: false, pane: "run" }).addTo(S.layers.run);
   }
   const busy = !run.done;
   $("stop").disabled = !busy; $("skip").disabled = !busy; $("pause").disabled = !busy;
