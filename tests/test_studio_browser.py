@@ -882,3 +882,53 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
+
+
+def test_a_leg_with_no_path_is_drawn_named_and_left_out_of_the_total(page: Any) -> None:
+    """A waypoint on a pillar: its leg has no path; the route line still gives the planned
+    legs' total and names the leg left out, and the leg's label says why."""
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    total = float(page.locator("#route").inner_text().split(" · ")[1].split(" m")[0])
+    start = screen_point(page, *FREE_SPOT)
+    target = screen_point(page, *PILLAR)
+
+    def drag() -> None:
+        page.mouse.move(*start)
+        page.mouse.down()
+        page.mouse.move(*target, steps=12)
+        page.mouse.up()
+
+    checked_after(page, drag)
+    assert page.evaluate("S.legs.filter((leg) => leg.points === null).map((leg) => leg.to)") == [7]
+    route = page.locator("#route").inner_text()
+    assert "not counting 1 leg with no path (7→8" in route
+    planned = float(route.split(" · ")[1].split(" m planned")[0])
+    assert planned < total  # the seven planned legs, without the last one
+    label = page.locator(".leg-label.no-path")
+    assert label.count() == 1 and label.inner_text() == "no path"
+    assert (label.get_attribute("title") or "").startswith("no path from waypoint 7 to waypoint 8")
+    assert _overlaps(page) == []
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_order_shows_the_time_spent_and_cancel_gives_the_page_back(page: Any) -> None:
+    """While the server orders the waypoints the page counts the seconds; Cancel stops
+    waiting, and the waypoints stay as they were (the late answer is dropped)."""
+    held: list[Any] = []
+    page.route("**/api/order", lambda route: held.append(route))
+    before = page.evaluate("JSON.stringify(S.doc.waypoints)")
+    page.get_by_test_id("order").select_option("shortest")
+    page.wait_for_function(
+        "document.getElementById('message').textContent.includes('… 1 s')", timeout=10_000
+    )
+    assert "finding the shortest order of 7 waypoints" in page.locator("#message").inner_text()
+    assert page.get_by_test_id("order").is_disabled()
+    page.get_by_test_id("order-cancel").click()
+    message_of(page, "ordering cancelled")
+    assert page.get_by_test_id("order-cancel").is_hidden()
+    assert page.get_by_test_id("order").is_enabled()
+    held[0].continue_()  # the server's answer comes late: nothing changes
+    page.wait_for_timeout(300)
+    assert page.evaluate("JSON.stringify(S.doc.waypoints)") == before
+    assert page.get_by_test_id("waypoint-row").count() == 7
+    assert page.errors == []  # type: ignore[attr-defined]
