@@ -387,6 +387,9 @@ def test_import_the_tutorials_launch_file_and_export_one(
     checked_after(page, lambda: page.keyboard.press("Enter"))
     assert not dialog.is_visible()
     assert marks(page) == 4
+    size = page.evaluate("[map.getSize().x, map.getSize().y]")
+    for mark in drawn(page)["marks"]:  # the view fits the imported waypoints
+        assert 0 < mark["x"] < size[0] and 0 < mark["y"] < size[1]
     assert "imported 4 waypoints" in page.locator("#message").inner_text()
     # Still on the arena's map: its pre-flight runs on the imported points.
     assert page.locator("[data-testid=map-image]").count() == 1
@@ -865,6 +868,13 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         into = legs[0] if legs[0]["to"] == 9 else legs[1]
         assert into["points"][-1] == pytest.approx(after, abs=0.06)
         assert _overlaps(page) == []
+
+        # Tab goes on through the rows past the first ones built (4 stops a row).
+        rows.first.locator("button.pick").focus()
+        for _ in range(4 * 60):
+            page.keyboard.press("Tab")
+        assert page.evaluate("document.activeElement.dataset.focus") == "row-60"
+        assert rows.count() < 100
 
         # The list's last row is reached by scrolling its box.
         page.locator("#waypoint-box").evaluate("(el) => { el.scrollTop = el.scrollHeight; }")

@@ -748,6 +748,19 @@ $("waypoint-box").addEventListener("scroll", () => {
     if (el) el.focus({ preventScroll: true });
   });
 });
+// A row reached with Tab is scrolled in and the rows after it built at once (not at the
+// next frame): a fast Tab would otherwise leave the list at the last row built.
+$("waypoints").addEventListener("focusin", (e) => {
+  const key = e.target.dataset?.focus || "";
+  const row = key.match(/^row-(\d+)/);
+  if (!row) return;
+  showRow(Number(row[1]));
+  const [first, last] = rowsInSight();
+  if (S.rows && S.rows[0] === first && S.rows[1] === last && S.rows[2] === S.doc.waypoints.length) return;
+  renderList();
+  const el = document.querySelector(`[data-focus="${key}"]`);
+  if (el && el !== document.activeElement) el.focus({ preventScroll: true });
+});
 function waypointRow(i, n) {
   const w = S.doc.waypoints[i];
   const li = document.createElement("li");
