@@ -1,33 +1,34 @@
-"""navseq studio: page ready, drag -> problems latency and live updates, on two maps.
+"""navseq studio at mission sizes: page ready, drag, typed change, Order…, live run.
 
-Side by side on the TurtleBot3 arena (384 x 384 cells) and a generated 2000 x 2000 map
-(5 x 4 seeded warehouses from :mod:`navseq.sim.mapgen`, joined by doorways), each with a
-mission of a dozen waypoints:
+On the TurtleBot3 arena (384 x 384 cells) and a generated 2000 x 2000 map (5 x 4 seeded
+warehouses from :mod:`navseq.sim.mapgen`, joined by doorways), with missions of 7, 300,
+2000 and 5000 waypoints (``--sizes``; spread over the free space in a serpentine tour,
+the 7 on the arena being the example's), each served by ``navseq studio`` and driven in
+headless Chromium (Debian's ``/usr/bin/chromium`` through Playwright):
 
-- **page ready**: from navigating to the studio's URL until the page says it is ready
-  (map image drawn, markers placed), in headless Chromium (Debian's
-  ``/usr/bin/chromium`` through Playwright), median of ``--repeat`` loads; the first
-  load is the one right after ``navseq studio`` started (nothing made yet), the studio
-  started ``--repeat`` times for it; later loads are fresh pages on a studio that
-  served the page once already;
-- **plans shown**: from navigating until the first check's answer (pre-flight
-  problems and every leg planned) is drawn; before the page had ``data-planned`` it
-  was ready only then, so it is its ready time;
-- **before**: with ``--before REF`` (a git commit, e.g. ``main``) the studio of that
-  commit is served too (its ``src/`` exported, the compiled A* copied in) and its page
-  figures are put beside the current ones, measured on the same maps and run;
-- **drag -> problems (page)**: a waypoint marker dragged with the mouse to another free
-  spot, until the page has the server's answer (problems and planned legs) drawn;
-- **check (server)**: ``POST /api/check`` of the mission with one waypoint moved,
-  in process, with the costmap kept per (map, robot) as the studio does, and rebuilt on
-  every check as the first slice did (the ratio is what the cache saves);
-- **live updates/s at 1x**: server-sent events received per second while the mission
-  runs on the simulator at real time (``realtime: 1``), and how many of them showed
-  the robot moved.
+- **page ready, first load**: from navigating to the studio's URL, right after it
+  started, until the page says it is ready (map image drawn, waypoints painted, list
+  built); **later loads**: median of ``--repeat`` fresh pages;
+- **plans shown**: until the first check's answer (pre-flight problems and every leg
+  planned) is drawn;
+- **drag -> problems drawn**: a waypoint dragged with the mouse to another free spot,
+  from the button's release until the server's answer (problems, the legs planned
+  again) is drawn; **drag, page redraw**: the page's own part of it (the edit and the
+  redraw, before the answer);
+- **typed change -> redrawn**: a new x typed in the waypoint form (its change event)
+  until the next frame, everything redrawn; **-> checked**: until the check's answer
+  is drawn;
+- **check (server)**: ``POST /api/check`` of the mission with one waypoint moved;
+- **Order…**: ``shortest route`` chosen, until the new order is drawn, at most
+  ``--order-limit`` s (then Cancel is pressed: "> limit");
+- **live updates/s**: run updates the page drew per second while the mission ran on
+  the simulator at real time (``1×``).
 
-Targets (issue 12): ready <= 1 s / 2 s, drag -> problems <= 150 ms / 500 ms, live >= 10/s.
+Targets (issue 12 and the scale issue): ready <= 1.5 s at 5000, drag -> problems
+<= 150 ms, typed change <= 100 ms, Order… <= 3 s at 400 and <= 30 s at 2000, live
+>= 10/s at 5000.
 
-    .venv/bin/python benchmarks/bench_studio.py [--repeat 5] [--live-seconds 6] [--before main]
+    .venv/bin/python benchmarks/bench_studio.py [--repeat 3] [--sizes 7,300,2000,5000]
 """
 
 from __future__ import annotations
@@ -43,7 +44,6 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
-from math import cos, sin
 from pathlib import Path
 from typing import Any
 
@@ -87,32 +87,43 @@ def big_map() -> OccupancyGrid:
 
 
 def spread_waypoints(map_yaml: Path, count: int, seed: int) -> list[tuple[float, float]]:
-    """``count`` roomy free spots of the map's main region, in a serpentine tour."""
+    """``count`` roomy free spots of the map's main region, in a serpentine tour: the map
+    cut in boxes (finer until ``count`` of them hold a free spot), one spot per box."""
     from scipy import ndimage
 
     from navseq.commands.common import costmap_for_map
 
     costmap = costmap_for_map(map_yaml)
-    free = costmap.free_mask() & (costmap.clearance >= 0.5)
     labels, _ = ndimage.label(costmap.free_mask(), structure=np.ones((3, 3), bool))
     main = np.bincount(labels[labels > 0]).argmax()
-    cells = np.argwhere(free & (labels == main))
+    # As roomy as the map allows for that many (5000 on the small arena: closer to walls).
+    for clearance in (0.3, 0.2, 0.15, 0.1, 0.0):
+        cells = np.argwhere(
+            costmap.free_mask() & (costmap.clearance >= clearance) & (labels == main)
+        )
+        if len(cells) >= 2 * count:
+            break
+    if len(cells) < count:
+        raise SystemExit(f"{map_yaml.name} has no room for {count} waypoints")
     rng = np.random.default_rng(seed)
-    side = int(np.ceil(np.sqrt(count)))
     rows, cols = costmap.cost.shape
+    side = int(np.ceil(np.sqrt(count)))
+    while True:
+        band, column = cells[:, 0] * side // rows, cells[:, 1] * side // cols
+        # Serpentine: odd bands run right to left.
+        key = band * side + np.where(band % 2 == 0, column, side - 1 - column)
+        boxes = np.unique(key)
+        if len(boxes) >= count or side >= max(rows, cols):
+            break
+        side = min(side + max(1, side // 8), max(rows, cols))
+    order = np.argsort(key, kind="stable")
+    sorted_keys = key[order]
     picked: list[tuple[float, float]] = []
-    for band in range(side):
-        order = range(side) if band % 2 == 0 else range(side - 1, -1, -1)
-        for column in order:
-            if len(picked) == count:
-                break
-            in_box = cells[
-                (cells[:, 0] * side // rows == band) & (cells[:, 1] * side // cols == column)
-            ]
-            if len(in_box):
-                row, col = in_box[rng.integers(len(in_box))]
-                x, y = costmap.cell_to_world(int(row), int(col))
-                picked.append((round(x, 2), round(y, 2)))
+    for box in boxes[:count]:
+        lo, hi = np.searchsorted(sorted_keys, [box, box + 1])
+        row, col = cells[order[lo + rng.integers(hi - lo)]]
+        x, y = costmap.cell_to_world(int(row), int(col))
+        picked.append((round(x, 2), round(y, 2)))
     return picked
 
 
@@ -129,6 +140,7 @@ def nearby_free(map_yaml: Path, x: float, y: float, dx: float, dy: float) -> tup
 
 
 def workspace(base: Path, name: str, map_yaml: Path, points: list[tuple[float, float]]) -> Path:
+    """A folder with ``mission.yaml``: the start pose on ``points[0]``, waypoints after."""
     folder = base / name
     folder.mkdir()
     mission = {
@@ -142,45 +154,13 @@ def workspace(base: Path, name: str, map_yaml: Path, points: list[tuple[float, f
     return path
 
 
-# --- in process: the check's latency ---------------------------------------------------
-
-
-def check_latency(mission: Path, moves: list[tuple[float, float]], cached: bool) -> float:
-    """Median time of the studio's check after moving waypoint 2 to each of ``moves``."""
-    from navseq.commands.common import costmap_for_map
-    from navseq.studio.app import Studio, StudioConfig
-    from navseq.studio.security import FileRoots
-
-    roots = FileRoots([mission.parent, mission.parent.parent], mission.parent)
-    studio = Studio(StudioConfig(token="t", roots=roots, mission_path=mission))
-    if not cached:  # the first slice: validate's function inflated the map every time
-        studio.costmap = lambda map_path, robot: costmap_for_map(map_path, robot)  # type: ignore[method-assign]
-    document = studio.mission()["mission"]
-    studio.check(document)  # the page's first check, on opening
-    times = []
-    for x, y in moves:
-        document["waypoints"][2].update(x=x, y=y)
-        began = time.perf_counter()
-        answer = studio.check(document)
-        times.append(time.perf_counter() - began)
-        assert answer["legs"], answer
-    return statistics.median(times)
-
-
-# --- the real thing: navseq studio and a browser ----------------------------------------
-
-
 class Served:
     """``navseq studio MISSION --no-browser`` as a user starts it."""
 
-    def __init__(self, mission: Path, source: Path | None = None) -> None:
-        env = dict(os.environ)
-        if source is not None:  # another commit's navseq (--before)
-            env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(source), env.get("PYTHONPATH")]))
+    def __init__(self, mission: Path) -> None:
         self.process = subprocess.Popen(
             [sys.executable, "-m", "navseq", "studio", str(mission), "--no-browser"],
             cwd=mission.parent,
-            env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
@@ -188,6 +168,15 @@ class Served:
         assert self.process.stdout is not None
         self.url = self.process.stdout.readline().split(": ", 1)[1].strip()
         self.base, _, self.token = self.url.partition("/?token=")
+
+    def call(self, method: str, path: str, body: Any = None) -> Any:
+        import urllib.request
+
+        headers = {"x-navseq-token": self.token, "content-type": "application/json"}
+        data = None if body is None else json.dumps(body).encode()
+        request = urllib.request.Request(self.base + path, data, headers, method=method)
+        with urllib.request.urlopen(request, timeout=300) as answer:
+            return json.load(answer)
 
     def close(self) -> None:
         self.process.send_signal(signal.SIGINT)
@@ -198,167 +187,192 @@ class Served:
             self.process.wait()
 
 
-# The first check's plans are drawn: data-planned, or (a page from before it had it)
-# data-ready, which that page set only once the first check was drawn.
-PLANS_SHOWN = (
-    "document.body.dataset.planned === 'true' ||"
-    " (typeof S.planned === 'undefined' && document.body.dataset.ready === 'true')"
-)
-
-
 def load(browser: Any, url: str) -> tuple[float, float, Any]:
     """(page ready, plans shown) in seconds from navigating to ``url`` in a fresh page
     (its own context: nothing cached by the browser), and the page."""
-    page = browser.new_page(viewport={"width": 1400, "height": 860})
+    # bypass_csp: Playwright evaluates the string expressions waited for with eval.
+    context = browser.new_context(viewport={"width": 1400, "height": 860}, bypass_csp=True)
+    page = context.new_page()
     began = time.perf_counter()
     page.goto(url)
-    page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
+    page.wait_for_selector("body[data-ready=true]", state="attached", timeout=120_000)
     ready = time.perf_counter() - began
-    page.wait_for_function(PLANS_SHOWN, timeout=60_000, polling=10)
+    page.wait_for_selector("body[data-planned=true]", state="attached", timeout=600_000)
     return ready, time.perf_counter() - began, page
 
 
-def first_loads(
-    mission: Path, sources: dict[str, Path | None], repeat: int
-) -> dict[str, dict[str, float]]:
-    """Median (page ready, plans shown) of the first load right after ``navseq studio``
-    started (nothing made yet: the map's PNG, costmap and plans are made then), each
-    source's studio started ``repeat`` times, the sources in turn so that they share
-    the machine's ups and downs."""
-    from playwright.sync_api import sync_playwright
-
-    ready: dict[str, list[float]] = {label: [] for label in sources}
-    planned: dict[str, list[float]] = {label: [] for label in sources}
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        for _ in range(repeat):
-            for label, source in sources.items():
-                served = Served(mission, source)
-                try:
-                    shown, plans, page = load(browser, served.url)
-                    page.close()
-                finally:
-                    served.close()
-                ready[label].append(shown)
-                planned[label].append(plans)
-        browser.close()
-    return {
-        label: {
-            "first": statistics.median(ready[label]),
-            "first_plans": statistics.median(planned[label]),
-        }
-        for label in sources
-    }
+def checked_after(page: Any, action: Callable[[], None]) -> float:
+    """Seconds from ``action`` until the page drew the answer of the check it sent."""
+    before = page.evaluate("Number(document.body.dataset.checked || 0)")
+    began = time.perf_counter()
+    action()
+    page.wait_for_function(
+        f"Number(document.body.dataset.checked || 0) > {before}", timeout=120_000, polling=5
+    )
+    return time.perf_counter() - began
 
 
-def page_figures(served: Served, moves: list[tuple[float, float]], repeat: int) -> dict[str, float]:
-    """Seconds: median page ready and plans shown of later loads (after a first one,
-    not counted), and median drag -> problems drawn (absent when ``moves`` is empty)."""
-    from playwright.sync_api import sync_playwright
+def drags(page: Any, moves: list[tuple[float, float]]) -> tuple[float, float]:
+    """Median (drag -> answer drawn, the page's own redraw of the drop) in seconds: waypoint
+    3 dragged to each of ``moves`` with the mouse, the view centred on it first."""
+    answered, redrawn = [], []
+    for x, y in moves:
+        page.evaluate(
+            "() => { const w = S.doc.waypoints[2]; map.setView([w.y, w.x], map.getZoom(),"
+            " { animate: false }); missionLayer.draw(); }"
+        )
+        box = page.get_by_test_id("map").bounding_box()
+        mark = page.evaluate("missionLayer.drawn().marks[2]")
+        target = page.evaluate(
+            "([x, y]) => { const p = map.latLngToContainerPoint(L.latLng(y, x));"
+            " return [p.x, p.y]; }",
+            [x, y],
+        )
+        page.mouse.move(box["x"] + mark["x"], box["y"] + mark["y"])
+        page.mouse.down()
+        page.mouse.move(box["x"] + target[0], box["y"] + target[1], steps=4)
+        answered.append(checked_after(page, page.mouse.up))
+        redrawn.append(page.evaluate("S.dragDropMs"))
+    return statistics.median(answered), statistics.median(redrawn) / 1e3
 
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        load(browser, served.url)[2].close()  # the first load: first_loads measures it
+
+TYPE_X = """async (x) => {
+    const input = document.getElementById("fields-x");
+    input.value = String(x);
+    const began = performance.now();
+    input.dispatchEvent(new Event("change"));
+    await new Promise((done) => requestAnimationFrame(() => done()));
+    return performance.now() - began;
+}"""
+
+
+def typed_changes(page: Any, repeat: int) -> tuple[float, float]:
+    """Median (typed x -> redrawn at the next frame, -> check drawn) in seconds."""
+    page.get_by_test_id("waypoint-row").nth(2).click()
+    x0 = page.evaluate("S.doc.waypoints[2].x")
+    redrawn: list[float] = []
+    checked: list[float] = []
+    for k in range(repeat):
+
+        def type_x(x: float = x0 + 0.01 * (k + 1)) -> None:
+            redrawn.append(page.evaluate(TYPE_X, x) / 1e3)
+
+        checked.append(checked_after(page, type_x))
+    return statistics.median(redrawn), statistics.median(checked)
+
+
+def check_latency(served: Served, moves: list[tuple[float, float]]) -> float:
+    """Median seconds of ``POST /api/check`` with waypoint 3 moved to each of ``moves``."""
+    document = served.call("GET", "/api/mission")["mission"]
+    times = []
+    for x, y in moves:
+        document["waypoints"][2].update(x=x + 0.05, y=y)
+        began = time.perf_counter()
+        served.call("POST", "/api/check", {"mission": document})
+        times.append(time.perf_counter() - began)
+    return statistics.median(times)
+
+
+def order_time(page: Any, limit: float) -> float:
+    """Seconds until the page drew the shortest order; ``inf`` when it took over
+    ``limit`` (Cancel pressed then: the page is given back), NaN when the server
+    refused (its message printed)."""
+    began = time.perf_counter()
+    page.get_by_test_id("order").select_option("shortest")
+    try:
+        page.wait_for_function("!S.ordering", timeout=limit * 1e3, polling=20)
+    except Exception:  # Playwright's timeout: cancel and say so
+        page.get_by_test_id("order-cancel").click()
+        page.wait_for_function(
+            "document.getElementById('message').textContent.startsWith('ordering cancelled')"
+        )
+        return float("inf")
+    took = time.perf_counter() - began
+    said = str(page.locator("#message").inner_text())
+    if said.startswith("waypoints put") or "already are" in said:
+        return took
+    print(f"Order… answered after {took:.1f} s: {said}", file=sys.stderr)
+    return float("nan")
+
+
+def live_rate(page: Any, seconds: float) -> float:
+    """Run updates the page drew per second while the mission ran at 1x."""
+    page.locator("#speed").select_option("1")
+    page.get_by_test_id("run").click()
+    page.wait_for_function(
+        "document.querySelector('[data-testid=run-status]').dataset.status === 'running'",
+        timeout=300_000,
+    )
+    first = page.evaluate("S.runUpdates")
+    began = time.perf_counter()
+    page.wait_for_timeout(seconds * 1e3)
+    rate = (page.evaluate("S.runUpdates") - first) / (time.perf_counter() - began)
+    page.get_by_test_id("stop").click()
+    page.wait_for_function(
+        "['stopped', 'completed', 'failed', 'error'].includes("
+        "document.querySelector('[data-testid=run-status]').dataset.status)",
+        timeout=60_000,
+    )
+    return float(rate)
+
+
+def measure(
+    browser: Any, mission: Path, moves: list[tuple[float, float]], args: argparse.Namespace
+) -> dict[str, float]:
+    """Every figure of one mission on one map (a studio started for it)."""
+    figures: dict[str, float] = {}
+    served = Served(mission)
+    try:
+        figures["first"], figures["first_plans"], page = load(browser, served.url)
+        page.context.close()
         ready, planned = [], []
-        for _ in range(repeat):
+        for _ in range(args.repeat):
             shown, plans, page = load(browser, served.url)
             ready.append(shown)
             planned.append(plans)
-            if len(ready) < repeat:
-                page.close()
-        drags = []
-        for x, y in moves:
-            marker = page.get_by_test_id("waypoint-marker").nth(2).bounding_box()
-            assert marker is not None
-            start = (marker["x"] + marker["width"] / 2, marker["y"] + marker["height"] / 2)
-            target = page.evaluate(
-                "([x, y]) => { const p = map.latLngToContainerPoint(L.latLng(y, x));"
-                " const b = document.getElementById('map').getBoundingClientRect();"
-                " return [b.left + p.x, b.top + p.y]; }",
-                [x, y],
-            )
-            before = page.evaluate("Number(document.body.dataset.checked || 0)")
-            page.mouse.move(*start)
-            page.mouse.down()
-            page.mouse.move(*target, steps=4)
-            began = time.perf_counter()
-            page.mouse.up()  # the drag ends: the page sends the check
-            page.wait_for_function(
-                f"Number(document.body.dataset.checked || 0) > {before}", timeout=60_000
-            )
-            drags.append(time.perf_counter() - began)
-        browser.close()
-    figures = {"ready": statistics.median(ready), "plans": statistics.median(planned)}
-    if drags:
-        figures["drag"] = statistics.median(drags)
+            page.context.close()
+        figures["ready"], figures["plans"] = statistics.median(ready), statistics.median(planned)
+        figures["waypoints"] = page_count = 0.0
+        shown, plans, page = load(browser, served.url)
+        page_count = page.evaluate("S.doc.waypoints.length")
+        figures["waypoints"] = float(page_count)
+        figures["drag"], figures["drag_page"] = drags(page, moves)
+        figures["typed"], figures["typed_checked"] = typed_changes(page, args.repeat)
+        figures["check"] = check_latency(served, moves)
+        if page_count in args.order_sizes:
+            page.keyboard.press("Escape")
+            figures["order"] = order_time(page, args.order_limit)
+        figures["live"] = live_rate(page, args.live_seconds)
+        page.context.close()
+    finally:
+        served.close()
     return figures
-
-
-def exported(ref: str, into: Path) -> Path:
-    """``src/`` of git commit ``ref`` under ``into``, with this tree's compiled A*."""
-    archive = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", ref, "src"], check=True, capture_output=True
-    ).stdout
-    into.mkdir(parents=True)
-    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
-    for built in (ROOT / "src/navseq/sim").glob("_astar*.so"):
-        shutil.copy2(built, into / "src/navseq/sim" / built.name)
-    return into / "src"
-
-
-def live_rate(served: Served, seconds: float) -> tuple[float, float]:
-    """(events/s, events/s in which the robot had moved) while running at 1x."""
-    import urllib.request
-
-    headers = {"x-navseq-token": served.token, "content-type": "application/json"}
-
-    def call(method: str, path: str, body: Any = None) -> Any:
-        data = None if body is None else json.dumps(body).encode()
-        request = urllib.request.Request(served.base + path, data, headers, method=method)
-        return urllib.request.urlopen(request, timeout=60)
-
-    with call("GET", "/api/mission") as answer:
-        document = json.load(answer)["mission"]
-    call("POST", "/api/run", {"mission": document, "realtime": 1}).close()
-    events, moved, last_pose = 0, 0, None
-    began = time.perf_counter()
-    with call("GET", "/api/run/events") as stream:
-        for raw in stream:
-            line = raw.decode()
-            if not line.startswith("data: "):
-                continue
-            state = json.loads(line[6:])
-            if state["status"] == "starting":
-                began = time.perf_counter()
-                continue
-            events += 1
-            if state["pose"] != last_pose:
-                moved += 1
-            last_pose = state["pose"]
-            if time.perf_counter() - began >= seconds:
-                break
-    elapsed = time.perf_counter() - began
-    call("POST", "/api/run/stop", {}).close()
-    return events / elapsed, moved / elapsed
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--repeat", type=int, default=5, help="page loads and drags per map")
-    parser.add_argument("--live-seconds", type=float, default=6.0)
-    parser.add_argument(
-        "--before", metavar="REF", help="also measure the page loads of git commit REF"
-    )
+    parser.add_argument("--repeat", type=int, default=3, help="page loads, drags, typed changes")
+    parser.add_argument("--sizes", default="7,300,2000,5000", help="waypoints per mission")
+    parser.add_argument("--order-sizes", default="400,2000", help="missions Order… is timed on")
+    parser.add_argument("--order-limit", type=float, default=60.0, help="seconds, then Cancel")
+    parser.add_argument("--live-seconds", type=float, default=5.0)
+    parser.add_argument("--maps", default="turtlebot3,warehouses", help="which maps")
     args = parser.parse_args()
+    sizes = [int(n) for n in args.sizes.split(",")]
+    args.order_sizes = {int(n) for n in args.order_sizes.split(",") if n}
     if not Path(CHROMIUM).exists():
         print(f"no Chromium at {CHROMIUM}: scripts/install-browser.sh", file=sys.stderr)
         return 2
+    from playwright.sync_api import sync_playwright
+
     base = Path(tempfile.mkdtemp(prefix="navseq-bench-studio-"))
     try:
         shutil.copytree(ROOT / "maps", base / "maps")
-        big_yaml = save_map(big_map(), base / "maps/warehouses_2000.yaml")
-        tb3_yaml = base / "maps/turtlebot3_world.yaml"
-        tb3_points = [
+        maps = {
+            "turtlebot3": base / "maps/turtlebot3_world.yaml",
+            "warehouses": save_map(big_map(), base / "maps/warehouses_2000.yaml"),
+        }
+        tb3_seven = [
             (-2.0, -0.5),
             (-0.55, -1.75),
             (1.75, -0.55),
@@ -368,89 +382,69 @@ def main() -> int:
             (-0.55, -0.55),
             (-2.0, -0.5),
         ]
-        cases: dict[str, tuple[Path, Path, list[tuple[float, float]]]] = {}
-        for name, map_yaml, points in (
-            ("turtlebot3_world 384x384", tb3_yaml, tb3_points),
-            ("warehouses 2000x2000", big_yaml, spread_waypoints(big_yaml, 13, seed=4)),
-        ):
-            mission = workspace(base, name.split()[0], map_yaml, points)
-            # Waypoint 3 (index 2) dragged to a new free spot each time, so that its two
-            # legs are planned again every time (none comes from the leg cache).
-            x, y = points[3]
-            step = 0.6 if "2000" in name else 0.08  # several pixels at the fit zoom: a drag
-            moves = [
-                nearby_free(map_yaml, x, y, *(step * (k + 1) * f(2.4 * k) for f in (cos, sin)))
-                for k in range(args.repeat)
-            ]
-            assert len(set(moves)) == len(moves), moves
-            cases[name] = (mission, map_yaml, moves)
-
-        before = exported(args.before, base / "before") if args.before else None
-        figures: dict[str, dict[str, float]] = {name: {} for name in cases}
-        for name, (mission, _, moves) in cases.items():
-            rebuilt = check_latency(mission, moves, cached=False)
-            cached = check_latency(mission, moves, cached=True)
-            sources: dict[str, Path | None] = {"": None}
-            if before is not None:
-                sources["_before"] = before
-            for suffix, measured in first_loads(mission, sources, args.repeat).items():
-                figures[name].update({key + suffix: value for key, value in measured.items()})
-            if before is not None:
-                served = Served(mission, before)
-                try:
-                    old = page_figures(served, [], args.repeat)
-                finally:
-                    served.close()
-                figures[name].update({f"{key}_before": value for key, value in old.items()})
-            served = Served(mission)
-            try:
-                figures[name].update(page_figures(served, moves, args.repeat))
-                live, moving = live_rate(served, args.live_seconds)
-            finally:
-                served.close()
-            figures[name] |= {
-                "rebuilt": rebuilt,
-                "cached": cached,
-                "live": live,
-                "moving": moving,
-            }
+        cases: dict[str, tuple[Path, list[tuple[float, float]]]] = {}
+        for map_name in args.maps.split(","):
+            map_yaml = maps[map_name]
+            counts = sorted(set(sizes) | (args.order_sizes - set(sizes)))
+            for count in counts:
+                if map_name == "turtlebot3" and count == 7:
+                    points = tb3_seven
+                else:
+                    points = spread_waypoints(map_yaml, count + 1, seed=4)  # + the start
+                mission = workspace(base, f"{map_name}-{count}", map_yaml, points)
+                # Waypoint 3 dragged to a new free spot each time (its legs are planned
+                # again: none comes from the leg cache), a few marker widths away.
+                x, y = points[3]
+                step = 0.6 if map_name == "warehouses" else 0.08
+                moves = []
+                for k in range(args.repeat):
+                    spot = nearby_free(map_yaml, x, y, step * (k + 1), step * (k % 2))
+                    moves.append(spot if spot not in moves else (spot[0] + 0.05, spot[1]))
+                cases[f"{map_name} {count}"] = (mission, moves)
+        figures: dict[str, dict[str, float]] = {}
+        with sync_playwright() as playwright:
+            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+            for name, (mission, moves) in cases.items():
+                print(f"measuring {name}…", file=sys.stderr, flush=True)
+                figures[name] = measure(browser, mission, moves, args)
+            browser.close()
         seconds: Callable[[float], str] = lambda v: f"{v:.2f}"  # noqa: E731
-        then = f"  before ({args.before})"
-        targets = {
-            "first": ("page ready, first load [s]", "<= 1 / 2", seconds),
-            "first_before": (then, "", seconds),
-            "ready": ("page ready, later loads [s]", "<= 1 / 2", seconds),
-            "ready_before": (then, "", seconds),
+        millis: Callable[[float], str] = lambda v: f"{v * 1e3:.0f}"  # noqa: E731
+        limit = args.order_limit
+        rows: dict[str, tuple[str, str, Callable[[float], str]]] = {
+            "waypoints": ("waypoints", "", lambda v: f"{v:.0f}"),
+            "first": ("page ready, first load [s]", "<= 1.5", seconds),
+            "ready": ("page ready, later loads [s]", "<= 1.5", seconds),
             "first_plans": ("plans shown, first load [s]", "", seconds),
-            "first_plans_before": (then, "", seconds),
             "plans": ("plans shown, later loads [s]", "", seconds),
-            "plans_before": (then, "", seconds),
-            "drag": (
-                "drag -> problems drawn, page [ms]",
-                "<= 150 / 500",
-                lambda v: f"{v * 1e3:.0f}",
+            "drag": ("drag -> problems drawn [ms]", "<= 150", millis),
+            "drag_page": ("  drag, page redraw [ms]", "", millis),
+            "typed": ("typed change -> redrawn [ms]", "<= 100", millis),
+            "typed_checked": ("typed change -> checked [ms]", "", millis),
+            "check": ("check, server [ms]", "", millis),
+            "order": (
+                "Order… shortest [s]",
+                "<= 3 (400), 30 (2000)",
+                lambda v: (
+                    f"> {limit:.0f}, cancelled"
+                    if v == float("inf")
+                    else "refused"
+                    if v != v
+                    else f"{v:.1f}"
+                ),
             ),
-            "cached": ("check, costmap kept [ms]", "", lambda v: f"{v * 1e3:.0f}"),
-            "rebuilt": ("check, costmap rebuilt (1st slice) [ms]", "", lambda v: f"{v * 1e3:.0f}"),
-            "ratio": ("rebuilt / kept", "", lambda v: f"{v:.1f}x"),
             "live": ("live updates/s at 1x", ">= 10", lambda v: f"{v:.1f}"),
-            "moving": ("  of which the robot moved /s", "", lambda v: f"{v:.1f}"),
         }
-        for name in cases:
-            figures[name]["ratio"] = figures[name]["rebuilt"] / figures[name]["cached"]
         table = Table(title=f"navseq studio (median of {args.repeat}; Chromium headless)")
         table.add_column("measure")
         for name in cases:
-            table.add_column(name, justify="right")
+            table.add_column(name.replace(" ", "\n"), justify="right")
         table.add_column("target", justify="right")
-        for key, (label, target, shown) in targets.items():
-            if key.endswith("_before") and before is None:
-                continue
-            format_: Callable[[float], str] = shown
+        for key, (label, target, shown) in rows.items():
             # escape: "[s]" would otherwise be taken as rich markup and vanish.
-            row = (format_(figures[name][key]) for name in cases)
+            row = (shown(figures[name][key]) if key in figures[name] else "" for name in cases)
             table.add_row(escape(label), *row, escape(target))
-        Console(width=120).print(table)
+        Console(width=200).print(table)
     finally:
         shutil.rmtree(base, ignore_errors=True)
     return 0

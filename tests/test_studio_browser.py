@@ -147,6 +147,25 @@ def screen_point(page: Any, x: float, y: float) -> tuple[float, float]:
     return box["x"] + point[0], box["y"] + point[1]
 
 
+def drawn(page: Any) -> dict[str, Any]:
+    """What the map's canvas painted last (``missionLayer.drawn()``): each waypoint's
+    screen point in the map (``marks``), the start pose's, the replayed run's marks."""
+    return dict(page.evaluate("missionLayer.drawn()"))
+
+
+def marks(page: Any) -> int:
+    """How many waypoints the map shows."""
+    return len(drawn(page)["marks"])
+
+
+def mark_point(page: Any, index: int) -> tuple[float, float]:
+    """Where waypoint ``index``'s marker is on the screen."""
+    box = page.get_by_test_id("map").bounding_box()
+    mark = drawn(page)["marks"][index]
+    assert mark["index"] == index
+    return box["x"] + mark["x"], box["y"] + mark["y"]
+
+
 def checked_after(page: Any, action: Any) -> None:
     """Do ``action`` and wait until the page's check of the change has come back."""
     before = page.evaluate("Number(document.body.dataset.checked || 0)")
@@ -158,16 +177,15 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     page: Any, studio: tuple[str, Path, Any]
 ) -> None:
     _, workspace, process = studio
-    markers = page.get_by_test_id("waypoint-marker")
     assert page.get_by_test_id("map").is_visible()
     assert page.locator("[data-testid=map-image]").count() == 1
-    assert markers.count() == 7
+    assert marks(page) == 7
     assert page.get_by_test_id("waypoint-row").count() == 7
     assert page.get_by_test_id("problem").count() == 0
 
     # Click free space: an eighth waypoint, no problem.
     checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
-    assert markers.count() == 8
+    assert marks(page) == 8
     assert page.get_by_test_id("problem").count() == 0
 
     # Drag it onto a pillar: a problem names it, and saving is still allowed but marked.
@@ -208,7 +226,7 @@ def test_make_check_save_and_run_a_mission_in_the_browser(
     # Undo the drag and the click: back to the 7 waypoints, which run.
     checked_after(page, lambda: page.keyboard.press("Control+z"))
     checked_after(page, lambda: page.keyboard.press("Control+z"))
-    assert markers.count() == 7 and page.get_by_test_id("problem").count() == 0
+    assert marks(page) == 7 and page.get_by_test_id("problem").count() == 0
 
     page.get_by_test_id("run").click()
     status = page.get_by_test_id("run-status")
@@ -279,7 +297,7 @@ def test_the_page_is_ready_before_the_first_check_and_plans_come_after(
         page.goto(studio[0])
         page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
         assert page.get_by_test_id("map-image").count() == 1
-        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert marks(page) == 7
         assert len(held) == 1  # asked at once, not answered yet
         assert page.evaluate("document.body.dataset.planned") is None
         assert page.locator(".leg-label").count() == 0
@@ -304,7 +322,7 @@ def test_the_shortest_order_is_one_undoable_edit(page: Any, studio: tuple[str, P
     after = names()
     assert after != before and sorted(after) == sorted(before) and after[-1] == "home"
     assert "instead of" in page.locator("#message").inner_text()
-    assert page.get_by_test_id("waypoint-marker").count() == 7
+    assert marks(page) == 7
     checked_after(page, lambda: page.keyboard.press("Control+z"))
     assert names() == before
     assert page.errors == []
@@ -335,7 +353,7 @@ def test_two_tabs_the_stale_save_is_refused_and_nothing_is_lost(
     assert len(saved.waypoints) == 8  # the first tab's mission, whole
     assert saved.waypoints[7].x == pytest.approx(FREE_SPOT[0], abs=0.03)
     # The second tab keeps its edits: they can still be saved under another name.
-    assert second.get_by_test_id("waypoint-marker").count() == 9
+    assert marks(second) == 9
     accept_dialogs(second, ["second-tab.yaml"])
     second.locator("#save-as").click()
     message_of(second, "saved second-tab.yaml")
@@ -368,7 +386,10 @@ def test_import_the_tutorials_launch_file_and_export_one(
     page.locator("[data-testid=import-file][data-path='tutorial_params.yaml']").focus()
     checked_after(page, lambda: page.keyboard.press("Enter"))
     assert not dialog.is_visible()
-    assert page.get_by_test_id("waypoint-marker").count() == 4
+    assert marks(page) == 4
+    size = page.evaluate("[map.getSize().x, map.getSize().y]")
+    for mark in drawn(page)["marks"]:  # the view fits the imported waypoints
+        assert 0 < mark["x"] < size[0] and 0 < mark["y"] < size[1]
     assert "imported 4 waypoints" in page.locator("#message").inner_text()
     # Still on the arena's map: its pre-flight runs on the imported points.
     assert page.locator("[data-testid=map-image]").count() == 1
@@ -382,7 +403,7 @@ def test_import_the_tutorials_launch_file_and_export_one(
     assert "no place for" in said and "map" in said
     # Undo brings the opened mission back.
     checked_after(page, lambda: page.keyboard.press("Control+z"))
-    assert page.get_by_test_id("waypoint-marker").count() == 7
+    assert marks(page) == 7
     assert page.errors == []  # type: ignore[attr-defined]
 
 
@@ -403,8 +424,7 @@ def test_defaults_loops_and_a_start_pose_placed_and_turned_on_the_map(
     # The start pose: placed with a click, then turned with its handle to face +y.
     page.locator("#place-start").click()
     checked_after(page, lambda: page.mouse.click(*screen_point(page, -1.2, -1.2)))
-    start = page.get_by_test_id("start-marker")
-    assert start.count() == 1
+    assert drawn(page)["start"] is not None
     handle = page.get_by_test_id("yaw-handle").bounding_box()
     centre = screen_point(page, -1.2, -1.2)
 
@@ -435,7 +455,7 @@ def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, P
     runs = page.get_by_test_id("runs")
     page.wait_for_function("document.getElementById('runs').options.length > 1")
     runs.select_option(index=1)
-    page.wait_for_selector("[data-testid=replay-waypoint]")
+    page.wait_for_function("missionLayer.drawn().replayed.length === 7")
     slider = page.get_by_test_id("replay-time")
     duration = float(slider.get_attribute("max") or 0)
     assert duration > 10
@@ -444,10 +464,7 @@ def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, P
         slider.evaluate(
             "(el, t) => { el.value = String(t); el.dispatchEvent(new Event('input')); }", t
         )
-        return [
-            str(marker.get_attribute("data-status"))
-            for marker in page.get_by_test_id("replay-waypoint").all()
-        ]
+        return [str(mark["status"]) for mark in drawn(page)["replayed"]]
 
     assert at(0)[1:] == ["pending"] * 6  # the first is driving from t = 0
     middle = at(duration / 2)
@@ -473,7 +490,7 @@ def test_the_page_works_under_its_content_security_policy(
         page.goto(studio[0])
         page.wait_for_selector("body[data-planned=true]", state="attached", timeout=20_000)
         assert page.get_by_test_id("waypoint-row").count() == 7
-        assert page.get_by_test_id("waypoint-marker").count() == 7
+        assert marks(page) == 7
         assert errors == []
     finally:
         page.context.close()
@@ -560,16 +577,17 @@ def test_the_mission_is_edited_with_the_keyboard_alone(page: Any) -> None:
     checked_after(page, lambda: page.keyboard.press("Control+Shift+z"))
     assert _row_xy(page, 2) == pytest.approx((x0 + 0.05, y0 + 0.5), abs=1e-9)
 
-    # A marker: focused, Enter selects it, the arrows move it, it keeps the focus.
-    marker = page.get_by_test_id("waypoint-marker").nth(3)
-    assert (marker.get_attribute("aria-label") or "").startswith("waypoint 4")
-    marker.focus()
+    # The map: with the focus on it, the arrows move the selected waypoint, and it keeps
+    # the focus (the markers are painted on a canvas: the rows are their keyboard way).
+    rows.nth(3).locator("button.pick").focus()
     page.keyboard.press("Enter")
     assert page.locator("#editor-title").inner_text() == "4"
+    page.get_by_test_id("map").focus()
     x3, y3 = _row_xy(page, 3)
     checked_after(page, lambda: page.keyboard.press("ArrowDown"))
     assert _row_xy(page, 3) == pytest.approx((x3, y3 - 0.05), abs=1e-9)
-    assert _focused(page).startswith("waypoint 4") and "selected" in _focused(page)
+    assert page.evaluate("document.activeElement.dataset.testid") == "map"
+    assert drawn(page)["marks"][3]["selected"]
 
     # ▲ ▼ ✕ are named by what they do; the focus follows the moved waypoint.
     up = rows.nth(3).get_by_role("button", name="move waypoint 4 up")
@@ -675,7 +693,7 @@ def test_no_serious_accessibility_violation_in_the_editor_a_run_and_a_replay(
 
     page.wait_for_function("document.getElementById('runs').options.length > 1")
     page.get_by_test_id("runs").select_option(index=1)
-    page.wait_for_selector("[data-testid=replay-waypoint]")
+    page.wait_for_function("missionLayer.drawn().replayed.length === 7")
     assert serious_violations(page) == []
     assert page.errors == []  # type: ignore[attr-defined]
 
@@ -725,11 +743,7 @@ def test_tasks_edited_confirmed_in_a_run_and_reported_at_once(
     assert texts == ["1. wait 5 s", "2. input: Load the tray"]
     checked_after(page, lambda: tasks.get_by_label("remove task 1").click())
     assert tasks.locator(".task-text").all_inner_texts() == ["1. input: Load the tray"]
-    marker = page.locator(
-        "[data-testid=waypoint-marker][data-index='1'] .wp-icon, "
-        "[data-testid=waypoint-marker][data-index='1']"
-    ).first
-    assert "tasks" in (marker.get_attribute("class") or "")
+    assert page.evaluate("missionLayer.drawn().marks[1].tasks") is True
     assert page.get_by_test_id("waypoint-row").nth(1).locator(".task-flag").count() == 1
     assert page.get_by_test_id("problem").all_inner_texts() == []
     page.get_by_test_id("legend").locator("summary").click()  # the legend, open
@@ -767,6 +781,230 @@ def test_tasks_edited_confirmed_in_a_run_and_reported_at_once(
         .overrides.get("tasks")
         is None
     )
+
+
+def _big_mission(folder: Path, count: int) -> Path:
+    """A mission of ``count`` waypoints spread over the arena's free space (seeded), in
+    serpentine order, with the start pose on the first waypoint's spot."""
+    import json
+
+    import numpy as np
+
+    from navseq.commands.common import costmap_for_map
+
+    map_yaml = folder / "maps/turtlebot3_world.yaml"
+    costmap = costmap_for_map(map_yaml)
+    cells = np.argwhere(costmap.free_mask() & (costmap.clearance >= 0.25))
+    picked = cells[np.random.default_rng(7).choice(len(cells), count, replace=False)]
+    points = [costmap.cell_to_world(int(row), int(col)) for row, col in picked]
+    band = lambda p: int((p[1] + 3) // 0.25)  # noqa: E731
+    points.sort(key=lambda p: (band(p), p[0] if band(p) % 2 == 0 else -p[0]))
+    mission = {
+        "navseq": 1,
+        "map": "../maps/turtlebot3_world.yaml",
+        "start": {"x": round(points[0][0], 2), "y": round(points[0][1], 2), "yaw": 0},
+        "waypoints": [{"x": round(x, 2), "y": round(y, 2), "yaw": 0} for x, y in points],
+    }
+    path = folder / "examples/big.yaml"
+    path.write_text(json.dumps(mission), encoding="utf-8")
+    return path
+
+
+def _overlaps(page: Any) -> list[str]:
+    """Leg labels shown that overlap another label or a marker (its plate, as painted)."""
+    return list(
+        page.evaluate(
+            """() => {
+            const map = document.getElementById("map").getBoundingClientRect();
+            const labels = [...document.querySelectorAll(".leg-label")].map((el) => {
+                const r = el.getBoundingClientRect();
+                return { text: el.textContent, x: r.left - map.left, y: r.top - map.top,
+                         w: r.width, h: r.height };
+            });
+            const hit = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w
+                && a.y < b.y + b.h && b.y < a.y + a.h;
+            const found = [];
+            labels.forEach((a, k) => labels.slice(k + 1).forEach((b) => {
+                if (hit(a, b)) found.push(`${a.text} over ${b.text}`);
+            }));
+            const drawn = missionLayer.drawn();
+            for (const m of drawn.marks) {
+                const plate = { x: m.x - m.half, y: m.y - m.r, w: 2 * m.half, h: 2 * m.r };
+                for (const a of labels) {
+                    if (hit(a, plate)) found.push(`${a.text} over waypoint ${m.index + 1}`);
+                }
+            }
+            return found;
+        }"""
+        )
+    )
+
+
+def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anything(
+    chromium: Any, tmp_path: Path
+) -> None:
+    """2000 waypoints: the page opens with all of them on the map and a list that builds
+    only the rows in sight (the last one reached by scrolling); a drag moves one and its
+    legs are planned again; leg lengths are shown only where they cover no marker and
+    no other label, at the whole-mission view and zoomed in; 4-digit numbers fit their
+    plates; the start pose, on the first waypoint's spot, is still seen around it."""
+    _skip_unless_there()
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    (tmp_path / "examples").mkdir()
+    mission = _big_mission(tmp_path, 2000)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "navseq", "studio", str(mission), "--no-browser"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    page = new_page(chromium)
+    try:
+        assert process.stdout is not None
+        url = process.stdout.readline().split(": ", 1)[1].strip()
+        errors: list[str] = []
+        page.on("pageerror", lambda error: errors.append(str(error)))
+        page.goto(url)
+        page.wait_for_selector("body[data-ready=true]", state="attached", timeout=60_000)
+        assert marks(page) == 2000
+        rows = page.get_by_test_id("waypoint-row")
+        assert 0 < rows.count() < 100  # the rows in sight, not 2000
+        assert rows.first.get_attribute("aria-setsize") == "2000"
+        page.wait_for_selector("body[data-planned=true]", state="attached", timeout=120_000)
+        assert page.evaluate("S.legs.length") == 2000  # the start's leg and 1999 more
+        assert _overlaps(page) == []
+
+        # Zoomed in on the middle: numbered plates, labels where they fit, none over anything.
+        page.evaluate(
+            "map.setView(map.getCenter(), map.getMaxZoom(), { animate: false });"
+            " missionLayer.draw()"
+        )
+        assert not drawn(page)["compact"], page.evaluate("[map.getZoom(), map.getSize()]")
+        assert page.locator(".leg-label").count() > 0
+        assert _overlaps(page) == []
+
+        # Waypoint 2000: its 4 digits fit its plate.
+        last = page.evaluate(
+            """() => { const w = S.doc.waypoints[1999];
+            map.setView([w.y, w.x], map.getZoom(), { animate: false }); missionLayer.draw();
+            const ctx = document.createElement("canvas").getContext("2d");
+            ctx.font = "bold 11px system-ui, sans-serif";
+            return [missionLayer.drawn().marks[1999].half, ctx.measureText("2000").width]; }"""
+        )
+        assert last[0] * 2 >= last[1] + 4
+
+        # The start pose, on waypoint 1's spot: its ring shows around waypoint 1's plate.
+        colours = page.evaluate(
+            """() => { const s = S.doc.start;
+            map.setView([s.y, s.x], map.getZoom(), { animate: false }); missionLayer.draw();
+            const d = missionLayer.drawn();
+            const c = document.querySelector("[data-testid=mission-canvas]");
+            const ctx = c.getContext("2d"), k = c.width / c.clientWidth;
+            const at = (x, y) => [
+                ...ctx.getImageData(Math.round(x * k), Math.round(y * k), 1, 1).data];
+            return { ring: at(d.start[0] - 15, d.start[1]),
+                     plate: at(d.marks[0].x, d.marks[0].y + 7) }; }"""
+        )
+        assert max(colours["ring"][:3]) < 80 and colours["ring"][3] > 200  # #111827
+        assert colours["plate"][2] > 150 and colours["plate"][0] < 100  # #2563eb, waypoint 1
+
+        # Drag waypoint 10 a little: it moves, and its two legs are planned again.
+        page.evaluate(
+            "const w = S.doc.waypoints[9];"
+            " map.setView([w.y, w.x], map.getZoom(), { animate: false }); missionLayer.draw();"
+        )
+        before = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
+        start = mark_point(page, 9)
+        page.mouse.move(*start)
+        page.mouse.down()
+
+        def drop() -> None:
+            page.mouse.move(start[0] + 12, start[1] + 6, steps=4)
+            page.mouse.up()
+
+        checked_after(page, drop)
+        after = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
+        assert after != before and page.evaluate("S.doc.waypoints.length") == 2000
+        legs = page.evaluate("S.legs.filter((leg) => leg.to === 9 || leg.from === '9')")
+        assert len(legs) == 2
+        into = legs[0] if legs[0]["to"] == 9 else legs[1]
+        assert into["points"][-1] == pytest.approx(after, abs=0.06)
+        assert _overlaps(page) == []
+
+        # Tab goes on through the rows past the first ones built (4 stops a row).
+        rows.first.locator("button.pick").focus()
+        for _ in range(4 * 60):
+            page.keyboard.press("Tab")
+        assert page.evaluate("document.activeElement.dataset.focus") == "row-60"
+        assert rows.count() < 100
+
+        # The list's last row is reached by scrolling its box.
+        page.locator("#waypoint-box").evaluate("(el) => { el.scrollTop = el.scrollHeight; }")
+        page.wait_for_function(
+            "[...document.querySelectorAll('#waypoints .num')]"
+            ".some((el) => el.textContent === '2000')"
+        )
+        assert rows.count() < 100
+        assert errors == []
+    finally:
+        page.context.close()
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+def test_a_leg_with_no_path_is_drawn_named_and_left_out_of_the_total(page: Any) -> None:
+    """A waypoint on a pillar: its leg has no path; the route line still gives the planned
+    legs' total and names the leg left out, and the leg's label says why."""
+    checked_after(page, lambda: page.mouse.click(*screen_point(page, *FREE_SPOT)))
+    total = float(page.locator("#route").inner_text().split(" · ")[1].split(" m")[0])
+    start = screen_point(page, *FREE_SPOT)
+    target = screen_point(page, *PILLAR)
+
+    def drag() -> None:
+        page.mouse.move(*start)
+        page.mouse.down()
+        page.mouse.move(*target, steps=12)
+        page.mouse.up()
+
+    checked_after(page, drag)
+    assert page.evaluate("S.legs.filter((leg) => leg.points === null).map((leg) => leg.to)") == [7]
+    route = page.locator("#route").inner_text()
+    assert "not counting 1 leg with no path (7→8" in route
+    planned = float(route.split(" · ")[1].split(" m planned")[0])
+    assert planned < total  # the seven planned legs, without the last one
+    label = page.locator(".leg-label.no-path")
+    assert label.count() == 1 and label.inner_text() == "no path"
+    assert (label.get_attribute("title") or "").startswith("no path from waypoint 7 to waypoint 8")
+    assert _overlaps(page) == []
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
+def test_order_shows_the_time_spent_and_cancel_gives_the_page_back(page: Any) -> None:
+    """While the server orders the waypoints the page counts the seconds; Cancel stops
+    waiting, and the waypoints stay as they were (the late answer is dropped)."""
+    held: list[Any] = []
+    page.route("**/api/order", lambda route: held.append(route))
+    before = page.evaluate("JSON.stringify(S.doc.waypoints)")
+    page.get_by_test_id("order").select_option("shortest")
+    page.wait_for_function(
+        "document.getElementById('message').textContent.includes('… 1 s')", timeout=10_000
+    )
+    assert "finding the shortest order of 7 waypoints" in page.locator("#message").inner_text()
+    assert page.get_by_test_id("order").is_disabled()
+    page.get_by_test_id("order-cancel").click()
+    message_of(page, "ordering cancelled")
+    assert page.get_by_test_id("order-cancel").is_hidden()
+    assert page.get_by_test_id("order").is_enabled()
+    held[0].continue_()  # the server's answer comes late: nothing changes
+    page.wait_for_timeout(300)
+    assert page.evaluate("JSON.stringify(S.doc.waypoints)") == before
+    assert page.get_by_test_id("waypoint-row").count() == 7
+    assert page.errors == []  # type: ignore[attr-defined]
 
 
 def test_a_misplaced_waypoint_is_moved_to_the_nearest_free_spot_in_one_click(page: Any) -> None:

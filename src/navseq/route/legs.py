@@ -36,10 +36,13 @@ class LegPlanner:
     """Plans legs on one costmap, keeping the last plans so that unchanged legs are free.
 
     Dragging one waypoint changes the two legs touching it; the others come from the
-    cache (keyed by their exact end points).
+    cache (keyed by their exact end points). The capacity holds every leg of a mission
+    of several thousand waypoints: a cache smaller than the mission's legs, walked in
+    order at every check, drops each leg before it is asked for again (a 5000-waypoint
+    mission then planned all its legs anew at each drag: 8 s instead of under one).
     """
 
-    def __init__(self, costmap: Costmap, capacity: int = 4096) -> None:
+    def __init__(self, costmap: Costmap, capacity: int = 16384) -> None:
         self.costmap = costmap
         self._cache: OrderedDict[tuple[float, float, float, float], Leg] = OrderedDict()
         self._capacity = capacity

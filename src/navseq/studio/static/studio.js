@@ -27,10 +27,10 @@ const $ = (id) => document.getElementById(id);
 const selectedPoint = () => (S.selected === "start" ? S.doc.start : S.selected !== null ? S.doc.waypoints[S.selected] : null);
 
 // ---- API -------------------------------------------------------------------------------
-async function api(method, path, body) {
+async function api(method, path, body, signal) {
   const response = await fetch(path, {
     method, headers: body ? { "content-type": "application/json" } : {},
-    body: body ? JSON.stringify(body) : undefined, credentials: "same-origin",
+    body: typeof body === "string" ? body : body ? JSON.stringify(body) : undefined, credentials: "same-origin", signal,
   });
   let data = null;
   try { data = await response.json(); } catch (e) { data = { error: response.statusText }; }
@@ -97,6 +97,13 @@ function focusBounds(mapBounds) {
   return L.latLngBounds(pts).pad(0.25);
 }
 const okPoint = (p) => p && typeof p.x === "number" && typeof p.y === "number";
+// The view on the whole mission (after an import: its waypoints may be anywhere).
+function fitMission() {
+  const pts = S.doc.waypoints.filter(okPoint).map((w) => ll(w.x, w.y));
+  if (okPoint(S.doc.start)) pts.push(ll(S.doc.start.x, S.doc.start.y));
+  if (pts.length > 1) map.fitBounds(L.latLngBounds(pts).pad(0.1), { padding: [20, 20] });
+  else if (pts.length === 1) map.panTo(pts[0]);
+}
 
 // ---- editing ---------------------------------------------------------------------------
 function snapshot() { return JSON.stringify({ doc: S.doc, selected: S.selected }); }
@@ -180,11 +187,11 @@ document.addEventListener("keydown", (e) => {
 $("undo").onclick = () => restore(S.undo, S.redo);
 $("redo").onclick = () => restore(S.redo, S.undo);
 function removeWaypoint(i) {
-  // The focus goes to the row (or the marker, from a marker) that takes the removed one's
-  // place, else the one before.
+  // From a row, the focus goes to the row that takes the removed one's place, else the one
+  // before; from the map, it stays on the map.
   const n = S.doc.waypoints.length - 1;
-  const kind = (document.activeElement?.dataset?.focus || "").startsWith("marker-") ? "marker" : "row";
-  S.focusNext = n > 0 ? `${kind}-${Math.min(i, n - 1)}` : null;
+  const onRow = (document.activeElement?.dataset?.focus || "").startsWith("row-");
+  S.focusNext = onRow && n > 0 ? `row-${Math.min(i, n - 1)}` : null;
   edit(() => { S.doc.waypoints.splice(i, 1); S.selected = null; });
 }
 function moveWaypoint(from, to) {
@@ -200,80 +207,404 @@ function moveWaypoint(from, to) {
 }
 
 // ---- drawing ---------------------------------------------------------------------------
+// The waypoints, the start pose and the legs are painted on one canvas (missionLayer), not
+// an element each: a mission of 5000 waypoints draws in milliseconds where 5000 markers
+// took seconds to build. What the mouse is on is found from the positions painted
+// (hitTest); the keyboard's way is the list's rows and the focused map (the arrows move
+// the selected waypoint). Leg lengths are elements (.leg-label), put only where they fit
+// without covering a marker or another label.
 function problemsOf(i) { return S.problems.filter((p) => p.waypoint === i); }
-function wpIcon(w, i, extra) {
-  const yaw = typeof w.yaw === "number" ? w.yaw : 0;
-  const cls = ["wp-icon", extra || ""];
-  if (w.pass_through) cls.push("pass");
-  if (i !== null && hasTasks(i)) cls.push("tasks");
-  if (i !== null && problemsOf(i).length) cls.push("bad");
-  if ((i !== null && i === S.selected) || (i === null && S.selected === "start")) cls.push("selected");
-  return L.divIcon({
-    className: cls.join(" "), iconSize: [26, 26], iconAnchor: [13, 13],
-    html: `<div class="arrow" style="transform: rotate(${-yaw}deg)"></div><div class="dot">${i === null ? "S" : i + 1}</div>`,
-  });
+const MARK_R = 10;  // px: a waypoint's disc
+const DOT_R = 4;    // px: a waypoint as a dot, when too many are on the screen for numbers
+const START_R = MARK_R + 5;  // px: the start pose's ring, around a waypoint at the same spot
+const LABEL_H = 14, LABEL_GAP = 2, MAX_LABELS = 400;
+const MARK_FONT = "bold 11px system-ui, sans-serif", LABEL_FONT = "10px system-ui, sans-serif";
+// Fill colours (white numbers on them: 4.5:1 at least), as the list and the CSS.
+const COLOUR = {
+  waypoint: "#2563eb", pass: "#7c3aed", bad: "#dc2626", start: "#111827", selected: "#facc15",
+  leg: "#0ea5e9", loop: "#6b7280", noPath: "#dc2626",
+  pending: "#6b7280", driving: "#c2410c", dwelling: "#c2410c", reached: "#15803d",
+  skipped: "#dc2626", failed: "#dc2626", stopped: "#92400e",
+};
+map.createPane("mission").style.zIndex = 450;  // over the map image (400), under the yaw handle (600)
+// The robot over the waypoints (seen where it stands on one); its trail and plan stay
+// under them (the numbers stay readable).
+map.createPane("run").style.zIndex = 460;
+const MissionLayer = L.Layer.extend({
+  onAdd(m) {
+    const pane = m.getPane("mission");
+    this.canvas = L.DomUtil.create("canvas", "mission-canvas leaflet-zoom-animated", pane);
+    this.canvas.dataset.testid = "mission-canvas";
+    this.canvas.setAttribute("aria-hidden", "true");  // the list says what it shows
+    this.labels = L.DomUtil.create("div", "leg-labels leaflet-zoom-animated", pane);
+    L.DomEvent.disableClickPropagation(this.labels);
+    this.px = new Float64Array(0); this.py = new Float64Array(0);
+    this.replayed = [];
+    m.on("move resize viewreset zoomend", this.schedule, this);
+    m.on("zoomanim", this.animateZoom, this);
+  },
+  // Redrawn once per frame however many moves came in it (panning, a drag).
+  schedule() {
+    if (!this.frame) this.frame = requestAnimationFrame(() => { this.frame = 0; this.draw(); });
+  },
+  // Leaflet's zoom animation scales the map pane's layers by CSS; the canvas follows it
+  // (as Leaflet's own overlays do) and is painted again at the new zoom.
+  animateZoom(e) {
+    const offset = map._latLngBoundsToNewLayerBounds(map.getBounds(), e.zoom, e.center).min;
+    const scale = map.getZoomScale(e.zoom);
+    L.DomUtil.setTransform(this.canvas, offset, scale);
+    L.DomUtil.setTransform(this.labels, offset, scale);
+  },
+  // Screen (container) point of a world point, without Leaflet's objects: CRS.Simple
+  // is x * 2^zoom, -y * 2^zoom from the origin's point.
+  frameOf() {
+    const o = map.latLngToContainerPoint([0, 0]), s = map.getZoomScale(map.getZoom(), 0);
+    return { ox: o.x, oy: o.y, s };
+  },
+  draw() {
+    if (!this._map || !S.doc) return;
+    if (this.frame) { cancelAnimationFrame(this.frame); this.frame = 0; }
+    const size = map.getSize(), dpr = window.devicePixelRatio || 1;
+    const c = this.canvas;
+    const corner = map.containerPointToLayerPoint([0, 0]);
+    L.DomUtil.setPosition(c, corner);
+    L.DomUtil.setPosition(this.labels, corner);
+    if (c.width !== Math.round(size.x * dpr) || c.height !== Math.round(size.y * dpr)) {
+      c.width = Math.round(size.x * dpr); c.height = Math.round(size.y * dpr);
+      c.style.width = `${size.x}px`; c.style.height = `${size.y}px`;
+    }
+    const ctx = c.getContext("2d");
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.clearRect(0, 0, size.x, size.y);
+    const f = this.frame0 = this.frameOf();
+    this.size = size;
+    this.project(f);
+    this.replayed = [];
+    this.drawLegs(ctx, f);
+    this.drawMarks(ctx, size);
+    if (S.replay) this.drawReplayed(ctx, f);
+    this.drawStart(ctx, f);
+    this.placeLabels(ctx, f, size);
+    c.dataset.drawn = String(this.shown);  // waypoints on the canvas, in the view or not
+  },
+  // Screen points of every waypoint (the one being dragged where the mouse is).
+  project(f) {
+    const wps = S.doc.waypoints, n = wps.length;
+    if (this.px.length !== n) { this.px = new Float64Array(n); this.py = new Float64Array(n); }
+    let shown = 0, inView = 0;
+    for (let i = 0; i < n; i++) {
+      const w = wps[i];
+      if (!okPoint(w)) { this.px[i] = NaN; this.py[i] = NaN; continue; }
+      const dragged = S.drag && S.drag.target === i;
+      const x = f.ox + (dragged ? S.drag.x : w.x) * f.s, y = f.oy - (dragged ? S.drag.y : w.y) * f.s;
+      this.px[i] = x; this.py[i] = y;
+      shown++;
+      if (x > -MARK_R && y > -MARK_R && x < this.size.x + MARK_R && y < this.size.y + MARK_R) inView++;
+    }
+    this.shown = shown;
+    // Numbered plates while they cover under a third of the view; dots beyond (zoom in
+    // to read the numbers): thousands of overlapping discs say nothing.
+    this.compact = inView * (2 * MARK_R) ** 2 > (this.size.x * this.size.y) / 3;
+  },
+  // Where a leg's ends are now: the start pose or a waypoint (the dragged one: the mouse).
+  endOf(name) {
+    if (name === "start") {
+      const st = S.doc.start;
+      if (!okPoint(st)) return null;
+      return S.drag && S.drag.target === "start" ? [S.drag.x, S.drag.y] : [st.x, st.y];
+    }
+    const w = S.doc.waypoints[name];
+    if (!okPoint(w)) return null;
+    return S.drag && S.drag.target === name ? [S.drag.x, S.drag.y] : [w.x, w.y];
+  },
+  // One path per kind of leg (planned, way back of a patrol, no path), each stroked once.
+  // A leg touching the waypoint being dragged is a thin straight line until the check
+  // plans it again; a leg with no path is dashed straight, in the problem colour.
+  drawLegs(ctx, f) {
+    const kinds = { leg: [], loop: [], noPath: [], moving: [] };
+    const dragged = S.drag ? S.drag.target : undefined;
+    for (const leg of S.legs) {
+      let pts = leg.points, kind = leg.loop ? "loop" : "leg";
+      if (dragged !== undefined && (leg.from === dragged || leg.to === dragged || (dragged === "start" && leg.from === "start"))) {
+        pts = null; kind = "moving";
+      } else if (!pts) kind = "noPath";
+      if (!pts) {
+        const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
+        if (!a || !b) continue;
+        pts = [a, b];
+      }
+      kinds[kind].push(pts);
+    }
+    const styles = {
+      leg: [COLOUR.leg, 3, []], loop: [COLOUR.loop, 3, [6, 6]], noPath: [COLOUR.noPath, 3, [8, 6]], moving: ["#475569", 1.5, [3, 4]],
+    };
+    ctx.lineJoin = "round"; ctx.lineCap = "round";
+    for (const [kind, paths] of Object.entries(kinds)) {
+      if (!paths.length) continue;
+      const [colour, width, dash] = styles[kind];
+      ctx.beginPath();
+      for (const pts of paths) {
+        ctx.moveTo(f.ox + pts[0][0] * f.s, f.oy - pts[0][1] * f.s);
+        for (let k = 1; k < pts.length; k++) ctx.lineTo(f.ox + pts[k][0] * f.s, f.oy - pts[k][1] * f.s);
+      }
+      ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.setLineDash(dash);
+      ctx.globalAlpha = kind === "leg" || kind === "loop" ? 0.85 : 1;
+      ctx.stroke();
+    }
+    ctx.setLineDash([]); ctx.globalAlpha = 1;
+  },
+  // The colour a waypoint is filled with: its state in the run shown, else its kind.
+  fillOf(i, w, bad) {
+    const state = S.run && !S.replay && S.run.waypoints ? S.run.waypoints[i] : null;
+    if (state && state !== "pending" && COLOUR[state]) return COLOUR[state];
+    if (bad.has(i)) return COLOUR.bad;
+    return w.pass_through ? COLOUR.pass : COLOUR.waypoint;
+  },
+  // Half the width of a waypoint's number plate: a disc, or wider for 3 and 4 digits.
+  halfWidth(ctx, i) {
+    const digits = String(i + 1).length;
+    this.widths = this.widths || {};
+    if (this.widths[digits] === undefined) {
+      ctx.font = MARK_FONT;
+      this.widths[digits] = Math.max(MARK_R, ctx.measureText("0".repeat(digits)).width / 2 + 5);
+    }
+    return this.widths[digits];
+  },
+  drawMarks(ctx, size) {
+    const wps = S.doc.waypoints, n = wps.length;
+    const bad = new Set(S.problems.map((p) => p.waypoint));
+    ctx.globalAlpha = S.replay ? 0.25 : 1;  // the replayed run's own waypoints go on top
+    const inView = (i, r) => this.px[i] > -r - 20 && this.py[i] > -r - 20 && this.px[i] < size.x + r + 20 && this.py[i] < size.y + r + 20;
+    if (this.compact) {  // one path per colour: thousands of dots in one fill each
+      const paths = new Map();
+      for (let i = 0; i < n; i++) {
+        if (Number.isNaN(this.px[i]) || !inView(i, DOT_R) || i === S.selected) continue;
+        const colour = this.fillOf(i, wps[i], bad);
+        let path = paths.get(colour);
+        if (!path) { path = new Path2D(); paths.set(colour, path); }
+        path.moveTo(this.px[i] + DOT_R, this.py[i]);
+        path.arc(this.px[i], this.py[i], DOT_R, 0, 2 * Math.PI);
+      }
+      for (const [colour, path] of paths) { ctx.fillStyle = colour; ctx.fill(path); }
+    } else {
+      for (let i = 0; i < n; i++) {
+        if (Number.isNaN(this.px[i]) || !inView(i, 2 * MARK_R) || i === S.selected) continue;
+        this.drawMark(ctx, i, wps[i], this.fillOf(i, wps[i], bad), false);
+      }
+    }
+    // The selected one on top, full size at any zoom.
+    if (typeof S.selected === "number" && !Number.isNaN(this.px[S.selected] ?? NaN)) {
+      this.drawMark(ctx, S.selected, wps[S.selected], this.fillOf(S.selected, wps[S.selected], bad), true);
+    }
+    ctx.globalAlpha = 1;
+  },
+  // A waypoint: its heading arrow, its numbered plate, a ring when selected.
+  drawMark(ctx, i, w, fill, selected, at) {
+    const x = at ? at[0] : this.px[i], y = at ? at[1] : this.py[i];
+    const yawDeg = S.dragYaw && S.dragYaw.target === i ? S.dragYaw.deg : w.yaw || 0;
+    const yaw = (yawDeg * Math.PI) / 180, c = Math.cos(yaw), s = -Math.sin(yaw);
+    const tip = MARK_R + 9;
+    ctx.strokeStyle = fill; ctx.fillStyle = fill; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x + c * tip, y + s * tip); ctx.stroke();
+    ctx.beginPath();
+    ctx.moveTo(x + c * (tip + 3), y + s * (tip + 3));
+    ctx.lineTo(x + c * (tip - 4) - s * 4, y + s * (tip - 4) + c * 4);
+    ctx.lineTo(x + c * (tip - 4) + s * 4, y + s * (tip - 4) - c * 4);
+    ctx.fill();
+    const half = this.halfWidth(ctx, i);
+    ctx.beginPath();
+    if (half > MARK_R) ctx.roundRect(x - half, y - MARK_R, 2 * half, 2 * MARK_R, MARK_R);
+    else ctx.arc(x, y, MARK_R, 0, 2 * Math.PI);
+    ctx.fill();
+    ctx.lineWidth = 2; ctx.strokeStyle = selected ? COLOUR.selected : "white"; ctx.stroke();
+    if (selected) {
+      ctx.beginPath();
+      if (half > MARK_R) ctx.roundRect(x - half - 3, y - MARK_R - 3, 2 * half + 6, 2 * MARK_R + 6, MARK_R + 3);
+      else ctx.arc(x, y, MARK_R + 3, 0, 2 * Math.PI);
+      ctx.strokeStyle = "#111827"; ctx.lineWidth = 1.5; ctx.stroke();
+    }
+    if (!at && hasTasks(i)) {
+      // Tasks run here: a small dark square on the plate's corner (the legend's "has tasks").
+      ctx.fillStyle = "#111827"; ctx.strokeStyle = "white"; ctx.lineWidth = 1;
+      ctx.fillRect(x + half - 4, y - MARK_R - 3, 7, 7); ctx.strokeRect(x + half - 4, y - MARK_R - 3, 7, 7);
+    }
+    ctx.fillStyle = "white"; ctx.font = MARK_FONT; ctx.textAlign = "center"; ctx.textBaseline = "middle";
+    ctx.fillText(String(i + 1), x, y + 0.5);
+  },
+  // The replayed run's waypoints (its own mission's), in their states at the slider's time.
+  drawReplayed(ctx, f) {
+    const R = S.replay, wps = (R.mission || {}).waypoints || [], statuses = R.cursor ? R.cursor.statuses : [];
+    this.replayed = [];
+    wps.forEach((w, i) => {
+      if (!okPoint(w)) return;
+      const at = [f.ox + w.x * f.s, f.oy - w.y * f.s], status = statuses[i] || "pending";
+      this.replayed.push({ index: i, x: at[0], y: at[1], status });
+      this.drawMark(ctx, i, w, COLOUR[status] || COLOUR.pending, false, at);
+    });
+  },
+  // The start pose: a dark ring with an S tab, drawn last: a waypoint at the same spot
+  // shows inside it instead of hiding it.
+  drawStart(ctx, f) {
+    this.start = null;
+    const at = this.endOf("start");
+    if (!at) return;
+    const x = f.ox + at[0] * f.s, y = f.oy - at[1] * f.s;
+    this.start = [x, y];
+    const yawDeg = S.dragYaw && S.dragYaw.target === "start" ? S.dragYaw.deg : S.doc.start.yaw || 0;
+    const yaw = (yawDeg * Math.PI) / 180, c = Math.cos(yaw), s = -Math.sin(yaw);
+    ctx.lineCap = "round";
+    ctx.beginPath(); ctx.moveTo(x + c * START_R, y + s * START_R); ctx.lineTo(x + c * (START_R + 10), y + s * (START_R + 10));
+    ctx.strokeStyle = COLOUR.start; ctx.lineWidth = 3; ctx.stroke();
+    ctx.beginPath(); ctx.arc(x, y, START_R, 0, 2 * Math.PI);
+    ctx.strokeStyle = "white"; ctx.lineWidth = 6; ctx.stroke();
+    ctx.strokeStyle = S.selected === "start" ? COLOUR.selected : COLOUR.start; ctx.lineWidth = 3; ctx.stroke();
+    const bx = x - START_R * 0.72, by = y - START_R * 0.72;
+    ctx.beginPath(); ctx.arc(bx, by, 7, 0, 2 * Math.PI);
+    ctx.fillStyle = COLOUR.start; ctx.fill(); ctx.strokeStyle = "white"; ctx.lineWidth = 1.5; ctx.stroke();
+    ctx.fillStyle = "white"; ctx.font = "bold 9px system-ui, sans-serif"; ctx.textAlign = "center"; ctx.textBaseline = "middle";
+    ctx.fillText("S", bx, by + 0.5);
+  },
+  // Leg lengths where they fit: along a leg long enough on the screen for its text,
+  // inside the view, over no marker and no other label (a grid of what is taken finds
+  // the overlaps without comparing every pair). A leg with no path says so, with why.
+  placeLabels(ctx, f, size) {
+    const box = this.labels;
+    box.textContent = "";
+    if (!S.planned || S.drag) return;
+    const CELL = 48, COLS = Math.ceil(size.x / CELL) + 2, taken = new Map();
+    const hits = (a, b) => a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
+    // Rectangles by grid cell (numbered row by row; the view's margin clamped to its edge).
+    const visit = (r, each) => {
+      const x0 = Math.max(-1, Math.floor(r[0] / CELL)), x1 = Math.min(COLS - 2, Math.floor((r[0] + r[2]) / CELL));
+      const y0 = Math.max(-1, Math.floor(r[1] / CELL)), y1 = Math.floor((r[1] + r[3]) / CELL);
+      for (let gy = y0; gy <= y1; gy++) for (let gx = x0; gx <= x1; gx++) if (each((gy + 1) * COLS + gx + 1) === false) return false;
+      return true;
+    };
+    const free = (r) => visit(r, (key) => !(taken.get(key) || []).some((o) => hits(r, o)));
+    const take = (r) => visit(r, (key) => { const list = taken.get(key); if (list) list.push(r); else taken.set(key, [r]); });
+    const markR = (this.compact ? DOT_R : MARK_R) + LABEL_GAP;
+    for (let i = 0; i < this.px.length; i++) {
+      const x = this.px[i], y = this.py[i];
+      if (Number.isNaN(x) || x < -markR || y < -markR || x > size.x + markR || y > size.y + markR) continue;
+      const compact = this.compact && i !== S.selected;
+      const half = compact ? DOT_R : this.halfWidth(ctx, i) + 3, high = compact ? DOT_R : MARK_R;
+      take([x - half - LABEL_GAP, y - high - LABEL_GAP, 2 * (half + LABEL_GAP), 2 * (high + LABEL_GAP)]);
+    }
+    if (this.start) take([this.start[0] - START_R - 8, this.start[1] - START_R - 8, 2 * START_R + 16, 2 * START_R + 16]);
+    for (const r of this.replayed) take([r.x - MARK_R - 4, r.y - MARK_R - 4, 2 * MARK_R + 8, 2 * MARK_R + 8]);
+    ctx.font = LABEL_FONT;
+    const shortest = 2 * MARK_R + 30;  // px: no label is narrower than 30 px
+    const made = [];
+    for (const leg of S.legs) {
+      if (made.length >= MAX_LABELS) break;
+      let pts = leg.points;
+      if (!pts) {
+        const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
+        if (!a || !b) continue;
+        pts = [a, b];
+      }
+      const mid = this.midpoint(pts, f, shortest, size);
+      if (!mid) continue;
+      const text = leg.points ? `${leg.length_m.toFixed(2)} m` : "no path";
+      const w = Math.ceil(ctx.measureText(text).width) + 6;
+      if (mid.length_px < w + 2 * MARK_R) continue;  // the leg is shorter than its label
+      const r = [Math.round(mid.x - w / 2), Math.round(mid.y - LABEL_H / 2), w, LABEL_H];
+      if (r[0] < 0 || r[1] < 0 || r[0] + w > size.x || r[1] + LABEL_H > size.y) continue;
+      const padded = [r[0] - LABEL_GAP, r[1] - LABEL_GAP, w + 2 * LABEL_GAP, LABEL_H + 2 * LABEL_GAP];
+      if (!free(padded)) continue;
+      take(padded);
+      const el = document.createElement("div");
+      el.className = leg.points ? "leg-label" : "leg-label no-path";
+      el.textContent = text;
+      el.style.left = `${r[0]}px`; el.style.top = `${r[1]}px`; el.style.width = `${w}px`;
+      if (!leg.points) el.title = noPathReason(leg);
+      made.push(el);
+    }
+    box.append(...made);
+  },
+  // The point halfway along a leg on the screen and the leg's length there (px); null
+  // when the leg is shorter than ``shortest`` or its middle is out of the view.
+  midpoint(pts, f, shortest, size) {
+    const sx = (k) => f.ox + pts[k][0] * f.s, sy = (k) => f.oy - pts[k][1] * f.s;
+    let total = 0;
+    for (let k = 1; k < pts.length; k++) total += Math.hypot(sx(k) - sx(k - 1), sy(k) - sy(k - 1));
+    if (!(total >= shortest)) return null;
+    let left = total / 2;
+    for (let k = 1; k < pts.length; k++) {
+      const d = Math.hypot(sx(k) - sx(k - 1), sy(k) - sy(k - 1));
+      if (left <= d) {
+        const x = sx(k - 1) + ((sx(k) - sx(k - 1)) * left) / d, y = sy(k - 1) + ((sy(k) - sy(k - 1)) * left) / d;
+        return x < 0 || y < 0 || x > size.x || y > size.y ? null : { x, y, length_px: total };
+      }
+      left -= d;
+    }
+    return null;
+  },
+  // What is under a screen point: "start", a waypoint's index, or null. The start
+  // pose's ring and tab first (drawn on top), then the waypoints from the top one down.
+  hitTest(x, y) {
+    if (!this.frame0) return null;
+    if (this.start) {
+      const d = Math.hypot(x - this.start[0], y - this.start[1]);
+      const tab = Math.hypot(x - (this.start[0] - START_R * 0.72), y - (this.start[1] - START_R * 0.72));
+      if ((d >= MARK_R + 1 && d <= START_R + 4) || tab <= 8) return "start";
+    }
+    const ctx = this.canvas.getContext("2d");
+    const over = (i) => {
+      if (Number.isNaN(this.px[i])) return false;
+      const dx = Math.abs(x - this.px[i]), dy = Math.abs(y - this.py[i]);
+      if (this.compact && i !== S.selected) return dx * dx + dy * dy <= (DOT_R + 3) ** 2;
+      const half = this.halfWidth(ctx, i);
+      return dy <= MARK_R && dx <= half && (half > MARK_R || dx * dx + dy * dy <= MARK_R * MARK_R);
+    };
+    if (typeof S.selected === "number" && S.selected < this.px.length && over(S.selected)) return S.selected;
+    for (let i = this.px.length - 1; i >= 0; i--) if (over(i)) return i;
+    if (this.start && Math.hypot(x - this.start[0], y - this.start[1]) <= START_R + 4) return "start";
+    return null;
+  },
+  // What the last paint showed, for tests and tools: each waypoint's screen point
+  // (container pixels), the plate's half width and state, and the start pose's point.
+  drawn() {
+    const ctx = this.canvas.getContext("2d"), bad = new Set(S.problems.map((p) => p.waypoint));
+    const marks = [];
+    for (let i = 0; i < this.px.length; i++) {
+      if (Number.isNaN(this.px[i])) continue;
+      const state = S.run && S.run.waypoints ? S.run.waypoints[i] || "pending" : null;
+      marks.push({ index: i, x: this.px[i], y: this.py[i], half: this.compact && i !== S.selected ? DOT_R : this.halfWidth(ctx, i),
+        r: this.compact && i !== S.selected ? DOT_R : MARK_R, bad: bad.has(i), selected: i === S.selected, state, tasks: hasTasks(i) });
+    }
+    return { marks, start: this.start, compact: this.compact, replayed: this.replayed };
+  },
+});
+const missionLayer = new MissionLayer().addTo(map);
+// Why a leg has no path: the pre-flight's problem about its end waypoint, if it has one.
+function noPathReason(leg) {
+  const problem = S.problems.find((p) => p.waypoint === leg.to);
+  const from = leg.from === "start" ? "the start pose" : `waypoint ${Number(leg.from) + 1}`;
+  return `no path from ${from} to waypoint ${leg.to + 1}${problem ? `: ${problem.text}` : ""}`;
 }
-// The element with the focus is rebuilt by render (a row, a marker): the focus goes to the
-// new one in its place (data-focus), as a keyboard user would lose it otherwise.
+
+// The element with the focus is rebuilt by render (a row): the focus goes to the new one
+// in its place (data-focus), as a keyboard user would lose it otherwise.
 function render() {
+  const began = performance.now();
   const focused = S.focusNext !== undefined ? S.focusNext : document.activeElement?.dataset?.focus;
   S.focusNext = undefined;
+  const row = (focused || "").match(/^row-(\d+)/);
+  if (row) showRow(Number(row[1]));  // built, so that it can have the focus
   renderAll();
+  S.renderMs = performance.now() - began;  // read by benchmarks/bench_studio.py
   if (!focused) return;
   const el = document.querySelector(`[data-focus="${focused}"]`);
   if (el && el !== document.activeElement) el.focus({ preventScroll: true });
 }
-// Enter or Space on a focused marker selects it, as a click does.
-function keySelects(marker, select) {
-  marker.getElement().addEventListener("keydown", (e) => {
-    if (e.key !== "Enter" && e.key !== " ") return;
-    e.preventDefault();
-    e.stopPropagation();
-    select();
-  });
-}
 function renderAll() {
-  S.layers.markers.forEach((m) => m.remove());
-  S.layers.markers = [];
-  if (S.layers.start) S.layers.start.remove();
-  S.layers.start = null;
-  const start = S.doc.start;
-  if (okPoint(start)) {
-    S.layers.start = L.marker(ll(start.x, start.y), { icon: wpIcon(start, null, "start"), draggable: true,
-      title: "start pose", zIndexOffset: -100 }).addTo(map);
-    S.layers.start.getElement().dataset.testid = "start-marker";
-    S.layers.start.getElement().dataset.focus = "marker-start";
-    S.layers.start.getElement().setAttribute("aria-label", `start pose${S.selected === "start" ? ", selected" : ""}`);
-    keySelects(S.layers.start, () => { S.selected = "start"; render(); });
-    S.layers.start.on("dragstart", () => { S.selected = "start"; drawHandle(); });
-    S.layers.start.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, start.yaw || 0); });
-    S.layers.start.on("dragend", (e) => {
-      const p = e.target.getLatLng();
-      edit(() => { S.doc.start.x = round(p.lng, 2); S.doc.start.y = round(p.lat, 2); });
-    });
-    S.layers.start.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = "start"; render(); });
-  }
-  S.doc.waypoints.forEach((w, i) => {
-    if (!okPoint(w)) return;
-    const m = L.marker(ll(w.x, w.y), { icon: wpIcon(w, i), draggable: true, title: w.name || `waypoint ${i + 1}` });
-    m.addTo(map);
-    const el = m.getElement();
-    el.dataset.testid = "waypoint-marker";
-    el.dataset.index = String(i);
-    el.dataset.focus = `marker-${i}`;
-    el.setAttribute("aria-label", `waypoint ${i + 1}${w.name ? ` ${w.name}` : ""}${i === S.selected ? ", selected" : ""}`);
-    keySelects(m, () => { S.selected = i; render(); });
-    m.on("click", (e) => { L.DomEvent.stopPropagation(e); S.selected = i; render(); });
-    m.on("dragstart", () => { S.selected = i; drawHandle(); });
-    m.on("drag", (e) => { const p = e.target.getLatLng(); moveHandle(p.lng, p.lat, w.yaw || 0); });
-    m.on("dragend", (e) => {
-      const p = e.target.getLatLng();
-      edit(() => { w.x = round(p.lng, 2); w.y = round(p.lat, 2); });
-    });
-    S.layers.markers.push(m);
-  });
-  drawLegs();
+  missionLayer.draw();
   drawHandle();
+  if (S.selected !== S.listedSelection) {  // a waypoint selected on the map: its row shown
+    S.listedSelection = S.selected;
+    if (typeof S.selected === "number") showRow(S.selected);
+  }
   renderList();
   renderEditor();
   renderSettings();
@@ -282,19 +613,65 @@ function renderAll() {
   $("undo").disabled = !S.undo.length;
   $("redo").disabled = !S.redo.length;
 }
-function drawLegs() {
-  if (S.layers.legs) S.layers.legs.remove();
-  S.layers.legs = L.layerGroup().addTo(map);
-  for (const leg of S.legs) {
-    if (!leg.points) continue;
-    const line = L.polyline(leg.points.map(([x, y]) => ll(x, y)),
-      { color: leg.loop ? "#6b7280" : "#0ea5e9", weight: 3, opacity: 0.85, dashArray: leg.loop ? "6 6" : null, interactive: false });
-    line.addTo(S.layers.legs);
-    const mid = leg.points[Math.floor(leg.points.length / 2)];
-    L.tooltip({ permanent: true, direction: "center", className: "leg-label", interactive: false })
-      .setLatLng(ll(mid[0], mid[1])).setContent(`${leg.length_m.toFixed(2)} m`).addTo(S.layers.legs);
-  }
+
+// ---- the mouse on the map: select, drag (hit-tested on the painted positions) ----------
+const mapBox = map.getContainer();
+mapBox.setAttribute("aria-describedby", "keys-help");
+const busyNow = () => (S.run && !S.run.done) || S.replay;
+function pointerHit(e) {
+  const box = mapBox.getBoundingClientRect();
+  return missionLayer.hitTest(e.clientX - box.left, e.clientY - box.top);
 }
+// A press on a marker is the marker's, not the map's: Leaflet neither pans nor adds a
+// waypoint with it (listened to in the capture phase, before Leaflet's own listeners).
+for (const type of ["pointerdown", "touchstart"]) {
+  mapBox.addEventListener(type, (e) => { if (S.doc && pointerHit(e.touches ? e.touches[0] : e) !== null) e.stopPropagation(); }, true);
+}
+mapBox.addEventListener("mousedown", (e) => {
+  if (e.button !== 0 || !S.doc || S.placingStart) return;
+  const hit = pointerHit(e);
+  if (hit === null) return;
+  e.stopPropagation();
+  e.preventDefault();
+  mapBox.focus({ preventScroll: true });  // the arrows then move what was pressed
+  S.press = { hit, x0: e.clientX, y0: e.clientY, moved: false };
+}, true);
+document.addEventListener("mousemove", (e) => {
+  const p = S.press;
+  if (!p) {
+    if (S.doc && e.target.closest && e.target.closest("#map")) mapBox.classList.toggle("over-mark", pointerHit(e) !== null);
+    return;
+  }
+  if (busyNow()) return;
+  if (!p.moved && Math.hypot(e.clientX - p.x0, e.clientY - p.y0) < 3) return;
+  if (!p.moved) { p.moved = true; S.selected = p.hit; drawHandle(); }
+  const at = map.mouseEventToLatLng(e);
+  S.drag = { target: p.hit, x: at.lng, y: at.lat };
+  const point = selectedPoint();
+  moveHandle(at.lng, at.lat, (point && point.yaw) || 0);
+  missionLayer.schedule();
+});
+document.addEventListener("mouseup", () => {
+  const p = S.press;
+  if (!p) return;
+  S.press = null;
+  // The click that follows the press is not the map's (it would add a waypoint).
+  S.swallowClick = true;
+  setTimeout(() => { S.swallowClick = false; }, 0);
+  const drag = S.drag;
+  S.drag = null;
+  const began = performance.now();
+  if (p.moved && drag) {
+    edit(() => {
+      const point = drag.target === "start" ? S.doc.start : S.doc.waypoints[drag.target];
+      point.x = round(drag.x, 2); point.y = round(drag.y, 2);
+      S.selected = drag.target;
+    });
+  } else { S.selected = p.hit; render(); }
+  S.dragDropMs = performance.now() - began;  // the page's own part (benchmarks/bench_studio.py)
+}, true);
+mapBox.addEventListener("click", (e) => { if (S.swallowClick) { S.swallowClick = false; e.stopPropagation(); } }, true);
+
 // The yaw handle of the selected waypoint: drag it around the point to set the heading.
 function handleOffset() { return 40 / 2 ** map.getZoom(); }  // 40 px in metres
 function drawHandle() {
@@ -315,13 +692,12 @@ function drawHandle() {
   S.layers.handle.on("click", (e) => L.DomEvent.stopPropagation(e));
   S.layers.handle.on("drag", (e) => {
     const p = e.target.getLatLng();
-    const deg = Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI);
-    const arrow = S.selected === "start" ? S.layers.start
-      : S.layers.markers.find((m) => m.getElement().dataset.index === String(S.selected));
-    if (arrow) arrow.getElement().querySelector(".arrow").style.transform = `rotate(${-deg}deg)`;
+    S.dragYaw = { target: S.selected, deg: Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI) };
+    missionLayer.schedule();
   });
   S.layers.handle.on("dragend", (e) => {
     const p = e.target.getLatLng();
+    S.dragYaw = null;
     edit(() => { w.yaw = Math.round((Math.atan2(p.lat - w.y, p.lng - w.x) * 180) / Math.PI); });
   });
 }
@@ -332,43 +708,101 @@ function moveHandle(x, y, yawDeg) {
 }
 map.on("zoomend", drawHandle);
 
+// ---- the waypoint list: only the rows in sight are built ---------------------------------
+// The list scrolls in a box of its own; rows have one height, so the rows in sight follow
+// from the scroll position: a mission of 5000 waypoints builds some forty rows, not 5000.
+// Tab goes through the rows built; focusing one near the box's edge scrolls it in, which
+// builds the next ones. Each row says its place (aria-posinset of aria-setsize).
+const ROW_H = 24, ROW_SPARE = 8;
+function showRow(i) {
+  const list = $("waypoint-box");
+  const height = list.clientHeight || listHeight();
+  if (i * ROW_H < list.scrollTop) list.scrollTop = i * ROW_H;
+  else if ((i + 1) * ROW_H > list.scrollTop + height) list.scrollTop = (i + 1) * ROW_H - height;
+}
+const listHeight = () => Math.min(S.doc.waypoints.length * ROW_H, Math.max(window.innerHeight * 0.4, 8 * ROW_H));
+function rowsInSight() {
+  const list = $("waypoint-box"), n = S.doc.waypoints.length;
+  const height = list.clientHeight || listHeight();
+  const first = Math.max(0, Math.floor(list.scrollTop / ROW_H) - ROW_SPARE);
+  const last = Math.min(n, Math.ceil((list.scrollTop + height) / ROW_H) + ROW_SPARE);
+  return [first, last];
+}
 function renderList() {
-  const list = $("waypoints");
-  list.textContent = "";
-  S.doc.waypoints.forEach((w, i) => {
-    const li = document.createElement("li");
-    li.dataset.testid = "waypoint-row";
-    li.draggable = true;
-    if (i === S.selected) li.classList.add("selected");
-    if (problemsOf(i).length) li.classList.add("bad");
-    const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
-    const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
-    // The row's waypoint is a button (Tab reaches it, Enter or Space selects it); ▲ ▼ ✕
-    // are named for a screen reader by what they do, not by their glyph.
-    li.innerHTML = `<button type="button" class="pick"><span class="num"></span><span class="label"></span><span class="state"></span></button>
-      <button type="button" class="up">▲</button><button type="button" class="down">▼</button><button type="button" class="del">✕</button>`;
-    li.querySelector(".num").textContent = i + 1;
-    li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
-    li.querySelector(".state").textContent = state;
-    if (hasTasks(i)) li.querySelector(".state").before(taskFlag(i));
-    const [pick, up, down, del] = li.querySelectorAll("button");
-    pick.dataset.focus = `row-${i}`;
-    if (i === S.selected) pick.setAttribute("aria-current", "true");
-    for (const [button, part, what] of [[up, "up", "move waypoint # up"], [down, "down", "move waypoint # down"], [del, "del", "delete waypoint #"]]) {
-      button.dataset.focus = `row-${i}-${part}`;
-      button.setAttribute("aria-label", what.replace("#", String(i + 1)));
-      button.title = what.replace(" #", "");
-    }
-    up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
-    down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
-    del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
-    li.onclick = () => { S.selected = i; render(); if (okPoint(w)) map.panTo(ll(w.x, w.y)); };
-    li.ondragstart = (e) => { e.dataTransfer.setData("text/plain", String(i)); };
-    li.ondragover = (e) => { e.preventDefault(); li.classList.add("drop-target"); };
-    li.ondragleave = () => li.classList.remove("drop-target");
-    li.ondrop = (e) => { e.preventDefault(); moveWaypoint(Number(e.dataTransfer.getData("text/plain")), i); };
-    list.appendChild(li);
+  const list = $("waypoints"), n = S.doc.waypoints.length;
+  const [first, last] = rowsInSight();
+  S.rows = [first, last, n];
+  list.style.paddingTop = `${first * ROW_H}px`;
+  list.style.paddingBottom = `${(n - last) * ROW_H}px`;
+  const made = [];
+  for (let i = first; i < last; i++) made.push(waypointRow(i, n));
+  list.replaceChildren(...made);
+}
+$("waypoint-box").addEventListener("scroll", () => {
+  if (S.listFrame) return;
+  S.listFrame = requestAnimationFrame(() => {
+    S.listFrame = 0;
+    const [first, last] = rowsInSight();
+    if (S.rows && S.rows[0] === first && S.rows[1] === last && S.rows[2] === S.doc.waypoints.length) return;
+    // A focused row scrolled out of the box: the focus goes to the nearest row built.
+    const focused = (document.activeElement?.dataset?.focus || "").match(/^row-(\d+)(-.*)?$/);
+    renderList();
+    if (!focused) return;
+    const i = Math.min(Math.max(Number(focused[1]), first), last - 1);
+    const el = document.querySelector(`[data-focus="row-${i}${focused[2] || ""}"]`);
+    if (el) el.focus({ preventScroll: true });
   });
+});
+// A row reached with Tab is scrolled in and the rows after it built at once (not at the
+// next frame): a fast Tab would otherwise leave the list at the last row built.
+$("waypoints").addEventListener("focusin", (e) => {
+  const key = e.target.dataset?.focus || "";
+  const row = key.match(/^row-(\d+)/);
+  if (!row) return;
+  showRow(Number(row[1]));
+  const [first, last] = rowsInSight();
+  if (S.rows && S.rows[0] === first && S.rows[1] === last && S.rows[2] === S.doc.waypoints.length) return;
+  renderList();
+  const el = document.querySelector(`[data-focus="${key}"]`);
+  if (el && el !== document.activeElement) el.focus({ preventScroll: true });
+});
+function waypointRow(i, n) {
+  const w = S.doc.waypoints[i];
+  const li = document.createElement("li");
+  li.dataset.testid = "waypoint-row";
+  li.dataset.index = String(i);
+  li.setAttribute("aria-setsize", String(n));
+  li.setAttribute("aria-posinset", String(i + 1));
+  li.draggable = true;
+  if (i === S.selected) li.classList.add("selected");
+  if (problemsOf(i).length) li.classList.add("bad");
+  const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
+  const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
+  // The row's waypoint is a button (Tab reaches it, Enter or Space selects it); ▲ ▼ ✕
+  // are named for a screen reader by what they do, not by their glyph.
+  li.innerHTML = `<button type="button" class="pick"><span class="num"></span><span class="label"></span><span class="state"></span></button>
+    <button type="button" class="up">▲</button><button type="button" class="down">▼</button><button type="button" class="del">✕</button>`;
+  li.querySelector(".num").textContent = i + 1;
+  li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
+  li.querySelector(".state").textContent = state;
+  if (hasTasks(i)) li.querySelector(".state").before(taskFlag(i));
+  const [pick, up, down, del] = li.querySelectorAll("button");
+  pick.dataset.focus = `row-${i}`;
+  if (i === S.selected) pick.setAttribute("aria-current", "true");
+  for (const [button, part, what] of [[up, "up", "move waypoint # up"], [down, "down", "move waypoint # down"], [del, "del", "delete waypoint #"]]) {
+    button.dataset.focus = `row-${i}-${part}`;
+    button.setAttribute("aria-label", what.replace("#", String(i + 1)));
+    button.title = what.replace(" #", "");
+  }
+  up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
+  down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
+  del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
+  li.onclick = () => { S.selected = i; S.listedSelection = i; render(); if (okPoint(w)) map.panTo(ll(w.x, w.y)); };
+  li.ondragstart = (e) => { e.dataTransfer.setData("text/plain", String(i)); };
+  li.ondragover = (e) => { e.preventDefault(); li.classList.add("drop-target"); };
+  li.ondragleave = () => li.classList.remove("drop-target");
+  li.ondrop = (e) => { e.preventDefault(); moveWaypoint(Number(e.dataTransfer.getData("text/plain")), i); };
+  return li;
 }
 // The forms are built once for their set of fields and then updated in place: rebuilding
 // them at every edit replaced the input being typed in, so Enter or Tab dropped the focus
@@ -475,7 +909,9 @@ $("place-start").onclick = () => placeStart(!S.placingStart);
 function renderProblems() {
   const list = $("problems");
   list.textContent = "";
-  for (const p of S.problems) {
+  // The first ones listed (a mission of thousands may have thousands): the rest are
+  // counted, and each waypoint's own are on its row (red) and marker.
+  for (const p of S.problems.slice(0, MAX_PROBLEMS_LISTED)) {
     const li = document.createElement("li");
     li.dataset.testid = "problem";
     if (p.waypoint !== null) {
@@ -488,14 +924,31 @@ function renderProblems() {
     if (p.fix) li.appendChild(fixButton(p));
     list.appendChild(li);
   }
+  if (S.problems.length > MAX_PROBLEMS_LISTED) {
+    const more = document.createElement("li");
+    more.textContent = `and ${S.problems.length - MAX_PROBLEMS_LISTED} more`;
+    list.appendChild(more);
+  }
   $("problem-count").textContent = S.problems.length ? `(${S.problems.length})` : "";
   const save = $("save");
   save.classList.toggle("warn", S.problems.length > 0);
   save.textContent = S.problems.length ? `Save (${S.problems.length} problem${S.problems.length > 1 ? "s" : ""})` : "Save";
-  const r = S.route;
-  $("route").textContent = r.total_length_m != null
-    ? `${S.doc.waypoints.length} waypoints · ${r.total_length_m.toFixed(2)} m · ${r.estimated_duration}`
-    : `${S.doc.waypoints.length} waypoints${!S.planned ? " · checking and planning…" : r.unplanned_legs ? " · some legs have no path" : ""}`;
+  $("route").textContent = routeText();
+}
+const MAX_PROBLEMS_LISTED = 100;
+// The route's length; with legs that have no path, the planned legs' total and which legs
+// are left out (they are drawn dashed, in red).
+function routeText() {
+  const r = S.route, n = `${S.doc.waypoints.length} waypoints`;
+  if (r.total_length_m != null) return `${n} · ${r.total_length_m.toFixed(2)} m · ${r.estimated_duration}`;
+  if (!S.planned) return `${n} · checking and planning…`;
+  if (!r.unplanned_legs) return n;
+  const legs = S.legs.filter((leg) => !leg.loop);
+  const open = legs.filter((leg) => leg.length_m == null);
+  const planned = legs.reduce((sum, leg) => sum + (leg.length_m ?? 0), 0);
+  const name = (leg) => `${leg.from === "start" ? "S" : Number(leg.from) + 1}→${leg.to + 1}`;
+  const named = open.slice(0, 5).map(name).join(", ") + (open.length > 5 ? ` and ${open.length - 5} more` : "");
+  return `${n} · ${planned.toFixed(2)} m planned, not counting ${open.length} leg${open.length > 1 ? "s" : ""} with no path (${named}; dashed red)`;
 }
 
 // ---- tasks at waypoints (docs/mission-format.md, Tasks at waypoints) -------------------
@@ -737,8 +1190,9 @@ async function check() {
   if (S.checkBusy) { S.checkAgain = true; return; }
   S.checkBusy = true;
   const seq = ++S.checkSeq;
-  const sent = JSON.parse(JSON.stringify(S.doc));
-  const answer = await api("POST", "/api/check", { mission: sent });
+  // Written out once, now: the draft as it is at this moment (edits may follow while
+  // the answer is on its way), and no second copy of a mission of thousands.
+  const answer = await api("POST", "/api/check", JSON.stringify({ mission: S.doc }));
   S.checkBusy = false;
   if (S.checkAgain) { S.checkAgain = false; check(); return; }
   if (seq !== S.checkSeq) return;
@@ -842,15 +1296,39 @@ async function importFile(path) {
   if (!imported.map && S.doc.map) imported.map = S.doc.map;
   if (!Array.isArray(imported.waypoints)) imported.waypoints = [];
   edit(() => { S.doc = imported; S.selected = null; });
+  fitMission();
   say(`imported ${imported.waypoints.length} waypoints from ${answer.data.path} (undo: Ctrl+Z); save to keep them`);
 }
 // ---- shortest order ----------------------------------------------------------------------
 $("order").onchange = async (e) => {
   const choice = e.target.value;
   e.target.value = "";
-  if (!choice || (S.run && !S.run.done) || S.replay) return;
-  say("finding the shortest order…");
-  const answer = await api("POST", "/api/order", { mission: S.doc, keep_last: choice === "keep-last" });
+  if (!choice || (S.run && !S.run.done) || S.replay || S.ordering) return;
+  // Seconds on a big mission: the time spent is shown, and Cancel gives the page back
+  // (the answer, when it comes, is dropped; the mission is as it was).
+  const aborter = new AbortController();
+  const began = performance.now();
+  const count = S.doc.waypoints.length;
+  const tell = () => say(`finding the shortest order of ${count} waypoints… ${Math.round((performance.now() - began) / 1000)} s (Cancel stops waiting)`);
+  S.ordering = aborter;
+  tell();
+  const ticker = setInterval(tell, 1000);
+  const cancel = $("order-cancel");
+  cancel.hidden = false;
+  cancel.onclick = () => aborter.abort();
+  $("order").disabled = true;
+  let answer;
+  try {
+    answer = await api("POST", "/api/order", { mission: S.doc, keep_last: choice === "keep-last" }, aborter.signal);
+  } catch (error) {
+    answer = null;
+  } finally {
+    clearInterval(ticker);
+    S.ordering = null;
+    cancel.hidden = true;
+    $("order").disabled = false;
+  }
+  if (!answer) { say("ordering cancelled: the waypoints are as they were"); return; }
   if (!answer.ok) {
     const first = (answer.data.problems || [])[0];
     say(first ? `${answer.data.error}: ${first.text}` : answer.data.error, true);
@@ -919,6 +1397,7 @@ $("runs").onchange = async (e) => {
   if (!answer.ok) { say(answer.data.error, true); return; }
   stopReplayPlay();
   S.replay = answer.data;
+  S.replay.markedAt = undefined;
   $("replay").hidden = false;
   $("map").classList.add("replaying");
   const slider = $("replay-time");
@@ -956,7 +1435,7 @@ function closeReplay() {
   $("replay").hidden = true;
   $("map").classList.remove("replaying");
   if (S.layers.replay) { S.layers.replay.remove(); S.layers.replay = null; }
-  if (S.layers.replayMarks) { S.layers.replayMarks.remove(); S.layers.replayMarks = null; }
+  missionLayer.draw();
 }
 // Index of the last item (sorted by time) at or before t, or null; key: its time field.
 function lastAt(items, t, key) {
@@ -981,21 +1460,11 @@ function replayStatuses(R, si) {
   R.cursor = { si, statuses };
   return statuses;
 }
-// The waypoint markers, redrawn only when their states change (not at every frame).
+// The replayed mission's waypoints, painted again only when their states change (not at
+// every frame): the canvas draws them in their states (missionLayer.drawReplayed).
 function drawReplayMarks(R, statuses, si) {
-  if (!S.layers.replayMarks) S.layers.replayMarks = L.layerGroup().addTo(map);
-  S.layers.replayMarks.clearLayers();
   R.markedAt = si;
-  const wps = (R.mission || {}).waypoints || [];
-  wps.forEach((w, i) => {
-    if (!okPoint(w)) return;
-    const status = statuses[i] || "pending";
-    const icon = L.divIcon({ className: `wp-icon replay ${status}`, iconSize: [26, 26], iconAnchor: [13, 13],
-      html: `<div class="arrow" style="transform: rotate(${-(w.yaw || 0)}deg)"></div><div class="dot">${i + 1}</div>` });
-    const m = L.marker(ll(w.x, w.y), { icon, interactive: false }).addTo(S.layers.replayMarks);
-    m.getElement().dataset.testid = "replay-waypoint";
-    m.getElement().dataset.status = status;
-  });
+  missionLayer.draw();
 }
 // The run at time t: waypoint states, driven path so far, plan of the current leg, robot.
 function drawReplay(t) {
@@ -1006,7 +1475,7 @@ function drawReplay(t) {
   const si = lastAt(R.states, t, "t");
   const state = si === null ? { current: null, loop: 0, status: "starting" } : R.states[si];
   const statuses = replayStatuses(R, si);
-  if (R.markedAt !== si || !S.layers.replayMarks) drawReplayMarks(R, statuses, si);
+  if (R.markedAt !== si) drawReplayMarks(R, statuses, si);
   const pi = lastAt(R.poses, t);
   if (pi !== null) {
     const trail = R.poses.slice(0, pi + 1).map(([, px, py]) => ll(px, py));
@@ -1027,7 +1496,7 @@ function drawReplay(t) {
     }
     const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
     const outline = R.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
-    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.replay);
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false, pane: "run" }).addTo(S.layers.replay);
     body.getElement().dataset.testid = "replay-robot";
   }
   const at = state.current !== null && state.current !== undefined ? ` · waypoint ${state.current + 1} ${statuses[state.current] || "pending"}` : "";
@@ -1071,6 +1540,7 @@ function watchRun() {
     run.done = ["completed", "failed", "stopped", "error"].includes(run.status);
     const before = S.run ? S.run.waypoints : null;
     S.run = run;
+    S.runUpdates = (S.runUpdates || 0) + 1;  // counted for benchmarks/bench_studio.py
     drawRun(run, before);
     showRunTask(run);
     if (run.report && !run.done) showReport(run);  // written before the picture: shown now
@@ -1078,16 +1548,20 @@ function watchRun() {
   };
   S.events.onerror = () => { if (S.events && S.run && S.run.done) S.events.close(); };
 }
-// Only the rows whose state changed: rebuilding the whole list at every update (20 a
-// second) would stall the page on a mission of thousands of waypoints.
+// Only what changed: the rows in sight whose state changed (rebuilding the list at every
+// update, 20 a second, would stall the page on a mission of thousands of waypoints), and
+// the canvas once when a waypoint's state changed (its colour).
 function updateRowStates(states, before) {
-  const rows = $("waypoints").children;
-  if (!before || rows.length !== S.doc.waypoints.length) { renderList(); return; }
-  states.forEach((state, i) => {
-    if (before[i] === state) return;
-    const cell = rows[i] && rows[i].querySelector(".state");
-    if (cell) cell.textContent = state || "";
-  });
+  if (!before || before.length !== states.length) { renderList(); missionLayer.draw(); return; }
+  let changes = false;
+  for (let i = 0; i < states.length; i++) if (before[i] !== states[i]) { changes = true; break; }
+  if (!changes) return;
+  for (const row of $("waypoints").children) {
+    const i = Number(row.dataset.index);
+    const cell = row.querySelector(".state");
+    if (cell && cell.textContent !== (states[i] || "")) cell.textContent = states[i] || "";
+  }
+  missionLayer.draw();
 }
 function drawRun(run, before) {
   if (!S.layers.run) S.layers.run = L.layerGroup().addTo(map);
@@ -1098,9 +1572,9 @@ function drawRun(run, before) {
     const { x_m: x, y_m: y, yaw_deg: deg } = run.pose;
     const yaw = (deg * Math.PI) / 180, c = Math.cos(yaw), s = Math.sin(yaw);
     const outline = run.footprint_m.map(([fx, fy]) => ll(x + c * fx - s * fy, y + s * fx + c * fy));
-    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false }).addTo(S.layers.run);
+    const body = L.polygon(outline, { color: "#111827", weight: 2, fillColor: "#facc15", fillOpacity: 0.9, interactive: false, pane: "run" }).addTo(S.layers.run);
     body.getElement().dataset.testid = "robot";
-    L.polyline([ll(x, y), ll(x + 0.25 * c, y + 0.25 * s)], { color: "#111827", weight: 2, interactive: false }).addTo(S.layers.run);
+    L.polyline([ll(x, y), ll(x + 0.25 * c, y + 0.25 * s)], { color: "#111827", weight: 2, interactive: false, pane: "run" }).addTo(S.layers.run);
   }
   const busy = !run.done;
   $("stop").disabled = !busy; $("skip").disabled = !busy; $("pause").disabled = !busy;
