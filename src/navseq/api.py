@@ -162,12 +162,11 @@ def order_waypoints(
     """
     from navseq.commands.common import legs_on_map
     from navseq.mission.robot_format import choose_robot
-    from navseq.route.legs import lengths
     from navseq.route.order import shortest_order
 
     map_path = Path(map) if map is not None else mission.map
     legs = legs_on_map(map_path, choose_robot(robot, mission))
-    ordering = shortest_order(mission, lengths(legs), time_limit_s, keep_last=keep_last)
+    ordering = shortest_order(mission, legs, time_limit_s, keep_last=keep_last)
     return ordering.apply(mission)
 
 

@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     from navseq.commands.common import choose_robot, legs_on_map, require_file
     from navseq.errors import NavseqError
     from navseq.mission import load_mission
-    from navseq.route.legs import legs_of, lengths
+    from navseq.route.legs import legs_of
 
     if args.keep_last and args.order != "shortest":
         raise NavseqError(
@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     if args.order == "shortest":
         from navseq.route.order import shortest_order
 
-        ordering = shortest_order(mission, lengths(legs), args.time_limit, keep_last=args.keep_last)
+        ordering = shortest_order(mission, legs, args.time_limit, keep_last=args.keep_last)
         order, ordered = list(ordering.order), ordering.apply(mission)
     route = legs_of(ordered, legs) if ordered is not mission else in_file_order
     if args.out is not None:

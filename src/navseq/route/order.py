@@ -24,7 +24,7 @@ import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -34,8 +34,9 @@ from navseq.extras import require_extra
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
 
-#: Waypoints at most: the distances need a plan for every pair (n² / 2 of them).
-MAX_WAYPOINTS = 400
+#: Waypoints at most: the distances take one search per waypoint over the map, and the
+#: solver a matrix of n² of them.
+MAX_WAYPOINTS = 2000
 #: The cost of a leg with no path, in metres: more than any route on any map.
 NO_PATH_M = 1.0e6
 #: Distances go to the solver in millimetres (it works in integers).
@@ -89,9 +90,25 @@ def distance_matrix(
     return matrix
 
 
+@runtime_checkable
+class Distances(Protocol):
+    """What measures every distance at once (a :class:`~navseq.route.legs.LegPlanner`:
+    one search per place, not one plan per pair)."""
+
+    def distances(self, places: Sequence[Place]) -> np.ndarray: ...
+
+
+def distances_between(places: Sequence[Place], length: LegLength | Distances) -> np.ndarray:
+    """Metres from every place to every other, ``NO_PATH_M`` where there is no path."""
+    if isinstance(length, Distances):
+        matrix = np.asarray(length.distances(places), dtype=float)
+        return np.where(np.isfinite(matrix), matrix, NO_PATH_M)
+    return distance_matrix(places, length)
+
+
 def shortest_order(
     mission: Mission,
-    length: LegLength = straight_line,
+    length: LegLength | Distances = straight_line,
     time_limit_s: float = 2.0,
     *,
     keep_last: bool = False,
@@ -99,13 +116,15 @@ def shortest_order(
     """The order of ``mission``'s waypoints that drives the least (see the module doc).
 
     ``keep_last``: the file's last waypoint stays last (the robot ends at its dock).
+    ``length`` measures a leg, or (a :class:`Distances`, such as a leg planner) all of
+    them at once.
     """
     require_extra("plan", "the shortest order")
     waypoints = [(w.x, w.y) for w in mission.waypoints]
     if len(waypoints) > MAX_WAYPOINTS:
         raise NavseqError(
-            f"{len(waypoints)} waypoints: ordering plans a path between every two of them "
-            f"and takes at most {MAX_WAYPOINTS}; order the mission in parts "
+            f"{len(waypoints)} waypoints: ordering measures the way between every two of "
+            f"them and takes at most {MAX_WAYPOINTS}; order the mission in parts "
             "(navseq run --from/--to take parts of a file)",
             source=mission.source,
         )
@@ -116,7 +135,7 @@ def shortest_order(
     fixed = (0 if from_start else 1) + (1 if keep_last else 0)
     if len(places) - fixed <= 1:
         return Ordering(tuple(range(len(waypoints))))  # nothing to choose
-    matrix = distance_matrix(places, length)
+    matrix = distances_between(places, length)
     last = len(places) - 1 if keep_last else None
     tour = shortest_tour(matrix, closed=closed, last=last, time_limit_s=time_limit_s)
     as_in_file = list(range(len(places)))
@@ -156,8 +175,14 @@ def shortest_tour(
     manager = pywrapcp.RoutingIndexManager(nodes, 1, [0], [end])
     routing = pywrapcp.RoutingModel(manager)
 
+    # Plain lists and the index -> node table made once: the solver calls this for every
+    # arc it considers (hundreds of thousands for 400 waypoints), and numpy indexing
+    # plus two manager calls per arc made the first tour alone outlast the time limit.
+    rows = costs.tolist()
+    node_of = [manager.IndexToNode(index) for index in range(routing.Size() + 1)]
+
     def arc_cost(from_index: int, to_index: int) -> int:
-        return int(costs[manager.IndexToNode(from_index), manager.IndexToNode(to_index)])
+        return int(rows[node_of[from_index]][node_of[to_index]])
 
     routing.SetArcCostEvaluatorOfAllVehicles(routing.RegisterTransitCallback(arc_cost))
     parameters = pywrapcp.DefaultRoutingSearchParameters()
@@ -182,8 +207,10 @@ def shortest_tour(
 __all__ = [
     "MAX_WAYPOINTS",
     "NO_PATH_M",
+    "Distances",
     "Ordering",
     "distance_matrix",
+    "distances_between",
     "shortest_order",
     "shortest_tour",
     "straight_line",

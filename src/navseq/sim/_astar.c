@@ -9,6 +9,11 @@
  *   start, goal : flat cell indices (row * width + col)
  *   heuristic_scale : a lower bound on every finite traversal cost
  *
+ * distances(cost, width, lut, start, targets) -> bytes (float64 per target)
+ *
+ *   targets : int64 flat cell indices; the result is each one's length in cells along
+ *             the cheapest route from start (inf when there is none), from one search
+ *
  * A step between 8-neighbours a -> b costs |step| * (lut[a] + lut[b]) / 2, |step|
  * being 1 or sqrt(2). The heuristic is the octile distance times heuristic_scale,
  * which is admissible and consistent, so the goal's first pop is optimal. Queue
@@ -219,10 +224,140 @@ done:
     return result;
 }
 
+/* Dijkstra from `start` until every wanted cell is closed: the length (in cells, along
+ * the cheapest route's steps) to each wanted cell, INFINITY for one it cannot reach. The
+ * cheapest route is the one A* finds (same step costs); its geometric length is kept
+ * beside its cost as the search goes. */
+static Outcome reach(const uint8_t *cost, int64_t height, int64_t width, const double *lut,
+                     int64_t start, uint8_t *wanted, int64_t remaining, double *best,
+                     double *length, uint8_t *closed) {
+    static const int d_row[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+    static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+    const double diagonal = sqrt(2.0);
+    int64_t n = height * width;
+    for (int64_t i = 0; i < n; i++) best[i] = length[i] = INFINITY;
+    Heap heap = {NULL, 0, 0};
+    best[start] = length[start] = 0.0;
+    if (heap_push(&heap, (Entry){0.0, 0.0, start}) < 0) return OUT_OF_MEMORY;
+    while (heap.size > 0 && remaining > 0) {
+        Entry entry = heap_pop(&heap);
+        int64_t cell = entry.cell;
+        if (closed[cell]) continue;
+        closed[cell] = 1;
+        if (wanted[cell]) {
+            wanted[cell] = 0;
+            remaining--;
+        }
+        int64_t row = cell / width, col = cell % width;
+        double here = lut[cost[cell]];
+        for (int k = 0; k < 8; k++) {
+            int64_t r = row + d_row[k], c = col + d_col[k];
+            if (r < 0 || r >= height || c < 0 || c >= width) continue;
+            int64_t next = r * width + c;
+            if (closed[next]) continue;
+            double there = lut[cost[next]];
+            if (isinf(there)) continue;
+            double step = (d_row[k] != 0 && d_col[k] != 0) ? diagonal : 1.0;
+            double g = entry.g + step * 0.5 * (here + there);
+            if (g < best[next]) {
+                best[next] = g;
+                length[next] = length[cell] + step;
+                if (heap_push(&heap, (Entry){g, g, next}) < 0) {
+                    free(heap.items);
+                    return OUT_OF_MEMORY;
+                }
+            }
+        }
+    }
+    free(heap.items);
+    return FOUND;
+}
+
+static PyObject *distances(PyObject *self, PyObject *args) {
+    Py_buffer cost_buffer, lut_buffer, target_buffer;
+    Py_ssize_t width, start;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*ny*ny*", &cost_buffer, &width, &lut_buffer, &start,
+                          &target_buffer))
+        return NULL;
+    PyObject *result = NULL;
+    double *best = NULL, *length = NULL;
+    uint8_t *closed = NULL, *wanted = NULL;
+    Py_ssize_t n = cost_buffer.len;
+    Py_ssize_t count = target_buffer.len / (Py_ssize_t)sizeof(int64_t);
+    const int64_t *targets = target_buffer.buf;
+    if (width <= 0 || n % width != 0) {
+        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+        goto finish;
+    }
+    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
+        target_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
+        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, targets int64 values");
+        goto finish;
+    }
+    if (start < 0 || start >= n) {
+        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
+        goto finish;
+    }
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (targets[i] < 0 || targets[i] >= n) {
+            PyErr_SetString(PyExc_IndexError, "target cell outside the grid");
+            goto finish;
+        }
+    }
+    best = malloc((size_t)n * sizeof(double));
+    length = malloc((size_t)n * sizeof(double));
+    closed = calloc((size_t)n, 1);
+    wanted = calloc((size_t)n, 1);
+    result = PyBytes_FromStringAndSize(NULL, count * (Py_ssize_t)sizeof(double));
+    if (best == NULL || length == NULL || closed == NULL || wanted == NULL || result == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto finish;
+    }
+    const uint8_t *cost = cost_buffer.buf;
+    const double *lut = lut_buffer.buf;
+    double *out = (double *)PyBytes_AS_STRING(result);
+    Outcome outcome = FOUND;
+    Py_BEGIN_ALLOW_THREADS
+    int64_t remaining = 0;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (!wanted[targets[i]] && !isinf(lut[cost[targets[i]]])) {
+            wanted[targets[i]] = 1;
+            remaining++;
+        }
+    }
+    if (!isinf(lut[cost[start]])) {
+        outcome = reach(cost, n / width, width, lut, start, wanted, remaining, best, length,
+                        closed);
+    } else {
+        for (int64_t i = 0; i < n; i++) length[i] = INFINITY;
+    }
+    for (Py_ssize_t i = 0; i < count; i++) out[i] = length[targets[i]];
+    Py_END_ALLOW_THREADS
+    if (outcome == OUT_OF_MEMORY) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+
+finish:
+    free(best);
+    free(length);
+    free(closed);
+    free(wanted);
+    PyBuffer_Release(&cost_buffer);
+    PyBuffer_Release(&lut_buffer);
+    PyBuffer_Release(&target_buffer);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"search", search, METH_VARARGS,
      "search(cost, width, lut, start, goal, heuristic_scale) -> (total, cells) or None\n\n"
      "A* over an 8-connected uint8 costmap; see navseq.sim.planner."},
+    {"distances", distances, METH_VARARGS,
+     "distances(cost, width, lut, start, targets) -> bytes of float64 lengths in cells\n\n"
+     "One Dijkstra search from start until every target is reached (inf: unreachable)."},
     {NULL, NULL, 0, NULL},
 };
 

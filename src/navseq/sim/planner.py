@@ -128,6 +128,83 @@ def search_cells(
     return np.column_stack(np.divmod(flat, width)), float(total)
 
 
+def reach_lengths(
+    costmap: Costmap,
+    start: tuple[float, float],
+    goals: list[tuple[float, float]],
+    *,
+    use_compiled: bool | None = None,
+) -> np.ndarray:
+    """Metres from ``start`` to each of ``goals`` along the plans :func:`plan_path` would
+    make (``inf`` where it would make none), from one search that stops once it reached
+    them all: for the distances between many places, one search per place instead of
+    one per pair. Places snap to their cells as in :func:`plan_path`."""
+    grid = costmap.grid
+    cost = np.ascontiguousarray(costmap.planning_cost, dtype=np.uint8)
+    lut = np.ascontiguousarray(_TRAVERSAL_LUT, dtype=np.float64)
+    width = cost.shape[1]
+    lengths = np.full(len(goals), np.inf)
+    row, col = grid.world_to_cell(*start)
+    if not grid.in_bounds(row, col) or cost[row, col] >= INSCRIBED:
+        return lengths
+    targets = np.full(len(goals), -1, dtype=np.int64)
+    for index, goal in enumerate(goals):
+        goal_row, goal_col = grid.world_to_cell(*goal)
+        if grid.in_bounds(goal_row, goal_col) and cost[goal_row, goal_col] < INSCRIBED:
+            targets[index] = goal_row * width + goal_col
+    known = targets >= 0
+    if use_compiled and _compiled_astar is None:
+        raise RuntimeError("the compiled A* (navseq.sim._astar) is not built")
+    compiled = _compiled_astar is not None if use_compiled is None else use_compiled
+    reach = _compiled_reach if compiled else _reach_python
+    cells = reach(cost, width, lut, row * width + col, targets[known])
+    lengths[known] = cells * grid.resolution
+    return lengths
+
+
+def _compiled_reach(
+    cost: np.ndarray, width: int, lut: np.ndarray, start: int, targets: np.ndarray
+) -> np.ndarray:
+    raw = _compiled_astar.distances(cost, width, lut, start, targets.tobytes())
+    return np.frombuffer(raw, dtype=np.float64)
+
+
+def _reach_python(
+    cost: np.ndarray, width: int, lut: np.ndarray, start: int, targets: np.ndarray
+) -> np.ndarray:
+    """Dijkstra until every target is closed; the readable twin of ``_astar.c``'s
+    ``distances``: each target's length in cells along its cheapest route."""
+    traversal = lut[cost.ravel()].tolist()
+    height = cost.size // width
+    wanted = {int(target) for target in targets}
+    best, length = {start: 0.0}, {start: 0.0}
+    closed: set[int] = set()
+    queue = [(0.0, start)]
+    inf = math.inf
+    while queue and wanted:
+        g, cell = heapq.heappop(queue)
+        if cell in closed:
+            continue
+        closed.add(cell)
+        wanted.discard(cell)
+        row, col = divmod(cell, width)
+        here = traversal[cell]
+        for dr, dc, step in _STEPS:
+            r, c = row + dr, col + dc
+            if not (0 <= r < height and 0 <= c < width):
+                continue
+            neighbour = r * width + c
+            there = traversal[neighbour]
+            if there == inf or neighbour in closed:
+                continue
+            candidate = g + step * 0.5 * (here + there)
+            if candidate < best.get(neighbour, inf):
+                best[neighbour] = candidate
+                length[neighbour] = length[cell] + step
+                heapq.heappush(queue, (candidate, neighbour))
+    return np.array([length.get(int(t), inf) if int(t) in closed else inf for t in targets])
+
+
 _STEPS = tuple(
     (dr, dc, SQRT2 if dr and dc else 1.0) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if dr or dc
 )

@@ -429,7 +429,7 @@ class Studio:
         """The draft's shortest visiting order (``POST /api/order``), as ``navseq plan
         --order shortest`` finds it on the draft's map (straight lines without one)."""
         from navseq.commands.common import choose_robot
-        from navseq.route.legs import StraightLegs, lengths, route_length
+        from navseq.route.legs import StraightLegs, route_length
         from navseq.route.order import shortest_order
 
         keep_last = body.get("keep_last", False)
@@ -440,7 +440,7 @@ class Studio:
         legs: Legs = StraightLegs()
         if checked.map_path is not None and checked.map_path.is_file():
             legs = self.planner(checked.map_path, robot)
-        ordering = shortest_order(mission, lengths(legs), ORDER_TIME_LIMIT_S, keep_last=keep_last)
+        ordering = shortest_order(mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last)
         return {
             "order": list(ordering.order),
             "length_m": route_length(legs_of(ordering.apply(mission), legs)),
