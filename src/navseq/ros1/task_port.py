@@ -20,7 +20,7 @@ import genpy.message
 import roslib.message
 import rospy
 
-from navseq.tasks.ros_port import Stop
+from navseq.tasks.ros_port import Stop, StopSet
 
 #: Bytes rospy reads a message into at once: an image's megabytes in one go (rospy's
 #: 64 KiB default takes many reads for one camera frame).
@@ -132,13 +132,13 @@ class Ros1TaskPort(Ros1Types):
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._publishers: dict[tuple[str, str], _Publisher] = {}
-        self._stops: set[Stop] = set()
+        self._stops = StopSet()
 
     def subscribe(self, topic: str, type_name: str, on_message: Callable[[Any], None]) -> Stop:
         subscriber = rospy.Subscriber(
             topic, _message_class(type_name), on_message, buff_size=RECEIVE_BUFFER
         )
-        return self._keep(subscriber.unregister)
+        return self._stops.keep(subscriber.unregister)
 
     def advertise(self, topic: str, type_name: str) -> _Publisher:
         key = (topic, type_name)
@@ -179,34 +179,17 @@ class Ros1TaskPort(Ros1Types):
             answer(response, None)
 
         threading.Thread(target=call, name="navseq-call-task", daemon=True).start()
-        return self._keep(dropped.set)
+        return self._stops.keep(dropped.set)
 
     def to_yaml(self, message: Any) -> str:
         return str(message) + "\n"
 
     def close(self) -> None:
         with self._lock:
-            stops, self._stops = list(self._stops), set()
             publishers, self._publishers = list(self._publishers.values()), {}
-        for stop in stops:
-            stop()
+        self._stops.stop_all()
         for publisher in publishers:
             publisher.publisher.unregister()
-
-    def _keep(self, stop: Callable[[], None]) -> Stop:
-        """``stop``, done at most once, by the job or by :meth:`close`."""
-        done = threading.Event()
-
-        def once() -> None:
-            with self._lock:
-                self._stops.discard(once)
-            if not done.is_set():
-                done.set()
-                stop()
-
-        with self._lock:
-            self._stops.add(once)
-        return once
 
 
 __all__ = ["Ros1TaskPort", "Ros1Types", "ros_types"]

@@ -18,9 +18,9 @@ from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
 from navseq.ros2.lifecycle import Nav2Lifecycle
-from navseq.ros2.messages import duration_msg
+from navseq.ros2.messages import duration_msg, finish_goal
 from navseq.ros2.standin import Nav2StandIn
-from navseq.sim.behaviors import Behavior, BehaviorEnding, BehaviorGoal, Outcome
+from navseq.sim.behaviors import Behavior, BehaviorEnding, BehaviorGoal
 
 #: Wall seconds between two feedback messages (Nav2's behaviours publish every cycle, 10 Hz).
 FEEDBACK_PERIOD = 0.1
@@ -98,13 +98,10 @@ class BehaviorActions:
             result.error_code = int(getattr(action.Result, ending.error))
         if ending.log:
             self._log.warning(f"{behavior.value}: {ending.log}")
-        if ending.outcome is Outcome.SUCCEEDED:
-            handle.succeed()
+        status = finish_goal(handle, ending.outcome.value)
+        if status == "SUCCEEDED":
             self._log.info(f"{behavior.value} completed successfully")
-        elif ending.outcome is Outcome.CANCELED and handle.is_cancel_requested:
-            handle.canceled()
-        else:
-            handle.abort()
+        elif status == "ABORTED":
             self._log.warning(f"{behavior.value} failed")
         return result
 

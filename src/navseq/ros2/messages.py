@@ -115,6 +115,19 @@ def path_msg(plan: Plan | None, goal: Pose2D | None, frame: str, stamp: Time) ->
     return path
 
 
+def finish_goal(handle: Any, outcome: str) -> str:
+    """Set an action goal's terminal status from ``outcome`` ("SUCCEEDED", "CANCELED" or
+    "ABORTED"; CANCELED only when the client asked for it, else ABORTED); the status set."""
+    if outcome == "SUCCEEDED":
+        handle.succeed()
+    elif outcome == "CANCELED" and handle.is_cancel_requested:
+        handle.canceled()
+    else:
+        handle.abort()
+        return "ABORTED"
+    return outcome
+
+
 def seconds_of(duration: Any) -> float:
     """Seconds of a ``builtin_interfaces/Duration`` (or ``Time``)."""
     return float(duration.sec) + float(duration.nanosec) * 1e-9

@@ -36,7 +36,7 @@ from rclpy.node import Node
 
 from navseq.geometry import Pose2D
 from navseq.ros2.lifecycle import Nav2Lifecycle
-from navseq.ros2.messages import duration_msg, path_msg, pose_stamped, seconds_of
+from navseq.ros2.messages import duration_msg, finish_goal, path_msg, pose_stamped, seconds_of
 from navseq.ros2.standin import Ending, Nav2StandIn, Outcome
 from navseq.sim.planner import Plan
 from navseq.sim.smoother import headings, smooth_path
@@ -266,12 +266,7 @@ class PathActions:
             ending = task.ending
         result.error_code = int(ending.error_code)
         result.error_msg = ending.error_msg
-        if ending.outcome is Outcome.SUCCEEDED:
-            handle.succeed()
-        elif ending.outcome is Outcome.CANCELED and handle.is_cancel_requested:
-            handle.canceled()
-        else:
-            handle.abort()
+        if finish_goal(handle, ending.outcome.value) == "ABORTED":
             self._log.info(f"follow_path: ABORTED {ending.error_msg}")
         return result
 

@@ -120,6 +120,7 @@ from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import (
     duration_msg,
+    finish_goal,
     grid_msg,
     path_msg,
     pose2d_of,
@@ -508,7 +509,7 @@ class SimNode:
         result = action.Result()
         result.error_code = int(ending.error_code)
         result.error_msg = ending.error_msg
-        _finish(handle, ending)
+        finish_goal(handle, ending.outcome.value)
         if ending.outcome is not Outcome.SUCCEEDED:
             self.log.info(f"{navigator.value}: {ending.outcome.value} {ending.error_msg}")
         elif task is not None and task.succeeded_on_old_path:
@@ -586,7 +587,7 @@ class SimNode:
             ]
         result.error_code = int(ending.error_code)
         result.error_msg = ending.error_msg
-        _finish(handle, ending)
+        finish_goal(handle, ending.outcome.value)
         return result
 
     # -- topics and services -------------------------------------------------------------
@@ -652,16 +653,6 @@ class SimNode:
 
 def _accept_cancel(_handle: Any) -> CancelResponse:
     return CancelResponse.ACCEPT
-
-
-def _finish(handle: Any, ending: Ending) -> None:
-    """Set the goal's terminal status from ``ending`` (CANCELED only if it was asked)."""
-    if ending.outcome is Outcome.SUCCEEDED:
-        handle.succeed()
-    elif ending.outcome is Outcome.CANCELED and handle.is_cancel_requested:
-        handle.canceled()
-    else:
-        handle.abort()
 
 
 def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:

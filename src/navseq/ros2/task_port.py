@@ -26,7 +26,7 @@ from rosidl_runtime_py import message_to_yaml, set_message_fields
 from rosidl_runtime_py.utilities import get_message, get_service
 
 from navseq.ros2.session import Ros2Session
-from navseq.tasks.ros_port import Stop
+from navseq.tasks.ros_port import Stop, StopSet
 
 #: Seconds between looks for a service that is not there yet.
 SERVICE_LOOK = 0.1
@@ -106,13 +106,13 @@ class Ros2TaskPort(Ros2Types):
         self._node = session.node
         self._lock = threading.Lock()
         self._publishers: dict[tuple[str, str], _Publisher] = {}
-        self._stops: set[Stop] = set()
+        self._stops = StopSet()
 
     def subscribe(self, topic: str, type_name: str, on_message: Callable[[Any], None]) -> Stop:
         subscription = self._node.create_subscription(
             _loaded(type_name, service=False), topic, on_message, qos_profile_sensor_data
         )
-        return self._keep(
+        return self._stops.keep(
             lambda: self._session.call_soon(self._node.destroy_subscription, subscription)
         )
 
@@ -161,34 +161,17 @@ class Ros2TaskPort(Ros2Types):
             dropped.set()
             self._session.call_soon(self._node.destroy_client, client)
 
-        return self._keep(stop)
+        return self._stops.keep(stop)
 
     def to_yaml(self, message: Any) -> str:
         return str(message_to_yaml(message))
 
     def close(self) -> None:
         with self._lock:
-            stops, self._stops = list(self._stops), set()
             publishers, self._publishers = list(self._publishers.values()), {}
-        for stop in stops:
-            stop()
+        self._stops.stop_all()
         for publisher in publishers:
             self._session.call_soon(self._node.destroy_publisher, publisher.publisher)
-
-    def _keep(self, stop: Callable[[], None]) -> Stop:
-        """``stop``, done at most once, by the job or by :meth:`close`."""
-        done = threading.Event()
-
-        def once() -> None:
-            with self._lock:
-                self._stops.discard(once)
-            if not done.is_set():
-                done.set()
-                stop()
-
-        with self._lock:
-            self._stops.add(once)
-        return once
 
 
 __all__ = ["Ros2TaskPort", "Ros2Types", "ros_types"]

@@ -14,6 +14,7 @@ store what they got, and the jobs look at it from the run's thread.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
@@ -71,6 +72,36 @@ class RosPort(RosTypes, Protocol):
         """Drop every publisher, subscription and call still open (the run ended)."""
 
 
+class StopSet:
+    """The stops of a port's running jobs (unsubscribe, drop a call), each done at most
+    once: by its job, or all together when the port closes. Thread-safe."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._stops: set[Stop] = set()
+
+    def keep(self, stop: Stop) -> Stop:
+        """``stop``, made to run at most once and kept until it ran."""
+        done = threading.Event()
+
+        def once() -> None:
+            with self._lock:
+                self._stops.discard(once)
+            if not done.is_set():
+                done.set()
+                stop()
+
+        with self._lock:
+            self._stops.add(once)
+        return once
+
+    def stop_all(self) -> None:
+        with self._lock:
+            stops = list(self._stops)
+        for stop in stops:
+            stop()
+
+
 def ros_port_of(navigator: object) -> RosPort | None:
     """The navigator's ROS port (``navigator.ros_tasks()``), or None when it has no ROS."""
     offer = getattr(navigator, "ros_tasks", None)
@@ -80,4 +111,11 @@ def ros_port_of(navigator: object) -> RosPort | None:
     return port
 
 
-__all__ = ["RosPort", "RosPublisher", "RosTypes", "Stop", "ros_port_of"]
+__all__ = [
+    "RosPort",
+    "RosPublisher",
+    "RosTypes",
+    "Stop",
+    "StopSet",
+    "ros_port_of",
+]
