@@ -84,7 +84,6 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
-    GoalOutcome,
     NavEvent,
     PublishedSink,
 )
@@ -93,11 +92,11 @@ from navseq.navigators.stack_map import MAP_WAIT, MapCatch, StackMap, stack_map_
 from navseq.ros2.messages import (
     add_transforms,
     navigate_goal,
-    result_text,
     seconds_of,
     terminal_status,
 )
 from navseq.ros2.record import TopicTap
+from navseq.ros2.results import goal_done
 from navseq.ros2.session import Ros2Session
 from navseq.ros2.task_port import Ros2TaskPort
 from navseq.roscore.clock import CLOCK_WAIT
@@ -598,13 +597,8 @@ class Nav2Navigator:
             self._inbox.put(GoalDone.lost(goal_id, f"no result: {error}"))
             return
         response = future.result()
-        outcome, status = terminal_status(response.status) or (GoalOutcome.LOST, "LOST")
-        result = response.result
-        # Humble's NavigateToPose result has neither field.
-        text = result_text(getattr(result, "error_code", 0), getattr(result, "error_msg", ""))
-        if outcome is GoalOutcome.LOST and not text:
-            text = "the server does not know the goal (restarted?)"
-        done = GoalDone(goal_id, outcome, status, text)
+        # Humble's NavigateToPose result has neither error_code nor error_msg.
+        done = goal_done(goal_id, terminal_status(response.status), response.result)
         stamp = self._node.get_clock().now().nanoseconds * 1e-9
         if self._result_hold.should_hold(done, stamp):
             # Judged on the robot's pose: wait (bounded) until /tf is as recent as this.
