@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, TypeVar
 
 from navseq.executor import CancelGoal, ClearCostmaps, Command, MissionExecutor, SendGoal
-from navseq.executor.commands import CancelTask, StartTask
+from navseq.executor.commands import CancelRecovery, CancelTask, RunRecovery, StartTask
 from navseq.executor.events import MissionEvent
 from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D
@@ -14,6 +14,7 @@ from navseq.mission.robot import RobotProfile
 from navseq.navigators.base import (
     GoalFeedback,
     GoalPlan,
+    RecoveryDone,
     ServerBack,
     ServerLost,
 )
@@ -133,6 +134,17 @@ class Harness:
         """The last task started ends by itself (or the task ``task_id``)."""
         tid = self.started_tasks()[-1].task_id if task_id is None else task_id
         return self._keep(self.executor.on_task_done(TaskDone(tid, succeeded, detail), t))
+
+    def recoveries_run(self) -> list[RunRecovery]:
+        return [c for c in self.commands if isinstance(c, RunRecovery)]
+
+    def recoveries_cancelled(self) -> list[CancelRecovery]:
+        return [c for c in self.commands if isinstance(c, CancelRecovery)]
+
+    def recovery_done(self, t: float, succeeded: bool = True, detail: str = "") -> list[Command]:
+        """The last recovery started ends by itself, as the navigator reports it."""
+        rid = self.recoveries_run()[-1].recovery_id
+        return self._keep(self.executor.on_event(RecoveryDone(rid, succeeded, detail), t))
 
     def of_type(self, cls: type[E]) -> list[E]:
         return [e for e in self.events if isinstance(e, cls)]

@@ -24,6 +24,7 @@ from navseq.executor.states import (
 )
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction
+from navseq.mission.recovery import Recovery
 from navseq.mission.tasks import InputTask, WaitTask
 
 S, T = ExecutorState, Trigger
@@ -257,6 +258,54 @@ def resume_task() -> Harness:
     return h
 
 
+TWO_RECOVERIES = (Recovery("spin", 90.0), Recovery("backup", 0.15))
+
+
+def recovering() -> Harness:
+    h = Harness(line_mission(2, retries=1, recoveries=TWO_RECOVERIES))
+    h.start(0.0)
+    h.done("ABORTED", 2.0)
+    h.tick(3.0)  # the back-off is over: the first recovery runs
+    assert h.executor.state is S.RECOVERING and len(h.recoveries_run()) == 1
+    return h
+
+
+def next_recovery() -> Harness:
+    h = recovering()
+    h.recovery_done(5.0)
+    assert [c.recovery.kind for c in h.recoveries_run()] == ["spin", "backup"]
+    return h
+
+
+def recoveries_done_then_retry() -> Harness:
+    h = next_recovery()
+    h.recovery_done(7.0)
+    assert len(h.goals()) == 2 and h.executor.result.visits[0].attempts == 2
+    return h
+
+
+def recoveries_done_then_server_gone() -> Harness:
+    h = next_recovery()
+    h.server_lost(6.0)
+    h.recovery_done(7.0)
+    assert len(h.goals()) == 1 and h.executor.state is S.WAITING_SERVER
+    return h
+
+
+def interrupt_recovery() -> Harness:
+    h = recovering()
+    h.interrupt(4.0, "interrupted: SIGINT")
+    assert len(h.recoveries_cancelled()) == 1 and len(h.cancels()) == 1
+    return h
+
+
+def resume_recovery() -> Harness:
+    h = paused(recovering(), t=4.0)
+    h.resume(9.0)
+    assert [c.recovery.kind for c in h.recoveries_run()] == ["spin", "spin"]
+    return h
+
+
 #: One scenario per table entry; each must take its entry at least once.
 SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.IDLE, T.GOAL_SENT): started,
@@ -293,6 +342,13 @@ SCENARIOS: dict[tuple[ExecutorState, Trigger], Callable[[], Harness]] = {
     (S.PAUSED, T.BACKOFF_GOES_ON): resume_backoff,
     (S.PAUSED, T.END): interrupt_pause,
     (S.PAUSED, T.TASK): resume_task,
+    (S.WAITING_RETRY, T.RECOVER): recovering,
+    (S.RECOVERING, T.RECOVER): next_recovery,
+    (S.RECOVERING, T.GOAL_SENT): recoveries_done_then_retry,
+    (S.RECOVERING, T.SERVER_AWAY): recoveries_done_then_server_gone,
+    (S.RECOVERING, T.PAUSE): lambda: paused(recovering(), t=4.0),
+    (S.RECOVERING, T.END): interrupt_recovery,
+    (S.PAUSED, T.RECOVER): resume_recovery,
 }
 
 Taken = list[tuple[ExecutorState, Trigger, ExecutorState]]

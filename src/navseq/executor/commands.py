@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from navseq.mission.recovery import Recovery
 from navseq.mission.tasks import Task
 from navseq.navigators.base import Goal
 
@@ -50,4 +51,22 @@ class CancelTask:
     task_id: int
 
 
-Command = SendGoal | CancelGoal | ClearCostmaps | StartTask | CancelTask
+@dataclass(frozen=True)
+class RunRecovery:
+    """Run ``recovery`` on the robot (no goal is out); its end comes back as
+    :class:`~navseq.navigators.base.RecoveryDone` with ``recovery_id``."""
+
+    recovery_id: int
+    recovery: Recovery
+
+
+@dataclass(frozen=True)
+class CancelRecovery:
+    """Stop the recovery ``recovery_id`` and the robot (timeout, pause, skip, cancel)."""
+
+    recovery_id: int
+
+
+Command = (
+    SendGoal | CancelGoal | ClearCostmaps | StartTask | CancelTask | RunRecovery | CancelRecovery
+)

@@ -138,6 +138,37 @@ class TaskFinished:
 
 
 @dataclass(frozen=True)
+class RecoveryStarted:
+    """A recovery of the waypoint's ``recovery:`` list began, before attempt ``attempt``
+    (``recovery``: its 1-based number in the list)."""
+
+    t: float
+    index: int
+    loop: int
+    recovery: int
+    recovery_kind: str  # spin, backup, wait, clear_costmaps
+    attempt: int  # the attempt it prepares (2 for the first retry)
+    amount: float | None = None  # degrees (spin), metres (backup), seconds (wait)
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class RecoveryFinished:
+    """A recovery ended: ``outcome`` succeeded, failed, timed_out or cancelled. The retry
+    goes ahead whatever it is (as Nav2's recovery subtree does)."""
+
+    t: float
+    index: int
+    loop: int
+    recovery: int
+    recovery_kind: str
+    attempt: int
+    outcome: str
+    duration: float
+    detail: str = ""
+
+
+@dataclass(frozen=True)
 class WaypointFinished:
     t: float
     index: int
@@ -197,6 +228,8 @@ MissionEvent = (
     | WaypointDwelling
     | TaskStarted
     | TaskFinished
+    | RecoveryStarted
+    | RecoveryFinished
     | WaypointFinished
     | ServerStatusChanged
     | MissionPaused

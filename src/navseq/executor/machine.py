@@ -21,6 +21,13 @@ navigator's clock):
   from ``now`` by the executor (``CancelTask``) and its failure handled by the
   waypoint's ``retries`` / ``on_failure``.
 
+Recoveries: when an attempt failed and another follows, the waypoint's ``recovery:``
+list runs first, in order, after the back-off (``RunRecovery``; the navigator reports
+the end as ``RecoveryDone`` among its events). Each is timed out by the executor
+(``CancelRecovery``); a failed one is recorded and the next goes ahead, and the retry
+goes ahead after the last, as Nav2's recovery subtree does. A pause stops the running
+recovery (it runs again from its start on resume); skip, cancel and interrupt stop it.
+
 Its states and the only ways between them are the table in
 :mod:`navseq.executor.states`; every state change goes through it.
 
@@ -63,9 +70,11 @@ from navseq.errors import NavseqError
 from navseq.executor.arrival import arrival_miss, goal_tolerance
 from navseq.executor.commands import (
     CancelGoal,
+    CancelRecovery,
     CancelTask,
     ClearCostmaps,
     Command,
+    RunRecovery,
     SendGoal,
     StartTask,
 )
@@ -77,6 +86,8 @@ from navseq.executor.events import (
     MissionPaused,
     MissionResumed,
     MissionStarted,
+    RecoveryFinished,
+    RecoveryStarted,
     ServerStatusChanged,
     TaskFinished,
     TaskStarted,
@@ -89,12 +100,13 @@ from navseq.executor.events import (
 )
 from navseq.executor.monitor import AttemptMonitor
 from navseq.executor.odometer import Odometer
-from navseq.executor.result import MissionResult, TaskResult, WaypointResult
+from navseq.executor.result import MissionResult, RecoveryResult, TaskResult, WaypointResult
 from navseq.executor.resume import ResumePoint, check_resume_point, visit_log
 from navseq.executor.states import ExecutorState, Trigger, next_state
 from navseq.executor.visit import Visit, next_position
 from navseq.geometry import Pose2D
 from navseq.mission.model import FailureAction, Mission, Policy
+from navseq.mission.recovery import Recovery
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
 from navseq.mission.tasks import Task
 from navseq.navigators.base import (
@@ -104,6 +116,7 @@ from navseq.navigators.base import (
     GoalOutcome,
     GoalPlan,
     NavEvent,
+    RecoveryDone,
     ServerBack,
     ServerLost,
 )
@@ -124,6 +137,16 @@ _GOES_ON = {
 }
 
 MissionListener = Callable[[MissionEvent], None]
+
+
+@dataclass(frozen=True)
+class _RunningRecovery:
+    """The recovery a RunRecovery went out for (number: 1-based in the list), and when."""
+
+    recovery_id: int
+    recovery: Recovery
+    number: int
+    started_at: float
 
 
 @dataclass(frozen=True)
@@ -171,6 +194,8 @@ class MissionExecutor:
         self._next_goal_id = 1
         self._next_task_id = 1
         self._task: _RunningTask | None = None  # the task out, in RUNNING_TASK
+        self._recovery: _RunningRecovery | None = None  # the recovery out, in RECOVERING
+        self._next_recovery_id = 1
         self._deadline = 0.0  # end of dwell or back-off, by state
         self._clear_costmaps_before_send = False
         self._server_up = True
@@ -294,6 +319,8 @@ class MissionExecutor:
             return self._on_server_lost(now, event.reason or "server lost")
         if isinstance(event, ServerBack):
             return self._on_server_back(now)
+        if isinstance(event, RecoveryDone):
+            return self._on_recovery_done(now, event)
         if self._state is not ExecutorState.ACTIVE or self._monitor is None:
             return []
         if getattr(event, "goal_id", None) != self._monitor.goal.goal_id:
@@ -372,7 +399,7 @@ class MissionExecutor:
         interrupted: ExecutorState = self._state
         if interrupted is ExecutorState.PAUSED:
             interrupted = self._end_pause(now)
-        stopped = self._stop_task(now, reason)
+        stopped = [*self._stop_task(now, reason), *self._stop_recovery(now, reason)]
         if interrupted is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
         else:
@@ -397,6 +424,7 @@ class MissionExecutor:
         if self._task is not None:  # run again from its start on resume
             commands.append(CancelTask(self._task.task_id))
             self._task = None
+        commands += self._stop_recovery(now, "paused")  # runs again from its start on resume
         paused_from = self._paused_from = self._state
         self._paused_at = now
         self._paused_monitor = self._monitor
@@ -423,6 +451,8 @@ class MissionExecutor:
             return self._check_clock(now)
         if interrupted is ExecutorState.RUNNING_TASK:
             return self._start_task(now)
+        if interrupted is ExecutorState.RECOVERING:
+            return self._start_recovery(now)
         # ACTIVE: the same attempt, a fresh goal id (late events of the cancelled goal
         # are ignored). WAITING_SERVER: sent if the server came back while paused.
         commands = self._send_goal(now)
@@ -456,7 +486,7 @@ class MissionExecutor:
             self._started_at = now
             self._finish_mission(now, reason)
             return []
-        stopped = self._stop_task(now, reason)
+        stopped = [*self._stop_task(now, reason), *self._stop_recovery(now, reason)]
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, reason)
         return [CancelGoal(), *stopped]
@@ -719,6 +749,102 @@ class MissionExecutor:
         self._success = self._log.all_reached(self._active_result())
         self._emit(MissionFinished(t=now, success=self._success, reason=reason))
 
+    # ------------------------------------------------------------------ recoveries
+
+    def _start_recovery(self, now: float) -> list[Command]:
+        """Run the visit's next due recovery (``visit.next_recovery``)."""
+        visit = self._current
+        assert visit.next_recovery is not None
+        number = visit.next_recovery + 1
+        recovery = visit.policy.recoveries[visit.next_recovery]
+        running = self._recovery = _RunningRecovery(
+            self._next_recovery_id, recovery, number, now
+        )
+        self._next_recovery_id += 1
+        self._move(Trigger.RECOVER)
+        self._emit(
+            RecoveryStarted(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                recovery=number,
+                recovery_kind=recovery.kind,
+                attempt=visit.result.attempts + 1,
+                amount=recovery.amount,
+                description=recovery.describe(),
+            )
+        )
+        return [RunRecovery(running.recovery_id, recovery)]
+
+    def _on_recovery_done(self, now: float, done: RecoveryDone) -> list[Command]:
+        running = self._recovery
+        if (
+            self._state is not ExecutorState.RECOVERING
+            or running is None
+            or done.recovery_id != running.recovery_id
+        ):
+            return []  # one we stopped (timeout, pause, skip): its end is no news
+        outcome = "succeeded" if done.succeeded else "failed"
+        self._record_recovery(now, outcome, done.detail)
+        return self._after_recovery(now)
+
+    def _check_recovery(self, now: float) -> list[Command]:
+        running = self._recovery
+        if running is None or now - running.started_at < running.recovery.timeout_s:
+            return []
+        self._record_recovery(now, "timed_out", f"no end after {running.recovery.timeout_s:g} s")
+        return [CancelRecovery(running.recovery_id), *self._after_recovery(now)]
+
+    def _after_recovery(self, now: float) -> list[Command]:
+        """The next recovery of the list, or the retry once they have all run."""
+        visit = self._current
+        following = (visit.next_recovery or 0) + 1
+        if following < len(visit.policy.recoveries):
+            visit.next_recovery = following
+            return self._start_recovery(now)
+        visit.next_recovery = None
+        return self._start_attempt(now)
+
+    def _stop_recovery(self, now: float, reason: str) -> list[Command]:
+        """Stop the running recovery, if any (pause, skip, cancel), recording why."""
+        running = self._recovery
+        if running is None:
+            return []
+        self._record_recovery(now, "cancelled", reason)
+        return [CancelRecovery(running.recovery_id)]
+
+    def _record_recovery(self, now: float, outcome: str, detail: str) -> None:
+        """Put the running recovery's end into the visit's result and tell the sinks."""
+        visit, running = self._current, self._recovery
+        assert running is not None
+        self._recovery = None
+        duration = max(0.0, now - running.started_at)
+        attempt = visit.result.attempts + 1
+        visit.result.recoveries.append(
+            RecoveryResult(
+                number=running.number,
+                kind=running.recovery.kind,
+                amount=running.recovery.amount,
+                attempt=attempt,
+                outcome=outcome,
+                duration=duration,
+                detail=detail,
+            )
+        )
+        self._emit(
+            RecoveryFinished(
+                t=now,
+                index=visit.index,
+                loop=visit.loop,
+                recovery=running.number,
+                recovery_kind=running.recovery.kind,
+                attempt=attempt,
+                outcome=outcome,
+                duration=duration,
+                detail=detail,
+            )
+        )
+
     # ------------------------------------------------------------------ failures
 
     def _attempt_failed(
@@ -757,6 +883,7 @@ class MissionExecutor:
             self._move(Trigger.RETRY_LATER)
             self._deadline = now + RETRY_BACKOFF
             self._clear_costmaps_before_send = policy.clear_costmaps_on_retry
+            visit.next_recovery = 0 if policy.recoveries else None
             return commands
         if policy.on_failure is FailureAction.SKIP:
             self._finish_visit(now, WaypointOutcome.SKIPPED, reason)
@@ -837,7 +964,11 @@ class MissionExecutor:
             return self._check_task(now)
         elif state is ExecutorState.WAITING_RETRY:
             if now >= self._deadline:
+                if self._current.next_recovery is not None:
+                    return self._start_recovery(now)
                 return self._start_attempt(now)
+        elif state is ExecutorState.RECOVERING:
+            return self._check_recovery(now)
         elif state is ExecutorState.WAITING_SERVER:
             timeout = self._mission.server_timeout
             if timeout is not None and now - self._server_lost_at >= timeout:

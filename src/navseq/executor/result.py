@@ -66,6 +66,19 @@ class TaskResult:
 
 
 @dataclass
+class RecoveryResult:
+    """One recovery run before a retry of a visit."""
+
+    number: int  # 1-based position in the waypoint's recovery list
+    kind: str
+    amount: float | None
+    attempt: int  # the attempt it prepared
+    outcome: str  # succeeded, failed, timed_out, cancelled
+    duration: float = 0.0  # s, navigator clock
+    detail: str = ""
+
+
+@dataclass
 class WaypointResult:
     """One visit of one waypoint (a patrol visits each waypoint once per loop)."""
 
@@ -83,6 +96,7 @@ class WaypointResult:
     passed_through: bool = False
     attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
     tasks: list[TaskResult] = field(default_factory=list)  # every task run, in order
+    recoveries: list[RecoveryResult] = field(default_factory=list)  # run before retries
 
     @property
     def yaw_deg(self) -> float:

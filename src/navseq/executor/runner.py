@@ -23,9 +23,11 @@ from typing import TYPE_CHECKING
 from navseq.errors import NavseqError
 from navseq.executor.commands import (
     CancelGoal,
+    CancelRecovery,
     CancelTask,
     ClearCostmaps,
     Command,
+    RunRecovery,
     SendGoal,
     StartTask,
 )
@@ -37,7 +39,7 @@ from navseq.executor.resume import ResumePoint
 from navseq.geometry import Pose2D
 from navseq.mission.model import Mission
 from navseq.mission.robot import RobotProfile
-from navseq.navigators.base import Navigator
+from navseq.navigators.base import NavEvent, Navigator, RecoveryDone, RecoveryRunner
 from navseq.signals import SignalGuard, Terminated
 
 if TYPE_CHECKING:
@@ -225,6 +227,7 @@ class _Outside:
     def __init__(self, navigator: Navigator, tasks: TaskRunner) -> None:
         self.navigator = navigator
         self.tasks = tasks
+        self.local_events: list[NavEvent] = []  # events the runner itself reports
 
     def apply(self, commands: list[Command]) -> None:
         navigator = self.navigator
@@ -239,6 +242,25 @@ class _Outside:
                 self.tasks.start(command, navigator.now())
             elif isinstance(command, CancelTask):
                 self.tasks.cancel(command.task_id)
+            elif isinstance(command, RunRecovery):
+                self._run_recovery(command)
+            elif isinstance(command, CancelRecovery):
+                _cancel_recovery(navigator)
+
+    def _run_recovery(self, command: RunRecovery) -> None:
+        """Hand the recovery to the navigator; one that runs none (a navigator of the
+        Python API: pre-flight refuses recoveries for the registered kinds that cannot
+        run them) has it fail, and the retry goes ahead."""
+        if isinstance(self.navigator, RecoveryRunner):
+            self.navigator.run_recovery(command.recovery_id, command.recovery)
+        else:
+            why = f"this navigator runs no recoveries ({command.recovery.describe()})"
+            self.local_events.append(RecoveryDone(command.recovery_id, False, why))
+
+
+def _cancel_recovery(navigator: Navigator) -> None:
+    if isinstance(navigator, RecoveryRunner):
+        navigator.cancel_recovery()
 
 
 def _drive(
@@ -258,6 +280,8 @@ def _steps(
     _apply(executor.start(navigator.now(), navigator.robot_pose()))
     while not executor.finished:
         events = navigator.poll()
+        if outside.local_events:
+            events, outside.local_events = [*outside.local_events, *events], []
         if control is not None and control.stop_reason is not None:
             # Asked after taking the events: a shutdown is announced before the goal is
             # cancelled under us, so that cancel's result is never a failed waypoint.
@@ -320,6 +344,7 @@ def _abort(
     """
     try:
         navigator.cancel_goal()
+        _cancel_recovery(navigator)  # a spin or backup under way stops too
     except Exception:
         _log.exception("cancelling the active goal failed")
     try:

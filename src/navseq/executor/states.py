@@ -24,6 +24,7 @@ class ExecutorState(enum.Enum):
     DWELLING = "dwelling"  # goal reached; waiting the waypoint's dwell time
     RUNNING_TASK = "running_task"  # goal reached; a task runs (or waits to run again)
     WAITING_RETRY = "waiting_retry"  # attempt failed; back-off before the next attempt
+    RECOVERING = "recovering"  # a recovery of the retry's recovery: list runs
     WAITING_SERVER = "waiting_server"  # server gone; the goal is resent when it is back
     PAUSED = "paused"  # the operator paused: no goal out, no deadline running
     FINISHED = "finished"  # the mission ended (see result.reason)
@@ -37,6 +38,7 @@ class Trigger(enum.Enum):
     DWELL = "dwell"  # the goal was reached; the waypoint's dwell time runs
     TASK = "task"  # a task of the reached waypoint starts (the first, next, or again)
     RETRY_LATER = "retry later"  # the attempt failed; back off before the next one
+    RECOVER = "recover"  # a recovery runs before the retry (the first, next, or again)
     PAUSE = "pause"  # the operator paused the run
     DWELL_GOES_ON = "dwell goes on"  # a pause during a dwell ended
     BACKOFF_GOES_ON = "back-off goes on"  # a pause during a back-off ended
@@ -74,6 +76,12 @@ TRANSITIONS: dict[tuple[ExecutorState, Trigger], ExecutorState] = {
     (_S.WAITING_RETRY, _T.SERVER_AWAY): _S.WAITING_SERVER,
     (_S.WAITING_RETRY, _T.PAUSE): _S.PAUSED,
     (_S.WAITING_RETRY, _T.END): _S.FINISHED,
+    (_S.WAITING_RETRY, _T.RECOVER): _S.RECOVERING,
+    (_S.RECOVERING, _T.RECOVER): _S.RECOVERING,  # the next recovery of the list
+    (_S.RECOVERING, _T.GOAL_SENT): _S.ACTIVE,  # the recoveries are done: the retry
+    (_S.RECOVERING, _T.SERVER_AWAY): _S.WAITING_SERVER,
+    (_S.RECOVERING, _T.PAUSE): _S.PAUSED,
+    (_S.RECOVERING, _T.END): _S.FINISHED,
     (_S.WAITING_SERVER, _T.GOAL_SENT): _S.ACTIVE,
     (_S.WAITING_SERVER, _T.SERVER_AWAY): _S.WAITING_SERVER,  # skipped to the next visit
     (_S.WAITING_SERVER, _T.PAUSE): _S.PAUSED,
@@ -81,6 +89,7 @@ TRANSITIONS: dict[tuple[ExecutorState, Trigger], ExecutorState] = {
     (_S.PAUSED, _T.GOAL_SENT): _S.ACTIVE,
     (_S.PAUSED, _T.SERVER_AWAY): _S.WAITING_SERVER,
     (_S.PAUSED, _T.TASK): _S.RUNNING_TASK,  # the interrupted task runs again from its start
+    (_S.PAUSED, _T.RECOVER): _S.RECOVERING,  # the interrupted recovery runs again
     (_S.PAUSED, _T.DWELL_GOES_ON): _S.DWELLING,
     (_S.PAUSED, _T.BACKOFF_GOES_ON): _S.WAITING_RETRY,
     (_S.PAUSED, _T.END): _S.FINISHED,

@@ -35,6 +35,9 @@ class Visit:
     # have succeeded), and which run of it this is (1 + its failures so far).
     next_task: int = 0
     task_attempt: int = 1
+    # The policy's recoveries before the next attempt: the 0-based position of the one to
+    # run next; None when none is due.
+    next_recovery: int | None = None
 
     @classmethod
     def of(cls, mission: Mission, loop: int, index: int) -> Visit:

@@ -55,6 +55,8 @@ EVENT_TYPES: dict[str, type] = {
         ev.WaypointDwelling,
         ev.TaskStarted,
         ev.TaskFinished,
+        ev.RecoveryStarted,
+        ev.RecoveryFinished,
         ev.WaypointFinished,
         ev.MissionPaused,
         ev.MissionResumed,

@@ -16,6 +16,7 @@ from types import MappingProxyType
 from typing import Any, NoReturn
 
 from navseq.geometry import Pose2D
+from navseq.mission.recovery import Recovery
 from navseq.mission.robot import RobotProfile
 from navseq.mission.tasks import Task
 
@@ -56,6 +57,8 @@ class Policy:
     stall_timeout_s: float | None = None  # s without progress before the attempt fails
     retries: int = 0
     clear_costmaps_on_retry: bool = False
+    # Run in order after a failed attempt, before the next one (navseq.mission.recovery).
+    recoveries: tuple[Recovery, ...] = ()
     on_failure: FailureAction = FailureAction.STOP
     pass_through_m: float | None = None  # radius; None: the robot stops at the waypoint
     dwell_s: float = 0.0
@@ -73,6 +76,7 @@ class Policy:
         stall_timeout_s: float | None = None,
         retries: int = 0,
         clear_costmaps_on_retry: bool = False,
+        recoveries: tuple[Recovery, ...] = (),
         on_failure: FailureAction = FailureAction.STOP,
         pass_through_m: float | None = None,
         dwell_s: float = 0.0,
@@ -101,6 +105,7 @@ class Policy:
             ("stall_timeout_s", stall_timeout_s),
             ("retries", retries),
             ("clear_costmaps_on_retry", clear_costmaps_on_retry),
+            ("recoveries", tuple(recoveries)),
             ("on_failure", on_failure),
             ("pass_through_m", pass_through_m),
             ("dwell_s", dwell_s),
@@ -134,6 +139,7 @@ POLICY_KEYS: Mapping[str, str] = MappingProxyType(
         "stall_timeout": "stall_timeout_s",
         "retries": "retries",
         "clear_costmaps_on_retry": "clear_costmaps_on_retry",
+        "recovery": "recoveries",
         "on_failure": "on_failure",
         "pass_through": "pass_through_m",
         "dwell": "dwell_s",

@@ -22,6 +22,7 @@ from navseq.files import write_atomically
 from navseq.geometry import Pose2D
 from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
+from navseq.mission.recovery_format import recovery_document
 from navseq.mission.robot import BUILTIN_PROFILES, RobotProfile
 from navseq.mission.task_format import task_document
 from navseq.mission.yaml_doc import EXPONENT_FLOAT
@@ -341,6 +342,11 @@ def _waypoint(waypoint: Waypoint) -> _FlowMapping:
 def _policy_values(policy: Policy, keys: Any) -> dict[str, Any]:
     """The file keys ``keys`` with ``policy``'s values, in the file's units."""
     values = {key: getattr(policy, POLICY_KEYS[key]) for key in keys}
+    if "recovery" in values:
+        if values["recovery"]:
+            values["recovery"] = recovery_document(values["recovery"])
+        else:
+            del values["recovery"]  # none: the key stays out of the file
     if values.get("yaw_tolerance") is not None:
         values["yaw_tolerance"] = round(math.degrees(values["yaw_tolerance"]), 6)
     return {

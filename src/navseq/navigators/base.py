@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 from navseq.geometry import Pose2D
+from navseq.mission.recovery import Recovery
 
 
 class GoalOutcome(str, enum.Enum):
@@ -111,7 +112,21 @@ class ServerBack:
     """The navigation server is reachable again after :class:`ServerLost`."""
 
 
-NavEvent = GoalAccepted | GoalFeedback | GoalPlan | GoalDone | ServerLost | ServerBack
+@dataclass(frozen=True)
+class RecoveryDone:
+    """A recovery the executor asked for (``run_recovery``) ended by itself.
+
+    ``succeeded`` False with ``detail`` in the stack's words (``COLLISION_AHEAD``, ...).
+    """
+
+    recovery_id: int
+    succeeded: bool
+    detail: str = ""
+
+
+NavEvent = (
+    GoalAccepted | GoalFeedback | GoalPlan | GoalDone | ServerLost | ServerBack | RecoveryDone
+)
 
 
 @runtime_checkable
@@ -160,6 +175,24 @@ class Navigator(Protocol):
 
     def close(self) -> None:
         """Release resources; cancels an active goal first."""
+        ...
+
+
+@runtime_checkable
+class RecoveryRunner(Protocol):
+    """What a navigator that runs recoveries (a retry's ``recovery:`` list) adds.
+
+    One recovery at a time, never while a goal is out; its end is reported by
+    :meth:`Navigator.poll` as :class:`RecoveryDone`. Which kinds a navigator runs is
+    declared by its kind (``NavigatorKind.recoveries``) and checked before the run.
+    """
+
+    def run_recovery(self, recovery_id: int, recovery: Recovery) -> None:
+        """Start ``recovery``; any recovery still running is stopped first."""
+        ...
+
+    def cancel_recovery(self) -> None:
+        """Stop the running recovery and the robot, if one runs (no RecoveryDone follows)."""
         ...
 
 

@@ -32,15 +32,20 @@ from navseq.navigators.base import (
     GoalFeedback,
     GoalPlan,
     NavEvent,
+    RecoveryDone,
 )
+from navseq.navigators.recovery_behaviors import behavior_request, start_on
 from navseq.navigators.registry import NavigatorDraft, NavigatorSetup
 from navseq.navigators.settings import SimNavigatorSettings
+from navseq.sim.behaviors import BehaviorGoal, BehaviorServer
+from navseq.sim.behaviors import Outcome as BehaviorOutcome
 from navseq.sim.navserver import NavParams, NavState
 from navseq.sim.occupancy import load_map
 from navseq.sim.world import SimWorld, default_start
 from navseq.track import Track
 
 if TYPE_CHECKING:
+    from navseq.mission.recovery import Recovery
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.occupancy import OccupancyGrid
@@ -90,6 +95,9 @@ class SimNavigator:
         self._plan_version = world.server.plan_version
         self._next_feedback = math.inf
         self._unspun = 0.0  # simulated seconds asked for but shorter than a step
+        # A retry's recoveries run on Nav2's behaviours, on the simulated robot.
+        self._behaviors = BehaviorServer()
+        self._recovery: tuple[int, BehaviorGoal] | None = None
 
     @classmethod
     def from_map(
@@ -138,6 +146,26 @@ class SimNavigator:
     def clear_costmaps(self) -> None:
         self.world.server.clear_costmaps()
 
+    def run_recovery(self, recovery_id: int, recovery: Recovery) -> None:
+        """Spin, back up or wait on the simulated robot with Nav2's behaviours (collision
+        checked ahead as Nav2's are); clear_costmaps clears the simulated server's."""
+        self.cancel_recovery()
+        request = behavior_request(recovery)
+        if request is None:
+            self.world.server.clear_costmaps()
+            self._events.append(RecoveryDone(recovery_id, True))
+            return
+        goal = start_on(self._behaviors, request, self.world.time)
+        self._recovery = (recovery_id, goal)
+        self._settle_recovery()  # a goal refused at once (invalid input) ends here
+
+    def cancel_recovery(self) -> None:
+        if self._recovery is None:
+            return
+        self._behaviors.cancel(self._recovery[1], self.world.time)
+        self._recovery = None
+        self.world.body.command(0.0, 0.0)  # the robot brakes
+
     def robot_pose(self) -> Pose2D | None:
         return self.world.robot.pose
 
@@ -155,9 +183,15 @@ class SimNavigator:
         self._unspun -= steps * world.dt
         robot = world.robot
         trajectory = self.trajectory
+        behaviors = self._behaviors
         for _ in range(steps):
             before = robot.pose
-            world.step()
+            if behaviors.running:
+                body = world.body
+                world.step_commanded(*behaviors.step(world.time, body.pose, body.collides))
+                self._settle_recovery()
+            else:
+                world.step()
             if robot.pose is not before:
                 trajectory.append((world.time, robot.pose.x, robot.pose.y))
             if self._active is not None:
@@ -169,6 +203,19 @@ class SimNavigator:
         self.cancel_goal()
 
     # -- internals ---------------------------------------------------------------------
+
+    def _settle_recovery(self) -> None:
+        """Report the running recovery's end, once its behaviour ended."""
+        if self._recovery is None:
+            return
+        recovery_id, goal = self._recovery
+        ending = goal.ending
+        if ending is None:
+            return
+        self._recovery = None
+        succeeded = ending.outcome is BehaviorOutcome.SUCCEEDED
+        detail = "" if succeeded else (ending.error or ending.log or ending.outcome.value)
+        self._events.append(RecoveryDone(recovery_id, succeeded, detail))
 
     def _pace(self) -> None:
         """Sleep until the wall clock is where simulated time says it should be."""

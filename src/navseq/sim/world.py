@@ -99,6 +99,14 @@ class SimWorld:
         self.body.command(cmd_v, cmd_w)
         self.body.step(self.dt)
 
+    def step_commanded(self, v: float, w: float) -> None:
+        """Advance one ``dt`` with the robot commanded from outside (a behaviour such as a
+        recovery's spin), not by the navigation server; it still never enters a wall."""
+        self.steps += 1
+        self.time = self.steps * self.dt
+        self.body.command(v, w)
+        self.body.step(self.dt)
+
     def set_other_robots(self, others: Sequence[tuple[Pose2D, Footprint]]) -> None:
         """Other robots (poses in the map frame, footprints) for the body and the server.
 

@@ -33,7 +33,7 @@ from typing import IO, Any, Protocol
 from navseq.executor.events import MissionEvent, WaypointOutcome, WaypointProgress
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 
 
 #: Decimals kept in every number of a record.
@@ -73,6 +73,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "outcome": ("outcome", _outcome),
     "path": ("path", _points),
     "task_kind": ("kind", None),  # TaskStarted / TaskFinished, as the report's tasks say
+    "recovery_kind": ("kind", None),  # RecoveryStarted / RecoveryFinished, likewise
 }
 
 

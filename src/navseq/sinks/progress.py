@@ -40,6 +40,8 @@ from navseq.executor.events import (
     MissionResumed,
     MissionStarted,
     ServerStatusChanged,
+    RecoveryFinished,
+    RecoveryStarted,
     TaskFinished,
     TaskStarted,
     WaypointDwelling,
@@ -182,6 +184,10 @@ class RunView:
             self.distance_remaining = 0.0
         elif isinstance(event, TaskFinished):
             self.status = f"task {event.task} {_task_outcome(event)}"
+        elif isinstance(event, RecoveryStarted):
+            self.status = f"recovery {event.recovery}: {printable(event.description)}"
+        elif isinstance(event, RecoveryFinished):
+            self.status = f"recovery {event.recovery} {_recovery_outcome(event)}"
         elif isinstance(event, WaypointFinished):
             outcome = WaypointOutcome(event.outcome)
             self.loop_outcomes[event.index] = outcome
@@ -355,6 +361,16 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
             f"{view.waypoint_label(event.index)}: task {event.task} ({event.task_kind}) "
             f"{_task_outcome(event)} after {event.duration:.1f} s"
         )
+    if isinstance(event, RecoveryStarted):
+        return (
+            f"{view.waypoint_label(event.index)}: recovery {event.recovery} "
+            f"{printable(event.description)} before attempt {event.attempt}"
+        )
+    if isinstance(event, RecoveryFinished):
+        return (
+            f"{view.waypoint_label(event.index)}: recovery {event.recovery} "
+            f"({event.recovery_kind}) {_recovery_outcome(event)} after {event.duration:.1f} s"
+        )
     if isinstance(event, WaypointFinished):
         outcome = WaypointOutcome(event.outcome)
         how = "passed through" if event.passed_through else outcome.value.replace("_", " ")
@@ -378,6 +394,14 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
     if isinstance(event, MissionFinished):
         return f"mission finished: {final_status(event.reason, event.success)}"
     return None  # WaypointProgress, WaypointPlan
+
+
+def _recovery_outcome(event: RecoveryFinished) -> str:
+    """``succeeded``, ``failed (COLLISION_AHEAD)`` ..."""
+    text = event.outcome.replace("_", " ")
+    if event.detail and event.outcome != "succeeded":
+        text += f" ({printable(event.detail)})"
+    return text
 
 
 def _task_outcome(event: TaskFinished) -> str:

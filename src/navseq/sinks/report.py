@@ -30,7 +30,9 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
                                 "duration_s", "distance_m", "recoveries"}],
                   "duration_s", "distance_m", "reason", "passed_through",
                   "tasks": [{"number", "kind", "attempt", "outcome", "duration_s",
-                             "detail", "files", "output"}]}],
+                             "detail", "files", "output"}],
+                  "recoveries_run": [{"number", "kind", "amount", "attempt", "outcome",
+                                      "duration_s", "detail"}]}],
       "files": {"journal", "picture", ...},
       "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
       "clock": {"navigator_s", "wall_s", "real_time_factor"}   # (not navseq report)
@@ -80,6 +82,7 @@ from navseq.executor.result import (
     KEEP_NOT_REACHED_VISITS,
     AttemptResult,
     MissionResult,
+    RecoveryResult,
     TaskResult,
     WaypointResult,
     WaypointTotals,
@@ -96,7 +99,7 @@ try:  # a dependency, but a ROS install of the package may not have it (see repo
 except ImportError:  # pragma: no cover - the tests run with it installed
     orjson = None  # type: ignore[assignment]
 
-SCHEMA_VERSION = 6
+SCHEMA_VERSION = 7
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -158,6 +161,21 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "reason": visit.reason,
         "passed_through": visit.passed_through,
         "tasks": [_task_dict(task) for task in visit.tasks],
+        "recoveries_run": [_recovery_dict(run) for run in visit.recoveries],
+    }
+
+
+def _recovery_dict(run: RecoveryResult) -> dict[str, Any]:
+    """One recovery run before a retry: ``amount`` in the kind's unit (spin degrees,
+    backup metres, wait seconds; null for clear_costmaps)."""
+    return {
+        "number": run.number,
+        "kind": run.kind,
+        "amount": run.amount,
+        "attempt": run.attempt,
+        "outcome": run.outcome,
+        "duration_s": _rounded(run.duration, 2),
+        "detail": run.detail,
     }
 
 
