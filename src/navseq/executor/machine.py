@@ -757,9 +757,7 @@ class MissionExecutor:
         assert visit.next_recovery is not None
         number = visit.next_recovery + 1
         recovery = visit.policy.recoveries[visit.next_recovery]
-        running = self._recovery = _RunningRecovery(
-            self._next_recovery_id, recovery, number, now
-        )
+        running = self._recovery = _RunningRecovery(self._next_recovery_id, recovery, number, now)
         self._next_recovery_id += 1
         self._move(Trigger.RECOVER)
         self._emit(

@@ -40,13 +40,9 @@ RECOVERY_KINDS: Mapping[str, RecoveryKind] = MappingProxyType(
                 signed=True,
                 meaning="turn in place by this angle (counter-clockwise; negative: clockwise)",
             ),
-            RecoveryKind(
-                "backup", "m", maximum=5.0, meaning="drive straight backwards this far"
-            ),
+            RecoveryKind("backup", "m", maximum=5.0, meaning="drive straight backwards this far"),
             RecoveryKind("wait", "s", maximum=3600.0, meaning="stand still this long"),
-            RecoveryKind(
-                "clear_costmaps", None, meaning="forget the obstacles the costmaps hold"
-            ),
+            RecoveryKind("clear_costmaps", None, meaning="forget the obstacles the costmaps hold"),
         )
     }
 )

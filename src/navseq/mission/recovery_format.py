@@ -10,6 +10,7 @@ Every bad entry is reported with its file:line, all of them at once.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from navseq.errors import MissionErrors, NavseqError
@@ -36,7 +37,8 @@ def read_recoveries(node: Located, subject: str) -> tuple[Recovery, ...]:
     problems = Problems()
     recoveries: list[Recovery] = []
     for number, item in enumerate(items, 1):
-        recovery = fields.attempt(problems, lambda: _recovery(item, f"{subject} {number}"))
+        read = functools.partial(_recovery, item, f"{subject} {number}")
+        recovery = fields.attempt(problems, read)
         if recovery is not None:
             recoveries.append(recovery)
     if len(problems.errors) == 1:
@@ -101,9 +103,7 @@ def _recovery(item: Located, subject: str) -> Recovery:
 
 def recovery_document(recoveries: tuple[Recovery, ...]) -> list[Any]:
     """The recoveries as a mission file writes them (read back by :func:`read_recoveries`)."""
-    return [
-        r.kind if r.amount is None else {r.kind: _tidy(r.amount)} for r in recoveries
-    ]
+    return [r.kind if r.amount is None else {r.kind: _tidy(r.amount)} for r in recoveries]
 
 
 def _tidy(value: float) -> float | int:

@@ -45,8 +45,8 @@ from navseq.sim.world import SimWorld, default_start
 from navseq.track import Track
 
 if TYPE_CHECKING:
-    from navseq.mission.recovery import Recovery
     from navseq.mission.model import Mission
+    from navseq.mission.recovery import Recovery
     from navseq.mission.robot import RobotProfile
     from navseq.sim.occupancy import OccupancyGrid
 

@@ -79,6 +79,7 @@ from tf2_msgs.msg import TFMessage
 
 from navseq.errors import NavseqError
 from navseq.geometry import FrameTree, Pose2D, pose2d_from_pose
+from navseq.mission.recovery import Recovery
 from navseq.navigators.base import (
     Goal,
     GoalAccepted,
@@ -96,6 +97,7 @@ from navseq.ros2.messages import (
     terminal_status,
 )
 from navseq.ros2.record import TopicTap
+from navseq.ros2.recovery_actions import Nav2Recoveries
 from navseq.ros2.results import goal_done
 from navseq.ros2.session import Ros2Session
 from navseq.ros2.task_port import Ros2TaskPort
@@ -239,6 +241,8 @@ class Nav2Navigator:
         self._clock_sub: Any = None
         if sim_time:
             self._watch_clock()
+        # A retry's recoveries: Nav2's behaviour actions (spin, backup, wait).
+        self._recoveries = Nav2Recoveries(node, self._in_ros, self._inbox.put, self.clear_costmaps)
 
     def _in_ros(self, callback: Any, *args: Any) -> None:
         """Run ``callback(*args)`` on the executor's thread (rclpy is not used from two)."""
@@ -392,6 +396,14 @@ class Nav2Navigator:
                 "waiting for it",
             )
 
+    def run_recovery(self, recovery_id: int, recovery: Recovery) -> None:
+        """Run ``recovery`` through Nav2's behaviour server (spin, backup, wait) or the
+        costmaps' clear services (:mod:`navseq.ros2.recovery_actions`)."""
+        self._recoveries.run(recovery_id, recovery)
+
+    def cancel_recovery(self) -> None:
+        self._recoveries.cancel()
+
     def read_parameters(
         self, nodes: Mapping[str, str], timeout: float = PARAMS_WAIT
     ) -> dict[str, dict[str, Any]]:
@@ -515,6 +527,7 @@ class Nav2Navigator:
             self._task_port.close()
         if self._tap is not None:
             self._tap.close()
+        self._recoveries.cancel()
         self._core.cancel_and_wait()
         self.now()  # keep the clock's last value for after close
         self._closed = True
