@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
 
+from navseq.mission.recovery import RECOVERY_KINDS
+from navseq.navigators.plain_recoveries import PLAIN_KINDS
 from navseq.navigators.settings import (
     Nav2NavigatorSettings,
     NavigatorSettings,
@@ -130,7 +132,8 @@ class NavigatorKind:
     ROS tasks run there (on the navigator's node), and are only rehearsed
     (``--simulate-tasks``) on the kinds without; ``task_types`` is then the module whose
     ``ros_types()`` says which message types the running ROS can load (checked before
-    the run)."""
+    the run). ``recoveries``: the recovery kinds (a retry's ``recovery:`` list) it can
+    run; a mission naming another is refused before the robot moves."""
 
     name: str
     help: str
@@ -142,6 +145,7 @@ class NavigatorKind:
     paced: bool = False
     ros: bool = False
     task_types: str = ""
+    recoveries: frozenset[str] = frozenset(RECOVERY_KINDS)
 
     def ros_types(self) -> RosTypes:
         """The running ROS's message types, for the check before the run. Where the
@@ -214,6 +218,8 @@ NAVIGATORS: tuple[NavigatorKind, ...] = (
         places_robot=False,
         ros=True,
         task_types="navseq.ros1.task_port",
+        # move_base has no action per behaviour: wait and clear_costmaps only.
+        recoveries=PLAIN_KINDS,
     ),
     NavigatorKind(
         "nav2",

@@ -72,6 +72,7 @@ from std_srvs.srv import Empty
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.mission.recovery import Recovery
 from navseq.navigators.base import (
     Goal,
     GoalAccepted,
@@ -81,6 +82,7 @@ from navseq.navigators.base import (
     NavEvent,
     PublishedSink,
 )
+from navseq.navigators.plain_recoveries import PlainRecoveries
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
 from navseq.ros1.task_port import Ros1TaskPort
@@ -212,6 +214,7 @@ class Ros1Navigator:
             self, self.resolved_action, lost_after=0.0, cancel_wait=cancel_wait
         )
         self._inbox = self._core.inbox
+        self._recoveries = PlainRecoveries(self.now, self.clear_costmaps)
         self._plans = self._core.plans
         self._book = self._core.book
         self._feedback_pose: Pose2D | None = None
@@ -439,6 +442,14 @@ class Ros1Navigator:
         elif errors:
             self._core.warn_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
 
+    def run_recovery(self, recovery_id: int, recovery: Recovery) -> None:
+        """``wait`` on ROS time and ``clear_costmaps`` through move_base's service;
+        move_base has no spin or backup to ask for (refused before the run)."""
+        self._recoveries.run(recovery_id, recovery)
+
+    def cancel_recovery(self) -> None:
+        self._recoveries.cancel()
+
     def robot_pose(self) -> Pose2D | None:
         if self._tf_buffer is not None:
             frame = self.frame or "map"
@@ -468,7 +479,8 @@ class Ros1Navigator:
 
     def poll(self) -> list[NavEvent]:
         why_lost = f"no status for {self.status_timeout:g} s"
-        return [*self._inbox.drain(), *self._core.check_server(why_lost)]
+        ended = self._recoveries.poll()
+        return [*self._inbox.drain(), *ended, *self._core.check_server(why_lost)]
 
     def close(self) -> None:
         """Cancel the tracked goal and wait (bounded) until move_base takes the cancel in."""

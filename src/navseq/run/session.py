@@ -517,6 +517,7 @@ def prepare(request: RunRequest) -> Session:
     if part is not None:
         mission = part.apply(mission)
     _refuse_tasks(mission, request, kind)
+    _refuse_recoveries(mission, request, kind)
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
@@ -661,6 +662,28 @@ def _refuse_tasks(mission: Mission, request: RunRequest, kind: NavigatorKind | N
         types=types,
         has_folder=request.outputs is not None or request.tasks.snapshot_folder is not None,
     )
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        raise MissionErrors(problems)
+
+
+def _refuse_recoveries(mission: Mission, request: RunRequest, kind: NavigatorKind | None) -> None:
+    """Recoveries the navigator cannot run (spin on move_base), each with its file:line,
+    before anything moves."""
+    from navseq.errors import MissionErrors
+    from navseq.mission.recovery import RECOVERY_KINDS
+    from navseq.navigators.base import RecoveryRunner
+    from navseq.navigators.recovery_check import recovery_problems
+
+    if isinstance(request.navigator, UseNavigator):
+        name = str(request.navigator.info["kind"])
+        runs = isinstance(request.navigator.navigator, RecoveryRunner)
+        supported: frozenset[str] = frozenset(RECOVERY_KINDS) if runs else frozenset()
+    else:
+        assert kind is not None
+        name, supported = kind.name, kind.recoveries
+    problems = recovery_problems(mission, name, supported)
     if len(problems) == 1:
         raise problems[0]
     if problems:
