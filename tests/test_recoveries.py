@@ -232,3 +232,15 @@ def test_a_navigator_of_the_api_without_recoveries_has_them_refused(tmp_path: Pa
     (problem,) = recovery_problems(mission, "mine", frozenset())
     assert isinstance(problem, NavseqError)
     assert "the mine navigator cannot run the recovery wait 1 s (it runs none)" in str(problem)
+
+
+def test_a_report_rebuilt_from_the_journal_lists_the_recoveries(tmp_path: Path) -> None:
+    mission_file(tmp_path, RUN_MISSION)
+    assert navseq("run", "m.yaml", "--out", "out", cwd=tmp_path).returncode == 1
+    report = tmp_path / "out" / "report.json"
+    written = json.loads(report.read_text())
+    report.unlink()
+    rebuilt = navseq("report", "out", cwd=tmp_path)
+    assert rebuilt.returncode in (0, 1), rebuilt.stderr
+    again = json.loads(report.read_text())
+    assert again["visits"][0]["recoveries_run"] == written["visits"][0]["recoveries_run"]

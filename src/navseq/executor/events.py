@@ -166,6 +166,7 @@ class RecoveryFinished:
     outcome: str
     duration: float
     detail: str = ""
+    amount: float | None = None  # as in RecoveryStarted
 
 
 @dataclass(frozen=True)

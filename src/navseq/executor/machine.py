@@ -840,6 +840,7 @@ class MissionExecutor:
                 outcome=outcome,
                 duration=duration,
                 detail=detail,
+                amount=running.recovery.amount,
             )
         )
 

@@ -26,7 +26,13 @@ from typing import Any, NamedTuple, overload
 
 from navseq.errors import NavseqError
 from navseq.executor import events as ev
-from navseq.executor.result import AttemptResult, TaskResult, VisitLog, WaypointResult
+from navseq.executor.result import (
+    AttemptResult,
+    RecoveryResult,
+    TaskResult,
+    VisitLog,
+    WaypointResult,
+)
 from navseq.executor.resume import ResumePoint
 from navseq.journal.reader import Damaged, Entry, Event, JournalHeader, JournalReader, Resumed
 from navseq.sinks.recorder import RunRecorder
@@ -95,6 +101,8 @@ class _VisitTrail:
     # The stack's recovery count last journaled for the latest attempt (the journal
     # keeps every progress event whose count changed).
     recoveries: int | None = None
+    # The recoveries run before its retries (RecoveryFinished), in order.
+    recovery_runs: list[RecoveryResult] = field(default_factory=list)
 
 
 @dataclass
@@ -189,6 +197,21 @@ class VisitHistory:
         number that succeeded (0 when none)."""
         succeeded = TaskOutcome.SUCCEEDED.value
         return max((t.number for t in self.tasks_of(key) if t.outcome == succeeded), default=0)
+
+    def finish_recovery(self, event: ev.RecoveryFinished) -> None:
+        trail = self._trail
+        if trail is not None and trail.key == (event.loop, event.index):
+            trail.recovery_runs.append(
+                RecoveryResult(
+                    number=event.recovery,
+                    kind=event.recovery_kind,
+                    amount=event.amount,
+                    attempt=event.attempt,
+                    outcome=event.outcome,
+                    duration=event.duration,
+                    detail=event.detail,
+                )
+            )
 
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
@@ -339,6 +362,8 @@ def _fold(state: JournalState, entries: Iterable[Entry]) -> None:
             visits.fail_attempt(event)
         elif isinstance(event, ev.TaskFinished):
             visits.finish_task(event)
+        elif isinstance(event, ev.RecoveryFinished):
+            visits.finish_recovery(event)
         elif isinstance(event, ev.WaypointFinished):
             visits.finish_visit(event, f"{path}:{entry.line}")
         elif isinstance(event, ev.MissionFinished):
@@ -455,6 +480,7 @@ def _visit_of(
         passed_through=event.passed_through,
         attempt_results=_attempts_of(event, trail),
         tasks=tasks or [],
+        recoveries=list(trail.recovery_runs) if trail is not None else [],
     )
 
 

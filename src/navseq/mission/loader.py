@@ -25,12 +25,13 @@ from navseq.mission.csv_format import mission_from_csv
 from navseq.mission.launch_xml import mission_from_launch
 from navseq.mission.located import Located, from_plain
 from navseq.mission.model import Mission
-from navseq.mission.nav2_waypoints_format import nav2_reader_for, parse_echo
+from navseq.mission.nav2_waypoints_format import echoed_message, nav2_reader_for
 from navseq.mission.navseq_format import mission_from_document
 from navseq.mission.params import mission_from_namespace
 from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
 from navseq.mission.rosparam_format import find_mission_namespaces, mission_from_tree
+from navseq.mission.yaml_doc import parse_yaml
 
 Reader = Callable[[str, str, Path, Problems], "Mission | None"]
 
@@ -163,7 +164,7 @@ def _sniff(path: Path, text: str) -> Reader:
     if lines and all(_CSV_LINE.fullmatch(line) for line in lines[1:] or lines):
         return _read_csv
     try:
-        doc = parse_echo(text, str(path), Problems())
+        doc = echoed_message(text, str(path), Problems()) or parse_yaml(text, str(path), Problems())
     except NavseqError:
         doc = None
     if doc is not None and doc.is_mapping:
@@ -175,7 +176,7 @@ def _sniff(path: Path, text: str) -> Reader:
 
 def _read_yaml(text: str, source: str, base_dir: Path, problems: Problems) -> Mission | None:
     # ``ros2 topic echo`` separates messages by ``---``: its last message is read.
-    doc = parse_echo(text, source, problems)
+    doc = echoed_message(text, source, problems) or parse_yaml(text, source, problems)
     nav2_reader = nav2_reader_for(doc)
     if nav2_reader is not None:
         assert doc is not None

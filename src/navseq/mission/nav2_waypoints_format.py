@@ -51,12 +51,37 @@ def nav2_reader_for(doc: Located | None) -> Nav2Reader | None:
     if doc is None or not doc.is_mapping:
         return None
     waypoints = doc.value.get("waypoints")
-    if waypoints is not None and waypoints.is_mapping and set(doc.value) == {"waypoints"}:
+    if _is_panel_list(waypoints) and set(doc.value) == {"waypoints"}:
         return mission_from_panel  # navseq's own ``waypoints:`` is a list
     poses = doc.value.get("poses")
     if poses is not None and poses.is_list and set(doc.value) <= {"header", "poses"}:
         return mission_from_echoed_poses
     return None
+
+
+def _is_panel_list(waypoints: Located | None) -> bool:
+    """``waypoints:`` as the panel writes it: a mapping of entries, one with a ``pose``."""
+    if waypoints is None or not waypoints.is_mapping or not waypoints.value:
+        return False
+    entries = list(waypoints.value.values())
+    return all(e.is_mapping for e in entries) and any("pose" in e.value for e in entries)
+
+
+def echoed_message(text: str, source: str, problems: Problems) -> Located | None:
+    """The last message of ``ros2 topic echo``'s output of several (``---`` between
+    them) when it is a PoseArray or Path; None for any other text (read as usual)."""
+    if not _SEPARATOR.search(text):
+        return None
+    own = Problems()
+    try:
+        doc = parse_echo(text, source, own)
+    except NavseqError:
+        return None
+    if doc is None or nav2_reader_for(doc) is None:
+        return None
+    for error in own.errors:
+        problems.record(error)
+    return doc
 
 
 def last_echoed_message(text: str) -> tuple[str, int]:
@@ -282,6 +307,7 @@ def _num(value: float) -> str:
 __all__ = [
     "PANEL_FRAME",
     "dump_nav2_panel",
+    "echoed_message",
     "last_echoed_message",
     "mission_from_echoed_poses",
     "mission_from_panel",
