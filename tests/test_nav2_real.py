@@ -287,3 +287,24 @@ def test_the_real_behaviour_server_answers_as_the_stand_in_does(
     shown = {key: value for key, value in seen.items() if key != "feedback"}
     assert (seen["status"], seen["error_code"]) == (case.status, case.error_code), shown
     assert case.check(seen), shown
+
+
+def test_a_retrys_recoveries_run_on_nav2s_behaviour_server(
+    placed: RealNav2, tmp_path: Path
+) -> None:
+    # A goal in an unknown frame fails at once, twice; between the attempts the real
+    # behaviour server turns the robot and waits, and both costmaps are cleared.
+    mission = write_mission(
+        tmp_path / "recover.yaml",
+        "  - {name: nowhere, x: 0.5, y: 0.0, yaw: 0}\n",
+        header="frame: nowhere\ndefaults: {retries: 1, on_failure: skip, goal_timeout: 60, "
+        "recovery: [spin: 90, wait: 1, clear_costmaps]}\n",
+    )
+    result = run(placed, mission, tmp_path / "out", "--no-preflight")
+    assert result.returncode == 1, result.stdout + result.stderr
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    [visit] = report["visits"]
+    assert len(visit["attempts"]) == 2
+    runs = [(r["kind"], r["outcome"]) for r in visit["recoveries_run"]]
+    assert runs == [("spin", "succeeded"), ("wait", "succeeded"), ("clear_costmaps", "succeeded")]
+    assert visit["recoveries_run"][1]["duration_s"] >= 1.0

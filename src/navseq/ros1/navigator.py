@@ -82,7 +82,7 @@ from navseq.navigators.base import (
     NavEvent,
     PublishedSink,
 )
-from navseq.navigators.plain_recoveries import PlainRecoveries
+from navseq.navigators.plain_recoveries import PLAIN_KINDS, PlainRecoveries
 from navseq.ros1.conversions import move_base_goal, pose2d_from_pose, pose2d_from_transform
 from navseq.ros1.conversions import terminal_status as terminal_status_of
 from navseq.ros1.task_port import Ros1TaskPort
@@ -441,6 +441,9 @@ class Ros1Navigator:
             )
         elif errors:
             self._core.warn_once("failed", f"{service} failed, retrying anyway ({errors[0]})")
+
+    #: The recoveries it runs (a node's run refuses the others before the robot moves).
+    recovery_kinds = PLAIN_KINDS
 
     def run_recovery(self, recovery_id: int, recovery: Recovery) -> None:
         """``wait`` on ROS time and ``clear_costmaps`` through move_base's service;

@@ -678,8 +678,11 @@ def _refuse_recoveries(mission: Mission, request: RunRequest, kind: NavigatorKin
 
     if isinstance(request.navigator, UseNavigator):
         name = str(request.navigator.info["kind"])
-        runs = isinstance(request.navigator.navigator, RecoveryRunner)
-        supported: frozenset[str] = frozenset(RECOVERY_KINDS) if runs else frozenset()
+        given = request.navigator.navigator
+        runs = isinstance(given, RecoveryRunner)
+        # A navigator that runs only some kinds says which (the ros1 one: wait, clear).
+        every = frozenset(RECOVERY_KINDS) if runs else frozenset()
+        supported: frozenset[str] = frozenset(getattr(given, "recovery_kinds", every))
     else:
         assert kind is not None
         name, supported = kind.name, kind.recoveries
