@@ -730,6 +730,26 @@ def test_the_tutorials_files_import_as_documents(
     assert client.post("/api/check", json={"mission": body["mission"]}).json()["readable"]
 
 
+def test_nav2s_waypoint_files_import_as_documents(client: TestClient, workspace: Path) -> None:
+    (workspace / "examples/wp.yaml.yaml").write_text(
+        "waypoints:\n  waypoint0:\n    pose: [-1.6, -0.5, 0.0]\n"
+        "    orientation: [0.7071068, 0.0, 0.0, 0.7071068]\n",
+        encoding="utf-8",
+    )
+    pose = "- position: {x: %s, y: 0.5, z: 0.0}\n  orientation: {x: 0.0, y: 0.0, z: 0.0, w: 1.0}\n"
+    echo = "header: {frame_id: map}\nposes:\n"
+    (workspace / "examples/poses.yaml").write_text(
+        f"{echo}{pose % 9.0}---\n{echo}{pose % 1.6}---\n", encoding="utf-8"
+    )
+    panel = client.post("/api/import", json={"path": "wp.yaml.yaml"})
+    assert panel.status_code == 200, panel.text
+    [waypoint] = panel.json()["mission"]["waypoints"]
+    assert (waypoint["x"], waypoint["y"], waypoint["yaw"]) == pytest.approx((-1.6, -0.5, 90.0))
+    echoed = client.post("/api/import", json={"path": "poses.yaml"})
+    assert echoed.status_code == 200, echoed.text
+    assert [w["x"] for w in echoed.json()["mission"]["waypoints"]] == [1.6]  # the last message
+
+
 def test_a_bad_or_missing_import_is_a_4xx_with_its_problems(
     client: TestClient, workspace: Path
 ) -> None:
