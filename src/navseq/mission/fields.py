@@ -266,18 +266,13 @@ def _failure_action(node: Located, subject: str) -> FailureAction:
     return FailureAction(choice(node, subject, [a.value for a in FailureAction]))
 
 
-def _recoveries(node: Located, subject: str) -> Any:
-    from navseq.mission.recovery_format import read_recoveries  # it reads through this module
-
-    return read_recoveries(node, subject)
-
-
+#: Each policy key's reader. ``recovery`` is registered by
+#: :mod:`navseq.mission.recovery_format`, which reads through this module's readers.
 POLICY_READERS: dict[str, Callable[[Located, str], Any]] = {
     "goal_timeout": _optional(positive_seconds),
     "stall_timeout": _optional(positive_seconds),
     "retries": lambda node, subject: integer(node, subject, minimum=0),
     "clear_costmaps_on_retry": boolean,
-    "recovery": _recoveries,
     "on_failure": _failure_action,
     "pass_through": _optional(
         lambda node, subject: bounded_number(

@@ -29,7 +29,10 @@ from typing import Any
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, quaternion_to_yaw
-from navseq.mission import fields
+from navseq.mission import (
+    fields,
+    recovery_format,  # noqa: F401  (registers the recovery: key)
+)
 from navseq.mission.located import Located, describe
 from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.problems import Problems, Salvage

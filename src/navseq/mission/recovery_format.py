@@ -101,6 +101,10 @@ def _recovery(item: Located, subject: str) -> Recovery:
     return Recovery(kind.name, value)
 
 
+# The policy key ``recovery:`` reads through this module (fields cannot import it back).
+fields.POLICY_READERS["recovery"] = read_recoveries
+
+
 def recovery_document(recoveries: tuple[Recovery, ...]) -> list[Any]:
     """The recoveries as a mission file writes them (read back by :func:`read_recoveries`)."""
     return [r.kind if r.amount is None else {r.kind: _tidy(r.amount)} for r in recoveries]
