@@ -400,6 +400,25 @@ def test_a_retry_clears_the_costmaps_before_its_goal_only_when_asked(
     assert order == (["goal", "clear_costmaps", "goal"] if clear else ["goal", "goal"])
 
 
+def test_a_retrys_wait_and_clear_recoveries_run_on_move_base(ros_master: RosMaster, tmp_path: Path):
+    log = tmp_path / "server.jsonl"
+    start_server(ros_master, log, "abort:0.2 succeed:0.2")
+    navseq = run_navseq(
+        ros_master,
+        tmp_path,
+        "  - {name: a, x: 1.0, y: 0.0, yaw: 0}\n",
+        "retries: 1, goal_timeout: 30, recovery: [wait: 0.5, clear_costmaps]",
+    )
+    assert navseq.popen.returncode == 0, navseq.output()
+    (visit,) = visits_of(tmp_path)
+    assert [a["status"] for a in visit["attempts"]] == ["ABORTED", "SUCCEEDED"]
+    runs = [(r["kind"], r["outcome"]) for r in visit["recoveries_run"]]
+    assert runs == [("wait", "succeeded"), ("clear_costmaps", "succeeded")]
+    assert visit["recoveries_run"][0]["duration_s"] >= 0.5  # on ROS time
+    order = [r["event"] for r in server_log(log) if r["event"] in ("goal", "clear_costmaps")]
+    assert order == ["goal", "clear_costmaps", "goal"]
+
+
 @pytest.mark.parametrize(
     ("behaviour", "warning"),
     [
