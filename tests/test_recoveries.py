@@ -244,3 +244,21 @@ def test_a_report_rebuilt_from_the_journal_lists_the_recoveries(tmp_path: Path) 
     assert rebuilt.returncode in (0, 1), rebuilt.stderr
     again = json.loads(report.read_text())
     assert again["visits"][0]["recoveries_run"] == written["visits"][0]["recoveries_run"]
+
+
+def test_leaving_a_run_during_a_spin_stops_the_robot(tmp_path: Path) -> None:
+    # What Ctrl-C does through the runner: the run ends, the recovery is cancelled first.
+    from navseq.executor.events import RecoveryStarted
+    from navseq.executor.runner import iter_mission
+
+    mission = load_mission(mission_file(tmp_path, RUN_MISSION.replace("spin: 90", "spin: 270")))
+    navigator = SimNavigator(SimWorld(load_map(TURTLEBOT3_MAP), START))
+    events = iter_mission(mission, navigator)
+    for event in events:
+        if isinstance(event, RecoveryStarted):
+            break
+    navigator.spin(0.5)  # the spin is under way
+    assert navigator.world.robot.w != 0.0
+    events.close()
+    navigator.spin(1.0)
+    assert navigator.world.robot.w == 0.0 and navigator.world.robot.v == 0.0
