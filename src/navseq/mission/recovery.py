@@ -50,6 +50,8 @@ RECOVERY_KINDS: Mapping[str, RecoveryKind] = MappingProxyType(
 #: How long a recovery may take before the executor gives up on it, beyond what its
 #: amount needs (a slow robot turning a full circle, a backup blocked by an obstacle).
 RECOVERY_TIMEOUT_S = 30.0
+#: m/s a backup drives at: Nav2's default trees (``<BackUp backup_speed="0.15"/>``).
+BACKUP_SPEED_MPS = 0.15
 
 
 @dataclass(frozen=True)
@@ -70,9 +72,11 @@ class Recovery:
 
     @property
     def timeout_s(self) -> float:
-        """Seconds the executor waits for it to end (a wait's own length, plus slack)."""
-        own = self.amount if self.kind == "wait" and self.amount is not None else 0.0
+        """Seconds the executor waits for it to end: what its amount takes (a wait's
+        length, a backup's distance at :data:`BACKUP_SPEED_MPS`), plus slack."""
+        amount = abs(self.amount or 0.0)
+        own = {"wait": amount, "backup": amount / BACKUP_SPEED_MPS}.get(self.kind, 0.0)
         return own + RECOVERY_TIMEOUT_S
 
 
-__all__ = ["RECOVERY_KINDS", "RECOVERY_TIMEOUT_S", "Recovery", "RecoveryKind"]
+__all__ = ["BACKUP_SPEED_MPS", "RECOVERY_KINDS", "RECOVERY_TIMEOUT_S", "Recovery", "RecoveryKind"]

@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from navseq.mission.recovery import Recovery
+from navseq.mission.recovery import BACKUP_SPEED_MPS, Recovery
 from navseq.sim.behaviors import Behavior, BehaviorGoal, BehaviorServer
 
 #: m/s backwards: Nav2's default trees (``<BackUp backup_dist="0.30" backup_speed="0.15"/>``).
-BACKUP_SPEED = 0.15
+BACKUP_SPEED = BACKUP_SPEED_MPS
 
 
 @dataclass(frozen=True)
