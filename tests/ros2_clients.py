@@ -50,6 +50,7 @@ from nav2_msgs.action import (
     BackUp,
     ComputePathThroughPoses,
     ComputePathToPose,
+    DockRobot,
     DriveOnHeading,
     FollowPath,
     FollowWaypoints,
@@ -57,6 +58,7 @@ from nav2_msgs.action import (
     NavigateToPose,
     SmoothPath,
     Spin,
+    UndockRobot,
     Wait,
 )
 from nav2_msgs.srv import ClearEntireCostmap
@@ -404,6 +406,83 @@ def teleop(node: Node, args: argparse.Namespace) -> dict:
     return {**out, **motion(node, poses, before)}
 
 
+def map_pose(node: Node, args: argparse.Namespace) -> list[float] | None:
+    """The robot's pose in ``map`` (``map -> odom -> base`` on ``/tf``), once heard."""
+    frames: dict[str, tuple[float, float, float]] = {}
+
+    def on_tf(message: TFMessage) -> None:
+        for transform in message.transforms:
+            t, q = transform.transform.translation, transform.transform.rotation
+            child = transform.child_frame_id
+            key = "odom" if child.endswith("odom") else "base" if "base" in child else None
+            if key is not None:
+                frames[key] = (t.x, t.y, 2 * math.atan2(q.z, q.w))
+
+    subscription = node.create_subscription(TFMessage, "/tf", on_tf, 100)
+    end = time.monotonic() + 5.0
+    while len(frames) < 2 and time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    node.destroy_subscription(subscription)
+    if len(frames) < 2:
+        return None
+    (ox, oy, oyaw), (bx, by, byaw) = frames["odom"], frames["base"]
+    return [
+        ox + bx * math.cos(oyaw) - by * math.sin(oyaw),
+        oy + bx * math.sin(oyaw) + by * math.cos(oyaw),
+        math.remainder(oyaw + byaw, math.tau),
+    ]
+
+
+def docking(node: Node, args: argparse.Namespace, undock: bool) -> dict:
+    """A dock_robot goal (by id, or at a pose X,Y,YAW with --frame) or an undock_robot goal."""
+    if undock:
+        action, server, goal = UndockRobot, "undock_robot", UndockRobot.Goal()
+    else:
+        action, server = DockRobot, "dock_robot"
+        target = args.poses[0]
+        if "," in target:
+            goal = DockRobot.Goal(use_dock_id=False, dock_pose=pose_stamped(target, args.frame))
+        else:
+            goal = DockRobot.Goal(use_dock_id=True, dock_id=target)
+        goal.navigate_to_staging_pose = args.value <= 0
+    client = ActionClient(node, action, name(args.ns, server))
+    if not client.wait_for_server(timeout_sec=args.timeout):
+        raise SystemExit(f"no {server} server")
+    states: list[int] = []
+
+    def on_feedback(message: Any) -> None:
+        states.append(int(message.feedback.state))
+
+    handle = wait(node, client.send_goal_async(goal, feedback_callback=on_feedback), args.timeout)
+    if not handle.accepted:
+        return {"accepted": False}
+    result_future = handle.get_result_async()
+    if args.cancel_after is not None:
+        end = time.monotonic() + args.cancel_after
+        while time.monotonic() < end and not result_future.done():
+            rclpy.spin_once(node, timeout_sec=0.05)
+        wait(node, handle.cancel_goal_async(), args.timeout)
+    result = wait(node, result_future, args.timeout)
+    settle = time.monotonic() + 0.5
+    while time.monotonic() < settle:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    return {
+        "status": STATUS.get(result.status, str(result.status)),
+        "success": bool(result.result.success),
+        "error_code": int(result.result.error_code),
+        "states": [state for index, state in enumerate(states) if state not in states[:index]],
+        "pose": map_pose(node, args),
+    }
+
+
+def dock(node: Node, args: argparse.Namespace) -> dict:
+    return docking(node, args, undock=False)
+
+
+def undock(node: Node, args: argparse.Namespace) -> dict:
+    return docking(node, args, undock=True)
+
+
 def ready(node: Node, args: argparse.Namespace) -> dict:
     out: dict[str, Any] = {}
     for server in ("bt_navigator", "amcl"):
@@ -450,6 +529,8 @@ VERBS = {
     "behavior": behavior,
     "refusals": refusals,
     "manage": manage,
+    "dock": dock,
+    "undock": undock,
 }
 
 

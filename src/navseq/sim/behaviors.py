@@ -191,6 +191,10 @@ class BehaviorServer:
     def running(self) -> bool:
         return self.active is not None
 
+    def drives(self, _now: float) -> bool:
+        """Whether a behaviour drives the robot this step (the stand-in's driver rule)."""
+        return self.active is not None
+
     def _start(self, goal: BehaviorGoal) -> BehaviorGoal:
         previous = self.active
         if previous is not None:
