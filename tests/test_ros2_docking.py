@@ -6,18 +6,23 @@ at (-2, -0.5) facing +x; docks of ``examples/turtlebot3_docks.yaml``: ``home_doc
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
+import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
+from nav2_real_support import nav2_missing_reason, nav2_prefix
 from ros2_support import ros2_environment, ros2_prefix
 from test_ros2_sim import MAP, REPO, SPEED, START, SimProcess
 
 pytestmark = pytest.mark.ros2
 
 DOCKS = REPO / "examples" / "turtlebot3_docks.yaml"
+COMMANDER = Path(__file__).with_name("nav2") / "commander_docking.py"
 DOCKING = [1, 2, 3, 4]  # NAV_TO_STAGING_POSE, INITIAL_PERCEPTION, CONTROLLING, WAIT_FOR_CHARGE
 
 
@@ -117,3 +122,44 @@ def test_ros2_action_send_goal_docks_and_undocks(sim: SimProcess) -> None:
         assert "Goal accepted" in done.stdout
         assert "Goal finished with status: SUCCEEDED" in done.stdout, done.stdout
         assert "success: true" in done.stdout
+
+
+def test_nav2_simple_commander_runs_assisted_teleop_docks_and_undocks_unchanged() -> None:
+    """example_assisted_teleop's assistedTeleop (ended by its time allowance: FAILED, as
+    on Nav2), then dockRobotByID, undockRobot and dockRobotByPose: each call returns."""
+    reason = nav2_missing_reason()
+    if reason is not None:
+        pytest.skip(reason)
+    prefix = nav2_prefix()
+    assert prefix is not None
+    node = SimProcess(
+        ros2_environment(prefix),
+        "--map",
+        str(MAP),
+        f"--start={START}",
+        "--speed",
+        SPEED,
+        "--docks",
+        str(DOCKS),
+    )
+    try:
+        done = subprocess.run(
+            [sys.executable, str(COMMANDER)],
+            env=node.env,
+            capture_output=True,
+            text=True,
+            timeout=180,
+        )
+    finally:
+        err = node.stop()
+    assert done.returncode == 0, done.stderr[-3000:]
+    seen = json.loads(done.stdout.strip().splitlines()[-1])
+    assert seen == {
+        "assistedTeleop accepted": True,
+        "assistedTeleop": "FAILED",  # TIMEOUT after its 2 s
+        "dockRobotByID": "SUCCEEDED",
+        "undockRobot": "SUCCEEDED",
+        "dockRobotByPose": "SUCCEEDED",
+    }
+    assert "Robot is charging!" in err and "Robot has undocked!" in err
+    assert "Traceback" not in err
