@@ -21,7 +21,8 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   (:mod:`navseq.ros2.path_actions`);
 - both costmaps' topics (``global_costmap/costmap``, ``costmap_raw``,
   ``published_footprint``, the local ones) and ``get_costmap`` services
-  (:mod:`navseq.ros2.costmap_topics`);
+  (:mod:`navseq.ros2.costmap_topics`), their region clears and ``get_cost``, and the
+  planner's ``is_path_valid`` (:mod:`navseq.ros2.costmap_services`);
 - opennav_docking's ``dock_robot`` / ``undock_robot`` on the docks of ``--docks``
   (:mod:`navseq.ros2.docking`, :mod:`navseq.ros2.docking_actions`);
 - the behaviour server's ``spin``, ``backup``, ``drive_on_heading``, ``wait`` and
@@ -718,6 +719,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             + ("following /clock" if config.follow_clock else f"speed x{config.speed:g}")
             + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
             + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else "")
+            + (f", docks {', '.join(d.name for d in config.docks)}" if config.docks else "")
             + (
                 f", re-plan period {config.replan_period:g} s on preemption"
                 if config.replan_period > 0
