@@ -163,3 +163,19 @@ def test_nav2_simple_commander_runs_assisted_teleop_docks_and_undocks_unchanged(
     }
     assert "Robot is charging!" in err and "Robot has undocked!" in err
     assert "Traceback" not in err
+
+
+def test_an_inactive_docking_server_rejects_goals_as_nav2s_does(sim: SimProcess) -> None:
+    def run(*command: str) -> str:
+        done = subprocess.run(command, env=sim.env, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        return done.stdout
+
+    deactivate = "{transition: {id: 4}}"  # lifecycle_msgs/Transition DEACTIVATE
+    run("ros2", "service", "call", "/docking_server/change_state",
+        "lifecycle_msgs/srv/ChangeState", deactivate)  # fmt: skip
+    refused = run(
+        "ros2", "action", "send_goal", "/dock_robot", "nav2_msgs/action/DockRobot",
+        "{dock_id: home_dock}",
+    )  # fmt: skip
+    assert "Goal was rejected" in refused, refused
