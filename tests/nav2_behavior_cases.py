@@ -1,4 +1,4 @@
-"""Behaviour goals and what Nav2 answers, held against both the stand-in
+"""Behaviour goals (assisted teleop's too) and what Nav2 answers, held against both the stand-in
 (``tests/test_ros2_behaviors.py``) and the real behaviour server
 (``tests/test_nav2_real.py``): one table, so the two cannot drift apart.
 
@@ -110,5 +110,31 @@ CASES = [
         "CANCELED",
         0,
         lambda s: abs(s["turned"]) > 0.1,
+    ),
+    # assisted_teleop: ``speed`` on cmd_vel_teleop, preempt_teleop after ``value`` wall
+    # seconds (0: never), ``allowance`` seconds of time allowance.
+    BehaviorCase(
+        "assisted teleop drives with the operator's command until preempt_teleop",
+        "assisted_teleop",
+        {"value": 2.0, "speed": 0.1, "allowance": 30},
+        "SUCCEEDED",
+        0,
+        lambda s: s["advanced"] > 0.1 and abs(s["turned"]) < 0.1,
+    ),
+    BehaviorCase(
+        "assisted teleop toward the wall stops short of it",
+        "assisted_teleop",
+        {"value": 6.0, "speed": -0.2, "allowance": 30},
+        "SUCCEEDED",
+        0,
+        lambda s: 0.05 < -s["advanced"] < 0.6,
+    ),
+    BehaviorCase(
+        "assisted teleop's time allowance runs out: TIMEOUT",
+        "assisted_teleop",
+        {"value": 0.0, "speed": 0.0, "allowance": 2},
+        "ABORTED",
+        731,
+        lambda s: s["moved"] < 0.01,
     ),
 ]

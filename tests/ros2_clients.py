@@ -13,6 +13,12 @@ and prints one JSON object on its last stdout line: what it saw. Verbs:
   ``backup`` / ``drive_on_heading`` (``--value`` metres at ``--speed``, ``--target-y``),
   or ``wait`` (``--value`` seconds), ``--allowance`` seconds of time allowance; says how
   far the robot turned and moved (its ``odom -> base`` transform on ``/tf``);
+- ``teleop``: an ``assisted_teleop`` goal (``--allowance`` seconds) while the operator's
+  ``cmd_vel_teleop`` says ``--speed`` m/s (10 Hz), then ``preempt_teleop`` after
+  ``--value`` wall seconds (0: never); says how far the robot moved, as ``behavior``;
+- ``dock DOCK_ID`` / ``undock``: ``dock_robot`` (by id; ``--value`` > 0 sets
+  ``navigate_to_staging_pose`` false) / ``undock_robot`` goals, with their result fields,
+  the feedback states and where the robot ended (``map -> odom -> base`` on ``/tf``);
 - ``refusals``: goals the planner, smoother and controller servers refuse (no goals,
   unknown plugin ids, an empty path, a pose in an unknown frame), each one's status and
   error code;
@@ -40,9 +46,11 @@ from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from lifecycle_msgs.srv import GetState
 from nav2_msgs.action import (
+    AssistedTeleop,
     BackUp,
     ComputePathThroughPoses,
     ComputePathToPose,
+    DockRobot,
     DriveOnHeading,
     FollowPath,
     FollowWaypoints,
@@ -50,6 +58,7 @@ from nav2_msgs.action import (
     NavigateToPose,
     SmoothPath,
     Spin,
+    UndockRobot,
     Wait,
 )
 from nav2_msgs.srv import ClearEntireCostmap
@@ -291,6 +300,8 @@ def behavior(node: Node, args: argparse.Namespace) -> dict:
     from builtin_interfaces.msg import Duration
 
     kind = args.poses[0]
+    if kind == "assisted_teleop":
+        return teleop(node, args)
     allowance = Duration(sec=int(args.allowance), nanosec=int(args.allowance % 1 * 1e9))
     if kind == "spin":
         action, goal = Spin, Spin.Goal(target_yaw=args.value, time_allowance=allowance)
@@ -301,6 +312,16 @@ def behavior(node: Node, args: argparse.Namespace) -> dict:
         action = BackUp if kind == "backup" else DriveOnHeading
         goal = action.Goal(speed=args.speed, time_allowance=allowance)
         goal.target.x, goal.target.y = args.value, args.target_y
+    poses = odom_poses(node, args)
+    before = poses[-1]
+    started = time.monotonic()
+    out = run_goal(node, args, action, kind, goal)
+    out["took"] = time.monotonic() - started
+    return {**out, **motion(node, poses, before)}
+
+
+def odom_poses(node: Node, args: argparse.Namespace) -> list[tuple[float, float, float]]:
+    """The robot's ``odom -> base`` poses as they come on ``/tf`` (one at least)."""
     poses: list[tuple[float, float, float]] = []
 
     def on_tf(message: TFMessage) -> None:
@@ -316,10 +337,14 @@ def behavior(node: Node, args: argparse.Namespace) -> dict:
         rclpy.spin_once(node, timeout_sec=0.05)
     if not poses:
         raise SystemExit("no odom -> base transform on /tf")
-    before = poses[-1]
-    started = time.monotonic()
-    out = run_goal(node, args, action, kind, goal)
-    out["took"] = time.monotonic() - started
+    return poses
+
+
+def motion(
+    node: Node, poses: list[tuple[float, float, float]], before: tuple[float, float, float]
+) -> dict:
+    """How far the robot moved since ``before``, once it settled (1 s)."""
+    out: dict[str, float] = {}
     settle = time.monotonic() + 1.0
     while time.monotonic() < settle:
         rclpy.spin_once(node, timeout_sec=0.05)
@@ -331,6 +356,131 @@ def behavior(node: Node, args: argparse.Namespace) -> dict:
     ) * math.sin(before[2])
     out["turned"] = math.remainder(after[2] - before[2], math.tau)
     return out
+
+
+def teleop(node: Node, args: argparse.Namespace) -> dict:
+    """An assisted_teleop goal driven by ``cmd_vel_teleop``, ended by ``preempt_teleop``."""
+    from builtin_interfaces.msg import Duration
+    from geometry_msgs.msg import Twist
+    from std_msgs.msg import Empty
+
+    allowance = Duration(sec=int(args.allowance), nanosec=int(args.allowance % 1 * 1e9))
+    client = ActionClient(node, AssistedTeleop, name(args.ns, "assisted_teleop"))
+    if not client.wait_for_server(timeout_sec=args.timeout):
+        raise SystemExit("no assisted_teleop server")
+    command = node.create_publisher(Twist, name(args.ns, "cmd_vel_teleop"), 10)
+    preempt = node.create_publisher(Empty, name(args.ns, "preempt_teleop"), 10)
+    poses = odom_poses(node, args)
+    before = poses[-1]
+    durations: list[float] = []
+
+    def on_feedback(message: Any) -> None:
+        elapsed = message.feedback.current_teleop_duration
+        durations.append(elapsed.sec + elapsed.nanosec * 1e-9)
+
+    goal = AssistedTeleop.Goal(time_allowance=allowance)
+    handle = wait(node, client.send_goal_async(goal, feedback_callback=on_feedback), args.timeout)
+    if not handle.accepted:
+        return {"accepted": False}
+    result_future = handle.get_result_async()
+    twist = Twist()
+    twist.linear.x = args.speed
+    started = time.monotonic()
+    end = started + args.timeout
+    preempted = False
+    while not result_future.done() and time.monotonic() < end:
+        command.publish(twist)
+        if args.value > 0 and not preempted and time.monotonic() - started >= args.value:
+            preempt.publish(Empty())
+            preempted = True
+        for _ in range(2):
+            rclpy.spin_once(node, timeout_sec=0.05)
+    command.publish(Twist())
+    result = wait(node, result_future, args.timeout)
+    out: dict[str, Any] = {
+        "status": STATUS.get(result.status, str(result.status)),
+        "error_code": int(result.result.error_code),
+        "took": time.monotonic() - started,
+        "feedback": durations,
+    }
+    return {**out, **motion(node, poses, before)}
+
+
+def map_pose(node: Node, args: argparse.Namespace) -> list[float] | None:
+    """The robot's pose in ``map`` (``map -> odom -> base`` on ``/tf``), once heard."""
+    frames: dict[str, tuple[float, float, float]] = {}
+
+    def on_tf(message: TFMessage) -> None:
+        for transform in message.transforms:
+            t, q = transform.transform.translation, transform.transform.rotation
+            child = transform.child_frame_id
+            key = "odom" if child.endswith("odom") else "base" if "base" in child else None
+            if key is not None:
+                frames[key] = (t.x, t.y, 2 * math.atan2(q.z, q.w))
+
+    subscription = node.create_subscription(TFMessage, "/tf", on_tf, 100)
+    end = time.monotonic() + 5.0
+    while len(frames) < 2 and time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    node.destroy_subscription(subscription)
+    if len(frames) < 2:
+        return None
+    (ox, oy, oyaw), (bx, by, byaw) = frames["odom"], frames["base"]
+    return [
+        ox + bx * math.cos(oyaw) - by * math.sin(oyaw),
+        oy + bx * math.sin(oyaw) + by * math.cos(oyaw),
+        math.remainder(oyaw + byaw, math.tau),
+    ]
+
+
+def docking(node: Node, args: argparse.Namespace, undock: bool) -> dict:
+    """A dock_robot goal (by id, or at a pose X,Y,YAW with --frame) or an undock_robot goal."""
+    if undock:
+        action, server, goal = UndockRobot, "undock_robot", UndockRobot.Goal()
+    else:
+        action, server = DockRobot, "dock_robot"
+        target = args.poses[0]
+        if "," in target:
+            goal = DockRobot.Goal(use_dock_id=False, dock_pose=pose_stamped(target, args.frame))
+        else:
+            goal = DockRobot.Goal(use_dock_id=True, dock_id=target)
+        goal.navigate_to_staging_pose = args.value <= 0
+    client = ActionClient(node, action, name(args.ns, server))
+    if not client.wait_for_server(timeout_sec=args.timeout):
+        raise SystemExit(f"no {server} server")
+    states: list[int] = []
+
+    def on_feedback(message: Any) -> None:
+        states.append(int(message.feedback.state))
+
+    handle = wait(node, client.send_goal_async(goal, feedback_callback=on_feedback), args.timeout)
+    if not handle.accepted:
+        return {"accepted": False}
+    result_future = handle.get_result_async()
+    if args.cancel_after is not None:
+        end = time.monotonic() + args.cancel_after
+        while time.monotonic() < end and not result_future.done():
+            rclpy.spin_once(node, timeout_sec=0.05)
+        wait(node, handle.cancel_goal_async(), args.timeout)
+    result = wait(node, result_future, args.timeout)
+    settle = time.monotonic() + 0.5
+    while time.monotonic() < settle:
+        rclpy.spin_once(node, timeout_sec=0.05)
+    return {
+        "status": STATUS.get(result.status, str(result.status)),
+        "success": bool(result.result.success),
+        "error_code": int(result.result.error_code),
+        "states": [state for index, state in enumerate(states) if state not in states[:index]],
+        "pose": map_pose(node, args),
+    }
+
+
+def dock(node: Node, args: argparse.Namespace) -> dict:
+    return docking(node, args, undock=False)
+
+
+def undock(node: Node, args: argparse.Namespace) -> dict:
+    return docking(node, args, undock=True)
 
 
 def ready(node: Node, args: argparse.Namespace) -> dict:
@@ -379,6 +529,8 @@ VERBS = {
     "behavior": behavior,
     "refusals": refusals,
     "manage": manage,
+    "dock": dock,
+    "undock": undock,
 }
 
 

@@ -83,6 +83,11 @@ RULES: tuple[Rule, ...] = (
         "tests/test_ros2_fleet.py::test_robot1_drives_around_robot2_parked_on_its_straight_path",
     ),
     Rule(
+        r"navseq sim --ros2 .*--docks|^ros2 action send_goal /(un)?dock_robot",
+        "ros",
+        "tests/test_ros2_docking.py::test_ros2_action_send_goal_docks_and_undocks",
+    ),
+    Rule(
         r"navseq sim --ros2",
         "ros",
         "tests/test_ros2_cli.py::test_navseq_sim_ros2_serves_until_a_signal_and_exits_0",

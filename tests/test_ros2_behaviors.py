@@ -1,5 +1,5 @@
-"""Nav2's behaviours (spin, backup, drive_on_heading, wait) on the ROS 2 simulator node,
-through real rclpy action clients (``tests/ros2_clients.py behavior``), as
+"""Nav2's behaviours (spin, backup, drive_on_heading, wait, assisted_teleop) on the ROS 2
+simulator node, through real rclpy action clients (``tests/ros2_clients.py behavior``), as
 nav2_simple_commander's ``spin()`` / ``backup()`` / ``driveOnHeading()`` / ``wait()``
 send them. The cases and Nav2's answers are ``tests/nav2_behavior_cases.py``'s, which
 ``tests/test_nav2_real.py`` holds against the real behaviour server.
@@ -7,6 +7,7 @@ send them. The cases and Nav2's answers are ``tests/nav2_behavior_cases.py``'s, 
 
 from __future__ import annotations
 
+import subprocess
 from collections.abc import Iterator
 
 import pytest
@@ -54,3 +55,25 @@ def test_wait_lasts_its_time(sim: SimProcess) -> None:
     seen = sim.client("behavior", "wait", value=2.0)
     assert seen["status"] == "SUCCEEDED"
     assert seen["took"] >= 2.0 / float(SPEED)  # simulated seconds at the node's speed
+
+
+def test_ros2_action_send_goal_runs_assisted_teleop_until_its_allowance(sim: SimProcess) -> None:
+    done = subprocess.run(
+        [
+            "ros2",
+            "action",
+            "send_goal",
+            "/assisted_teleop",
+            "nav2_msgs/action/AssistedTeleop",
+            "{time_allowance: {sec: 2}}",
+            "--feedback",
+        ],
+        env=sim.env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "current_teleop_duration" in done.stdout  # feedback: the time it has run
+    assert "Goal finished with status: ABORTED" in done.stdout, done.stdout
+    assert "error_code: 731" in done.stdout  # TIMEOUT

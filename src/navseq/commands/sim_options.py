@@ -77,6 +77,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "another keeps the old path until the next re-plan, and ends SUCCEEDED if the robot "
         "reaches the old goal first, as on Nav2. 0 (default): planned at once",
     )
+    parser.add_argument(
+        "--docks",
+        type=Path,
+        metavar="FILE",
+        help="(--ros2) the docking server's docks, in Nav2's docks YAML (docks: [name] "
+        "and name: {type, frame, pose: [x, y, yaw]}, or a dock database file): "
+        "dock_robot goals by id drive to them",
+    )
 
 
 def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
@@ -91,5 +99,6 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         other_robots=args.other_robots,
         follow_clock=args.follow_clock,
         replan_period=args.replan_period,
+        docks=args.docks,
         ros1=ros1,
     )

@@ -1,9 +1,12 @@
 """Nav2's behaviour server actions on the ROS 2 simulator node: spin, backup,
-drive_on_heading and wait (``nav2_msgs/action/...``), as nav2_bringup names them.
+drive_on_heading, wait and assisted_teleop (``nav2_msgs/action/...``), as nav2_bringup
+names them, and assisted teleop's two topics: ``cmd_vel_teleop``
+(``geometry_msgs/Twist``, the operator's command) and ``preempt_teleop``
+(``std_msgs/Empty``, the operator is done), both with the system default QoS as Nav2's.
 
 The rules are :class:`navseq.sim.behaviors.BehaviorServer`'s (the stand-in steps it with
 the robot); this module only translates goals, feedback (every cycle: radians turned,
-metres driven, time left) and results (``total_elapsed_time``, ``error_code`` — the
+metres driven, time left, time run) and results (``total_elapsed_time``, ``error_code`` — the
 action's own constant for the error's name — and, as in Nav2, no ``error_msg``).
 """
 
@@ -13,9 +16,12 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from nav2_msgs.action import BackUp, DriveOnHeading, Spin, Wait
+from geometry_msgs.msg import Twist
+from nav2_msgs.action import AssistedTeleop, BackUp, DriveOnHeading, Spin, Wait
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
+from rclpy.qos import qos_profile_system_default
+from std_msgs.msg import Empty
 
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import duration_msg, finish_goal
@@ -30,11 +36,12 @@ _ACTIONS: dict[Behavior, Any] = {
     Behavior.BACKUP: BackUp,
     Behavior.DRIVE_ON_HEADING: DriveOnHeading,
     Behavior.WAIT: Wait,
+    Behavior.ASSISTED_TELEOP: AssistedTeleop,
 }
 
 
 class BehaviorActions:
-    """The four behaviour action servers on ``node``, acting on ``standin`` under ``lock``."""
+    """The behaviour action servers on ``node``, acting on ``standin`` under ``lock``."""
 
     def __init__(
         self,
@@ -60,6 +67,28 @@ class BehaviorActions:
             )
             for behavior, action in _ACTIONS.items()
         ]
+        node.create_subscription(
+            Twist,
+            "cmd_vel_teleop",
+            self._on_teleop,
+            qos_profile_system_default,
+            callback_group=group,
+        )
+        node.create_subscription(
+            Empty,
+            "preempt_teleop",
+            self._on_preempt_teleop,
+            qos_profile_system_default,
+            callback_group=group,
+        )
+
+    def _on_teleop(self, message: Twist) -> None:
+        with self._lock:
+            self._standin.behaviors.teleop(float(message.linear.x), float(message.angular.z))
+
+    def _on_preempt_teleop(self, _message: Empty) -> None:
+        with self._lock:
+            self._standin.behaviors.preempt_teleop()
 
     def _executor(self, behavior: Behavior, action: Any) -> Callable[[Any], Any]:
         return lambda handle: self._execute(handle, behavior, action)
@@ -87,6 +116,8 @@ class BehaviorActions:
             return server.spin(now, float(request.target_yaw), allowance)
         if behavior is Behavior.WAIT:
             return server.wait(now, _seconds(request.time))
+        if behavior is Behavior.ASSISTED_TELEOP:
+            return server.assisted_teleop(now, _seconds(request.time_allowance))
         target = (float(request.target.x), float(request.target.y), float(request.target.z))
         allowance = _seconds(request.time_allowance)
         return server.drive(behavior, now, target, float(request.speed), allowance)
@@ -111,6 +142,8 @@ def _set_feedback(feedback: Any, behavior: Behavior, progress: float) -> None:
         feedback.angular_distance_traveled = float(progress)
     elif behavior is Behavior.WAIT:
         feedback.time_left = duration_msg(progress)
+    elif behavior is Behavior.ASSISTED_TELEOP:
+        feedback.current_teleop_duration = duration_msg(progress)
     else:
         feedback.distance_traveled = float(progress)
 

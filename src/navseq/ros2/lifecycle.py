@@ -64,6 +64,9 @@ ACTION_SERVERS = {
     "backup": "behavior_server",
     "drive_on_heading": "behavior_server",
     "wait": "behavior_server",
+    "assisted_teleop": "behavior_server",
+    "dock_robot": "docking_server",
+    "undock_robot": "docking_server",
 }
 
 _ACTIVE = State.PRIMARY_STATE_ACTIVE

@@ -21,8 +21,12 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   (:mod:`navseq.ros2.path_actions`);
 - both costmaps' topics (``global_costmap/costmap``, ``costmap_raw``,
   ``published_footprint``, the local ones) and ``get_costmap`` services
-  (:mod:`navseq.ros2.costmap_topics`);
-- the behaviour server's ``spin``, ``backup``, ``drive_on_heading`` and ``wait``, acting
+  (:mod:`navseq.ros2.costmap_topics`), their region clears and ``get_cost``, and the
+  planner's ``is_path_valid`` (:mod:`navseq.ros2.costmap_services`);
+- opennav_docking's ``dock_robot`` / ``undock_robot`` on the docks of ``--docks``
+  (:mod:`navseq.ros2.docking`, :mod:`navseq.ros2.docking_actions`);
+- the behaviour server's ``spin``, ``backup``, ``drive_on_heading``, ``wait`` and
+  ``assisted_teleop`` (with ``cmd_vel_teleop`` and ``preempt_teleop``), acting
   on the simulated robot with Nav2's collision check ahead, time allowance and error
   codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
   runs, a navigation goal's controller waits;
@@ -116,7 +120,9 @@ from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
+from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
+from navseq.ros2.docking_actions import DockingActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import (
     duration_msg,
@@ -287,6 +293,20 @@ class SimNode:
             stamp=self._stamp,
             frame=MAP_FRAME,
             lifecycle=lifecycle,
+        )
+        self._costmap_services = CostmapServices(
+            node, self.standin, self._lock, group, in_map=self._in_map
+        )
+        self._docking = DockingActions(
+            node,
+            self.standin,
+            self._lock,
+            group,
+            lifecycle,
+            docks=config.docks,
+            in_map=self._in_map,
+            stamp=self._stamp,
+            frame=MAP_FRAME,
         )
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
@@ -699,6 +719,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             + ("following /clock" if config.follow_clock else f"speed x{config.speed:g}")
             + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
             + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else "")
+            + (f", docks {', '.join(d.name for d in config.docks)}" if config.docks else "")
             + (
                 f", re-plan period {config.replan_period:g} s on preemption"
                 if config.replan_period > 0

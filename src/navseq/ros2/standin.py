@@ -47,8 +47,9 @@ import enum
 import itertools
 import math
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -64,6 +65,18 @@ PASS_RADIUS = 0.5  # m: Nav2's RemovePassedGoals default radius
 # space is planned to the nearest free cell within it and SUCCEEDS there (measured on
 # Nav2 Jazzy: 0.44 m and 0.52 m from goals on and inside a pillar).
 NAV2_PLANNER_TOLERANCE = 0.5
+
+
+class Driver(Protocol):
+    """A server that drives the robot itself while it runs (behaviours, docking)."""
+
+    def drives(self, now: float) -> bool: ...
+
+    def step(
+        self, now: float, pose: Pose2D, collides: Callable[[Pose2D], bool]
+    ) -> tuple[float, float]: ...
+
+    def abort_all(self, now: float, why: str) -> None: ...
 
 
 class Navigator(enum.Enum):
@@ -206,6 +219,9 @@ class Nav2StandIn:
         # than the world's two steps; while a goal runs a command comes every step.
         world.body.cmd_vel_timeout = max(world.body.cmd_vel_timeout, 0.5)
         self.behaviors = BehaviorServer()
+        # What drives the robot instead of the navigation server while it runs, first
+        # asked first: the behaviour server, then any added (the docking server).
+        self.drivers: list[Driver] = [self.behaviors]
 
     # -- goals -----------------------------------------------------------------------
 
@@ -314,7 +330,8 @@ class Nav2StandIn:
             self.waypoints = None
         if self.active is not None:
             self.active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, why))
-        self.behaviors.abort_all(self.time, why)
+        for driver in self.drivers:
+            driver.abort_all(self.time, why)
         self._stop()
 
     # -- simulation ------------------------------------------------------------------
@@ -326,10 +343,11 @@ class Nav2StandIn:
         if task is not None and task.ending is None:
             self._replan_if_due(task)
             self._pass_through(task)
-        if self.behaviors.running:
-            # A behaviour has the robot; a navigation goal's controller waits meanwhile.
+        driver = next((d for d in self.drivers if d.drives(self.time)), None)
+        if driver is not None:
+            # A behaviour (or docking) has the robot; a navigation goal's controller waits.
             body = world.body
-            body.command(*self.behaviors.step(self.time, body.pose, body.collides))
+            body.command(*driver.step(self.time, body.pose, body.collides))
             body.step(world.dt)
         elif world.server.state is NavState.ACTIVE:
             world.step()
@@ -348,7 +366,9 @@ class Nav2StandIn:
     def command(self, v: float, w: float) -> bool:
         """A velocity command from outside (teleop); ignored (False) while a goal or a
         behaviour runs."""
-        if self.world.server.state is NavState.ACTIVE or self.behaviors.running:
+        if self.world.server.state is NavState.ACTIVE or any(
+            d.drives(self.time) for d in self.drivers
+        ):
             return False
         self.world.body.command(v, w)
         return True

@@ -1,4 +1,5 @@
-"""Nav2's behaviour server on the simulated robot: spin, backup, drive_on_heading, wait.
+"""Nav2's behaviour server on the simulated robot: spin, backup, drive_on_heading, wait,
+assisted_teleop.
 
 The rules of ``nav2_behaviors`` (Jazzy), without ROS, so that they can be read and
 tested alone; the ROS 2 simulator node serves them as Nav2's four actions.
@@ -11,6 +12,13 @@ tested alone; the ROS 2 simulator node serves them as Nav2's four actions.
   whose sign differs from the target's. **backup** is the same backwards: it takes the
   magnitudes of both (Nav2 does so silently).
 - **wait** succeeds after ``time`` seconds.
+- **assisted_teleop** drives with the operator's last twist (:meth:`BehaviorServer.teleop`,
+  Nav2's ``cmd_vel_teleop``; kept until the next one, as Nav2 keeps it) through Nav2's
+  collision projection (:mod:`navseq.sim.assisted_teleop`: slowed down before an
+  obstacle, stopped when it is one step ahead). It SUCCEEDS when the operator says so
+  (:meth:`BehaviorServer.preempt_teleop`, Nav2's ``preempt_teleop`` topic) and ends
+  with TIMEOUT once a positive ``time_allowance`` runs out; its feedback is the time it
+  has run. The twist is forgotten when the goal ends.
 
 Each cycle, spin and drive_on_heading first look ``simulate_ahead_time`` seconds ahead
 along their command (in steps of one cycle, no further than what is left to do) and
@@ -34,6 +42,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from navseq.geometry import Pose2D
+from navseq.sim.assisted_teleop import TeleopParams, assisted_command
 
 
 class Behavior(enum.Enum):
@@ -43,6 +52,7 @@ class Behavior(enum.Enum):
     BACKUP = "backup"
     DRIVE_ON_HEADING = "drive_on_heading"
     WAIT = "wait"
+    ASSISTED_TELEOP = "assisted_teleop"
 
 
 @dataclass(frozen=True)
@@ -54,6 +64,7 @@ class BehaviorParams:
     max_rotational_vel: float = 1.0  # rad/s
     min_rotational_vel: float = 0.4  # rad/s
     rotational_acc_lim: float = 3.2  # rad/s²
+    teleop: TeleopParams = field(default_factory=TeleopParams)
 
 
 class Outcome(enum.Enum):
@@ -76,7 +87,7 @@ class BehaviorEnding:
 @dataclass
 class BehaviorGoal:
     """One behaviour goal and how far it got (``progress``: the action's feedback value:
-    radians turned, metres driven, or seconds left)."""
+    radians turned, metres driven, or seconds left; seconds run for assisted_teleop)."""
 
     behavior: Behavior
     started: float
@@ -89,6 +100,7 @@ class BehaviorGoal:
     # Where it started and what it measures from (set by the first cycle).
     _origin: Pose2D | None = None
     _last_yaw: float = 0.0
+    _preempted: bool = False  # assisted_teleop: the operator said it is done
 
     def end(self, ending: BehaviorEnding) -> None:
         if self.ending is None:
@@ -105,6 +117,7 @@ class BehaviorServer:
     def __init__(self, params: BehaviorParams | None = None) -> None:
         self.params = params or BehaviorParams()
         self.active: BehaviorGoal | None = None
+        self.teleop_twist = (0.0, 0.0)  # the operator's last (v, w) on cmd_vel_teleop
 
     # -- goals -----------------------------------------------------------------------
 
@@ -147,21 +160,39 @@ class BehaviorServer:
         goal = BehaviorGoal(Behavior.WAIT, now, target=seconds, progress=seconds)
         return self._start(goal)
 
+    def assisted_teleop(self, now: float, time_allowance: float) -> BehaviorGoal:
+        return self._start(BehaviorGoal(Behavior.ASSISTED_TELEOP, now, time_allowance))
+
+    def teleop(self, v: float, w: float) -> None:
+        """The operator's twist (``cmd_vel_teleop``): assisted_teleop drives with it."""
+        self.teleop_twist = (v, w)
+
+    def preempt_teleop(self) -> None:
+        """The operator ends assisted teleop (``preempt_teleop``): it SUCCEEDS at its next
+        cycle. Heard while none runs, it is forgotten (Nav2 clears it at every start)."""
+        goal = self.active
+        if goal is not None and goal.behavior is Behavior.ASSISTED_TELEOP:
+            goal._preempted = True
+
     def cancel(self, goal: BehaviorGoal, now: float) -> None:
         """The client cancels ``goal``: it ends CANCELED, the robot is told to stop."""
         goal.end(BehaviorEnding(Outcome.CANCELED, elapsed=now - goal.started))
         if goal is self.active:
-            self.active = None
+            self._release()
 
     def abort_all(self, now: float, why: str) -> None:
         if self.active is not None:
             self.active.end(
                 BehaviorEnding(Outcome.ABORTED, elapsed=now - self.active.started, log=why)
             )
-            self.active = None
+            self._release()
 
     @property
     def running(self) -> bool:
+        return self.active is not None
+
+    def drives(self, _now: float) -> bool:
+        """Whether a behaviour drives the robot this step (the stand-in's driver rule)."""
         return self.active is not None
 
     def _start(self, goal: BehaviorGoal) -> BehaviorGoal:
@@ -175,6 +206,7 @@ class BehaviorServer:
                     "aborting and stopping",
                 )
             )
+            self._release()
         self.active = goal
         return goal
 
@@ -190,9 +222,15 @@ class BehaviorServer:
             return (0.0, 0.0)
         command = self._cycle(goal, now, pose, collides)
         if goal.ending is not None:
-            self.active = None
+            self._release()
             return (0.0, 0.0)
         return command
+
+    def _release(self) -> None:
+        """The running goal has ended: none runs, and the operator's twist is forgotten
+        (Nav2's assisted teleop clears it on completion)."""
+        self.active = None
+        self.teleop_twist = (0.0, 0.0)
 
     def _cycle(
         self, goal: BehaviorGoal, now: float, pose: Pose2D, collides: Collides
@@ -214,11 +252,22 @@ class BehaviorServer:
                 )
             )
             return (0.0, 0.0)
+        if goal.behavior is Behavior.ASSISTED_TELEOP:
+            return self._teleop_cycle(goal, pose, elapsed, collides)
         if goal._origin is None:
             goal._origin, goal._last_yaw = pose, pose.yaw
         if goal.behavior is Behavior.SPIN:
             return self._spin_cycle(goal, pose, elapsed, collides)
         return self._drive_cycle(goal, pose, elapsed, collides)
+
+    def _teleop_cycle(
+        self, goal: BehaviorGoal, pose: Pose2D, elapsed: float, collides: Collides
+    ) -> tuple[float, float]:
+        goal.progress = elapsed
+        if goal._preempted:
+            goal.end(BehaviorEnding(Outcome.SUCCEEDED, elapsed=elapsed))
+            return (0.0, 0.0)
+        return assisted_command(pose, self.teleop_twist, collides, self.params.teleop)
 
     def _spin_cycle(
         self, goal: BehaviorGoal, pose: Pose2D, elapsed: float, collides: Collides
@@ -299,6 +348,7 @@ def _title(behavior: Behavior) -> str:
         Behavior.BACKUP: "DriveOnHeading",  # BackUp is a DriveOnHeading in Nav2
         Behavior.DRIVE_ON_HEADING: "DriveOnHeading",
         Behavior.WAIT: "Wait",
+        Behavior.ASSISTED_TELEOP: "assisted_teleop",  # Nav2 names it by its plugin name
     }[behavior]
 
 

@@ -17,6 +17,7 @@ from navseq.errors import NavseqError
 from navseq.files import require_file
 from navseq.geometry import Pose2D
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
+from navseq.sim.docks import Dock, read_docks_file
 from navseq.sim.fleet import other_robots_problem
 
 # Name rules for one namespace token: letters, digits, underscores; ROS 2 refuses a digit
@@ -45,6 +46,7 @@ class SimConfig:
     follow_clock: bool = False  # step with another node's /clock (a fleet at speed != 1)
     replan_period: float = 0.0  # s: Nav2's re-plan tick on preemption; 0 = plan at once
     rate: float = 20.0  # simulation steps per simulated second
+    docks: tuple[Dock, ...] = ()  # the docking server's docks (--docks, ROS 2 only)
 
     @property
     def frame_prefix(self) -> str:
@@ -127,6 +129,7 @@ def checked_config(
     other_robots: str = "",
     follow_clock: str = "false",
     replan_period: float = 0.0,
+    docks: Path | None = None,
     ros1: bool = False,
 ) -> SimConfig:
     """The checked settings from the values the options hold; every bad value is a
@@ -155,4 +158,17 @@ def checked_config(
         other_robots=other_robots_of(other_robots, own, ros1=ros1),
         follow_clock=follow_clock_of(follow_clock, speed),
         replan_period=replan_period_of(float(replan_period), ros1=ros1),
+        docks=docks_of(docks, ros1=ros1),
     )
+
+
+def docks_of(path: Path | None, *, ros1: bool = False) -> tuple[Dock, ...]:
+    """``--docks FILE``: the docks of a Nav2 docks file (ROS 2's docking server only)."""
+    if path is None:
+        return ()
+    if ros1:
+        raise NavseqError(
+            "docking is Nav2's (opennav_docking): use it with --ros2", source="--docks"
+        )
+    require_file(path, "--docks")
+    return read_docks_file(path)
