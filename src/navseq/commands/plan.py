@@ -98,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     mission = load_mission(args.mission)
     robot = choose_robot(args.robot, mission)
     map_path = args.map if args.map is not None else mission.map
-    legs = legs_on_map(map_path, robot)
+    legs = legs_on_map(map_path, robot, filters=mission.filters)
     in_file_order = legs_of(mission, legs)
     order = list(range(len(mission.waypoints)))
     ordered = mission

@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
 
         robot = choose_robot(args.robot, mission)
         start = args.start if args.start is not None else mission.start
-        legs = legs_on_map(map_path, robot, costmaps)
+        legs = legs_on_map(map_path, robot, costmaps, mission.filters)
         prediction = predict_legs(mission, legs, robot, start)
         for line in prediction_lines(prediction, has_start=start is not None):
             print(line, file=sys.stdout)
@@ -184,5 +184,11 @@ def _map_problems(
         return [error]
     if mission is None:
         return []
+    from navseq.sim.filters import costmap_with_filters
+
+    try:
+        costmap = costmap_with_filters(costmap, mission.filters)
+    except NavseqError as error:  # an unreadable mask, likewise
+        return [error]
     start = start if start is not None else mission.start
     return preflight_errors(mission, costmap, start, numbers, robot)

@@ -20,8 +20,12 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from pyproj import Transformer
 
 # UTM's range; beyond it navsat_transform switches to UPS, which navseq does not do.
 MIN_UTM_LATITUDE = -80.0
@@ -125,14 +129,14 @@ def checked_point(latitude: float, longitude: float, altitude: float | None) -> 
 def _projection(zone: int, south: bool) -> Callable[[float, float], tuple[float, float]]:
     """(longitude, latitude) degrees -> (easting, northing) metres in a UTM zone."""
     transformer = _transformer(zone, south, inverse=False)
-    return lambda lon, lat: transformer.transform(lon, lat)  # type: ignore[no-any-return]
+    return lambda lon, lat: transformer.transform(lon, lat)
 
 
 @functools.lru_cache(maxsize=8)
 def _inverse_projection(zone: int, south: bool) -> Callable[[float, float], tuple[float, float]]:
     """(easting, northing) metres in a UTM zone -> (longitude, latitude) degrees."""
     transformer = _transformer(zone, south, inverse=True)
-    return lambda east, north: transformer.transform(east, north)  # type: ignore[no-any-return]
+    return lambda east, north: transformer.transform(east, north)
 
 
 @functools.lru_cache(maxsize=64)
@@ -144,7 +148,7 @@ def _convergence_deg(zone: int, south: bool, point: GeoPoint) -> float:
     return float(utm.get_factors(point.longitude, point.latitude).meridian_convergence)
 
 
-def _transformer(zone: int, south: bool, *, inverse: bool) -> object:
+def _transformer(zone: int, south: bool, *, inverse: bool) -> Transformer:
     from pyproj import Transformer  # imported when a mission has GPS positions
 
     utm = f"EPSG:{32700 + zone if south else 32600 + zone}"
