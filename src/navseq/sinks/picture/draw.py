@@ -69,6 +69,7 @@ from navseq.sinks.picture.view import (
     make_layout,
     occupancy_rgb,
 )
+from navseq.sinks.picture.zones import draw_zones
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -289,6 +290,7 @@ def mission_figure(
     ax.set_aspect("equal")
     if grid is not None:
         draw_map(ax, grid, layout)
+        draw_zones(ax, grid, layout)
     outcomes = waypoint_outcomes(result, count)
     markers = group_markers(positions, outcomes, layout, dpi) if count else None
     crowded = markers is not None and not markers.numbered
