@@ -73,15 +73,15 @@ def cap_speed(limit: float, absolute: bool, max_speed: float) -> float:
 
 
 def with_filters(grid: OccupancyGrid, filters: Sequence[CostmapFilter]) -> OccupancyGrid:
-    """``grid`` with ``filters`` read and laid over its cells; ``grid`` itself without any.
+    """``grid`` with ``filters`` read and laid over its cells (added to any it has);
+    ``grid`` itself without any.
 
     Raises NavseqError for a mask that cannot be read (naming its file and key).
     """
     if not filters:
         return grid
-    keepout: np.ndarray | None = None
-    speed_limit: np.ndarray | None = None
-    absolute = False
+    had = grid.filters or MapFilters()
+    keepout, speed_limit, absolute = had.keepout, had.speed_limit, had.speed_absolute
     for spec in filters:
         values = mask_on_grid(load_map(spec.mask), grid)
         if spec.type is FilterType.KEEPOUT:
@@ -98,7 +98,7 @@ def with_filters(grid: OccupancyGrid, filters: Sequence[CostmapFilter]) -> Occup
     for array in (keepout, speed_limit):
         if array is not None:
             array.setflags(write=False)
-    sources = tuple(str(spec.mask) for spec in filters)
+    sources = (*had.sources, *(str(spec.mask) for spec in filters))
     return dataclasses.replace(grid, filters=MapFilters(keepout, speed_limit, absolute, sources))
 
 
