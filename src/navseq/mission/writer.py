@@ -74,18 +74,21 @@ _MissionDumper.add_representer(
 _RESOLVER = _MissionDumper(io.StringIO())
 
 
-def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
+def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None, gps: bool = True) -> str:
     """The mission as navseq YAML text.
 
     With ``base_dir`` (the folder the file will be written to) the map path is written
-    relative to it, so mission and map can be moved together.
+    relative to it, so mission and map can be moved together. Waypoints read as
+    latitude/longitude are written so again, unless ``gps`` is False (map coordinates,
+    for a face that draws them).
 
     PyYAML writes the settings; the waypoints, one flow mapping a line, are written by
     :func:`_waypoint_lines`, exactly as PyYAML would write them: PyYAML's emitter took
     12-25 s and 450 MB for 100 000 waypoints, most of a conversion's time.
     """
     doc = _settings(mission, base_dir)
-    waypoints = [_waypoint(w, mission.datum) for w in mission.waypoints]
+    datum = mission.datum if gps else None
+    waypoints = [_waypoint(w, datum) for w in mission.waypoints]
     lines = _waypoint_lines(waypoints) if waypoints else None
     if lines is None:  # none, or one the line writer does not write as PyYAML would
         doc["waypoints"] = waypoints

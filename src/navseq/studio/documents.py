@@ -63,13 +63,15 @@ def document_of(mission: Mission, base_dir: Path) -> dict[str, Any]:
     """The mission as a JSON-ready document: what the mission writer would write.
 
     The map path is relative to ``base_dir`` (the mission file's folder), as in a file.
+    GPS waypoints are given in map coordinates: the page draws and edits x/y.
     """
     from navseq.mission.writer import dump_mission_yaml
 
     # libyaml's safe loader when there is one: the writer's own text, read back; PyYAML's
     # pure-Python reader took 1.8 s on 3000 waypoints, the page's whole wait on opening.
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    document = yaml.load(dump_mission_yaml(mission, base_dir=base_dir), Loader=loader)
+    text = dump_mission_yaml(mission, base_dir=base_dir, gps=False)
+    document = yaml.load(text, Loader=loader)
     assert isinstance(document, dict)
     return document
 
