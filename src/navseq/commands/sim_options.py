@@ -77,6 +77,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "another keeps the old path until the next re-plan, and ends SUCCEEDED if the robot "
         "reaches the old goal first, as on Nav2. 0 (default): planned at once",
     )
+    add_datum_argument(parser)
+
+
+def add_datum_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--datum",
+        default="",
+        metavar="LAT,LON[,YAW]",
+        help="(--ros2) the map frame's origin on the globe and its x axis' heading "
+        "(degrees counter-clockwise from east, default 0), as navsat_transform's datum: "
+        "follow_gps_waypoints and fromLL convert with it",
+    )
 
 
 def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
@@ -92,4 +104,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         follow_clock=args.follow_clock,
         replan_period=args.replan_period,
         ros1=ros1,
+        datum=getattr(args, "datum", ""),
     )

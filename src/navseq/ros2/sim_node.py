@@ -117,6 +117,7 @@ from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
 from navseq.ros2.costmap_topics import CostmapTopics
+from navseq.ros2.gps_actions import GpsWaypointActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import (
     duration_msg,
@@ -288,6 +289,10 @@ class SimNode:
             frame=MAP_FRAME,
             lifecycle=lifecycle,
         )
+        self._gps = GpsWaypointActions(
+            node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
+            stamp=self._stamp, frame=MAP_FRAME,
+        )  # fmt: skip
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.
