@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -13,6 +14,7 @@ from navseq.errors import MissionErrors, NavseqError
 from navseq.mission.geodesy import Datum, GeoPoint, utm_zone
 from navseq.mission.loader import load_mission
 from navseq.mission.writer import dump_mission_yaml
+from navseq.navigators.gps_service import converted_through_from_ll
 
 # Wikipedia's UTM example: the CN Tower, 43.642567 N 79.387139 W, is at 630084 m E,
 # 4833438 m N in zone 17.
@@ -171,3 +173,51 @@ def test_the_gps_example_runs_on_the_simulator(tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "run" / "mission.png").stat().st_size > 0
     assert "north-dock" in result.stdout
+
+
+class FromLLPort:
+    """A ROS port whose fromLL answers with the datum of Delft, or never, or fails."""
+
+    def __init__(self, datum: Datum, mode: str = "answer") -> None:
+        self.datum, self.mode, self.calls = datum, mode, []
+
+    def call(self, service, type_name, fields, on_answer):
+        self.calls.append((service, type_name, fields))
+        if self.mode == "no type":
+            raise ValueError("the package robot_localization is not in this ROS 2")
+        if self.mode == "answer":
+            point = fields["ll_point"]
+            x, y, _ = self.datum.to_map(GeoPoint(point["latitude"], point["longitude"]))
+            on_answer(SimpleNamespace(map_point=SimpleNamespace(x=x + 0.5, y=y, z=0.0)), None)
+        return lambda: None
+
+
+def test_nav2_can_convert_gps_waypoints_through_the_stacks_from_ll() -> None:
+    mission = load_mission(EXAMPLES / "gps.yaml")
+    assert mission.datum is not None
+    port = FromLLPort(mission.datum)  # the stack's datum is 0.5 m off navseq's
+    converted = converted_through_from_ll(port, "fromLL", mission, timeout=1.0)
+    assert [call[:2] for call in port.calls] == [("fromLL", "robot_localization/FromLL")] * 4
+    for before, after in zip(mission.waypoints, converted.waypoints, strict=True):
+        shift = 0.5 if before.geo is not None else 0.0  # home is given as x/y
+        assert after.x == pytest.approx(before.x + shift, abs=1e-6)
+        assert (after.y, after.name, after.yaw_rad) == (
+            pytest.approx(before.y, abs=1e-6),
+            before.name,
+            before.yaw_rad,
+        )
+
+
+@pytest.mark.parametrize(
+    ("mode", "message"),
+    [
+        ("silent", "fromLL (robot_localization/FromLL) did not answer within 0.05 s"),
+        ("no type", "--from-ll: cannot call fromLL: the package robot_localization"),
+    ],
+)
+def test_a_from_ll_that_cannot_answer_is_one_clear_error(mode: str, message: str) -> None:
+    mission = load_mission(EXAMPLES / "gps.yaml")
+    assert mission.datum is not None
+    with pytest.raises(NavseqError) as caught:
+        converted_through_from_ll(FromLLPort(mission.datum, mode), "fromLL", mission, 0.05)
+    assert message in str(caught.value)

@@ -13,7 +13,6 @@ unchanged: a call the server does not answer hangs, and the test's timeout says 
 from __future__ import annotations
 
 import json
-import math
 import sys
 
 import rclpy

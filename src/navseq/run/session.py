@@ -542,6 +542,7 @@ def prepare(request: RunRequest) -> Session:
     )
     _check_recording(request.outputs, kind, mission)
     made = _navigator_setup(request, kind, draft)
+    mission = draft.mission  # a kind may settle it (GPS waypoints through the stack's fromLL)
     session = Session(
         request=request,
         mission=mission,
