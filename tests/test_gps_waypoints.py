@@ -15,6 +15,7 @@ from navseq.mission.geodesy import Datum, GeoPoint, utm_zone
 from navseq.mission.loader import load_mission
 from navseq.mission.writer import dump_mission_yaml
 from navseq.navigators.gps_service import converted_through_from_ll
+from navseq.sim.options import datum_of
 
 # Wikipedia's UTM example: the CN Tower, 43.642567 N 79.387139 W, is at 630084 m E,
 # 4833438 m N in zone 17.
@@ -221,3 +222,13 @@ def test_a_from_ll_that_cannot_answer_is_one_clear_error(mode: str, message: str
     with pytest.raises(NavseqError) as caught:
         converted_through_from_ll(FromLLPort(mission.datum, mode), "fromLL", mission, 0.05)
     assert message in str(caught.value)
+
+
+def test_the_simulators_datum_option_is_checked() -> None:
+    datum = datum_of("52.0116,4.3571,90")
+    assert (datum.point.latitude, datum.point.longitude) == (52.0116, 4.3571)
+    assert datum.yaw_rad == pytest.approx(math.pi / 2)
+    for bad, message in (("52.0", "expected LAT,LON"), ("95,4", "a latitude is within")):
+        with pytest.raises(NavseqError, match=message) as caught:
+            datum_of(bad)
+        assert caught.value.source == "--datum"

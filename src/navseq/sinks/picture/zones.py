@@ -4,7 +4,7 @@ tinted amber (the slower, the deeper), over the map and under the paths."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -20,18 +20,22 @@ SPEED_COLOUR = (0.96, 0.62, 0.04)  # amber
 MAX_SPEED_TINT = 0.45  # alpha of a zone that stops the robot; none at full speed
 
 
-def draw_zones(ax: Axes, grid: OccupancyGrid, layout: Layout) -> None:
-    """Keepout and speed zones of ``grid.filters`` (nothing without filters)."""
+def draw_zones(ax: Axes, grid: OccupancyGrid, layout: Layout) -> list[Any]:
+    """Keepout and speed zones of ``grid.filters`` (nothing without filters); the legend
+    handles of those drawn."""
+    from matplotlib.patches import Patch
+
+    handles: list[Any] = []
     zones = grid.filters
     if zones is None:
-        return
+        return handles
     rows, cols = _view_cells(grid, layout)
     transform = _grid_transform(ax, grid)
     x0 = grid.origin.x + cols.start * grid.resolution
     y0 = grid.origin.y + rows.start * grid.resolution
     height, width = rows.stop - rows.start, cols.stop - cols.start
     if height <= 0 or width <= 0:
-        return
+        return handles
     extent = (x0, x0 + width * grid.resolution, y0, y0 + height * grid.resolution)
     if zones.speed_limit is not None:
         limit = zones.speed_limit[rows, cols]
@@ -56,6 +60,9 @@ def draw_zones(ax: Axes, grid: OccupancyGrid, layout: Layout) -> None:
             )
             artist.set_gid("speed-zones")
             artist.set_transform(transform)
+            handles.append(
+                Patch(facecolor=(*SPEED_COLOUR, MAX_SPEED_TINT * 0.6), label="speed zone")
+            )
     if zones.keepout is not None:
         keepout = zones.keepout[rows, cols]
         if keepout.any():
@@ -73,6 +80,10 @@ def draw_zones(ax: Axes, grid: OccupancyGrid, layout: Layout) -> None:
                 transform=transform,
             )
             contours.set_gid("keepout-zones")
+            handles.append(
+                Patch(facecolor=KEEPOUT_COLOUR, alpha=0.3, hatch="////", label="keepout zone")
+            )
+    return handles
 
 
 def _view_cells(grid: OccupancyGrid, layout: Layout) -> tuple[slice, slice]:
