@@ -64,3 +64,15 @@ def test_gps_waypoints_open_in_map_coordinates(workspace: Path) -> None:
     assert waypoints[0]["x"] == pytest.approx(-0.55, abs=0.01)
     assert waypoints[0]["y"] == pytest.approx(-1.75, abs=0.01)
     assert "latitude" not in waypoints[0]
+
+
+def test_a_draft_with_filters_is_checked_against_its_keepout_zone(workspace: Path) -> None:
+    client = client_for(workspace, "examples/keepout.yaml")
+    document = client.get("/api/mission").json()["mission"]
+    answer = client.post("/api/check", json={"mission": document})
+    assert answer.status_code == 200, answer.text
+    assert answer.json()["problems"] == []
+    document["waypoints"][0].update(x=0.55, y=-1.75)  # into the keepout zone
+    problems = client.post("/api/check", json={"mission": document}).json()["problems"]
+    assert len(problems) == 1 and "is in a keepout zone" in problems[0]["text"]
+    assert problems[0]["fix"] is not None  # the nearest allowed spot, one click away

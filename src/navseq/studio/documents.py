@@ -244,6 +244,9 @@ def check_draft(
         # Resolved (and refused outside the studio's folders) before anything reads it.
         map_path = roots.resolve(map_value, "map", base=base_dir)
         document["map"] = str(map_path)
+    document["filters"] = _masks_resolved(document.get("filters"), roots, base_dir)
+    if document["filters"] is None:
+        del document["filters"]
     drafted = draft_text(document)
     with tempfile.TemporaryDirectory(prefix="navseq-studio-") as folder:
         path = Path(folder) / "draft.yaml"
@@ -251,6 +254,19 @@ def check_draft(
         mission, errors = mission_file_problems(path, costmaps=costmaps, tasks=tasks)
         problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
     return CheckedDraft(mission, problems, map_path)
+
+
+def _masks_resolved(filters: Any, roots: FileRoots, base_dir: Path) -> Any:
+    """The draft's costmap filters with each mask path resolved as the map's is (the
+    draft is checked from a temporary folder); anything else as the page sent it."""
+    if not isinstance(filters, list):
+        return filters
+    resolved = []
+    for item in filters:
+        if isinstance(item, dict) and isinstance(item.get("mask"), str):
+            item = {**item, "mask": str(roots.resolve(item["mask"], "filters mask", base=base_dir))}
+        resolved.append(item)
+    return resolved
 
 
 def shown_path(path: Path) -> str:
