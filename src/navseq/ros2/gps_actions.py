@@ -11,8 +11,9 @@
   ``fromLL`` service; the stand-in converts itself. Without ``--datum`` a goal ends
   ABORTED with ``TASK_EXECUTOR_FAILED`` (601) saying so.
 - ``fromLL`` (``robot_localization/srv/FromLL``, navsat_transform's service) with the
-  same datum, when robot_localization's interfaces are installed (Nav2's build has
-  them; a ROS 2 without them gets no such service, said in the log).
+  same datum, when a datum is given and robot_localization's interfaces are installed
+  (Nav2's build has them; a ROS 2 without them gets no such service, said in the log).
+  Without ``--datum`` the node serves what a default Nav2 bringup serves: no ``fromLL``.
 """
 
 from __future__ import annotations
@@ -85,7 +86,8 @@ class GpsWaypointActions:
             cancel_callback=lambda _handle: CancelResponse.ACCEPT,
             callback_group=group,
         )
-        self._from_ll = self._serve_from_ll(group)
+        # navsat_transform is not part of a default bringup: served only with a datum.
+        self._from_ll = self._serve_from_ll(group) if datum is not None else None
 
     def _gate(self, _request: Any) -> GoalResponse:
         if self._lifecycle.active(LIFECYCLE_ACTION):
