@@ -173,3 +173,16 @@ def test_a_bad_filter_is_refused_with_file_and_line(tmp_path: Path) -> None:
     missing = navseq("validate", EXAMPLES / "patrol.yaml", "--keepout", "nope.yaml", cwd=tmp_path)
     assert_clean_error(missing)
     assert "--keepout: no such file: nope.yaml" in missing.stderr
+
+
+def test_a_mask_that_cannot_be_read_is_named_where_the_mission_gives_it(tmp_path: Path) -> None:
+    path = tmp_path / "m.yaml"
+    path.write_text(
+        f"navseq: 1\nmap: {TURTLEBOT3_MAP}\nfilters:\n  - {{mask: nope.yaml}}\n"
+        "waypoints:\n  - {x: 0.5, y: 0.5}\n"
+    )
+    result = navseq("validate", path, cwd=tmp_path)
+    assert_clean_error(result)
+    assert f"{path}:4, filters: the mask cannot be read: {tmp_path / 'nope.yaml'}" in (
+        result.stderr
+    )

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from navseq.errors import NavseqError
 from navseq.mission.costmap_filters import CostmapFilter, FilterType
 from navseq.sim.costmap import Costmap
 from navseq.sim.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map
@@ -83,7 +84,13 @@ def with_filters(grid: OccupancyGrid, filters: Sequence[CostmapFilter]) -> Occup
     had = grid.filters or MapFilters()
     keepout, speed_limit, absolute = had.keepout, had.speed_limit, had.speed_absolute
     for spec in filters:
-        values = mask_on_grid(load_map(spec.mask), grid)
+        try:
+            mask = load_map(spec.mask)
+        except NavseqError as error:  # named where the mission gives the filter
+            raise NavseqError(
+                f"the mask cannot be read: {error}", source=spec.where, subject="filters"
+            ) from None
+        values = mask_on_grid(mask, grid)
         if spec.type is FilterType.KEEPOUT:
             zone = (values >= OCCUPIED) | (values < UNKNOWN)
             keepout = zone if keepout is None else keepout | zone
