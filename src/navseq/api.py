@@ -136,7 +136,9 @@ def check_mission(
         return []
     profile = choose_robot(robot, mission)
     try:
-        costmap = costmap_for_map(map_path, profile)
+        from navseq.sim.filters import costmap_with_filters
+
+        costmap = costmap_with_filters(costmap_for_map(map_path, profile), mission.filters)
     except NavseqError as error:
         return _problems([error])
     start = start if start is not None else mission.start
@@ -165,7 +167,7 @@ def order_waypoints(
     from navseq.route.order import shortest_order
 
     map_path = Path(map) if map is not None else mission.map
-    legs = legs_on_map(map_path, choose_robot(robot, mission))
+    legs = legs_on_map(map_path, choose_robot(robot, mission), filters=mission.filters)
     ordering = shortest_order(mission, legs, time_limit_s, keep_last=keep_last)
     return ordering.apply(mission)
 

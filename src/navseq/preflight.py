@@ -3,7 +3,8 @@
 ``check_mission`` looks at a mission against a costmap and reports, all at once:
 
 - a waypoint off the map;
-- a waypoint inside an obstacle, or in unmapped (unknown) space;
+- a waypoint inside an obstacle, in unmapped (unknown) space, or in a keepout zone of
+  the map's costmap filters (:mod:`navseq.sim.filters`);
 - a waypoint where the robot cannot turn: closer to an obstacle, unknown space or the
   map edge than the footprint's circumscribed radius (the robot stops and turns to the
   goal's heading at every waypoint, and at the start it turns toward the first one);
@@ -199,7 +200,10 @@ def _placement_problem(
             f"{costmap.grid.source})"
         )
     cost = costmap.cost_at(x, y)
-    if cost == LETHAL:
+    zones = costmap.grid.filters
+    if zones is not None and zones.in_keepout(costmap.grid, x, y):
+        what = f"is in a keepout zone ({zones.keepout_source()})"
+    elif cost == LETHAL:
         what = "is inside an obstacle"
     elif cost == NO_INFORMATION:
         what = "is in unmapped space (unknown cells)"
@@ -208,8 +212,13 @@ def _placement_problem(
         radius = costmap.params.circumscribed_radius
         if clearance >= radius and costmap.is_free(x, y):
             return None
+        near = (
+            "an obstacle, a keepout zone, unknown space or the map edge"
+            if costmap.grid.keepout_mask() is not None
+            else "an obstacle, unknown space or the map edge"
+        )
         what = (
-            f"is {clearance:.3f} m from an obstacle, unknown space or the map edge, within "
+            f"is {clearance:.3f} m from {near}, within "
             f"the robot's circumscribed radius ({radius:.3f} m, {free.robot.name}): "
             f"{consequence}"
         )

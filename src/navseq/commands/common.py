@@ -23,6 +23,7 @@ T = TypeVar("T")
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.route.legs import Legs
@@ -103,15 +104,19 @@ def legs_on_map(
     map_path: Path | None,
     robot: RobotProfile,
     costmaps: Callable[[Path, RobotProfile], Costmap] | None = None,
+    filters: Sequence[CostmapFilter] = (),
 ) -> Legs:
     """The legs a mission's route is made of: planned on ``map_path``'s costmap for
-    ``robot``, or straight lines when there is no map. ``costmaps`` builds (or recalls)
-    the costmap; by default the map is read and inflated here."""
+    ``robot`` (with the mission's costmap ``filters``: keepout and speed zones), or
+    straight lines when there is no map. ``costmaps`` builds (or recalls) the costmap;
+    by default the map is read and inflated here."""
     from navseq.route.legs import LegPlanner, StraightLegs
+    from navseq.sim.filters import costmap_with_filters
 
     if map_path is None:
         return StraightLegs()
-    return LegPlanner((costmaps or costmap_for_map)(map_path, robot))
+    costmap = (costmaps or costmap_for_map)(map_path, robot)
+    return LegPlanner(costmap_with_filters(costmap, filters))
 
 
 def add_robot_option(parser: argparse.ArgumentParser) -> None:

@@ -15,11 +15,13 @@ says why), 2 for bad input.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.commands.common import add_robot_option
+from navseq.commands.filter_options import add_filter_options, filters_of
 
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
@@ -41,6 +43,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "legs are straight lines)",
     )
     add_robot_option(parser)
+    add_filter_options(parser)
     parser.add_argument(
         "--order",
         choices=ORDERS,
@@ -96,9 +99,12 @@ def run(args: argparse.Namespace) -> int:
     if args.map is not None:
         require_file(args.map, "--map")
     mission = load_mission(args.mission)
+    given = filters_of(args)
+    if given is not None:
+        mission = dataclasses.replace(mission, filters=given)
     robot = choose_robot(args.robot, mission)
     map_path = args.map if args.map is not None else mission.map
-    legs = legs_on_map(map_path, robot)
+    legs = legs_on_map(map_path, robot, filters=mission.filters)
     in_file_order = legs_of(mission, legs)
     order = list(range(len(mission.waypoints)))
     ordered = mission

@@ -23,6 +23,7 @@ from navseq.commands.common import (
     parse_realtime,
     parse_waypoint_number,
 )
+from navseq.commands.filter_options import add_filter_options, filters_of
 from navseq.commands.task_options import add_task_options, task_options_of
 from navseq.errors import NavseqError
 from navseq.navigators import registry
@@ -146,6 +147,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     add_task_options(parser)
     add_robot_option(parser)
+    add_filter_options(parser)
     # Each navigator kind's options (navseq.navigators.registry), the test double's hidden.
     add_navigator_options(parser)
 
@@ -248,6 +250,7 @@ def request_of(args: argparse.Namespace) -> RunRequest:
         resume=args.resume,
         realtime=args.realtime,
         tasks=task_options_of(args),
+        filters=filters_of(args),
     )
 
 

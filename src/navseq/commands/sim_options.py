@@ -85,6 +85,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "and name: {type, frame, pose: [x, y, yaw]}, or a dock database file): "
         "dock_robot goals by id drive to them",
     )
+    add_datum_argument(parser)
+
+
+def add_datum_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--datum",
+        default="",
+        metavar="LAT,LON[,YAW]",
+        help="(--ros2) the map frame's origin on the globe and its x axis' heading "
+        "(degrees counter-clockwise from east, default 0), as navsat_transform's datum: "
+        "follow_gps_waypoints and fromLL convert with it",
+    )
 
 
 def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConfig:
@@ -101,4 +113,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         replan_period=args.replan_period,
         docks=args.docks,
         ros1=ros1,
+        datum=getattr(args, "datum", ""),
     )

@@ -9,6 +9,7 @@ others in the file have problems. Exit 0 when there is nothing to report, 2 othe
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 import sys
 from collections.abc import Callable, Sequence
@@ -16,12 +17,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from navseq.commands.common import add_robot_option, parse_pose
+from navseq.commands.filter_options import add_filter_options, filters_of
 from navseq.commands.task_options import add_task_options, task_options_of
 from navseq.errors import NavseqError
 from navseq.text import printable
 
 if TYPE_CHECKING:
     from navseq.geometry import Pose2D
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
@@ -49,6 +52,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     add_robot_option(parser)
     add_task_options(parser)
+    add_filter_options(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
             robot=args.robot,
             costmaps=costmaps,
             tasks=task_options_of(args),
+            filters=filters_of(args),
         )
     if errors:
         raise MissionErrors(errors)
@@ -112,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
 
         robot = choose_robot(args.robot, mission)
         start = args.start if args.start is not None else mission.start
-        legs = legs_on_map(map_path, robot, costmaps)
+        legs = legs_on_map(map_path, robot, costmaps, mission.filters)
         prediction = predict_legs(mission, legs, robot, start)
         for line in prediction_lines(prediction, has_start=start is not None):
             print(line, file=sys.stdout)
@@ -127,6 +132,7 @@ def mission_file_problems(
     robot: str | RobotProfile | None = None,
     costmaps: CostmapSource | None = None,
     tasks: TaskOptions | None = None,
+    filters: tuple[CostmapFilter, ...] | None = None,
 ) -> tuple[Mission | None, list[NavseqError]]:
     """The mission in ``path`` (None if it cannot be read) and every problem found.
 
@@ -138,10 +144,13 @@ def mission_file_problems(
     the tasks a simulator run with these options would refuse (``run`` without
     ``--allow-run``, ROS tasks without ``--simulate-tasks``); None: not checked. ``navseq
     validate``, :func:`navseq.validate_file` and the studio's checks all call this.
+    ``filters``: costmap filters in place of the mission's (``--keepout``, ``--speed-mask``).
     """
     from navseq.mission import inspect_mission_file
 
     mission, problems = inspect_mission_file(path)
+    if mission is not None and filters is not None:
+        mission = dataclasses.replace(mission, filters=filters)
     errors = list(problems.errors)
     if mission is None and problems.salvage is not None:
         # Check the waypoints that did read against the map as well, so that one run
@@ -184,5 +193,11 @@ def _map_problems(
         return [error]
     if mission is None:
         return []
+    from navseq.sim.filters import costmap_with_filters
+
+    try:
+        costmap = costmap_with_filters(costmap, mission.filters)
+    except NavseqError as error:  # an unreadable mask, likewise
+        return [error]
     start = start if start is not None else mission.start
     return preflight_errors(mission, costmap, start, numbers, robot)

@@ -274,7 +274,8 @@ def paced_leg(goal: Point, metres: float, seconds: float, yaw: float) -> DrivenP
 
 
 def costmap_speed_cap(costmap: Costmap, model: DriveModel) -> SpeedCap:
-    """The controller's slowdown near obstacles, read from ``costmap`` at each point."""
+    """The controller's slowdown near obstacles, read from ``costmap`` at each point, and
+    the speed zones' limits of its map's filters (:mod:`navseq.sim.filters`)."""
     from navseq.sim.controller import ControllerParams, speed_factors_by_cost
 
     factors = np.asarray(speed_factors_by_cost(ControllerParams(), costmap))
@@ -287,6 +288,16 @@ def costmap_speed_cap(costmap: Costmap, model: DriveModel) -> SpeedCap:
         costs = np.zeros(len(points), dtype=int)
         costs[inside] = costmap.cost[rows[inside], cols[inside]]
         speeds: np.ndarray = factors[costs] * model.max_speed
+        zones = grid.filters
+        if zones is not None and zones.speed_limit is not None:  # the speed zones' limits
+            limits = np.full(len(points), np.nan, dtype=np.float32)
+            limits[inside] = zones.speed_limit[rows[inside], cols[inside]]
+            allowed = (
+                np.fmin(limits, model.max_speed)
+                if zones.speed_absolute
+                else model.max_speed * limits / 100.0
+            )
+            speeds = np.fmin(speeds, allowed)  # fmin: NaN (no limit) leaves the speed
         return speeds
 
     return cap

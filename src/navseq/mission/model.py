@@ -16,6 +16,8 @@ from types import MappingProxyType
 from typing import Any, NoReturn
 
 from navseq.geometry import Pose2D
+from navseq.mission.costmap_filters import CostmapFilter
+from navseq.mission.geodesy import Datum, GeoPoint
 from navseq.mission.recovery import Recovery
 from navseq.mission.robot import RobotProfile
 from navseq.mission.tasks import Task
@@ -166,7 +168,9 @@ class Waypoint:
     ``overrides`` are per-waypoint :class:`Policy` values, by its keywords
     (``{"goal_timeout_s": 30.0}``; a wrong key is a TypeError here, not later);
     ``where`` (``"file.yaml:12"``) is where the user wrote it, for messages, and is
-    not part of equality.
+    not part of equality. ``geo`` is the GPS position the waypoint was written as (its
+    ``x``/``y`` are that position in the map frame, through the mission's ``datum``),
+    kept for writing the mission back; not part of equality either.
     """
 
     x: float  # m
@@ -176,6 +180,7 @@ class Waypoint:
     name: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=lambda: _NO_OVERRIDES)
     where: str | None = field(default=None, compare=False)
+    geo: GeoPoint | None = field(default=None, compare=False)
 
     def __init__(
         self,
@@ -188,6 +193,7 @@ class Waypoint:
         name: str | None = None,
         overrides: Mapping[str, Any] | None = None,
         where: str | None = None,
+        geo: GeoPoint | None = None,
         **unknown: NoReturn,
     ) -> None:
         # ``NoReturn`` above: a type checker flags Waypoint(1, 2, 90) and yaw=90 too.
@@ -218,6 +224,7 @@ class Waypoint:
             name=name,
             overrides=_NO_OVERRIDES if not overrides else MappingProxyType(dict(overrides)),
             where=where,
+            geo=geo,
         )
 
     @property
@@ -263,6 +270,11 @@ class Mission:
     server_timeout: float | None = 60.0  # s to wait for a vanished server; None = forever
     robot: RobotProfile | None = None  # the mission's robot: section; None: not said
     record: bool = False  # record the run as MCAP (navseq run --record), as record: says
+    # The map frame's origin on the globe, for waypoints given as latitude/longitude
+    # (already converted to x/y when read); None: the mission has no GPS positions.
+    datum: Datum | None = None
+    # Nav2 costmap-filter masks (keepout, speed zones) over the map, in file order.
+    filters: tuple[CostmapFilter, ...] = ()
     source: str = field(default="<memory>", compare=False)  # where it was read from
     # For a part of a mission file (``--from``/``--to``/``--only``, see
     # navseq.mission.part): each waypoint's 0-based position in the file, so that every

@@ -33,6 +33,8 @@ from navseq.mission import (
     fields,
     recovery_format,  # noqa: F401  (registers the recovery: key)
 )
+from navseq.mission.costmap_filters import read_filters
+from navseq.mission.geodesy import Datum, GeoPoint, check_latitude, check_longitude
 from navseq.mission.located import Located, describe
 from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.problems import Problems, Salvage
@@ -43,13 +45,34 @@ FORMAT_VERSION = 1
 FOREVER = "forever"
 DEFAULT_SERVER_TIMEOUT = Mission.__dataclass_fields__["server_timeout"].default
 
-MISSION_SETTINGS = ("frame", "map", "start", "loops", "server_timeout", "robot", "record")
-OPTIONAL_SETTINGS = ("map", "start", "robot")  # null: none, like leaving the key out
+MISSION_SETTINGS = (
+    "frame",
+    "map",
+    "start",
+    "loops",
+    "server_timeout",
+    "robot",
+    "record",
+    "datum",
+    "filters",
+)
+OPTIONAL_SETTINGS = ("map", "start", "robot", "datum")  # null: none, like leaving the key out
 TOP_LEVEL_KEYS = ("navseq", *MISSION_SETTINGS, "defaults", "waypoints")
 ORIENTATION_KEYS = ("yaw", "yaw_rad", "orientation")
 POSE_KEYS = ("x", "y", "z", *ORIENTATION_KEYS)
+GEO_KEYS = ("latitude", "longitude", "altitude")  # a GPS waypoint, through the datum
 TASKS_KEY = "tasks"  # a waypoint's (or the defaults') list, read by navseq.mission.task_format
-WAYPOINT_KEYS = ("name", *POSE_KEYS, *POLICY_KEYS, TASKS_KEY)
+WAYPOINT_KEYS = ("name", *POSE_KEYS, *GEO_KEYS, *POLICY_KEYS, TASKS_KEY)
+DATUM_KEYS = ("latitude", "longitude", "altitude", "yaw", "yaw_rad")
+
+
+class _NoDatum:
+    """The datum a waypoint converts through when the mission's is faulty: its problem is
+    reported once, at the datum, not again at every GPS waypoint."""
+
+
+FAULTY_DATUM = _NoDatum()
+DatumSetting = Datum | _NoDatum | None
 
 
 def mission_from_document(
@@ -76,6 +99,7 @@ def mission_from_document(
             subject="field navseq",
         )
     defaults = read_defaults(doc.get("defaults"), problems)
+    datum = read_datum_setting(doc, problems)
     waypoints_node = doc.get("waypoints")
     waypoints: tuple[Waypoint, ...] = ()
     numbers: tuple[int, ...] = ()
@@ -88,8 +112,10 @@ def mission_from_document(
                 source=doc.where,
             )
     else:
-        waypoints, numbers = read_numbered_waypoints(waypoints_node, problems)
+        waypoints, numbers = read_numbered_waypoints(waypoints_node, problems, datum)
     settings = read_settings(doc, base_dir, problems)
+    if isinstance(datum, Datum):
+        settings["datum"] = datum
     check_tasks_stop(waypoints, numbers, defaults, problems)
     if len(problems) > before:
         if waypoints:
@@ -148,6 +174,12 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
         "server_timeout": read_server_timeout,
         "robot": read_robot,
         "record": fields.boolean,
+        "filters": lambda entry, subject: read_filters(
+            entry,
+            subject,
+            lambda node, what: read_map_path(node, what, base_dir),
+            fields.number,
+        ),
     }
     settings: dict[str, Any] = {}
     for key, reader in readers.items():
@@ -162,6 +194,53 @@ def read_settings(node: Located, base_dir: Path | None, problems: Problems) -> d
         if len(problems) == before:
             settings[key] = value
     return settings
+
+
+def read_datum_setting(node: Located, problems: Problems) -> DatumSetting:
+    """The mission's ``datum:`` (None when absent or null; FAULTY_DATUM, with its problem
+    recorded, when it cannot be read)."""
+    entry = node.get("datum")
+    if entry is None or entry.value is None:
+        return None
+    datum = fields.attempt(problems, lambda: read_datum(entry, "field datum"))
+    return FAULTY_DATUM if datum is None else datum
+
+
+def read_datum(node: Located, subject: str) -> Datum:
+    """navsat_transform's datum: ``{latitude, longitude, altitude, yaw}`` (degrees, metres,
+    degrees counter-clockwise from east; or ``yaw_rad``), or its parameter's list
+    ``[latitude, longitude, yaw_radians]``."""
+    if node.is_list:
+        items = node.value
+        if len(items) not in (2, 3):
+            raise NavseqError(
+                "the list form is navsat_transform's datum parameter [latitude, longitude, "
+                f"yaw_radians], got {len(items)} values",
+                source=node.where,
+                subject=subject,
+            )
+        values = [fields.number(item, subject) for item in items]
+        point = _geo_point(node, subject, values[0], values[1], None)
+        return Datum(point, fields.normalized_yaw(values[2]) if len(values) == 3 else 0.0)
+    fields.mapping(node, subject)
+    problems = Problems()
+    fields.check_keys(node, DATUM_KEYS, "datum", problems)
+    latitude = _required_number(node, "latitude", "datum", problems)
+    longitude = _required_number(node, "longitude", "datum", problems)
+    altitude = _optional_number(node, "altitude", "datum", problems, fields.coordinate)
+    yaw = read_yaw(node, "datum", problems, keys=("yaw", "yaw_rad"))
+    problems.raise_if_any()
+    assert latitude is not None and longitude is not None and yaw is not None
+    return Datum(_geo_point(node, subject, latitude, longitude, altitude), yaw)
+
+
+def _geo_point(
+    node: Located, subject: str, latitude: float, longitude: float, altitude: float | None
+) -> GeoPoint:
+    problem = check_latitude(latitude) or check_longitude(longitude)
+    if problem:
+        raise NavseqError(problem, source=node.where, subject=subject)
+    return GeoPoint(latitude, longitude, altitude)
 
 
 def read_frame(node: Located, subject: str) -> str:
@@ -223,13 +302,16 @@ def read_start(node: Located, subject: str) -> Pose2D:
     return Pose2D(x, y, yaw)
 
 
-def read_waypoints(node: Located, problems: Problems) -> tuple[Waypoint, ...]:
-    return read_numbered_waypoints(node, problems)[0]
+def read_waypoints(
+    node: Located, problems: Problems, datum: DatumSetting = None
+) -> tuple[Waypoint, ...]:
+    return read_numbered_waypoints(node, problems, datum)[0]
 
 
 def read_numbered_waypoints(
     node: Located,
     problems: Problems,
+    datum: DatumSetting = None,
 ) -> tuple[tuple[Waypoint, ...], tuple[int, ...]]:
     """The waypoints that read without a problem, and their indices in the list."""
     items = fields.attempt(problems, lambda: fields.sequence(node, "field waypoints"))
@@ -242,7 +324,9 @@ def read_numbered_waypoints(
             subject="field waypoints",
         )
         return (), ()
-    read = [(index, read_waypoint(item, index, problems)) for index, item in enumerate(items)]
+    read = [
+        (index, read_waypoint(item, index, problems, datum)) for index, item in enumerate(items)
+    ]
     check_unique_names(items, problems)
     kept = [(index, waypoint) for index, waypoint in read if waypoint is not None]
     return tuple(w for _, w in kept), tuple(i for i, _ in kept)
@@ -284,8 +368,14 @@ def _plain_waypoint(node: Located) -> Waypoint | None:
         return None
 
 
-def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | None:
-    """One waypoint: a mapping, or the short form ``[x, y]`` / ``[x, y, yaw_degrees]``."""
+def read_waypoint(
+    node: Located, index: int, problems: Problems, datum: DatumSetting = None
+) -> Waypoint | None:
+    """One waypoint: a mapping, or the short form ``[x, y]`` / ``[x, y, yaw_degrees]``.
+
+    A mapping may give its position as ``latitude``/``longitude`` (and ``altitude``)
+    instead of ``x``/``y`` (and ``z``): converted to the map frame through ``datum``.
+    """
     plain = _plain_waypoint(node)
     if plain is not None:
         return plain
@@ -309,9 +399,13 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         if name is not None:
             label = f"{label} '{name}'"
     fields.check_keys(node, WAYPOINT_KEYS, label, problems)
-    x = _required_number(node, "x", label, problems, fields.coordinate)
-    y = _required_number(node, "y", label, problems, fields.coordinate)
-    z = _optional_number(node, "z", label, problems, fields.coordinate)
+    geo: GeoPoint | None = None
+    if any(node.get(key) is not None for key in GEO_KEYS):
+        x, y, z, geo = _gps_position(node, label, problems, datum)
+    else:
+        x = _required_number(node, "x", label, problems, fields.coordinate)
+        y = _required_number(node, "y", label, problems, fields.coordinate)
+        z = _optional_number(node, "z", label, problems, fields.coordinate)
     yaw = read_yaw(node, label, problems)
     overrides = fields.policy_values(node, label, problems)
     tasks = _tasks(node, label, problems)
@@ -327,7 +421,62 @@ def read_waypoint(node: Located, index: int, problems: Problems) -> Waypoint | N
         name=name,
         overrides=MappingProxyType(overrides),
         where=node.where,
+        geo=geo,
     )
+
+
+def _gps_position(
+    node: Located, label: str, problems: Problems, datum: DatumSetting
+) -> tuple[float | None, float | None, float | None, GeoPoint | None]:
+    """(x, y, z, the GPS position) of a waypoint written as latitude/longitude; Nones
+    with the problems recorded when it cannot be converted."""
+    failed = (None, None, None, None)
+    mixed = [key for key in ("x", "y", "z") if node.get(key) is not None]
+    if mixed:
+        problems.add(
+            f"gives both {', '.join(mixed)} and latitude/longitude: write the position "
+            "once, in the map frame (x, y, z) or as GPS (latitude, longitude, altitude)",
+            source=node.where,
+            subject=label,
+        )
+        return failed
+    before = len(problems)
+    latitude = _required_number(node, "latitude", label, problems)
+    longitude = _required_number(node, "longitude", label, problems)
+    altitude = _optional_number(node, "altitude", label, problems, fields.coordinate)
+    for key, value, check in (
+        ("latitude", latitude, check_latitude),
+        ("longitude", longitude, check_longitude),
+    ):
+        problem = check(value) if value is not None else None
+        if problem:
+            problems.add(
+                problem, source=node.value[key].where, subject=fields.field_subject(label, key)
+            )
+    if len(problems) > before or latitude is None or longitude is None:
+        return failed
+    if datum is None:
+        problems.add(
+            "is given as latitude/longitude but the mission has no datum: add "
+            "datum: {latitude, longitude, yaw} (the map frame's origin, as "
+            "navsat_transform's datum parameter)",
+            source=node.where,
+            subject=label,
+        )
+        return failed
+    if not isinstance(datum, Datum):
+        return failed  # the datum's own problem is reported
+    geo = GeoPoint(latitude, longitude, altitude)
+    x, y, z = datum.to_map(geo)
+    if max(abs(x), abs(y)) > fields.MAX_COORDINATE:
+        problems.add(
+            f"is {max(abs(x), abs(y)) / 1000:.0f} km from the datum; map coordinates "
+            f"are within ±{fields.MAX_COORDINATE:g} m",
+            source=node.where,
+            subject=label,
+        )
+        return failed
+    return x, y, z, geo
 
 
 def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoint | None:
@@ -354,12 +503,15 @@ def _waypoint_from_list(node: Located, index: int, problems: Problems) -> Waypoi
     return Waypoint(x=x, y=y, yaw_rad=yaw, where=node.where)
 
 
-def read_yaw(node: Located, owner: str, problems: Problems) -> float | None:
-    """Yaw in radians from exactly one of ``yaw`` (degrees), ``yaw_rad``, ``orientation``.
+def read_yaw(
+    node: Located, owner: str, problems: Problems, keys: Sequence[str] = ORIENTATION_KEYS
+) -> float | None:
+    """Yaw in radians from exactly one of ``yaw`` (degrees), ``yaw_rad``, ``orientation``
+    (those of them in ``keys``).
 
     None (with a recorded problem) when the orientation is invalid; 0 when absent.
     """
-    given = [key for key in ORIENTATION_KEYS if node.get(key) is not None]
+    given = [key for key in keys if node.get(key) is not None]
     if len(given) > 1:
         problems.add(
             f"give only one of {', '.join(given)}",

@@ -20,10 +20,12 @@ from contextvars import ContextVar
 from pathlib import Path
 
 from navseq.mission import fields
+from navseq.mission.geodesy import Datum
 from navseq.mission.located import Located
 from navseq.mission.model import POLICY_KEYS, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import (
     MISSION_SETTINGS,
+    read_datum_setting,
     read_path,
     read_settings,
     read_waypoints,
@@ -73,6 +75,9 @@ def mission_from_namespace(
         )
         return None
     settings = read_settings(namespace, base_dir, problems)
+    datum = read_datum_setting(namespace, problems)
+    if isinstance(datum, Datum):
+        settings["datum"] = datum
     policy = fields.policy_values(namespace, None, problems)
     if given[0] == "mission" and _reading_named_file.get():
         problems.add(
@@ -88,7 +93,7 @@ def mission_from_namespace(
         return dataclasses.replace(base, defaults=base.defaults.with_overrides(policy), **settings)
     waypoints: tuple[Waypoint, ...]
     if given[0] == "waypoints":
-        waypoints = read_waypoints(namespace.value["waypoints"], problems)
+        waypoints = read_waypoints(namespace.value["waypoints"], problems, datum)
         source = namespace.value["waypoints"].where
     else:
         positions = namespace.get(POSITIONS_KEY)

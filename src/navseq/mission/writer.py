@@ -20,6 +20,7 @@ import yaml
 from navseq.errors import NavseqError
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
+from navseq.mission.geodesy import Datum
 from navseq.mission.model import POLICY_KEYS, FailureAction, Mission, Policy, Waypoint
 from navseq.mission.navseq_format import FOREVER, FORMAT_VERSION
 from navseq.mission.recovery_format import recovery_document
@@ -74,18 +75,21 @@ _MissionDumper.add_representer(
 _RESOLVER = _MissionDumper(io.StringIO())
 
 
-def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
+def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None, gps: bool = True) -> str:
     """The mission as navseq YAML text.
 
     With ``base_dir`` (the folder the file will be written to) the map path is written
-    relative to it, so mission and map can be moved together.
+    relative to it, so mission and map can be moved together. Waypoints read as
+    latitude/longitude are written so again, unless ``gps`` is False (map coordinates,
+    for a face that draws them).
 
     PyYAML writes the settings; the waypoints, one flow mapping a line, are written by
     :func:`_waypoint_lines`, exactly as PyYAML would write them: PyYAML's emitter took
     12-25 s and 450 MB for 100 000 waypoints, most of a conversion's time.
     """
     doc = _settings(mission, base_dir)
-    waypoints = [_waypoint(w) for w in mission.waypoints]
+    datum = mission.datum if gps else None
+    waypoints = [_waypoint(w, datum) for w in mission.waypoints]
     lines = _waypoint_lines(waypoints) if waypoints else None
     if lines is None:  # none, or one the line writer does not write as PyYAML would
         doc["waypoints"] = waypoints
@@ -97,7 +101,7 @@ def dump_mission_yaml(mission: Mission, *, base_dir: Path | None = None) -> str:
 def dump_mission_yaml_slowly(mission: Mission, *, base_dir: Path | None = None) -> str:
     """:func:`dump_mission_yaml`, every line written by PyYAML (the reference in tests)."""
     doc = _settings(mission, base_dir)
-    doc["waypoints"] = [_waypoint(w) for w in mission.waypoints]
+    doc["waypoints"] = [_waypoint(w, mission.datum) for w in mission.waypoints]
     return HEADER + _dump(doc)
 
 
@@ -113,6 +117,18 @@ def _settings(mission: Mission, base_dir: Path | None) -> dict[str, Any]:
         doc["robot"] = robot_section(mission.robot)
     if mission.record:
         doc["record"] = True
+    if mission.datum is not None:
+        doc["datum"] = _datum(mission.datum)
+    if mission.filters:
+        doc["filters"] = [
+            _FlowMapping(
+                mask=_map_text(f.mask, base_dir),
+                type=int(f.type),
+                base=f.base,
+                multiplier=f.multiplier,
+            )
+            for f in mission.filters
+        ]
     doc["defaults"] = _policy_values(mission.defaults, POLICY_KEYS)
     if mission.defaults.tasks:
         doc["defaults"]["tasks"] = [task_document(t) for t in mission.defaults.tasks]
@@ -318,14 +334,38 @@ def _yaw_entry(yaw: float) -> dict[str, Any]:
     return {"yaw": yaw_degrees_for_file(yaw)}
 
 
-def _waypoint(waypoint: Waypoint) -> _FlowMapping:
+def _datum(datum: Datum) -> _FlowMapping:
+    entry = _FlowMapping(latitude=datum.point.latitude, longitude=datum.point.longitude)
+    if datum.point.altitude is not None:
+        entry["altitude"] = datum.point.altitude
+    entry.update(_yaw_entry(datum.yaw_rad))
+    return entry
+
+
+def _written_as_gps(waypoint: Waypoint, datum: Datum | None) -> bool:
+    """True when the waypoint was read as latitude/longitude and still is where that
+    puts it (a waypoint moved since, in the studio, is written as x/y)."""
+    if waypoint.geo is None or datum is None:
+        return False
+    x, y, _ = datum.to_map(waypoint.geo)
+    return abs(x - waypoint.x) < 1e-3 and abs(y - waypoint.y) < 1e-3
+
+
+def _waypoint(waypoint: Waypoint, datum: Datum | None = None) -> _FlowMapping:
     entry = _FlowMapping()
     if waypoint.name is not None:
         entry["name"] = waypoint.name
-    entry["x"] = waypoint.x
-    entry["y"] = waypoint.y
-    if waypoint.z != 0.0:
-        entry["z"] = waypoint.z
+    if _written_as_gps(waypoint, datum):
+        assert waypoint.geo is not None
+        entry["latitude"] = waypoint.geo.latitude
+        entry["longitude"] = waypoint.geo.longitude
+        if waypoint.geo.altitude is not None:
+            entry["altitude"] = waypoint.geo.altitude
+    else:
+        entry["x"] = waypoint.x
+        entry["y"] = waypoint.y
+        if waypoint.z != 0.0:
+            entry["z"] = waypoint.z
     entry.update(_yaw_entry(waypoint.yaw_rad))
     if waypoint.overrides:
         entry.update(

@@ -92,17 +92,20 @@ class NavigatorDraft:
         if not self.preflight:
             return
         from navseq.sim.costmap import Costmap
+        from navseq.sim.filters import with_filters
         from navseq.sim.profile import costmap_params_of
 
+        if grid.filters is None:  # a stack's map: the mission's keepout zones still apply
+            grid = with_filters(grid, self.mission.filters)
         self.check_against(Costmap.from_grid(grid, costmap_params_of(self.robot)), context)
 
     def optional_map(self) -> OccupancyGrid | None:
         """The map, if one is known, with the mission checked against it."""
         if self.map_path is None:
             return None
-        from navseq.sim.occupancy import load_map
+        from navseq.sim.filters import load_filtered_map
 
-        grid = load_map(self.map_path)
+        grid = load_filtered_map(self.map_path, self.mission.filters)
         self.check_map(grid)
         return grid
 

@@ -173,6 +173,16 @@ class Nav2NavigatorSettings:
         ),
     )
     map_wait: float = field(default=MAP_WAIT, metadata=_MAP_WAIT)
+    from_ll: str | None = field(
+        default=None,
+        metadata=option(
+            "--from-ll",
+            "convert the mission's GPS waypoints through this service of the running "
+            "stack (robot_localization's navsat_transform fromLL, e.g. fromLL) instead of "
+            "with the mission's datum",
+            metavar="SERVICE",
+        ),
+    )
 
 
 def _hidden(flag: str, parse: Callable[[str], Any] | None) -> dict[str, SettingInfo]:

@@ -318,7 +318,9 @@ def create(settings: SimNavigatorSettings, draft: NavigatorDraft) -> NavigatorSe
             "map: key in the mission",
             source=draft.mission.source,
         )
-    grid = load_map(draft.map_path)
+    from navseq.sim.filters import load_filtered_map
+
+    grid = load_filtered_map(draft.map_path, draft.mission.filters)
     ready = prepare_sim_world(
         draft.mission,
         grid,

@@ -68,6 +68,14 @@ def create(settings: Nav2NavigatorSettings, draft: NavigatorDraft) -> NavigatorS
     map_source = None
     try:
         navigator.require_server(server_timeout)
+        if settings.from_ll:
+            from navseq.navigators.gps_service import converted_through_from_ll
+
+            # Before pre-flight: the stack's own conversion is what is checked and driven.
+            draft.mission = converted_through_from_ll(
+                navigator.ros_tasks(), settings.from_ll, mission, server_timeout
+            )
+            notes.append(f"GPS waypoints converted by {settings.from_ll} (fromLL)")
         if not draft.robot_given:
             # The robot Nav2 drives, as its own parameters say, unless the user named one:
             # its goal checker's tolerance is the one arrival is judged by.

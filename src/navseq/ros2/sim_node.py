@@ -123,6 +123,7 @@ from navseq.ros2.behavior_actions import BehaviorActions
 from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
+from navseq.ros2.gps_actions import GpsWaypointActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.messages import (
     duration_msg,
@@ -308,6 +309,10 @@ class SimNode:
             stamp=self._stamp,
             frame=MAP_FRAME,
         )
+        self._gps = GpsWaypointActions(
+            node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
+            stamp=self._stamp, frame=MAP_FRAME,
+        )  # fmt: skip
         stamp = self._stamp()
         self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.

@@ -22,6 +22,7 @@ from navseq.tasks.options import TaskOptions
 
 if TYPE_CHECKING:
     from navseq.geometry import Pose2D
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.navigators.base import Navigator
@@ -126,6 +127,9 @@ class RunRequest:
     server_wait: float = 10.0
     tick: float = 0.1
     tasks: TaskOptions = field(default_factory=TaskOptions)
+    # Nav2 costmap filters (--keepout, --speed-mask) in place of the mission's filters:;
+    # None: the mission's. Not journaled: a resume gives them again.
+    filters: tuple[CostmapFilter, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.mission is None and self.resume is None:

@@ -512,6 +512,8 @@ def prepare(request: RunRequest) -> Session:
     if request.loops is not None:
         loops = None if request.loops == "forever" else int(request.loops)
         mission = dataclasses.replace(mission, loops=loops)
+    if request.filters is not None:
+        mission = dataclasses.replace(mission, filters=request.filters)
     spec = PartSpec(request.first, request.last, request.only)
     part = None if spec.whole else spec.select(mission)
     if part is not None:
@@ -541,6 +543,7 @@ def prepare(request: RunRequest) -> Session:
     )
     _check_recording(request.outputs, kind, mission)
     made = _navigator_setup(request, kind, draft)
+    mission = draft.mission  # a kind may settle it (GPS waypoints through the stack's fromLL)
     session = Session(
         request=request,
         mission=mission,

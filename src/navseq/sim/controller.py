@@ -161,6 +161,10 @@ class RegulatedPurePursuit:
             speed /= abs(curvature) * params.regulated_min_radius
         speed *= self._speed_factor_by_cost[self.costmap.cost_at(x, y)]
         speed = max(speed, params.min_regulated_speed)
+        zones = self.costmap.grid.filters
+        if zones is not None:  # Nav2's speed filter: the controller's speed limit,
+            # even below the regulation's floor
+            speed = min(speed, zones.speed_cap(self.costmap.grid, x, y, limits.max_v))
         approach = (
             distance_to_goal
             if self.distance_remaining < params.max_lookahead

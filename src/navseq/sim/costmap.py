@@ -177,6 +177,9 @@ def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:
     unknown = grid.unknown_mask()
     if params.unknown_is_lethal:
         obstacles = obstacles | unknown
+    keepout = grid.keepout_mask()
+    if keepout is not None:  # a keepout zone costs what an obstacle does (filters.py)
+        obstacles = obstacles | keepout
 
     cost = np.zeros(grid.data.shape, dtype=np.uint8)
     if obstacles.any():
@@ -194,6 +197,9 @@ def clearance_to_blocked(grid: OccupancyGrid, params: CostmapParams) -> np.ndarr
     border round the map, for nothing beyond it is known.
     """
     blocked = grid.occupied_mask()
+    keepout = grid.keepout_mask()
+    if keepout is not None:
+        blocked = blocked | keepout
     if params.unknown_is_lethal:
         blocked = np.pad(blocked | grid.unknown_mask(), 1, constant_values=True)
     _, to_square = _distances(blocked, grid.resolution)

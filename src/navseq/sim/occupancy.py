@@ -53,7 +53,7 @@ import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from PIL import Image, UnidentifiedImageError
@@ -66,6 +66,9 @@ from navseq.mission.problems import Problems
 from navseq.mission.reading import read_mission_text
 from navseq.mission.yaml_doc import parse_yaml
 from navseq.text import printable
+
+if TYPE_CHECKING:
+    from navseq.sim.filters import MapFilters
 
 OCCUPIED = 100
 FREE = 0
@@ -96,13 +99,16 @@ class OccupancyGrid:
     ``data[row, col]`` with row 0 at the bottom (``nav_msgs/OccupancyGrid`` order).
     ``origin`` is the pose of the lower-left corner of cell (0, 0); its yaw rotates the
     whole grid about that corner, as in ``nav_msgs/MapMetaData``. Grids compare (and
-    hash) by identity: ``data`` is large and treated as immutable.
+    hash) by identity: ``data`` is large and treated as immutable. ``filters``: Nav2
+    costmap filters (keepout and speed zones) laid over the cells
+    (:func:`navseq.sim.filters.with_filters`), None without any.
     """
 
     data: np.ndarray
     resolution: float
     origin: Pose2D = field(default_factory=lambda: Pose2D(0.0, 0.0, 0.0))
     source: str = "<memory>"
+    filters: MapFilters | None = None
 
     def __post_init__(self) -> None:
         if self.data.ndim != 2:
@@ -178,6 +184,10 @@ class OccupancyGrid:
         any other value it would call lethal: 101..127 and -128..-2).
         """
         return (self.data >= OCCUPIED) | (self.data < UNKNOWN)
+
+    def keepout_mask(self) -> np.ndarray | None:
+        """Cells in a keepout zone of the map's filters, None without keepout zones."""
+        return None if self.filters is None else self.filters.keepout
 
     def unknown_mask(self) -> np.ndarray:
         """Cells whose occupancy is unknown (value -1)."""

@@ -16,9 +16,11 @@ from pathlib import Path
 from navseq.errors import NavseqError
 from navseq.files import require_file
 from navseq.geometry import Pose2D
+from navseq.mission.geodesy import Datum, GeoPoint, check_latitude, check_longitude
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.docks import Dock, read_docks_file
 from navseq.sim.fleet import other_robots_problem
+from navseq.text import printable
 
 # Name rules for one namespace token: letters, digits, underscores; ROS 2 refuses a digit
 # first, ROS 1 anything but a letter first.
@@ -47,6 +49,7 @@ class SimConfig:
     replan_period: float = 0.0  # s: Nav2's re-plan tick on preemption; 0 = plan at once
     rate: float = 20.0  # simulation steps per simulated second
     docks: tuple[Dock, ...] = ()  # the docking server's docks (--docks, ROS 2 only)
+    datum: Datum | None = None  # --datum: follow_gps_waypoints' and fromLL's (ROS 2)
 
     @property
     def frame_prefix(self) -> str:
@@ -131,6 +134,7 @@ def checked_config(
     replan_period: float = 0.0,
     docks: Path | None = None,
     ros1: bool = False,
+    datum: str = "",
 ) -> SimConfig:
     """The checked settings from the values the options hold; every bad value is a
     NavseqError naming its option.
@@ -159,6 +163,7 @@ def checked_config(
         follow_clock=follow_clock_of(follow_clock, speed),
         replan_period=replan_period_of(float(replan_period), ros1=ros1),
         docks=docks_of(docks, ros1=ros1),
+        datum=datum_of(datum) if datum else None,
     )
 
 
@@ -172,3 +177,24 @@ def docks_of(path: Path | None, *, ros1: bool = False) -> tuple[Dock, ...]:
         )
     require_file(path, "--docks")
     return read_docks_file(path)
+
+
+def datum_of(text: str) -> Datum:
+    """``--datum LAT,LON[,YAW]``: degrees, degrees and the map x axis' heading in degrees
+    counter-clockwise from east (navseq's unit for yaw; navsat_transform's parameter has
+    radians)."""
+    parts = text.split(",")
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        values = []
+    if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
+        raise NavseqError(
+            f"expected LAT,LON or LAT,LON,YAW (degrees), got {printable(text)!r}",
+            source="--datum",
+        )
+    problem = check_latitude(values[0]) or check_longitude(values[1])
+    if problem:
+        raise NavseqError(problem, source="--datum")
+    yaw = math.radians(values[2]) if len(values) == 3 else 0.0
+    return Datum(GeoPoint(values[0], values[1]), yaw)

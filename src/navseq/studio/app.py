@@ -57,6 +57,7 @@ from navseq.tasks.options import DEFAULT_SIMULATED_SECONDS, TaskOptions
 from navseq.text import printable
 
 if TYPE_CHECKING:
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
@@ -217,10 +218,22 @@ class Studio:
     def map_image(self, map_text: str | None, layer: str) -> bytes:
         from navseq.mission.robot import DEFAULT_PROFILE
 
-        if layer not in ("map", "costmap"):
-            raise ApiError(400, f"unknown layer {printable(layer)!r}; map or costmap")
+        if layer not in ("map", "costmap", "zones"):
+            raise ApiError(400, f"unknown layer {printable(layer)!r}; map, costmap or zones")
         view = self.map_view(self._map_path(map_text))
+        if layer == "zones":
+            return view.zones_image(self._mission_filters())
         return view.image(layer, self.robot or DEFAULT_PROFILE)
+
+    def _mission_filters(self) -> tuple[CostmapFilter, ...]:
+        """The mission file's costmap filters (none for a new or unreadable mission)."""
+        from navseq.mission import inspect_mission_file
+
+        path = self.config.mission_path
+        if path is None or not path.is_file():
+            return ()
+        mission, _ = inspect_mission_file(path)
+        return mission.filters if mission is not None else ()
 
     def _map_path(self, map_text: str | None) -> Path:
         if map_text:

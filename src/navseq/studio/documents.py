@@ -63,13 +63,15 @@ def document_of(mission: Mission, base_dir: Path) -> dict[str, Any]:
     """The mission as a JSON-ready document: what the mission writer would write.
 
     The map path is relative to ``base_dir`` (the mission file's folder), as in a file.
+    GPS waypoints are given in map coordinates: the page draws and edits x/y.
     """
     from navseq.mission.writer import dump_mission_yaml
 
     # libyaml's safe loader when there is one: the writer's own text, read back; PyYAML's
     # pure-Python reader took 1.8 s on 3000 waypoints, the page's whole wait on opening.
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    document = yaml.load(dump_mission_yaml(mission, base_dir=base_dir), Loader=loader)
+    text = dump_mission_yaml(mission, base_dir=base_dir, gps=False)
+    document = yaml.load(text, Loader=loader)
     assert isinstance(document, dict)
     return document
 
@@ -242,6 +244,9 @@ def check_draft(
         # Resolved (and refused outside the studio's folders) before anything reads it.
         map_path = roots.resolve(map_value, "map", base=base_dir)
         document["map"] = str(map_path)
+    document["filters"] = _masks_resolved(document.get("filters"), roots, base_dir)
+    if document["filters"] is None:
+        del document["filters"]
     drafted = draft_text(document)
     with tempfile.TemporaryDirectory(prefix="navseq-studio-") as folder:
         path = Path(folder) / "draft.yaml"
@@ -249,6 +254,19 @@ def check_draft(
         mission, errors = mission_file_problems(path, costmaps=costmaps, tasks=tasks)
         problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
     return CheckedDraft(mission, problems, map_path)
+
+
+def _masks_resolved(filters: Any, roots: FileRoots, base_dir: Path) -> Any:
+    """The draft's costmap filters with each mask path resolved as the map's is (the
+    draft is checked from a temporary folder); anything else as the page sent it."""
+    if not isinstance(filters, list):
+        return filters
+    resolved = []
+    for item in filters:
+        if isinstance(item, dict) and isinstance(item.get("mask"), str):
+            item = {**item, "mask": str(roots.resolve(item["mask"], "filters mask", base=base_dir))}
+        resolved.append(item)
+    return resolved
 
 
 def shown_path(path: Path) -> str:

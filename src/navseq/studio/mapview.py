@@ -1,4 +1,5 @@
-"""The map as the page draws it: a PNG in world axes, and the costmap as an overlay.
+"""The map as the page draws it: a PNG in world axes, the costmap and the mission's
+keepout and speed zones (Nav2 costmap filters) as overlays.
 
 The grid comes from :func:`navseq.sim.occupancy.load_map` (every map mode, negate and
 threshold as the loader reads them), so the page shows what the planner and pre-flight
@@ -21,6 +22,7 @@ import numpy as np
 if TYPE_CHECKING:
     from PIL import Image
 
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.robot import RobotProfile
     from navseq.sim.costmap import Costmap
     from navseq.sim.occupancy import OccupancyGrid
@@ -99,6 +101,35 @@ def costmap_png(costmap: Costmap) -> bytes:
     return _png(image, costmap.grid.origin.yaw, 0)
 
 
+# The zones overlay's colours, as the picture's (navseq.sinks.picture.zones).
+_KEEPOUT_RGBA = (214, 39, 40, 140)
+_SPEED_RGB = (245, 158, 10)
+_MAX_SPEED_ALPHA = 130
+
+
+def zones_png(grid: OccupancyGrid) -> bytes:
+    """Keepout zones (red) and speed zones (amber, more opaque where slower) of
+    ``grid.filters``; all clear without filters."""
+    from PIL import Image
+
+    rgba = np.zeros((grid.height, grid.width, 4), dtype=np.uint8)
+    zones = grid.filters
+    if zones is not None and zones.speed_limit is not None:
+        limit = zones.speed_limit
+        if zones.speed_absolute:
+            top = float(np.nanmax(limit)) if np.isfinite(limit).any() else 1.0
+            slowed = 1.0 - limit / max(top, 1e-9)
+        else:
+            slowed = 1.0 - limit / 100.0
+        slowed = np.where(np.isnan(slowed), 0.0, np.clip(slowed, 0.1, 1.0))
+        rgba[..., :3] = _SPEED_RGB
+        rgba[..., 3] = (slowed * _MAX_SPEED_ALPHA).astype(np.uint8)
+    if zones is not None and zones.keepout is not None:
+        rgba[zones.keepout] = _KEEPOUT_RGBA
+    image = Image.fromarray(np.ascontiguousarray(rgba[::-1]), "RGBA")  # row 0 is the bottom
+    return _png(image, grid.origin.yaw, (0, 0, 0, 0))
+
+
 @dataclass
 class MapView:
     """One map file, loaded once, with its images and costmaps made on first use.
@@ -150,6 +181,18 @@ class MapView:
                 made = costmap_for_robot(self.grid, robot)
                 self._costmaps[robot] = made
             return made
+
+    def zones_image(self, filters: tuple[CostmapFilter, ...]) -> bytes:
+        """The zones of ``filters`` over this map (made once per set of filters)."""
+        from navseq.sim.filters import with_filters
+
+        key = ("zones", filters)
+        with self._lock_of(("image", key)):
+            png = self._images.get(str(key))
+            if png is None:
+                png = zones_png(with_filters(self.grid, filters))
+                self._images[str(key)] = png
+            return png
 
     def image(self, kind: str, robot: RobotProfile) -> bytes:
         key = kind if kind == "map" else f"{kind}:{robot.name}:{hash(robot)}"

@@ -69,6 +69,7 @@ from navseq.sinks.picture.view import (
     make_layout,
     occupancy_rgb,
 )
+from navseq.sinks.picture.zones import draw_zones
 from navseq.text import printable
 
 if TYPE_CHECKING:
@@ -287,8 +288,10 @@ def mission_figure(
     ax.set_xlim(view.xmin, view.xmax)
     ax.set_ylim(view.ymin, view.ymax)
     ax.set_aspect("equal")
+    zone_handles: list[Any] = []
     if grid is not None:
         draw_map(ax, grid, layout)
+        zone_handles = draw_zones(ax, grid, layout)
     outcomes = waypoint_outcomes(result, count)
     markers = group_markers(positions, outcomes, layout, dpi) if count else None
     crowded = markers is not None and not markers.numbered
@@ -329,5 +332,6 @@ def mission_figure(
         drew_plans=drew_plans,
         drew_radius=drew_radius,
         lines=lines,
+        zones=zone_handles,
     )
     return fig

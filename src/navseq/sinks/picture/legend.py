@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from navseq.geometry import Pose2D
@@ -39,6 +40,7 @@ def side_panel(
     drew_plans: bool,
     drew_radius: bool,
     lines: LineCollection | None,
+    zones: Sequence[Any] = (),
 ) -> None:
     """Legend (top) and time colour bar (bottom) beside the map, never over it."""
     from matplotlib.lines import Line2D
@@ -118,6 +120,7 @@ def side_panel(
         )
     if start is not None and robot is not None:
         handles.append(Line2D([], [], color="black", linewidth=0.9, label=f"{robot.name} outline"))
+    handles.extend(zones)  # the map's keepout and speed zones (navseq.sinks.picture.zones)
     if drew_plans:
         handles.append(
             Line2D([], [], linestyle=(0, (4, 3)), color=PLAN_COLOUR, label="planned path")
