@@ -135,9 +135,8 @@ def _table(fleet_run: FleetRun) -> Table:
 
 def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
     from rich.console import Console
-    from rich.table import Table
-
     from rich.markup import escape
+    from rich.table import Table
 
     from navseq.commands.plan_fleet import shown_path
     from navseq.sinks.summary import print_table

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from navseq.fleet.run import FleetRun, Member
+    from navseq.sinks.picture.view import Box
 
 #: The fleet report's version (docs/fleet.md shows one).
 SCHEMA_VERSION = 1
@@ -78,6 +79,28 @@ def fleet_report(run: FleetRun) -> dict[str, Any]:
     }
 
 
+def _view(run: FleetRun) -> Box:
+    """The mapped part of the map and every robot's start and waypoints, with a margin."""
+    import numpy as np
+
+    from navseq.sinks.picture.view import Box
+
+    grid = run.plan.grid
+    assert grid is not None
+    rows, cols = np.nonzero(grid.data != -1)
+    points = [(r.start.x, r.start.y) for r in run.plan.fleet.robots]
+    points += [(w.x, w.y) for w in run.plan.fleet.mission.waypoints]
+    if rows.size:
+        points += [tuple(p) for p in grid.cells_to_world(rows[[0, -1]], cols[[0, -1]])]
+        points += [
+            tuple(p)
+            for p in grid.cells_to_world(
+                np.array([rows.min(), rows.max()]), np.array([cols.min(), cols.max()])
+            )
+        ]
+    return Box.around(np.array(points, dtype=float)).grown(0.3)
+
+
 def fleet_picture_png(run: FleetRun) -> bytes:
     """The map, and per robot in its colour: its trail, its start and its waypoints
     (filled where reached, a cross where failed or skipped)."""
@@ -85,11 +108,11 @@ def fleet_picture_png(run: FleetRun) -> bytes:
     from matplotlib.figure import Figure
 
     from navseq.executor.events import WaypointOutcome
-    from navseq.sinks.picture.view import Box, draw_map, make_layout
+    from navseq.sinks.picture.view import draw_map, make_layout
 
     grid = run.plan.grid
     assert grid is not None
-    layout = make_layout(Box(*grid.bounds).grown(0.2), 100)
+    layout = make_layout(_view(run), 100)
     figure = Figure(figsize=layout.size, dpi=layout.dpi)
     FigureCanvasAgg(figure)
     left, bottom, width, height = layout.axes
