@@ -95,7 +95,7 @@ def main() -> None:
     parser.add_argument("--time-limit", type=float, default=2.0)
     args = parser.parse_args()
     counts = [int(n) for n in args.robots.split(",")]
-    print(f"| map | waypoints | robots | one robot [s] | makespan [s] | ratio | solve [s] |")
+    print("| map | waypoints | robots | one robot [s] | makespan [s] | ratio | solve [s] |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for seed in range(args.seeds):
         for robots in counts:

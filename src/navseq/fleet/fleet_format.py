@@ -126,7 +126,7 @@ def fleet_from_document(
     mission, read_from = _mission(doc, source, base_dir, problems, mission_path)
     default_profile = mission.robot if mission is not None and mission.robot else DEFAULT_PROFILE
     robots = _robots(doc, source, default_profile, problems)
-    allowed = _allowed(doc.get("waypoints"), mission, robots, problems)
+    allowed = _allowed(doc.get("waypoints"), mission, _listed_names(doc), problems)
     if mission is None:
         return None
     return Fleet(
@@ -295,10 +295,19 @@ def _check_unique(
             )
 
 
+def _listed_names(doc: Located) -> set[str]:
+    """The names the robot list gives, also of robots with problems of their own."""
+    node = doc.get("robots")
+    if node is None or not node.is_list:
+        return set()
+    names = (item.get("name") for item in node.value)
+    return {name.value for name in names if name is not None and isinstance(name.value, str)}
+
+
 def _allowed(
     node: Located | None,
     mission: Mission | None,
-    robots: Sequence[FleetRobot],
+    names: set[str],
     problems: Problems,
 ) -> dict[int, tuple[str, ...]]:
     """``waypoints:``: for a waypoint (by name or number), the robots that may take it."""
@@ -306,7 +315,6 @@ def _allowed(
         return {}
     if fields.attempt(problems, lambda: fields.mapping(node, "field waypoints")) is None:
         return {}
-    names = {robot.name for robot in robots}
     allowed: dict[int, tuple[str, ...]] = {}
     for key, rule in node.value.items():
         subject = f"waypoints, {fields.shortened(key)}"
@@ -337,7 +345,7 @@ def _allowed(
             )
             if robot is None:
                 continue
-            if robot not in names and robots:
+            if robot not in names and names:
                 problems.add(
                     f"{robot!r} is none of the fleet's robots ({', '.join(sorted(names))})",
                     source=entry.where,
