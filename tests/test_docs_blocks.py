@@ -105,7 +105,7 @@ def test_a_mission_block_loads(block: Block, tmp_path: Path) -> None:
     (tmp_path / "examples").mkdir()
     path = tmp_path / "examples" / f"doc{MISSION_SUFFIXES[block.language]}"
     path.write_text(block.text, encoding="utf-8")
-    if block.text.startswith("navseq_fleet:"):  # a fleet file (docs/fleet.md), its mission beside it
+    if block.text.startswith("navseq_fleet:"):  # a fleet file, its mission beside it
         from navseq.fleet.fleet_format import load_fleet
 
         shutil.copytree(REPO / "examples", tmp_path / "examples", dirs_exist_ok=True)

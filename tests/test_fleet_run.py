@@ -73,8 +73,8 @@ def test_a_robot_with_nothing_to_do_stays_parked_and_the_run_ends(tmp_path: Path
 def test_a_bad_fleet_file_moves_nothing_and_writes_nothing(tmp_path: Path) -> None:
     fleet = tmp_path / "fleet.yaml"
     fleet.write_text(FLEET.read_text().replace("x: 2.0, y: 0.5", "x: 0.0, y: 0.0"))
-    (tmp_path / "turtlebot3_world.yaml").write_text((EXAMPLES / "turtlebot3_world.yaml").read_text())
-    (tmp_path / "maps").mkdir()
+    mission = (EXAMPLES / "turtlebot3_world.yaml").read_text()
+    (tmp_path / "turtlebot3_world.yaml").write_text(mission)
     out = tmp_path / "run"
     done = navseq("run", "--fleet", fleet, "--map", TURTLEBOT3_MAP, "--out", out, cwd=tmp_path)
     assert_clean_error(done)
