@@ -92,3 +92,36 @@ def test_options_a_fleet_run_cannot_honour_are_refused(tmp_path: Path) -> None:
         assert_clean_error(done)
         assert named in done.stderr
         assert not (tmp_path / "navseq-out").exists()
+
+
+def test_ctrl_c_stops_every_robot_and_the_fleet_s_outputs_are_still_written(
+    tmp_path: Path,
+) -> None:
+    import signal
+    import time
+
+    from cli_support import start_navseq
+
+    out = tmp_path / "run"
+    process = start_navseq("run", "--fleet", FLEET, "--out", out, "--realtime", "1", cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 60
+        # Under way once every robot's journal has its first waypoint started.
+        while time.monotonic() < deadline and not all(
+            (out / name / "journal.jsonl").exists()
+            and "WaypointStarted" in (out / name / "journal.jsonl").read_text()
+            for name in ("alpha", "beta", "gamma")
+        ):
+            time.sleep(0.1)
+        process.send_signal(signal.SIGINT)
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 130, stderr
+    report = fleet_report(out)
+    assert report["interrupted"] == "SIGINT" and report["reached"] < 7
+    for name in ("alpha", "beta", "gamma"):
+        robot_report = json.loads((out / name / "report.json").read_text())
+        assert robot_report["totals"]["reached"] < robot_report["totals"]["visits"]

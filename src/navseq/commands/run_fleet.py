@@ -73,19 +73,21 @@ def run(args: argparse.Namespace) -> int:
         if member.session is not None:
             for note in member.session.notes:
                 print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
-    status, report = _execute(fleet_run)
+    status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
     _print_summary(fleet_run, report)
     return status
 
 
-def _execute(fleet_run: FleetRun) -> tuple[int, dict[str, Any]]:
-    """Run the robots with a live table; Ctrl-C / SIGTERM stop them all, then the outputs
-    are written."""
+def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any]]:
+    """Run the robots with a live table; Ctrl-C / SIGTERM / SIGHUP stop them all (also
+    where the shell started navseq with SIGINT ignored), then the outputs are written
+    and later signals are only counted."""
     from rich.console import Console
     from rich.live import Live
 
-    from navseq.signals import Terminated
+    from navseq.signals import SignalGuard, Terminated
 
+    guard = SignalGuard().arm()
     threads = fleet_run.start()
     console = Console(stderr=True)
     interrupted: str | None = None
@@ -96,15 +98,19 @@ def _execute(fleet_run: FleetRun) -> tuple[int, dict[str, Any]]:
                 fleet_run.clock.stepped.clear()
                 live.update(_table(fleet_run), refresh=True)
     except (KeyboardInterrupt, Terminated) as stop:
-        name = stop.signal_name if isinstance(stop, Terminated) else "SIGINT"
-        interrupted = f"interrupted: {name}"
+        interrupted = stop.signal_name if isinstance(stop, Terminated) else "SIGINT"
     finally:
+        guard.defer()
         if interrupted is not None or any(thread.is_alive() for thread in threads):
-            fleet_run.stop(interrupted or "interrupted")
+            fleet_run.stop(interrupted or "an error")
         for thread in threads:
             thread.join()
     errors = [m for m in fleet_run.members if m.error is not None]
-    status, report = fleet_run.finish()
+    try:
+        status, report = fleet_run.finish()
+    finally:
+        if not exits_after:
+            guard.restore()
     for member in errors:
         print(f"navseq run: {member.robot.name}: {member.error}", file=sys.stderr)
     return status, report

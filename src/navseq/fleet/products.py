@@ -52,11 +52,10 @@ def fleet_report(run: FleetRun) -> dict[str, Any]:
     mission = plan.fleet.mission
     robots = [member_summary(member) for member in run.members]
     statuses = [row["exit_status"] for row in robots]
-    interrupted = next((row["interrupted"] for row in robots if "interrupted" in row), None)
-    if interrupted is not None:
+    if run.stopped_by is not None:
         from navseq.executor.runner import SIGNAL_EXIT_CODES
 
-        exit_status = SIGNAL_EXIT_CODES.get(interrupted, _EXIT_NOT_ALL)
+        exit_status = SIGNAL_EXIT_CODES.get(run.stopped_by, _EXIT_NOT_ALL)
     elif all(status == _EXIT_OK for status in statuses) and not plan.split.dropped:
         exit_status = _EXIT_OK
     else:
@@ -75,6 +74,7 @@ def fleet_report(run: FleetRun) -> dict[str, Any]:
         "makespan_s": max(times, default=0.0),
         "planned_makespan_s": round(plan.split.makespan_s, 1),
         "robot_overlaps": run.world.collisions,
+        "interrupted": run.stopped_by,
         "exit_status": exit_status,
     }
 

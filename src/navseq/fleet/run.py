@@ -22,6 +22,7 @@ from navseq.errors import NavseqError
 from navseq.fleet.model import FleetRobot
 
 if TYPE_CHECKING:
+    from navseq.executor.control import MissionControl
     from navseq.executor.events import MissionEvent
     from navseq.fleet.lockstep import FleetClock, MemberNavigator
     from navseq.fleet.planning import FleetPlan
@@ -59,6 +60,7 @@ class Member:
     time_s: float = 0.0
     outcome: RunOutcome | None = None
     error: BaseException | None = None
+    control: MissionControl = field(default_factory=lambda: _control())
 
     def hear(self, event: MissionEvent) -> None:
         """A mission listener: the member's state as a live display shows it."""
@@ -96,11 +98,16 @@ class FleetRun:
     folder: Path
     members: list[Member]
     picture: bool = True
-    _stop: str | None = field(default=None, init=False)
+    #: The signal that stopped the run (SIGINT, SIGTERM ...), None while it was not.
+    stopped_by: str | None = field(default=None, init=False)
 
-    def stop(self, reason: str) -> None:
-        """End every robot's run (each cancels its goal and writes its outputs)."""
-        self._stop = reason
+    def stop(self, signal_name: str) -> None:
+        """End every robot's mission as an operator's cancel would (each cancels its goal,
+        and its journal and report say so); the fleet's exit status then says
+        ``signal_name``."""
+        self.stopped_by = signal_name
+        for member in self.members:
+            member.control.submit("cancel", f"fleet run interrupted ({signal_name})")
 
     def start(self) -> list[threading.Thread]:
         """One thread per robot with waypoints, running its session; started."""
@@ -116,13 +123,9 @@ class FleetRun:
         return threads
 
     def _run_member(self, member: Member) -> None:
-        from navseq.executor.control import MissionControl
-
         assert member.session is not None
         try:
-            member.outcome = member.session.run(
-                [member.hear], control=MissionControl(stop_reason=lambda: self._stop)
-            )
+            member.outcome = member.session.run([member.hear], control=member.control)
         except BaseException as error:  # reported by the face; the others go on
             member.error = error
             member.state = "error"
@@ -147,6 +150,12 @@ class FleetRun:
         report["files"] = files
         write_atomically(self.folder / "fleet-report.json", report_json(report))
         return report["exit_status"], report
+
+
+def _control() -> MissionControl:
+    from navseq.executor.control import MissionControl
+
+    return MissionControl()
 
 
 def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
