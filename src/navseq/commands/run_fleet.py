@@ -122,7 +122,14 @@ def _table(fleet_run: FleetRun) -> Table:
 
     from navseq.text import printable
 
-    table = Table(title=f"fleet at t = {fleet_run.world.now:.0f} s", title_justify="left")
+    totals = {
+        key: sum(m.counts[key] for m in fleet_run.members) for key in fleet_run.members[0].counts
+    }
+    table = Table(
+        title=f"fleet at t = {fleet_run.world.now:.0f} s: {totals['reached']} reached, "
+        f"{totals['skipped']} skipped, {totals['failed']} failed{_fleet_eta(fleet_run)}",
+        title_justify="left",
+    )
     for header in ("robot", "waypoint", "state", "reached", "skipped", "failed", "of"):
         table.add_column(header)
     for member in fleet_run.members:
@@ -137,6 +144,18 @@ def _table(fleet_run: FleetRun) -> Table:
             str(member.waypoints),
         )
     return table
+
+
+def _fleet_eta(fleet_run: FleetRun) -> str:
+    """``, done in ~40 s``: the latest of the running robots' ETAs (each its run's own)."""
+    left = []
+    for member in fleet_run.members:
+        if member.session is None or member.state in ("done", "ended", "error"):
+            continue
+        estimator = member.session.eta()
+        if estimator is not None and estimator.eta_s is not None:
+            left.append(estimator.eta_s)
+    return f", done in ~{max(left):.0f} s" if left else ""
 
 
 def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
