@@ -47,6 +47,7 @@ class FleetClock:
         self._step_hooks: dict[str, Callable[[], None]] = {}
         self._pace_origin: tuple[float, float] | None = None
         self.stepped = threading.Event()  # set after every round, for a live display
+        self._failure: BaseException | None = None  # a step that raised: every run ends
 
     def on_step(self, name: str, hook: Callable[[], None]) -> None:
         """Call ``hook`` after every fleet step (a member turning it into events)."""
@@ -59,8 +60,11 @@ class FleetClock:
             self._asked = max(self._asked, seconds)
             here = self._round
             self._step_if_all_asked()
-            while self._round == here:
+            while self._round == here and self._failure is None:
                 self._condition.wait()
+            if self._failure is not None:
+                # Every robot's run ends (its goal cancelled), not just the stepping one's.
+                raise RuntimeError(f"the fleet's simulator failed: {self._failure!r}")
 
     def leave(self, name: str) -> None:
         """Member ``name``'s run has ended: the fleet no longer waits for it (its robot
@@ -78,12 +82,17 @@ class FleetClock:
         steps = math.floor(self._unspun / fleet.dt + 1e-9)
         self._unspun -= steps * fleet.dt
         hooks = list(self._step_hooks.values())
-        for _ in range(steps):
-            fleet.step()
-            for hook in hooks:
-                hook()
-            if self.realtime is not None:
-                self._pace()
+        try:
+            for _ in range(steps):
+                fleet.step()
+                for hook in hooks:
+                    hook()
+                if self.realtime is not None:
+                    self._pace()
+        except BaseException as error:
+            self._failure = error
+            self._condition.notify_all()
+            raise
         self._waiting.clear()
         self._asked = 0.0
         self._round += 1

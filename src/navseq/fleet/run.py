@@ -130,7 +130,10 @@ class FleetRun:
             member.error = error
             member.state = "error"
         finally:
-            self.clock.leave(member.robot.name)
+            try:
+                self.clock.leave(member.robot.name)
+            except BaseException as error:  # the fleet's last step failed: said above
+                member.error = member.error or error
 
     def finish(self) -> tuple[int, dict[str, Any]]:
         """The fleet's exit status and report, written with its picture into the folder."""
