@@ -221,7 +221,8 @@ class FleetNavigationServer(NavigationServer):
 
 @dataclass
 class _Yield:
-    """Robot ``robot`` gives way to robot ``to`` (indices into the fleet)."""
+    """The robot this entry is filed under gives way to robot ``to`` (an index into the
+    fleet) since ``since`` (s of fleet time)."""
 
     to: int
     since: float
@@ -296,7 +297,7 @@ class RightOfWay:
         while index in self._yields:
             index = self._yields[index].to
             depth += 1
-            if index in seen:  # cannot happen, but never loop
+            if index in seen:  # a cycle, which only inversions could make: stop there
                 break
             seen.add(index)
         if self._busy(index):
