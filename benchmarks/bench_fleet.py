@@ -150,8 +150,8 @@ def run_mission(seed: int, *, right_of_way: bool) -> MissionResult:
                     result.other_aborts += 1
                 sent[name] = None
             if queues[name]:
-                sent[name] = queues[name].pop(0)
-                server.set_goal(sent[name])
+                goal = sent[name] = queues[name].pop(0)
+                server.set_goal(goal)
 
     started = time.perf_counter()
     dispatch()

@@ -147,6 +147,24 @@ def test_four_robots_cross_a_junction_to_the_opposite_ends() -> None:
         assert near(arrived.get(name), ends[other]), (name, states(fleet))
 
 
+def dead_end() -> OccupancyGrid:
+    """A 2 m x 2 m room with a corridor one robot wide, 3 m long, closed at its end."""
+    data = canvas(5.6, 2.4)
+    carve(data, 0.2, 0.2, 2.2, 2.2)
+    carve(data, 2.2, 1.0, 5.2, 1.4)
+    return grid_of(data, "dead end")
+
+
+def test_a_robot_in_a_dead_end_gets_out_before_the_first_robot_goes_in() -> None:
+    deep, room = Pose2D(4.9, 1.2, math.pi), Pose2D(1.0, 1.2, 0.0)
+    fleet = FleetWorld(dead_end(), [FleetRobot("first", room), FleetRobot("inside", deep)])
+    fleet.set_goal("first", Pose2D(4.9, 1.2, 0.0))  # where "inside" is now
+    fleet.set_goal("inside", Pose2D(1.0, 0.6, math.pi))
+    arrived = drive(fleet)
+    assert near(arrived.get("first"), deep), states(fleet)
+    assert near(arrived.get("inside"), Pose2D(1.0, 0.6, 0.0)), states(fleet)
+
+
 def test_an_idle_robot_parked_on_a_goal_moves_aside() -> None:
     goal = Pose2D(3.7, 1.2, 0.0)  # in the middle of the corridor
     fleet = FleetWorld(
@@ -159,16 +177,20 @@ def test_an_idle_robot_parked_on_a_goal_moves_aside() -> None:
     assert fleet.world("parked").server.state is NavState.IDLE  # it kept no goal of its own
 
 
-def test_mixed_footprints_each_robot_its_own() -> None:
+def test_a_waffle_and_a_burger_swap_ends_each_with_its_own_footprint() -> None:
     from navseq.mission.robot import BUILTIN_PROFILES
 
-    big = next(p for p in BUILTIN_PROFILES.values() if p.name != "turtlebot3_burger")
+    waffle = BUILTIN_PROFILES["turtlebot3_waffle"]
+    west, east = Pose2D(2.7, 1.2, 0.0), Pose2D(4.7, 1.2, math.pi)
     fleet = FleetWorld(
-        rooms_with_one_door(),
-        [FleetRobot("small", Pose2D(1.0, 1.0, 0.0)), FleetRobot("big", Pose2D(5.0, 2.2, 0.0), big)],
+        corridor_between_rooms(corridor_width=0.7),
+        [FleetRobot("burger", west), FleetRobot("waffle", east, waffle)],
     )
-    assert fleet.footprints[0] != fleet.footprints[1]
-    assert fleet.world("big").footprint is fleet.footprints[1]
+    assert fleet.world("waffle").footprint.circumscribed_radius > 0.25
+    fleet.set_goal("burger", east)
+    fleet.set_goal("waffle", west)
+    arrived = drive(fleet)
+    assert near(arrived.get("burger"), east) and near(arrived.get("waffle"), west), states(fleet)
 
 
 def test_robots_that_start_overlapping_are_refused() -> None:

@@ -45,8 +45,9 @@ from scipy import ndimage
 
 from navseq.geometry import Pose2D
 from navseq.sim.costmap import Costmap
-from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint
+from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_cells
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
+from navseq.sim.planner import Plan
 
 if TYPE_CHECKING:
     from navseq.sim.fleet_world import FleetWorld
@@ -59,7 +60,17 @@ class FleetNavigationServer(NavigationServer):
     costmap, seeing the same robots) while the goal waits: ``state``, ``goal`` and
     ``plan`` stay as they were, and the goal's clocks stand still. :meth:`end_give_way`
     takes the goal up again with a new plan from where the robot is.
+
+    Planning sees the other robots within ``sensing_range`` of this one only, as a robot
+    sees them with its sensors (Nav2's local costmap is a few metres across): a robot
+    far away will have moved by the time this one gets there, and re-planning around
+    all of them, in a fleet of twenty, would cost more than everything else together.
+    For the same reason a robot that moves near the plan makes the server re-plan at
+    most every ``robot_replan_interval`` seconds. The safety test sees every robot.
     """
+
+    sensing_range = 3.0  # m from this robot's centre to another's, for planning
+    robot_replan_interval = 1.0  # s between re-plans caused by robots moving near the plan
 
     def __init__(
         self,
@@ -70,6 +81,8 @@ class FleetNavigationServer(NavigationServer):
         super().__init__(costmap, params, footprint)
         self._aside: NavigationServer | None = None
         self.aside_target: Pose2D | None = None
+        self._at: Pose2D | None = None  # where the robot was at the last step or plan
+        self._sensed: list[tuple[int, Pose2D]] = []  # (index, pose) in planning_costmap
 
     @property
     def giving_way(self) -> bool:
@@ -114,12 +127,78 @@ class FleetNavigationServer(NavigationServer):
             self._blocked_since = self._goal_time
 
     def compute_velocity(self, pose: Pose2D, v: float, w: float, dt: float) -> tuple[float, float]:
+        self._at = pose
         if self.aside_target is None:
             return super().compute_velocity(pose, v, w, dt)
         aside = self._aside
         assert aside is not None
         aside.set_other_robots(self._others)
         return aside.compute_velocity(pose, v, w, dt)
+
+    def make_plan(self, start: Pose2D, goal: Pose2D) -> Plan | None:
+        self._at = start
+        return super().make_plan(start, goal)
+
+    def _sensed_robots(self) -> list[tuple[int, Pose2D, Footprint]]:
+        """The other robots within ``sensing_range`` (all of them before the first step)."""
+        at = self._at
+        reach = self.sensing_range
+        return [
+            (index, pose, footprint)
+            for index, (pose, footprint) in enumerate(self._others)
+            if at is None or math.hypot(pose.x - at.x, pose.y - at.y) <= reach
+        ]
+
+    def _refresh_planning_costmap(self) -> None:
+        """The map's costmap plus the sensed robots, rebuilt only when they changed."""
+        sensed = self._sensed_robots()
+        before = self._sensed
+        self._costmap_others = [pose for pose, _ in self._others]
+        if len(sensed) == len(before) and all(
+            index == seen_index and not self._robot_moved(seen, pose, footprint)
+            for (index, pose, footprint), (seen_index, seen) in zip(sensed, before, strict=True)
+        ):
+            return
+        self._sensed = [(index, pose) for index, pose, _ in sensed]
+        grid = self.costmap.grid
+        rows: list[np.ndarray] = []
+        cols: list[np.ndarray] = []
+        for _, pose, footprint in sensed:
+            cells = footprint_cells(grid, footprint, pose)
+            if cells is not None:
+                rows.append(cells[0])
+                cols.append(cells[1])
+        costmap = self.costmap
+        if rows:
+            costmap = costmap.with_obstacles(
+                np.concatenate(rows), np.concatenate(cols), padding=self.params.robot_margin
+            )
+        self._use_planning_costmap(costmap)
+
+    def _robot_near_plan(self) -> bool:
+        """True if a sensed robot that moved since the plan was made is near its rest."""
+        plan, at = self.plan, self._at
+        if plan is None or self._since_plan < self.robot_replan_interval:
+            return False
+        seen = self._plan_others
+        near_squared = self.params.robot_near_plan**2
+        reach = self.sensing_range
+        ahead: np.ndarray | None = None
+        for index, (pose, footprint) in enumerate(self._others):
+            if at is not None and abs(pose.x - at.x) + abs(pose.y - at.y) > reach * 1.5:
+                continue  # out of sight (a cheap bound on the distance)
+            if index < len(seen) and not self._robot_moved(seen[index], pose, footprint):
+                continue
+            if ahead is None:
+                ahead = plan.points[self.controller.closest_index :]
+            squared = (ahead[:, 0] - pose.x) ** 2 + (ahead[:, 1] - pose.y) ** 2
+            if squared.size and float(squared.min()) < near_squared:
+                return True
+        return False
+
+    def _use_costmap(self, costmap: Costmap) -> None:
+        super()._use_costmap(costmap)
+        self._sensed = []  # force the robots back in at the next plan
 
     def route(self) -> np.ndarray | None:
         """The rest of the plan the robot follows now (to its goal, or aside), or None."""
@@ -142,7 +221,8 @@ class FleetNavigationServer(NavigationServer):
 
 @dataclass
 class _Yield:
-    """Robot ``robot`` gives way to robot ``to`` (indices into the fleet)."""
+    """The robot this entry is filed under gives way to robot ``to`` (an index into the
+    fleet) since ``since`` (s of fleet time)."""
 
     to: int
     since: float
@@ -217,7 +297,7 @@ class RightOfWay:
         while index in self._yields:
             index = self._yields[index].to
             depth += 1
-            if index in seen:  # cannot happen, but never loop
+            if index in seen:  # a cycle, which only inversions could make: stop there
                 break
             seen.add(index)
         if self._busy(index):
