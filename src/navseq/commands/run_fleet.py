@@ -150,9 +150,9 @@ def _fleet_eta(fleet_run: FleetRun) -> str:
     """``, done in ~40 s``: the latest of the running robots' ETAs (each its run's own)."""
     left = []
     for member in fleet_run.members:
-        if member.session is None or member.state in ("done", "ended", "error"):
+        if member.state in ("done", "ended", "error"):
             continue
-        estimator = member.session.eta()
+        estimator = member.eta
         if estimator is not None and estimator.eta_s is not None:
             left.append(estimator.eta_s)
     return f", done in ~{max(left):.0f} s" if left else ""

@@ -22,6 +22,7 @@ from navseq.errors import NavseqError
 from navseq.fleet.model import FleetRobot
 
 if TYPE_CHECKING:
+    from navseq.eta.live import EtaEstimator
     from navseq.executor.control import MissionControl
     from navseq.executor.events import MissionEvent
     from navseq.fleet.lockstep import FleetClock, MemberNavigator
@@ -61,6 +62,9 @@ class Member:
     outcome: RunOutcome | None = None
     error: BaseException | None = None
     control: MissionControl = field(default_factory=lambda: _control())
+    # The run's ETA, taken on the robot's own thread once its run has made it (a display
+    # asking the session first would make a second one that hears no event).
+    eta: EtaEstimator | None = None
 
     def hear(self, event: MissionEvent) -> None:
         """A mission listener: the member's state as a live display shows it."""
@@ -72,6 +76,8 @@ class Member:
         )
 
         self.time_s = max(self.time_s, getattr(event, "t", 0.0))
+        if self.eta is None and self.session is not None:
+            self.eta = self.session.eta()
         mission = self.session.mission if self.session is not None else None
         if isinstance(event, WaypointStarted) and mission is not None:
             self.current = mission.waypoint_label(event.index)
