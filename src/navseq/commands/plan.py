@@ -10,6 +10,9 @@ YAML, never over an existing file unless ``--force``).
 
 Exit 0 when every leg has a path, 1 when some leg has none (``navseq validate --map``
 says why), 2 for bad input.
+
+``--fleet FLEET`` splits the mission among a fleet's robots instead
+(:mod:`navseq.commands.plan_fleet`).
 """
 
 from __future__ import annotations

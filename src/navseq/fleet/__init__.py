@@ -8,6 +8,8 @@
   on one another, waypoints no robot may take), before anything moves;
 - :mod:`~navseq.fleet.split`: the waypoints split among the robots so that the last
   robot finishes as early as it can (OR-tools vehicle routing);
-- :mod:`~navseq.fleet.world`, :mod:`~navseq.fleet.run`: the robots run together on the
-  embedded simulator, one clock, one run folder.
+- :mod:`~navseq.fleet.planning`: a fleet file made into a checked split, for both faces;
+- :mod:`~navseq.fleet.lockstep`, :mod:`~navseq.fleet.run`, :mod:`~navseq.fleet.products`:
+  the robots run together on the embedded simulator, one clock, one run folder, one
+  fleet report and picture.
 """

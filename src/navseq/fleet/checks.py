@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from navseq.errors import NavseqError
-from navseq.fleet.model import Fleet, FleetRobot
+from navseq.fleet.model import Fleet
 
 if TYPE_CHECKING:
     from navseq.mission.robot import RobotProfile
@@ -120,10 +120,6 @@ def untakeable_problems(fleet: Fleet, distances: FleetDistances) -> list[NavseqE
             )
         )
     return problems
-
-
-def robot_label(robot: FleetRobot) -> str:
-    return f"robot '{robot.name}'"
 
 
 def raise_all(problems: Sequence[NavseqError]) -> None:

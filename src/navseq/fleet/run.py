@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from navseq.errors import NavseqError
+from navseq.errors import NavseqError, error_text
 from navseq.fleet.model import FleetRobot
 
 if TYPE_CHECKING:
@@ -237,17 +237,13 @@ def _members(plan: FleetPlan, world: FleetWorld, clock: FleetClock, folder: Path
                 )
             )
         except NavseqError as error:
-            problems.append(NavseqError(error_text_of(error), source=f"robot '{robot.name}'"))
+            problems.append(
+                NavseqError(error_text(error), source=f"robot '{robot.name}'")
+            )  # with the others
             continue
         members.append(Member(robot, session, navigator, len(share.order)))
     raise_all(problems)
     return members
-
-
-def error_text_of(error: NavseqError) -> str:
-    from navseq.errors import error_text
-
-    return error_text(error)
 
 
 def _remove_tree(folder: Path) -> None:
