@@ -189,13 +189,14 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     with_work = [share.robot.name for share in plan.split.shares if share.order]
     clock = FleetClock(world, with_work, realtime=request.realtime)
     fresh = request.folder is None
+    made_here = fresh or not request.folder.exists()  # type: ignore[union-attr]
     folder = create_run_folder(
         request.folder or default_run_folder(request.fleet.stem), fresh=fresh
     )
     try:
         members = _members(plan, world, clock, folder)
     except BaseException:
-        if fresh:
+        if made_here:  # a refused run leaves nothing behind
             _remove_tree(folder)
         raise
     return FleetRun(plan, world, clock, folder, members, picture=request.picture)
