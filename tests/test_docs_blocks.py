@@ -9,7 +9,8 @@ How each kind of block is run:
   ``python ros1``: executed here against ``navseq sim --ros1`` on a private rosmaster;
 - ``yaml``, ``xml``, ``csv`` holding a mission (navseq YAML, rosparam, the tutorial's
   launch file, recorded poses): loaded here by ``navseq.load_mission``; a ``yaml``
-  block of only a ``robot:`` section is read as a robot file (``--robot FILE``);
+  block of only a ``robot:`` section is read as a robot file (``--robot FILE``), one
+  starting with ``navseq_fleet:`` as a fleet file (docs/fleet.md);
 - ``json``: a report (``schema_version`` and ``mission``) is checked here against
   ``docs/schemas/report.schema.json``, one event per line against the events schema.
 
@@ -104,6 +105,12 @@ def test_a_mission_block_loads(block: Block, tmp_path: Path) -> None:
     (tmp_path / "examples").mkdir()
     path = tmp_path / "examples" / f"doc{MISSION_SUFFIXES[block.language]}"
     path.write_text(block.text, encoding="utf-8")
+    if block.text.startswith("navseq_fleet:"):  # a fleet file, its mission beside it
+        from navseq.fleet.fleet_format import load_fleet
+
+        shutil.copytree(REPO / "examples", tmp_path / "examples", dirs_exist_ok=True)
+        assert load_fleet(path).robots
+        return
     if block.text.startswith("robot:\n"):  # a robot file (`--robot FILE`), not a mission
         from navseq.mission.robot_format import read_robot_file
 

@@ -10,6 +10,9 @@ YAML, never over an existing file unless ``--force``).
 
 Exit 0 when every leg has a path, 1 when some leg has none (``navseq validate --map``
 says why), 2 for bad input.
+
+``--fleet FLEET`` splits the mission among a fleet's robots instead
+(:mod:`navseq.commands.plan_fleet`).
 """
 
 from __future__ import annotations
@@ -34,7 +37,20 @@ SCHEMA_VERSION = 2
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("mission", type=Path, metavar="MISSION", help="mission file to plan")
+    parser.add_argument(
+        "mission",
+        type=Path,
+        nargs="?",
+        metavar="MISSION",
+        help="mission file to plan (with --fleet: instead of the fleet file's mission:)",
+    )
+    parser.add_argument(
+        "--fleet",
+        type=Path,
+        metavar="FLEET",
+        help="split the mission among a fleet's robots (docs/fleet.md); --out names a "
+        "folder for one mission per robot",
+    )
     parser.add_argument(
         "--map",
         type=Path,
@@ -68,7 +84,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--out",
         type=Path,
         metavar="FILE",
-        help="write the mission in the order shown (navseq YAML)",
+        help="write the mission in the order shown (navseq YAML); with --fleet: a folder",
     )
     parser.add_argument("--force", action="store_true", help="replace FILE if it exists")
     parser.add_argument("--json", action="store_true", help="print the route as JSON")
@@ -80,6 +96,14 @@ def run(args: argparse.Namespace) -> int:
     from navseq.mission import load_mission
     from navseq.route.legs import legs_of
 
+    if args.fleet is not None:
+        from navseq.commands import plan_fleet
+
+        return plan_fleet.run(args)
+    if args.mission is None:
+        raise NavseqError(
+            "name the mission file to plan (or a fleet with --fleet)", source="MISSION"
+        )
     if args.keep_last and args.order != "shortest":
         raise NavseqError(
             "keeps a waypoint last in a new order: give --order shortest too", source="--keep-last"

@@ -52,6 +52,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
     )
     add_navigator_choice(parser, default=None)  # None: sim, or the journal's when resuming
     parser.add_argument(
+        "--fleet",
+        type=Path,
+        metavar="FLEET",
+        help="run a fleet's robots together on the embedded simulator (docs/fleet.md); "
+        "MISSION, if given, replaces the fleet file's mission:",
+    )
+    parser.add_argument(
         "--map", type=Path, metavar="MAP", help="map_server YAML (default: the mission's map:)"
     )
     parser.add_argument(
@@ -277,6 +284,10 @@ def run(args: argparse.Namespace) -> int:
     from navseq.journal.writer import NothingToResume
     from navseq.signals import SignalGuard
 
+    if args.fleet is not None:
+        from navseq.commands import run_fleet
+
+        return run_fleet.run(args)
     try:
         session = prepare(request_of(args))
     except NothingToResume as finished:

@@ -53,7 +53,9 @@ step (:meth:`NavigationServer.set_other_robots`); with none, nothing above chang
   It ends ABORTED, "blocked by another robot", when no way has opened and the robot
   has not got 0.2 m closer within ``blocked_patience`` — move_base's planner_patience.
   Two robots that need the same narrow passage at once may both wait and give up:
-  nothing here negotiates who goes first.
+  nothing here negotiates who goes first. In a :class:`~navseq.sim.fleet_world.FleetWorld`
+  :mod:`navseq.sim.right_of_way` does: it sends robots aside so that every such
+  conflict resolves.
 """
 
 from __future__ import annotations

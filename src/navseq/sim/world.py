@@ -36,7 +36,9 @@ class SimWorld:
 
     The server's costmap is built from ``grid`` with ``costmap_params``, unless the
     caller passes one already built on this very ``grid`` as ``costmap`` (inflating a
-    large map takes a while; the CLI's pre-flight check has one ready).
+    large map takes a while; the CLI's pre-flight check has one ready). A caller with
+    its own kind of server (a fleet's, :mod:`navseq.sim.fleet_world`) passes it built on
+    that costmap as ``server``; ``nav_params`` and ``footprint`` are then the server's.
     """
 
     def __init__(
@@ -49,6 +51,7 @@ class SimWorld:
         nav_params: NavParams | None = None,
         footprint: Footprint = TURTLEBOT3_BURGER,
         costmap: Costmap | None = None,
+        server: NavigationServer | None = None,
     ) -> None:
         if not dt > 0:
             raise ValueError(f"dt must be positive, got {dt}")
@@ -63,7 +66,11 @@ class SimWorld:
         self.dt = dt
         self.footprint = footprint
         self.costmap = costmap if costmap is not None else Costmap.from_grid(grid, costmap_params)
-        self.server = NavigationServer(self.costmap, nav_params, footprint)
+        if server is not None and server.costmap is not self.costmap:
+            raise ValueError("server was built on another costmap than the world's")
+        self.server = (
+            server if server is not None else NavigationServer(self.costmap, nav_params, footprint)
+        )
         # A command arrives every step, so the body's command timeout (two steps, against
         # rounding) never applies.
         self.body = SimulatedBase(

@@ -1,0 +1,209 @@
+"""``navseq run --fleet FLEET``: a fleet's robots together on the embedded simulator.
+
+The fleet is planned and checked (every problem at once, exit 2, nothing moved), its
+robots run in one process on one clock (:mod:`navseq.fleet.run`), a live table shows
+each robot's current waypoint and state, and the run folder gets one folder per robot
+(its mission, journal and report) plus the fleet's report and picture. Exit 0 when
+every robot reached all its waypoints, 1 otherwise, 130/143 when interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING, Any
+
+from navseq.errors import NavseqError
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from navseq.fleet.run import FleetRun
+
+#: Options of a one-robot run that a fleet run takes from the fleet file, or lacks yet.
+_FLEET_REFUSES = {
+    "start": ("--start", "each robot's start: comes from the fleet file"),
+    "robot": ("--robot", "each robot's model (robot:) comes from the fleet file"),
+    "resume": ("--resume", "resuming a fleet run is not supported yet: run the fleet again"),
+    "from_waypoint": ("--from", "the fleet's split chooses each robot's waypoints"),
+    "to_waypoint": ("--to", "the fleet's split chooses each robot's waypoints"),
+    "only": ("--only", "the fleet's split chooses each robot's waypoints"),
+    "record": ("--record", "a fleet run is not recorded as MCAP yet"),
+    "json": ("--json", "a fleet run shows a live table; its fleet-report.json has the figures"),
+}
+
+
+def refuse_options(args: argparse.Namespace) -> None:
+    """What a fleet run cannot honour, refused before anything is read."""
+    navigator = getattr(args, "navigator", None)
+    if navigator not in (None, "sim"):
+        raise NavseqError(
+            f"runs on the embedded simulator only for now; --navigator {navigator} with one "
+            "namespaced stack per robot is not supported yet (run navseq run --navigator "
+            f"{navigator} --ns NS on each robot's mission from navseq plan --fleet --out DIR)",
+            source="--fleet",
+        )
+    for dest, (flag, why) in _FLEET_REFUSES.items():
+        if getattr(args, dest, None) not in (None, False, ()):
+            raise NavseqError(f"{why}; leave {flag} out with --fleet", source=flag)
+    if hasattr(args, "loops"):
+        raise NavseqError(
+            "a fleet runs each robot's share once; leave --loops out", source="--loops"
+        )
+
+
+def run(args: argparse.Namespace) -> int:
+    from navseq.fleet.run import FleetRunRequest, prepare_fleet_run
+
+    refuse_options(args)
+    from navseq.extras import require_extra
+
+    require_extra("plan", "--fleet")
+    fleet_run = prepare_fleet_run(
+        FleetRunRequest(
+            fleet=args.fleet,
+            mission=args.mission,
+            map=args.map,
+            folder=args.out,
+            realtime=args.realtime,
+            picture=not args.no_picture,
+        )
+    )
+    for member in fleet_run.members:
+        if member.session is not None:
+            for note in member.session.notes:
+                print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
+    status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+    _print_summary(fleet_run, report)
+    return status
+
+
+def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any]]:
+    """Run the robots with a live table; Ctrl-C / SIGTERM / SIGHUP stop them all (also
+    where the shell started navseq with SIGINT ignored), then the outputs are written
+    and later signals are only counted."""
+    from rich.console import Console
+    from rich.live import Live
+
+    from navseq.signals import SignalGuard, Terminated
+
+    guard = SignalGuard().arm()
+    threads = fleet_run.start()
+    console = Console(stderr=True)
+    interrupted: str | None = None
+    try:
+        with Live(_table(fleet_run), console=console, auto_refresh=False, transient=True) as live:
+            while any(thread.is_alive() for thread in threads):
+                fleet_run.clock.stepped.wait(0.2)
+                fleet_run.clock.stepped.clear()
+                live.update(_table(fleet_run), refresh=True)
+    except (KeyboardInterrupt, Terminated) as stop:
+        interrupted = stop.signal_name if isinstance(stop, Terminated) else "SIGINT"
+    finally:
+        guard.defer()
+        if interrupted is not None or any(thread.is_alive() for thread in threads):
+            fleet_run.stop(interrupted or "an error")
+        for thread in threads:
+            thread.join()
+    errors = [m for m in fleet_run.members if m.error is not None]
+    try:
+        status, report = fleet_run.finish()
+    finally:
+        if not exits_after:
+            guard.restore()
+    for member in errors:
+        print(f"navseq run: {member.robot.name}: {member.error}", file=sys.stderr)
+    return status, report
+
+
+def _table(fleet_run: FleetRun) -> Table:
+    from rich.markup import escape
+    from rich.table import Table
+
+    from navseq.text import printable
+
+    totals = {
+        key: sum(m.counts[key] for m in fleet_run.members) for key in fleet_run.members[0].counts
+    }
+    table = Table(
+        title=f"fleet at t = {fleet_run.world.now:.0f} s: {totals['reached']} reached, "
+        f"{totals['skipped']} skipped, {totals['failed']} failed{_fleet_eta(fleet_run)}",
+        title_justify="left",
+    )
+    for header in ("robot", "waypoint", "state", "reached", "skipped", "failed", "of"):
+        table.add_column(header)
+    for member in fleet_run.members:
+        counts = member.counts
+        table.add_row(
+            escape(member.robot.name),
+            escape(printable(member.current)),
+            escape(member.state),
+            str(counts["reached"]),
+            str(counts["skipped"]),
+            str(counts["failed"]),
+            str(member.waypoints),
+        )
+    return table
+
+
+def _fleet_eta(fleet_run: FleetRun) -> str:
+    """``, done in ~40 s``: the latest of the running robots' ETAs (each its run's own)."""
+    left = []
+    for member in fleet_run.members:
+        if member.state in ("done", "ended", "error"):
+            continue
+        estimator = member.eta
+        if estimator is not None and estimator.eta_s is not None:
+            left.append(estimator.eta_s)
+    return f", done in ~{max(left):.0f} s" if left else ""
+
+
+def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    from navseq.commands.plan_fleet import shown_path
+    from navseq.sinks.summary import print_table
+
+    console = Console()
+    table = Table()
+    for header, justify in (
+        ("robot", "left"),
+        ("reached", "right"),
+        ("skipped", "right"),
+        ("failed", "right"),
+        ("of", "right"),
+        ("time [s]", "right"),
+        ("driven [m]", "right"),
+    ):
+        table.add_column(escape(header), justify=justify)  # type: ignore[arg-type]
+    for row in report["robots"]:
+        table.add_row(
+            escape(row["name"]),
+            str(row["reached"]),
+            str(row["skipped"]),
+            str(row["failed"]),
+            str(row["waypoints"]),
+            "" if row["mission_time_s"] is None else f"{row['mission_time_s']:.0f}",
+            "" if row["distance_m"] is None else f"{row['distance_m']:.1f}",
+        )
+    print_table(table, console)
+    console.print(
+        f"fleet: {report['reached']} reached, {report['skipped']} skipped, "
+        f"{report['failed']} failed; makespan {report['makespan_s']:.0f} s "
+        f"(planned {report['planned_makespan_s']:.0f} s)",
+        markup=False,
+        highlight=False,
+        soft_wrap=True,
+    )
+    console.print(
+        f"wrote {shown_path(str(fleet_run.folder))}/ (fleet-report.json, fleet.png, "
+        "a folder per robot)",
+        markup=False,
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+__all__ = ["refuse_options", "run"]
