@@ -7,7 +7,9 @@ simulator) and speaks Nav2's ROS 2 interface around it. The rules of Nav2's navi
 (preemption, pass-through, missed waypoints) live in :mod:`navseq.ros2.standin`; this
 module only translates.
 
-Interface (names relative to the namespace ``--ns``, frames prefixed with it):
+Interface (names relative to the namespace ``--ns``; a namespaced robot's transforms
+on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
+``--tf-convention ros1`` on ``/tf`` with frames prefixed ``NS/``):
 
 - actions ``navigate_to_pose``, ``navigate_through_poses`` (``nav2_msgs/action/...``)
   with Nav2's feedback (current pose, navigation time, time remaining, recoveries,
@@ -26,13 +28,18 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   on the simulated robot with Nav2's collision check ahead, time allowance and error
   codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
   runs, a navigation goal's controller waits;
-- topics ``odom`` (``nav_msgs/Odometry``), ``/tf`` (``map -> odom -> base_footprint``),
-  ``/tf_static`` (``base_footprint -> base_link``), ``map`` (transient local, as
-  map_server), ``plan`` (``nav_msgs/Path``), ``cmd_vel`` (the velocity the controller
-  drives with; honoured as teleop while no goal runs), ``initialpose`` (teleports),
-  ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal), ``amcl_pose``
-  (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1
-  (subscribed instead with ``--follow-clock``);
+- topics ``odom`` (``nav_msgs/Odometry``, drifting with ``--odom-drift``), ``tf``
+  (``map -> odom`` the localisation's estimate, ``odom -> base_footprint``),
+  ``tf_static`` (``base_footprint -> base_link -> base_scan``), ``plan``
+  (``nav_msgs/Path``), ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
+  ``/clock`` when ``--speed`` is not 1 (subscribed instead with ``--follow-clock``);
+- Nav2's world around the robot: ``map_server`` (``map``, ``map_server/map``,
+  ``map_server/load_map``: :mod:`navseq.ros2.map_server`), ``amcl`` (``initialpose``
+  sets the estimate, ``amcl_pose``, ``particle_cloud``:
+  :mod:`navseq.ros2.localization_topics`), the laser (``scan``:
+  :mod:`navseq.ros2.scan_topic`), the velocity chain ``cmd_vel_nav`` ->
+  ``cmd_vel_smoothed`` -> ``cmd_vel`` with ``speed_limit``, and teleop on ``cmd_vel``
+  while no goal runs (:mod:`navseq.ros2.velocity_topics`);
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``);
   every clear-costmap call is logged (``global_costmap: cleared``), so a client's
@@ -52,7 +59,8 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   ("Action server is inactive. Rejecting the goal."); goals already running go on.
 
 Several robots that see each other: with ``--other-robots robot2`` the node also listens
-to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
+to ``/robot2/tf`` (or, in ROS 1's convention, to ``/tf`` for ``robot2/``-prefixed frames)
+for the other robots' ``map -> odom -> base_footprint``
 (:class:`navseq.sim.fleet.SeenRobots`) and hands their poses to the world every step,
 so their footprints are obstacles for the planner and the controller and the body
 refuses to drive into them — as the ROS 1 sim nodes do with ``~other_robots``. A robot
