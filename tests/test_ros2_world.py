@@ -23,6 +23,7 @@ pytestmark = pytest.mark.ros2
 
 NAV2_SCRIPTS = Path(__file__).with_name("nav2")
 GOAL = (-1.5, -0.5)
+PARAM_GET = ["ros2", "param", "get", "--no-daemon", "--spin-time", "5", "--hide-type"]
 INITIAL_POSE = (-1.0, 0.0)  # beside the robot: the estimate moves there, the robot stays
 
 
@@ -67,10 +68,19 @@ def test_the_world_a_nav2_user_sees(tmp_path: Path):
     }
     try:
         seen = run_script(env, "world_client.py", json.dumps(setup))
+        smoother = subprocess.run(
+            [*PARAM_GET, "/velocity_smoother", "max_velocity"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
     finally:
         err = sim.stop()
     assert sim.process.returncode == 0, err
     assert "Traceback" not in err
+    # The limits the chain smooths with, where Nav2 keeps them (nav2_bringup's values).
+    assert smoother.stdout.split() == ["[0.5,", "0.0,", "2.0]"], smoother
     # map_server: the arena, latched, and on map_server/map.
     assert seen["map"] == [384, 384, "map"]
     assert seen["get_map"] == [384, 384]

@@ -153,6 +153,7 @@ from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.options import SimConfig
 from navseq.sim.profile import SimSettings
+from navseq.sim.velocity_chain import NAV2_BRINGUP_SMOOTHER, SmootherLimits
 from navseq.sim.world import SimWorld, default_start
 from navseq.text import printable
 
@@ -742,7 +743,21 @@ def nav2_server_parameters(robot: RobotProfile) -> dict[str, list[Parameter]]:
             Parameter("planner_plugins", value=["GridBased"]),
             Parameter("GridBased.tolerance", value=NAV2_PLANNER_TOLERANCE),
         ],
+        "velocity_smoother": velocity_smoother_parameters(NAV2_BRINGUP_SMOOTHER),
     }
+
+
+def velocity_smoother_parameters(limits: SmootherLimits) -> list[Parameter]:
+    """The limits the stand-in smooths with, under nav2_bringup's parameter names."""
+    return [
+        Parameter("smoothing_frequency", value=20.0),
+        Parameter("feedback", value="OPEN_LOOP"),
+        Parameter("max_velocity", value=[limits.max_v, 0.0, limits.max_w]),
+        Parameter("min_velocity", value=[limits.min_v, 0.0, limits.min_w]),
+        Parameter("max_accel", value=[limits.accel_v, 0.0, limits.accel_w]),
+        Parameter("max_decel", value=[-limits.decel_v, 0.0, -limits.decel_w]),
+        Parameter("velocity_timeout", value=limits.timeout),
+    ]
 
 
 def nav2_costmap_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
