@@ -3,17 +3,21 @@ laser, the velocity chain and a map replaced at run time (issue 20)."""
 
 from __future__ import annotations
 
+import argparse
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from navseq.commands.sim_options import add_arguments, config_from_args
+from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.ros2.standin import Nav2StandIn, Navigator, NavTask, Outcome
 from navseq.sim.footprint import TURTLEBOT3_BURGER
 from navseq.sim.localization import Localization
 from navseq.sim.occupancy import OccupancyGrid, load_map
+from navseq.sim.options import SimConfig
 from navseq.sim.scan import TURTLEBOT3_LDS, ray_cast
 from navseq.sim.velocity_chain import SpeedLimit, VelocitySmoother
 from navseq.sim.world import SimWorld
@@ -193,3 +197,36 @@ def test_a_new_map_replaces_the_world(grid: OccupancyGrid):
     full = OccupancyGrid(np.full_like(grid.data, 100), grid.resolution, grid.origin)
     warning = standin.replace_map(full)
     assert warning is not None and "overlaps an obstacle" in warning
+
+
+# -- the options -------------------------------------------------------------------------------
+
+
+def sim_config(*argv: str, ros1: bool = False) -> SimConfig:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return config_from_args(parser.parse_args(["--map", str(MAP), *argv]), ros1=ros1)
+
+
+def test_a_namespaced_robot_takes_nav2s_tf_convention_unless_told_otherwise():
+    nav2 = sim_config("--ns", "robot1")
+    assert nav2.tf_topics == ("/robot1/tf", "/robot1/tf_static") and nav2.frame_prefix == ""
+    ros1 = sim_config("--ns", "robot1", "--tf-convention", "ros1")
+    assert ros1.tf_topics == ("/tf", "/tf_static") and ros1.frame_prefix == "robot1/"
+    assert sim_config().tf_topics == ("/tf", "/tf_static")  # no namespace: the same
+    assert sim_config("--ns", "robot1", ros1=True).frame_prefix == "robot1/"  # ROS 1's nodes
+
+
+@pytest.mark.parametrize(
+    ("argv", "ros1", "option"),
+    [
+        (("--tf-convention", "nav2"), True, "--tf-convention"),
+        (("--odom-drift", "-0.1"), False, "--odom-drift"),
+        (("--odom-drift", "nan"), False, "--odom-drift"),
+        (("--odom-drift", "0.1"), True, "--odom-drift"),
+    ],
+)
+def test_a_bad_world_option_names_itself(argv: tuple[str, ...], ros1: bool, option: str):
+    with pytest.raises(NavseqError) as raised:
+        sim_config(*argv, ros1=ros1)
+    assert raised.value.source == option
