@@ -288,7 +288,18 @@ def started(stack: str, workdir: Path, speed: float) -> Iterator[StackHandle]:
     assert prefix is not None
     env = ros2_environment(prefix)
     x, y, yaw = START
-    sim = SimNode(env, "--map", str(MAP), f"--start={x},{y},{yaw}", "--speed", f"{speed:g}")
+    # --initial-pose teleport: role_place puts the robot back at the start between runs
+    # through /initialpose, as Nav2's loopback simulator takes it.
+    sim = SimNode(
+        env,
+        "--map",
+        str(MAP),
+        f"--start={x},{y},{yaw}",
+        "--speed",
+        f"{speed:g}",
+        "--initial-pose",
+        "teleport",
+    )
     try:
         yield StackHandle(stack, env)
     finally:

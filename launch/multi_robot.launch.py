@@ -3,14 +3,16 @@
     ros2 launch launch/multi_robot.launch.py
 
 Starts ``launch/sim.launch.py`` twice: robot1 and robot2, each a navseq sim node with
-Nav2's interfaces under its namespace (``/robot1/navigate_to_pose``, frames
-``robot1/odom``, ``robot1/base_footprint``, ...) and the other's namespace in
-``other_robots``: each reads the other's pose from ``/tf``, plans around its footprint
-and never drives into it — what ``multi_robot.launch`` does for ROS 1. Both are the same
+Nav2's interfaces under its namespace (``/robot1/navigate_to_pose``; transforms on
+``/robot1/tf`` with plain frames ``map``, ``odom``, ``base_footprint`` as nav2_bringup's
+multi-robot launch, or with ``tf_convention:=ros1`` on ``/tf`` with frames
+``robot1/odom`` ...) and the other's namespace in ``other_robots``: each reads the
+other's pose from its transforms, plans around its footprint and never drives into it
+— what ``multi_robot.launch`` does for ROS 1. Both are the same
 model (``robot``). At a ``speed`` other than 1 robot1 publishes ``/clock`` and robot2
 steps with it (``follow_clock``), so both live on one simulated time. Arguments: map,
-robot, speed, robot1_start, robot2_start (x,y,yaw in degrees), python (the Python that
-can import navseq).
+robot, speed, robot1_start, robot2_start (x,y,yaw in degrees), tf_convention, python
+(the Python that can import navseq).
 """
 
 from pathlib import Path
@@ -33,6 +35,7 @@ def generate_launch_description() -> LaunchDescription:
         "speed": ("1.0", "simulated seconds per wall second; not 1: robot1 publishes /clock"),
         "robot1_start": ("-2.0,-0.5,0", "robot1's start x,y,yaw (metres, metres, degrees)"),
         "robot2_start": ("2.0,0.5,180", "robot2's start x,y,yaw (metres, metres, degrees)"),
+        "tf_convention": ("nav2", "nav2: /NS/tf, plain frames; ros1: /tf, frames NS/odom ..."),
         "python": ("python3", "the Python that can import navseq"),
     }
     declared = [
@@ -54,6 +57,7 @@ def generate_launch_description() -> LaunchDescription:
                         "map": LaunchConfiguration("map"),
                         "robot": LaunchConfiguration("robot"),
                         "python": LaunchConfiguration("python"),
+                        "tf_convention": LaunchConfiguration("tf_convention"),
                         # Set in this order: the include sets them one by one, and
                         # `fast` reads the launch's speed before robot2's 1.0 hides it.
                         "follow_clock": "false" if robot == CLOCK_DRIVER else fast,

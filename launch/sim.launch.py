@@ -8,7 +8,8 @@ e.g. the project's venv first on PATH, or ``pip install``ed) — the same node a
 TurtleBot3 world), start (x,y,yaw in degrees), ns, speed, robot, stop_on_failure,
 other_robots (namespaces of the other robots of a fleet, comma-separated, e.g. robot2:
 their footprints are obstacles for this one; see multi_robot.launch.py), follow_clock
-(true: step with another node's /clock instead of a clock of its own).
+(true: step with another node's /clock instead of a clock of its own), tf_convention
+(nav2: /NS/tf with plain frames, the default; ros1: /tf with NS/ frames).
 """
 
 from pathlib import Path
@@ -29,6 +30,7 @@ def generate_launch_description() -> LaunchDescription:
         "robot": ("turtlebot3_burger", "robot profile name or YAML file"),
         "other_robots": ("", "namespaces of the other robots of a fleet, e.g. robot2"),
         "follow_clock": ("false", "true: step with another simulator node's /clock"),
+        "tf_convention": ("nav2", "nav2: /NS/tf, plain frames; ros1: /tf, frames NS/odom ..."),
         "stop_on_failure": ("true", "follow_waypoints stops at the first missed waypoint"),
         "python": ("python3", "the Python that can import navseq"),
     }
@@ -51,6 +53,7 @@ def generate_launch_description() -> LaunchDescription:
             LaunchConfiguration("robot"),
             ["--other-robots=", LaunchConfiguration("other_robots")],
             ["--follow-clock=", LaunchConfiguration("follow_clock")],
+            ["--tf-convention=", LaunchConfiguration("tf_convention")],
             "--ros-args",
             "-p",
             ["stop_on_failure:=", LaunchConfiguration("stop_on_failure")],

@@ -15,6 +15,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -308,3 +309,26 @@ def test_a_retrys_recoveries_run_on_nav2s_behaviour_server(
     runs = [(r["kind"], r["outcome"]) for r in visit["recoveries_run"]]
     assert runs == [("spin", "succeeded"), ("wait", "succeeded"), ("clear_costmaps", "succeeded")]
     assert visit["recoveries_run"][1]["duration_s"] >= 1.0
+
+
+def test_the_real_map_server_answers_a_bad_map_url_as_the_stand_in_does(
+    nav2: RealNav2, tmp_path: Path
+) -> None:
+    """tests/test_ros2_world.py expects these codes of the stand-in: an empty URL 1
+    (MAP_DOES_NOT_EXIST), a YAML that is not there 3 (INVALID_MAP_METADATA), a YAML whose
+    image is not there 2 (INVALID_MAP_DATA). A failed load leaves the map as it was."""
+    no_image = tmp_path / "no_image.yaml"
+    no_image.write_text(
+        "image: missing.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    script = Path(__file__).with_name("nav2") / "load_map_codes.py"
+    done = subprocess.run(
+        [sys.executable, str(script), "", str(tmp_path / "nowhere.yaml"), str(no_image)],
+        env=nav2.env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == [1, 3, 2]

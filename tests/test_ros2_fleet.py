@@ -53,6 +53,17 @@ def test_seen_robots_composes_the_two_transforms_of_each_robot_and_ignores_the_r
     assert footprint is square  # the fleet's one model
 
 
+def test_seen_robots_hears_a_robot_on_its_own_tf_with_plain_frames():
+    """Nav2's multi-robot convention: robot2's map -> odom -> base_footprint on /robot2/tf."""
+    seen = SeenRobots(("robot2",), tolerance=1.0)
+    seen.heard_from("robot2", "map", "odom", Pose2D(1.0, 0.0, math.pi / 2), at=0.0)
+    seen.heard_from("robot2", "odom", "base_footprint", Pose2D(2.0, 0.0, 0.0), at=0.0)
+    seen.heard_from("robot3", "map", "odom", Pose2D(9.0, 9.0, 0.0), at=0.0)  # not ours
+    (found, _footprint), *rest = seen.poses(0.5)[0]
+    assert not rest
+    assert (found.x, found.y) == pytest.approx((1.0, 2.0))
+
+
 def test_a_robot_not_heard_from_for_the_tolerance_is_left_out_and_reported():
     seen = SeenRobots(("robot2", "robot3"), tolerance=1.0)
     for robot, at in (("robot2", 0.0), ("robot3", 5.0)):
@@ -231,6 +242,7 @@ def while_launched(
     robot1: tuple[float, float, float],
     robot2: tuple[float, float, float],
     command: list[str],
+    tf_convention: str = "nav2",
 ) -> tuple[subprocess.CompletedProcess[str], str]:
     """Run ``command`` while ``multi_robot.launch.py`` runs; its result, the launch's
     output (the launch is stopped with SIGINT, as Ctrl-C would, and must exit 0)."""
@@ -245,6 +257,7 @@ def while_launched(
             f"robot1_start:={robot1[0]},{robot1[1]},{math.degrees(robot1[2]):g}",
             f"robot2_start:={robot2[0]},{robot2[1]},{math.degrees(robot2[2]):g}",
             f"speed:={speed}",
+            f"tf_convention:={tf_convention}",
             f"python:={sys.executable}",
         ],
         cwd=REPO,
@@ -270,10 +283,13 @@ def while_launched(
 
 @pytest.mark.ros2
 @pytest.mark.flaky(reruns=1)  # two robots in real time: under load a goal can take long
-@pytest.mark.parametrize("speed", ["1", "4"])
-def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path, speed: str):
+@pytest.mark.parametrize(("speed", "tf_convention"), [("1", "nav2"), ("4", "ros1")])
+def test_robot1_drives_around_robot2_parked_on_its_straight_path(
+    tmp_path: Path, speed: str, tf_convention: str
+):
     """``ros2 launch launch/multi_robot.launch.py``, robot2 parked on robot1's way; at 4x
-    robot1 publishes /clock and robot2 steps with it."""
+    robot1 publishes /clock and robot2 steps with it. The robots see each other in both
+    TF conventions: Nav2's (each on its own ``/NS/tf``, plain frames) and ROS 1's."""
     # robot1 goes north along x = -2 to (-2, 1.2); robot2 is parked on that line at
     # (-2, 0.3): room round it on both sides, between the west wall and the pillars.
     robot1, robot2, goal = (-2.0, -0.5, math.pi / 2), (-2.0, 0.3, 0.0), (-2.0, 1.2, math.pi / 2)
@@ -281,7 +297,7 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(tmp_path: Path,
     script.write_text(WATCHER)
     setup = {"starts": {"robot1": robot1, "robot2": robot2}, "goal": goal, "timeout": 120}
     watcher, output = while_launched(
-        speed, robot1, robot2, [sys.executable, str(script), json.dumps(setup)]
+        speed, robot1, robot2, [sys.executable, str(script), json.dumps(setup)], tf_convention
     )
     report = json.loads(watcher.stdout.strip().splitlines()[-1])
     assert report["succeeded"], (report, output[-3000:])

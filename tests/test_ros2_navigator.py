@@ -530,8 +530,22 @@ def test_nav2s_replan_race_on_pass_through_is_caught_and_retried_to_the_missions
     assert math.dist(track[-1], points["end"]) < 0.1
 
 
-def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path):
-    sim = SimNode(env, f"--start={START}", "--speed", SPEED, "--ns", "robot1")
+@pytest.mark.parametrize("tf_convention", ["nav2", "ros1"])
+def test_a_namespaced_nav2_is_driven_with_ns(
+    env: dict[str, str], tmp_path: Path, tf_convention: str
+):
+    """The robot's frames are found in either convention: Nav2's (``odom`` ... on
+    ``/robot1/tf``, the simulator's default) and ROS 1's (``robot1/odom`` on ``/tf``)."""
+    sim = SimNode(
+        env,
+        f"--start={START}",
+        "--speed",
+        SPEED,
+        "--ns",
+        "robot1",
+        "--tf-convention",
+        tf_convention,
+    )
     mission = write_mission(tmp_path / "m.yaml", "  - {x: -1.4, y: -0.5, yaw: 90}\n")
     try:
         done = run_nav2(env, mission, tmp_path / "out", "--ns", "robot1")
@@ -546,7 +560,7 @@ def test_a_namespaced_nav2_is_driven_with_ns(env: dict[str, str], tmp_path: Path
     assert report["navigator"]["map_source"] == (
         "the map on /robot1/map: 384 x 384 cells at 0.050 m"
     )
-    # robot1/odom -> robot1/base_footprint on /tf, and /robot1/odom, were found.
+    # The robot's transforms (either convention), and /robot1/odom, were found.
     assert report["start_source"] == "robot"
     assert report["visits"][0]["distance_m"] == pytest.approx(0.6, abs=0.25)
 

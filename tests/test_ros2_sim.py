@@ -157,7 +157,7 @@ def test_nav2_clients_find_it_ready_localized_and_can_clear_costmaps(sim: SimPro
     seen = sim.client("ready", "-1.5,-0.5,90", timeout=20)
     assert seen["bt_navigator"] == "active"
     assert seen["amcl"] == "active"
-    assert seen["amcl_pose"] == pytest.approx([-1.5, -0.5], abs=1e-6)  # teleported there
+    assert seen["amcl_pose"] == pytest.approx([-1.5, -0.5], abs=1e-6)  # the estimate, set there
     assert seen["global_costmap"] == seen["local_costmap"] == "cleared"
 
 

@@ -31,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="",
         metavar="NS",
         help="ROS namespace of the robot (robot1 -> /robot1/navigate_to_pose with --ros2, "
-        "/robot1/move_base with --ros1; frames robot1/odom, robot1/base_footprint)",
+        "/robot1/move_base with --ros1); its frames follow --tf-convention",
     )
     parser.add_argument(
         "--speed",
@@ -53,7 +53,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="",
         metavar="NS[,NS...]",
         help="namespaces of the other simulated robots of a fleet (e.g. robot2): their "
-        "poses are read from /tf (map -> NS/odom -> NS/base_footprint) and their "
+        "poses are read from their transforms (/NS/tf under Nav2's convention, /tf with "
+        "NS/ frames under ROS 1's) and their "
         "footprints (this robot's model) are obstacles to plan around and never to drive "
         "into (see launch/multi_robot.launch.py)",
     )
@@ -86,6 +87,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "dock_robot goals by id drive to them",
     )
     add_datum_argument(parser)
+    add_world_arguments(parser)
 
 
 def add_datum_argument(parser: argparse.ArgumentParser) -> None:
@@ -96,6 +98,36 @@ def add_datum_argument(parser: argparse.ArgumentParser) -> None:
         help="(--ros2) the map frame's origin on the globe and its x axis' heading "
         "(degrees counter-clockwise from east, default 0), as navsat_transform's datum: "
         "follow_gps_waypoints and fromLL convert with it",
+    )
+
+
+def add_world_arguments(parser: argparse.ArgumentParser) -> None:
+    """The ROS 2 stand-in's world: TF convention, odometry drift, initial pose."""
+    parser.add_argument(
+        "--tf-convention",
+        choices=["nav2", "ros1"],
+        default=None,
+        help="how a namespaced robot publishes its transforms: nav2 (default with --ros2; "
+        "nav2_bringup's multi-robot launch) on /NS/tf and /NS/tf_static with plain frames "
+        "map, odom, base_footprint; ros1 (the only one of --ros1) on the global /tf with "
+        "frames NS/odom, NS/base_footprint",
+    )
+    parser.add_argument(
+        "--odom-drift",
+        type=float,
+        default=0.0,
+        metavar="D",
+        help="(--ros2) odometry error per metre driven: each metre reads 1+D metres and "
+        "turns the heading D rad; the amcl-like localisation corrects it as the robot "
+        "drives. 0 (default): exact odometry",
+    )
+    parser.add_argument(
+        "--initial-pose",
+        choices=["estimate", "teleport"],
+        default="estimate",
+        help="(--ros2) what initialpose does: estimate (default, as amcl) sets the "
+        "localisation's estimate (map -> odom) and the robot stays where it is; teleport "
+        "puts the simulated robot there (scripts that place the robot between runs)",
     )
 
 
@@ -112,6 +144,9 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         follow_clock=args.follow_clock,
         replan_period=args.replan_period,
         docks=args.docks,
+        tf_convention=args.tf_convention,
+        odom_drift=args.odom_drift,
+        initial_pose=args.initial_pose,
         ros1=ros1,
         datum=getattr(args, "datum", ""),
     )

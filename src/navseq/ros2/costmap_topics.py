@@ -97,7 +97,10 @@ class CostmapTopics:
             windows = {"local_costmap": self._local_window()}
             if changed:
                 windows["global_costmap"] = self._global_window()
-            pose, odom_pose, footprint = body.pose, body.odom_pose, body.footprint.polygon
+            # Where the robot believes it is: the transforms the node publishes.
+            localization = self._standin.localization
+            pose, odom_pose = localization.believed_pose, localization.odom_pose
+            footprint = body.footprint.polygon
         stamp = self._stamp()
         for name, window in windows.items():
             grid, raw, _ = self._publishers[name]
@@ -127,9 +130,10 @@ class CostmapTopics:
         """The rolling window about the robot, cut from the global costmap (cells off the
         map unknown), its origin given in the odom frame."""
         costmap = self._standin.world.server.costmap
-        grid, body = costmap.grid, self._standin.world.body
+        grid, localization = costmap.grid, self._standin.localization
         cells = round(LOCAL_SIZE_M / grid.resolution)
-        row, col = grid.world_to_cell(body.pose.x, body.pose.y)
+        believed = localization.believed_pose
+        row, col = grid.world_to_cell(believed.x, believed.y)
         top, left = row - cells // 2, col - cells // 2
         window = np.full((cells, cells), 255, dtype=np.uint8)
         rows = slice(max(top, 0), min(top + cells, grid.height))
@@ -139,7 +143,7 @@ class CostmapTopics:
                 costmap.cost[rows, cols]
             )
         corner = compose(grid.origin, Pose2D(left * grid.resolution, top * grid.resolution, 0.0))
-        in_odom = compose(inverse(body.map_to_odom), corner)
+        in_odom = compose(inverse(localization.estimate), corner)
         return CostWindow(window, grid.resolution, in_odom, self._odom_frame)
 
 

@@ -122,6 +122,10 @@ class Nav2Lifecycle:
         """Whether the server of ``action`` takes goals now."""
         return self.servers[ACTION_SERVERS[action]].state_id == _ACTIVE
 
+    def is_active(self, server: str) -> bool:
+        """Whether the Nav2 server named ``server`` (``map_server`` ...) is active."""
+        return self.servers[server].state_id == _ACTIVE
+
     def gate(self, action: str, log: Callable[[str], None]) -> Callable[[Any], GoalResponse]:
         """The goal callback of ``action``'s server: accept while it is active; a refusal
         is logged with Nav2's words."""

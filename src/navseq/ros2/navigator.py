@@ -135,9 +135,9 @@ class Nav2Navigator:
     """A :class:`~navseq.navigators.base.Navigator` over Nav2's ``navigate_to_pose``.
 
     ``namespace="robot1"`` talks to ``/robot1/navigate_to_pose`` and reads
-    ``/robot1/odom``; frames are then looked up as ``robot1/odom`` ... on ``/tf`` (the
-    simulator's and ROS 1's convention) and as plain ``odom`` ... on ``/robot1/tf``
-    (Nav2's multi-robot launch). ``frame`` overrides each goal's frame (None: the
+    ``/robot1/odom``; frames are then looked up as ``robot1/odom`` ... on ``/tf`` (ROS
+    1's convention) and as plain ``odom`` ... on ``/robot1/tf`` (Nav2's multi-robot
+    launch, the simulator's default). ``frame`` overrides each goal's frame (None: the
     goal's own). ``use_sim_time``: True, False, or None to follow ``/clock`` when it is
     published (see the module docstring). ``session``: the node to use (its namespace
     then applies, not ``namespace``'s node placement) instead of one of its own.

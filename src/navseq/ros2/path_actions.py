@@ -162,7 +162,8 @@ class PathActions:
         return _joined(pieces), goal, None
 
     def _robot(self) -> Pose2D:
-        return self._standin.world.robot.pose
+        # Where the robot believes it is, as Nav2's planner takes the start from TF.
+        return self._standin.localization.believed_pose
 
     # -- smoother_server -------------------------------------------------------------
 

@@ -7,7 +7,9 @@ simulator) and speaks Nav2's ROS 2 interface around it. The rules of Nav2's navi
 (preemption, pass-through, missed waypoints) live in :mod:`navseq.ros2.standin`; this
 module only translates.
 
-Interface (names relative to the namespace ``--ns``, frames prefixed with it):
+Interface (names relative to the namespace ``--ns``; a namespaced robot's transforms
+on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
+``--tf-convention ros1`` on ``/tf`` with frames prefixed ``NS/``):
 
 - actions ``navigate_to_pose``, ``navigate_through_poses`` (``nav2_msgs/action/...``)
   with Nav2's feedback (current pose, navigation time, time remaining, recoveries,
@@ -30,13 +32,18 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   on the simulated robot with Nav2's collision check ahead, time allowance and error
   codes (:mod:`navseq.sim.behaviors`, :mod:`navseq.ros2.behavior_actions`); while one
   runs, a navigation goal's controller waits;
-- topics ``odom`` (``nav_msgs/Odometry``), ``/tf`` (``map -> odom -> base_footprint``),
-  ``/tf_static`` (``base_footprint -> base_link``), ``map`` (transient local, as
-  map_server), ``plan`` (``nav_msgs/Path``), ``cmd_vel`` (the velocity the controller
-  drives with; honoured as teleop while no goal runs), ``initialpose`` (teleports),
-  ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal), ``amcl_pose``
-  (transient local, once an initial pose was given), ``/clock`` when ``--speed`` is not 1
-  (subscribed instead with ``--follow-clock``);
+- topics ``odom`` (``nav_msgs/Odometry``, drifting with ``--odom-drift``), ``tf``
+  (``map -> odom`` the localisation's estimate, ``odom -> base_footprint``),
+  ``tf_static`` (``base_footprint -> base_link -> base_scan``), ``plan``
+  (``nav_msgs/Path``), ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
+  ``/clock`` when ``--speed`` is not 1 (subscribed instead with ``--follow-clock``);
+- Nav2's world around the robot: ``map_server`` (``map``, ``map_server/map``,
+  ``map_server/load_map``: :mod:`navseq.ros2.map_server`), ``amcl`` (``initialpose``
+  sets the estimate, ``amcl_pose``, ``particle_cloud``:
+  :mod:`navseq.ros2.localization_topics`), the laser (``scan``:
+  :mod:`navseq.ros2.scan_topic`), the velocity chain ``cmd_vel_nav`` ->
+  ``cmd_vel_smoothed`` -> ``cmd_vel`` with ``speed_limit``, and teleop on ``cmd_vel``
+  while no goal runs (:mod:`navseq.ros2.velocity_topics`);
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``);
   every clear-costmap call is logged (``global_costmap: cleared``), so a client's
@@ -56,7 +63,8 @@ Interface (names relative to the namespace ``--ns``, frames prefixed with it):
   ("Action server is inactive. Rejecting the goal."); goals already running go on.
 
 Several robots that see each other: with ``--other-robots robot2`` the node also listens
-to ``/tf`` for the other robots' ``map -> robot2/odom -> robot2/base_footprint``
+to ``/robot2/tf`` (or, in ROS 1's convention, to ``/tf`` for ``robot2/``-prefixed frames)
+for the other robots' ``map -> odom -> base_footprint``
 (:class:`navseq.sim.fleet.SeenRobots`) and hands their poses to the world every step,
 so their footprints are obstacles for the planner and the controller and the body
 refuses to drive into them — as the ROS 1 sim nodes do with ``~other_robots``. A robot
@@ -95,7 +103,7 @@ from types import FrameType
 from typing import Any
 
 import rclpy
-from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformStamped, Twist
+from geometry_msgs.msg import PoseStamped, TransformStamped
 from nav2_msgs.action import (
     FollowWaypoints,
     NavigateThroughPoses,
@@ -103,7 +111,6 @@ from nav2_msgs.action import (
 )
 from nav2_msgs.msg import MissedWaypoint
 from nav2_msgs.srv import ClearEntireCostmap
-from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry, Path
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -125,10 +132,11 @@ from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
 from navseq.ros2.gps_actions import GpsWaypointActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
+from navseq.ros2.localization_topics import LocalizationTopics
+from navseq.ros2.map_server import MapServer
 from navseq.ros2.messages import (
     duration_msg,
     finish_goal,
-    grid_msg,
     path_msg,
     pose2d_of,
     pose_msg,
@@ -137,6 +145,7 @@ from navseq.ros2.messages import (
     transform_stamped,
 )
 from navseq.ros2.path_actions import PathActions
+from navseq.ros2.scan_topic import ScanTopic, base_scan_transform
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
     Ending,
@@ -146,18 +155,18 @@ from navseq.ros2.standin import (
     Outcome,
     WaypointRun,
 )
+from navseq.ros2.velocity_topics import VelocityTopics
 from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.options import SimConfig
 from navseq.sim.profile import SimSettings
+from navseq.sim.velocity_chain import NAV2_BRINGUP_SMOOTHER, SmootherLimits
 from navseq.sim.world import SimWorld, default_start
 from navseq.text import printable
 
 NODE_NAME = "navseq_sim"
 MAP_FRAME = "map"
 FEEDBACK_PERIOD = 0.1  # s of wall time between two feedback messages of a goal
-AMCL_POSE_PERIOD = 0.5  # s of simulated time between two amcl_pose messages
-TELEOP_QUIET = 0.5  # s of wall time after our own cmd_vel before outside commands count
 # Wall seconds without another robot's transforms before it is left out. Its node
 # publishes /tf every step (20 Hz); a second covers a busy CPU, not a dead node.
 OTHER_POSE_TOLERANCE = 1.0
@@ -195,13 +204,16 @@ class SimNode:
             nav_params=settings.nav_params,
             footprint=settings.footprint,
         )
-        self.standin = Nav2StandIn(world, replan_period=config.replan_period)
+        self.standin = Nav2StandIn(
+            world, replan_period=config.replan_period, odom_drift=config.odom_drift
+        )
         self.others = (
             SeenRobots(config.other_robots, OTHER_POSE_TOLERANCE, settings.footprint, MAP_FRAME)
             if config.other_robots
             else None
         )
         self._last_missing_warning = -float("inf")
+        self._other_poses: list[Any] = []  # the others as last seen (for the scan)
         # --follow-clock: the latest /clock heard, and simulated time minus our own time
         # (the clock's node started earlier; fixed at the first message heard).
         self._clock_target = 0.0
@@ -215,43 +227,28 @@ class SimNode:
         self.odom_frame = f"{prefix}odom"
         self.base_frame = f"{prefix}base_footprint"
         self.base_link = f"{prefix}base_link"
+        self.base_scan = f"{prefix}base_scan"
         self._plan_version = -1
-        self._was_active = False
-        self._last_own_cmd = -float("inf")
-        self._localized = False
-        self._last_amcl = -float("inf")
         self._topic_goal: NavTask | None = None
         self.log = node.get_logger()
         node.declare_parameter("stop_on_failure", True)
 
         group = ReentrantCallbackGroup()
         self._odom_pub = node.create_publisher(Odometry, "odom", 10)
-        self._tf_pub = node.create_publisher(TFMessage, "/tf", 100)
-        self._tf_static_pub = node.create_publisher(TFMessage, "/tf_static", TRANSIENT_LOCAL)
-        self._map_pub = node.create_publisher(OccupancyGridMsg, "map", TRANSIENT_LOCAL)
+        # Nav2's multi-robot convention: /NS/tf with plain frames; ROS 1's: /tf, NS/ frames.
+        tf_topic, tf_static_topic = config.tf_topics
+        self._tf_pub = node.create_publisher(TFMessage, tf_topic, 100)
+        self._tf_static_pub = node.create_publisher(TFMessage, tf_static_topic, TRANSIENT_LOCAL)
         self._plan_pub = node.create_publisher(Path, "plan", 1)
-        self._cmd_pub = node.create_publisher(Twist, "cmd_vel", 10)
-        self._amcl_pub = node.create_publisher(
-            PoseWithCovarianceStamped, "amcl_pose", TRANSIENT_LOCAL
-        )
         self._clock_pub = (
             node.create_publisher(Clock, "/clock", 10) if config.publishes_clock else None
         )
         if config.follow_clock:
             node.create_subscription(Clock, "/clock", self._on_clock, 10, callback_group=group)
         node.create_subscription(
-            PoseWithCovarianceStamped,
-            "initialpose",
-            self._on_initial_pose,
-            10,
-            callback_group=group,
-        )
-        node.create_subscription(
             PoseStamped, "goal_pose", self._on_goal_pose, 10, callback_group=group
         )
-        node.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10, callback_group=group)
-        if self.others is not None:
-            node.create_subscription(TFMessage, "/tf", self._on_tf, 100, callback_group=group)
+        self._subscribe_to_others(group)
         for service in (
             "global_costmap/clear_entirely_global_costmap",
             "local_costmap/clear_entirely_local_costmap",
@@ -313,16 +310,46 @@ class SimNode:
             node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
             stamp=self._stamp, frame=MAP_FRAME,
         )  # fmt: skip
+        # -- Nav2's world: map_server, amcl, the laser, the velocity chain (issue 20) --
+        servers = lifecycle.servers
+        self._map_server = MapServer(
+            servers["map_server"],
+            self.standin,
+            self._lock,
+            group,
+            active=lambda: lifecycle.is_active("map_server"),
+            stamp=self._stamp,
+            frame=MAP_FRAME,
+        )
+        self._localization = LocalizationTopics(
+            servers["amcl"],
+            self.standin,
+            self._lock,
+            group,
+            stamp=self._stamp,
+            frame=MAP_FRAME,
+            teleport=config.initial_pose == "teleport",
+        )
+        self._scan = ScanTopic(
+            node,
+            self.standin,
+            self._lock,
+            stamp=self._stamp,
+            frame=self.base_scan,
+            others=lambda: self._other_poses,
+        )
+        self._velocities = VelocityTopics(node, self.standin, self._lock, group)
         stamp = self._stamp()
-        self._map_pub.publish(grid_msg(grid, MAP_FRAME, stamp))
-        # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor.
+        # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor,
+        # the laser on it.
         base_link = TransformStamped()
         base_link.header.frame_id = self.base_frame
         base_link.header.stamp = stamp
         base_link.child_frame_id = self.base_link
         base_link.transform.translation.z = 0.010
         base_link.transform.rotation.w = 1.0
-        self._tf_static_pub.publish(TFMessage(transforms=[base_link]))
+        scan = base_scan_transform(self.base_link, self.base_scan, stamp, self._scan.spec)
+        self._tf_static_pub.publish(TFMessage(transforms=[base_link, scan]))
         self._publish_state()
 
     # -- life cycle ------------------------------------------------------------------
@@ -340,7 +367,7 @@ class SimNode:
         with self._lock:
             self.standin.abort_all("the simulator is shutting down")
         with contextlib.suppress(Exception):
-            self._cmd_pub.publish(Twist())
+            self._velocities.stop()
 
     # -- simulation thread -----------------------------------------------------------
 
@@ -395,6 +422,7 @@ class SimNode:
             return
         now = time.monotonic()
         found, missing = self.others.poses(now)
+        self._other_poses = found
         self.standin.world.set_other_robots(found)
         if missing and now - self._last_missing_warning >= WARN_PERIOD:
             self._last_missing_warning = now
@@ -409,12 +437,11 @@ class SimNode:
         with self._lock:
             standin = self.standin
             world = standin.world
-            sim_time = standin.time
             body = world.body
-            map_to_odom, odom_pose, pose = body.map_to_odom, body.odom_pose, body.pose
+            localization = standin.localization
+            map_to_odom, odom_pose = localization.estimate, localization.odom_pose
             v, w = body.robot.v, body.robot.w
             server = world.server
-            active = standin.active is not None
             new_plan = server.plan_version != self._plan_version
             plan, goal = server.plan, server.goal
             self._plan_version = server.plan_version
@@ -443,32 +470,13 @@ class SimNode:
         self._odom_pub.publish(odom)
         if new_plan and plan is not None:
             self._plan_pub.publish(path_msg(plan, goal, MAP_FRAME, stamp))
-        if active or self._was_active:
-            twist = Twist()
-            if active:
-                twist.linear.x, twist.angular.z = float(v), float(w)
-            self._cmd_pub.publish(twist)
-            self._last_own_cmd = time.monotonic()
-        self._was_active = active
-        if self._localized and sim_time - self._last_amcl >= AMCL_POSE_PERIOD:
-            self._publish_amcl_pose(pose, stamp, sim_time)
+        self._velocities.publish()
+        self._localization.publish()
+        self._scan.publish_if_due()
         if topic_ending is not None:
             self.log.info(
                 f"goal_pose goal ended {topic_ending.outcome.value} {topic_ending.error_msg}"
             )
-
-    def _publish_amcl_pose(self, pose: Pose2D, stamp: Any, sim_time: float) -> None:
-        message = PoseWithCovarianceStamped()
-        message.header.frame_id = MAP_FRAME
-        message.header.stamp = stamp
-        message.pose.pose = pose_msg(pose)
-        # amcl's covariance after converging: a few centimetres, a few degrees.
-        covariance = [0.0] * 36
-        covariance[0] = covariance[7] = 0.0025
-        covariance[35] = 0.0025
-        message.pose.covariance = covariance
-        self._amcl_pub.publish(message)
-        self._last_amcl = sim_time
 
     # -- goal poses ------------------------------------------------------------------
 
@@ -478,13 +486,13 @@ class SimNode:
         if isinstance(planar, str):
             return planar
         frame = pose.header.frame_id.lstrip("/")
-        body = self.standin.world.body
+        localization = self.standin.localization  # the transforms the node publishes
         if frame in ("", MAP_FRAME):
             return planar
         if frame == self.odom_frame:
-            return compose(body.map_to_odom, planar)
+            return compose(localization.estimate, planar)
         if frame in (self.base_frame, self.base_link):
-            return compose(body.pose, planar)
+            return compose(localization.believed_pose, planar)
         return (
             f"frame {frame!r} is not {MAP_FRAME!r}, {self.odom_frame!r} or "
             f"{self.base_frame!r} (the simulator knows no other transform)"
@@ -617,25 +625,6 @@ class SimNode:
 
     # -- topics and services -------------------------------------------------------------
 
-    def _on_initial_pose(self, message: PoseWithCovarianceStamped) -> None:
-        frame = message.header.frame_id.lstrip("/")
-        if frame not in ("", MAP_FRAME):
-            self.log.warning(f"initialpose ignored: frame {frame!r} is not {MAP_FRAME!r}")
-            return
-        pose = pose2d_of(message.pose.pose)
-        if isinstance(pose, str):
-            self.log.warning(f"initialpose ignored: {pose}")
-            return
-        with self._lock:
-            refused = self.standin.teleport(pose)
-            sim_time = self.standin.time
-        if refused is not None:
-            self.log.warning(f"initialpose refused: {refused}")
-            return
-        self.log.info(f"teleported to ({pose.x:.2f}, {pose.y:.2f}, {pose.yaw:.2f} rad)")
-        self._localized = True
-        self._publish_amcl_pose(pose, self._stamp(), sim_time)
-
     def _on_goal_pose(self, message: PoseStamped) -> None:
         """RViz's "Goal Pose": a navigate_to_pose goal, as bt_navigator makes of it."""
         with self._lock:
@@ -646,25 +635,36 @@ class SimNode:
             self._topic_goal = self.standin.navigate(Navigator.TO_POSE, [pose])
         self.log.info(f"goal_pose: navigating to ({pose.x:.2f}, {pose.y:.2f})")
 
-    def _on_cmd_vel(self, message: Twist) -> None:
-        """Teleop while no goal runs; our own commands (echoed back to us) are skipped."""
-        if time.monotonic() - self._last_own_cmd < TELEOP_QUIET:
+    def _subscribe_to_others(self, group: Any) -> None:
+        """Hear the other robots' transforms: each one's ``/NS/tf`` under Nav2's
+        convention, the global ``/tf`` under ROS 1's."""
+        if self.others is None:
             return
-        with self._lock:
-            self.standin.command(float(message.linear.x), float(message.angular.z))
+        if self.config.tf_convention == "ros1":
+            self.node.create_subscription(TFMessage, "/tf", self._on_tf, 100, callback_group=group)
+            return
+        for namespace in self.config.other_robots:
+            self.node.create_subscription(
+                TFMessage,
+                f"/{namespace}/tf",
+                lambda message, ns=namespace: self._on_tf(message, ns),
+                100,
+                callback_group=group,
+            )
 
-    def _on_tf(self, message: TFMessage) -> None:
-        """The other robots' transforms (every other one, ours included, is ignored)."""
+    def _on_tf(self, message: TFMessage, namespace: str | None = None) -> None:
+        """The other robots' transforms (every other one, ours included, is ignored);
+        ``namespace``: heard on that robot's own tf topic, with plain frame names."""
         assert self.others is not None
         now = time.monotonic()
         with self._lock:
             for transform in message.transforms:
-                self.others.heard(
-                    transform.header.frame_id,
-                    transform.child_frame_id,
-                    pose2d_from_transform(transform),
-                    now,
-                )
+                parent, child = transform.header.frame_id, transform.child_frame_id
+                pose = pose2d_from_transform(transform)
+                if namespace is None:
+                    self.others.heard(parent, child, pose, now)
+                else:
+                    self.others.heard_from(namespace, parent, child, pose, now)
 
     def _clear_costmap_callback(self, costmap: str) -> Any:
         def clear(_request: Any, response: Any) -> Any:
@@ -769,7 +769,21 @@ def nav2_server_parameters(robot: RobotProfile) -> dict[str, list[Parameter]]:
             Parameter("planner_plugins", value=["GridBased"]),
             Parameter("GridBased.tolerance", value=NAV2_PLANNER_TOLERANCE),
         ],
+        "velocity_smoother": velocity_smoother_parameters(NAV2_BRINGUP_SMOOTHER),
     }
+
+
+def velocity_smoother_parameters(limits: SmootherLimits) -> list[Parameter]:
+    """The limits the stand-in smooths with, under nav2_bringup's parameter names."""
+    return [
+        Parameter("smoothing_frequency", value=20.0),
+        Parameter("feedback", value="OPEN_LOOP"),
+        Parameter("max_velocity", value=[limits.max_v, 0.0, limits.max_w]),
+        Parameter("min_velocity", value=[limits.min_v, 0.0, limits.min_w]),
+        Parameter("max_accel", value=[limits.accel_v, 0.0, limits.accel_w]),
+        Parameter("max_decel", value=[-limits.decel_v, 0.0, -limits.decel_w]),
+        Parameter("velocity_timeout", value=limits.timeout),
+    ]
 
 
 def nav2_costmap_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:

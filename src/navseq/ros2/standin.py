@@ -36,6 +36,15 @@ is planned at once. The stand-in models this tick only for a preempting goal: ot
 it re-plans by its own rules (a new goal, a robot that strays from the plan), which
 give the same paths on a static map.
 
+The robot's world as a Nav2 robot sees it (:meth:`Nav2StandIn.step`): the navigation
+server steers from the pose :class:`navseq.sim.localization.Localization` believes (the
+truth unless the odometry drifts or an initial pose moved the estimate), and its
+commands, like the behaviours', go through Nav2's velocity chain
+(:mod:`navseq.sim.velocity_chain`: ``cmd_vel_nav`` capped by the ``speed_limit``, then
+smoothed) before they reach the body; :attr:`Nav2StandIn.commands` keeps each stage's
+last value for the node to publish. A new map (:meth:`Nav2StandIn.replace_map`)
+replaces the world's.
+
 Times are simulated seconds (:attr:`Nav2StandIn.time`); the node steps this object from
 one thread and calls everything else under the same lock.
 """
@@ -57,7 +66,10 @@ import numpy.typing as npt
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.sim.behaviors import BehaviorServer
+from navseq.sim.localization import Localization
 from navseq.sim.navserver import CONTROL_FAILED, NavState
+from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.velocity_chain import SpeedLimit, VelocitySmoother
 from navseq.sim.world import SimWorld
 
 PASS_RADIUS = 0.5  # m: Nav2's RemovePassedGoals default radius
@@ -178,6 +190,17 @@ class WaypointRun:
             self.done.set()
 
 
+@dataclass
+class Commands:
+    """The last command of each stage of the velocity chain, and whether the chain
+    drove this step (the node publishes ``cmd_vel_nav``, ``cmd_vel_smoothed`` and
+    ``cmd_vel`` then)."""
+
+    nav: tuple[float, float] = (0.0, 0.0)
+    smoothed: tuple[float, float] = (0.0, 0.0)
+    driving: bool = False
+
+
 @dataclass(frozen=True)
 class Feedback:
     """The numbers Nav2's navigators put in their feedback."""
@@ -200,6 +223,7 @@ class Nav2StandIn:
         pass_radius: float = PASS_RADIUS,
         replan_period: float = 0.0,
         planner_tolerance: float = NAV2_PLANNER_TOLERANCE,
+        odom_drift: float = 0.0,
     ) -> None:
         self.world = world
         # Nav2's planner plans to a free cell near a goal that is not free (NavFn's
@@ -222,6 +246,10 @@ class Nav2StandIn:
         # What drives the robot instead of the navigation server while it runs, first
         # asked first: the behaviour server, then any added (the docking server).
         self.drivers: list[Driver] = [self.behaviors]
+        self.localization = Localization(world.robot.pose, drift=odom_drift)
+        self.smoother = VelocitySmoother()
+        self.speed_limit = SpeedLimit(server.params.limits.max_v)
+        self.commands = Commands()
 
     # -- goals -----------------------------------------------------------------------
 
@@ -343,16 +371,28 @@ class Nav2StandIn:
         if task is not None and task.ending is None:
             self._replan_if_due(task)
             self._pass_through(task)
+        body = world.body
+        nav: tuple[float, float] | None = None
         driver = next((d for d in self.drivers if d.drives(self.time)), None)
         if driver is not None:
             # A behaviour (or docking) has the robot; a navigation goal's controller waits.
-            body = world.body
-            body.command(*driver.step(self.time, body.pose, body.collides))
-            body.step(world.dt)
+            nav = driver.step(self.time, body.pose, body.collides)
         elif world.server.state is NavState.ACTIVE:
-            world.step()
+            believed = self.localization.believed_pose
+            nav = self.speed_limit.apply(*world.controller_command(believed))
+        if nav is not None:
+            self.smoother.command(*nav, self.time)
+            self.commands.nav = nav
+        smoother = self.smoother
+        self.commands.driving = smoother.active(self.time) and (
+            nav is not None or smoother.output != (0.0, 0.0)
+        )
+        if self.commands.driving:
+            self.commands.smoothed = smoother.step(self.time, world.dt)
+            world.drive(*self.commands.smoothed)
         else:
-            world.body.step(world.dt)  # idle: a teleop command, or braking to rest
+            body.step(world.dt)  # idle: a teleop command, or braking to rest
+        self.localization.moved(body.pose)
         self.time += world.dt
         if task is not None and task.ending is None:
             self._settle(task)
@@ -374,11 +414,30 @@ class Nav2StandIn:
         return True
 
     def teleport(self, pose: Pose2D) -> str | None:
-        """Put the robot at ``pose``; why not, if it cannot be."""
+        """Put the robot at ``pose`` (and the belief with it); why not, if it cannot be."""
         try:
             self.world.teleport(pose)
         except NavseqError as error:
             return str(error)
+        self.smoother.output = (0.0, 0.0)
+        self.localization.teleported(self.world.robot.pose)
+        return None
+
+    def set_initial_pose(self, pose: Pose2D) -> None:
+        """An initial pose (``initialpose``): the robot believes it is at ``pose``; it does
+        not move. A running goal is steered from the new belief."""
+        self.localization.set_pose(pose)
+
+    def replace_map(self, grid: OccupancyGrid) -> str | None:
+        """A new map replaces the world's (planner, costmaps, the body's walls); a
+        warning when the robot now overlaps an obstacle of it (it cannot move then)."""
+        self.world.replace_map(grid)
+        pose = self.world.robot.pose
+        if self.world.body.collides(pose):
+            return (
+                f"the robot at ({pose.x:.2f}, {pose.y:.2f}) overlaps an obstacle or unknown "
+                "space of the new map: it cannot move until it is placed elsewhere"
+            )
         return None
 
     def feedback(self, task: NavTask) -> Feedback:
@@ -392,17 +451,18 @@ class Nav2StandIn:
         world = self.world
         robot = world.robot
         server = world.server
+        believed = self.localization.believed_pose
         if server.distance_remaining is not None and task is self.active:
             to_target = server.distance_remaining
         else:
-            to_target = robot.pose.distance_to(task.target)
+            to_target = believed.distance_to(task.target)
         ahead = sum(a.distance_to(b) for a, b in itertools.pairwise(task.poses[task.index :]))
         remaining = to_target + ahead
         speed = abs(robot.v)
         eta = remaining / speed if speed > 0.01 and remaining > 0.1 else 0.0
         recoveries = task.recoveries_before + (server.recoveries_run if task is self.active else 0)
         return Feedback(
-            pose=robot.pose,
+            pose=believed,
             navigation_time=self.time - task.started,
             estimated_time_remaining=eta,
             number_of_recoveries=recoveries,
@@ -416,6 +476,8 @@ class Nav2StandIn:
         self._replan_due = None
         self.world.server.cancel()
         self.world.body.command(0.0, 0.0)
+        # The controller's last word is a zero command; the smoother brakes to it.
+        self.smoother.command(0.0, 0.0, self.time)
 
     def _next_replan_tick(self) -> float:
         """The rate controller's first tick after now: ``replan_period`` apart, counted
@@ -439,7 +501,7 @@ class Nav2StandIn:
         """Through poses: the next pose becomes the target once this one is near."""
         while (
             task.index + 1 < len(task.poses)
-            and self.world.robot.pose.distance_to(task.target) <= self.pass_radius
+            and self.localization.believed_pose.distance_to(task.target) <= self.pass_radius
         ):
             task.recoveries_before += self.world.server.recoveries_run
             task.index += 1
@@ -470,7 +532,7 @@ class Nav2StandIn:
             return ErrorCode.NO_VALID_CONTROL
         # The pose the server pursued: a preempted goal's until the re-plan tick.
         goal = server.goal if server.goal is not None else task.target
-        code, _ = self.no_plan_reason(self.world.robot.pose, goal)
+        code, _ = self.no_plan_reason(self.localization.believed_pose, goal)
         if code in (ErrorCode.GOAL_OUTSIDE_MAP, ErrorCode.GOAL_OCCUPIED):
             return code
         if "another robot" in text:

@@ -97,6 +97,16 @@ class SeenRobots:
             sighting = self._by_base[child]
             sighting.odom_to_base, sighting.odom_to_base_at = pose, at
 
+    def heard_from(self, namespace: str, parent: str, child: str, pose: Pose2D, at: float) -> None:
+        """One transform heard on ``namespace``'s own tf topic (Nav2's multi-robot
+        convention: plain frame names ``map``, ``odom``, ``base_footprint``)."""
+        if namespace not in self._sightings:
+            return
+        parent, child = parent.lstrip("/"), child.lstrip("/")
+        if parent != self.map_frame:
+            parent = f"{namespace}/{parent}"
+        self.heard(parent, f"{namespace}/{child}", pose, at)
+
     def poses(self, now: float) -> tuple[list[tuple[Pose2D, Footprint]], list[str]]:
         """(pose in the map frame, footprint) of every robot heard from within
         ``tolerance`` of ``now``, and the namespaces of the others."""

@@ -308,6 +308,14 @@ class NavigationServer:
         if self.state is NavState.ACTIVE:
             self._needs_plan = True
 
+    def use_map(self, costmap: Costmap) -> None:
+        """Plan and steer on ``costmap`` (a new map's) from now on; an active goal is
+        planned again on it."""
+        self._use_costmap(costmap)
+        self._refresh_planning_costmap()
+        if self.state is NavState.ACTIVE and not self._follows_given_path:
+            self._needs_plan = True
+
     # -- internals -----------------------------------------------------------------------
 
     def _use_costmap(self, costmap: Costmap) -> None:

@@ -237,6 +237,14 @@ def load_map(yaml_path: str | Path) -> OccupancyGrid:
     )
 
 
+def check_map_description(yaml_path: str | Path) -> None:
+    """Read and check a map YAML's settings only (not its image); ``NavseqError`` if
+    they are unusable. Nav2's map_server answers a bad YAML and a bad image with
+    different codes, so its stand-in asks this before :func:`load_map`."""
+    path = Path(yaml_path)
+    _MapSettings.from_yaml(_read_yaml(path), str(path))
+
+
 def pixels_to_occupancy(
     pixels: np.ndarray,
     *,

@@ -27,6 +27,14 @@ from navseq.text import printable
 _NAMESPACE_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _ROS1_NAMESPACE_TOKEN = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 MAX_SPEED = 100.0  # beyond this the simulation cannot keep up on any machine anyway
+# --tf-convention: where a namespaced robot's transforms go and how its frames are named.
+# nav2: nav2_bringup's multi-robot launch (/NS/tf, /NS/tf_static, plain frame names);
+# ros1: ROS 1's multi_robot.launch (the global /tf, frames NS/odom, NS/base_footprint).
+TF_CONVENTIONS = ("nav2", "ros1")
+# --initial-pose: what initialpose does. estimate: amcl's (the belief moves, the robot
+# does not); teleport: the robot is put there (for scripts that place it, as before).
+INITIAL_POSE_MODES = ("estimate", "teleport")
+MAX_ODOM_DRIFT = 0.5  # per metre; more is no odometry at all
 
 
 def default_map() -> Path | None:
@@ -50,11 +58,23 @@ class SimConfig:
     rate: float = 20.0  # simulation steps per simulated second
     docks: tuple[Dock, ...] = ()  # the docking server's docks (--docks, ROS 2 only)
     datum: Datum | None = None  # --datum: follow_gps_waypoints' and fromLL's (ROS 2)
+    tf_convention: str = "nav2"  # one of TF_CONVENTIONS
+    odom_drift: float = 0.0  # odometry error per metre driven (ROS 2 stand-in)
+    initial_pose: str = "estimate"  # one of INITIAL_POSE_MODES (ROS 2 stand-in)
 
     @property
     def frame_prefix(self) -> str:
-        """``robot1/`` in a namespace, as the ROS 1 sim nodes name their frames."""
-        return f"{self.namespace}/" if self.namespace else ""
+        """``robot1/`` in a namespace under ROS 1's convention (the ROS 1 sim nodes');
+        empty under Nav2's, whose frames are plain names on the namespace's own tf."""
+        return f"{self.namespace}/" if self.namespace and self.tf_convention == "ros1" else ""
+
+    @property
+    def tf_topics(self) -> tuple[str, str]:
+        """Where this robot's ``tf`` and ``tf_static`` go: ``/NS/tf`` under Nav2's
+        convention in a namespace, else the global ``/tf``."""
+        if self.namespace and self.tf_convention == "nav2":
+            return f"/{self.namespace}/tf", f"/{self.namespace}/tf_static"
+        return "/tf", "/tf_static"
 
     @property
     def sim_time(self) -> bool:
@@ -122,6 +142,51 @@ def replan_period_of(value: float, *, ros1: bool = False) -> float:
     return value
 
 
+def tf_convention_of(text: str | None, *, ros1: bool = False) -> str:
+    """``--tf-convention``: ``nav2`` (default with --ros2) or ``ros1`` (the only one the
+    ROS 1 nodes have)."""
+    if text is None:
+        return "ros1" if ros1 else "nav2"
+    value = text.strip().lower()
+    if value not in TF_CONVENTIONS:
+        raise NavseqError(
+            f"expected {' or '.join(TF_CONVENTIONS)}, got {text!r}", source="--tf-convention"
+        )
+    if ros1 and value != "ros1":
+        raise NavseqError(
+            "the ROS 1 sim nodes publish ROS 1's convention only (frames NS/odom on /tf)",
+            source="--tf-convention",
+        )
+    return value
+
+
+def odom_drift_of(value: float, *, ros1: bool = False) -> float:
+    """``--odom-drift``: odometry error per metre, 0 to MAX_ODOM_DRIFT; --ros2 only."""
+    if not (math.isfinite(value) and 0.0 <= value <= MAX_ODOM_DRIFT):
+        raise NavseqError(
+            f"must be >= 0 and <= {MAX_ODOM_DRIFT:g} (error per metre driven), got {value:g}",
+            source="--odom-drift",
+        )
+    if ros1 and value > 0.0:
+        raise NavseqError(
+            "the ROS 1 sim nodes have no localisation to correct a drift: use it with --ros2",
+            source="--odom-drift",
+        )
+    return value
+
+
+def initial_pose_of(text: str, *, ros1: bool = False) -> str:
+    """``--initial-pose estimate|teleport``; the ROS 1 nodes always teleport."""
+    value = text.strip().lower()
+    if value not in INITIAL_POSE_MODES:
+        raise NavseqError(
+            f"expected {' or '.join(INITIAL_POSE_MODES)}, got {text!r}", source="--initial-pose"
+        )
+    if ros1 and value != "teleport":
+        return "teleport"  # ROS 1's stand-in has no amcl: its initialpose teleports
+    return value
+
+
 def checked_config(
     *,
     map_yaml: Path | None,
@@ -133,6 +198,9 @@ def checked_config(
     follow_clock: str = "false",
     replan_period: float = 0.0,
     docks: Path | None = None,
+    tf_convention: str | None = None,
+    odom_drift: float = 0.0,
+    initial_pose: str = "estimate",
     ros1: bool = False,
     datum: str = "",
 ) -> SimConfig:
@@ -164,6 +232,9 @@ def checked_config(
         replan_period=replan_period_of(float(replan_period), ros1=ros1),
         docks=docks_of(docks, ros1=ros1),
         datum=datum_of(datum) if datum else None,
+        tf_convention=tf_convention_of(tf_convention, ros1=ros1),
+        odom_drift=odom_drift_of(float(odom_drift), ros1=ros1),
+        initial_pose=initial_pose_of(initial_pose, ros1=ros1),
     )
 
 

@@ -97,8 +97,18 @@ class SimWorld:
 
     def step(self) -> None:
         """Advance one ``dt``: the server commands, the robot moves unless it would collide."""
+        self.drive(*self.controller_command())
+
+    def controller_command(self, believed: Pose2D | None = None) -> tuple[float, float]:
+        """The server's command for this step, steering from ``believed`` (where a
+        localiser puts the robot; None: its true pose)."""
         robot = self.robot
-        cmd_v, cmd_w = self.server.compute_velocity(robot.pose, robot.v, robot.w, self.dt)
+        pose = robot.pose if believed is None else believed
+        return self.server.compute_velocity(pose, robot.v, robot.w, self.dt)
+
+    def drive(self, cmd_v: float, cmd_w: float) -> None:
+        """Advance one ``dt`` with the command ``(cmd_v, cmd_w)`` given to the body."""
+        robot = self.robot
         self.steps += 1
         self.time = self.steps * self.dt  # no drift from adding dt thousands of times
         if cmd_v == 0.0 and cmd_w == 0.0 and robot.v == 0.0 and robot.w == 0.0:
@@ -126,6 +136,15 @@ class SimWorld:
         """Step for ``seconds`` of simulated time."""
         for _ in range(round(seconds / self.dt)):
             self.step()
+
+    def replace_map(self, grid: OccupancyGrid) -> None:
+        """A new map (``map_server/load_map``): the body collides with it, the server
+        plans on its costmap (same parameters) and re-plans an active goal. The robot
+        stays where it is, as on a real robot whose map changed."""
+        self.grid = grid
+        self.costmap = Costmap.from_grid(grid, self.costmap.params)
+        self.body.grid = grid
+        self.server.use_map(self.costmap)
 
     def teleport(self, pose: Pose2D) -> None:
         """Move the robot to ``pose`` at rest (the server keeps its goal and replans)."""
