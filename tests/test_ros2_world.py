@@ -25,6 +25,7 @@ NAV2_SCRIPTS = Path(__file__).with_name("nav2")
 GOAL = (-1.5, -0.5)
 PARAM_GET = ["ros2", "param", "get", "--no-daemon", "--spin-time", "5", "--hide-type"]
 INITIAL_POSE = (-1.0, 0.0)  # beside the robot: the estimate moves there, the robot stays
+SERVICE_POSE = (-1.2, 0.1)  # set_initial_pose's: the same, through amcl's service
 
 
 def run_script(env: dict[str, str], script: str, *args: str) -> dict[str, Any]:
@@ -64,6 +65,7 @@ def test_the_world_a_nav2_user_sees(tmp_path: Path):
         "goal": GOAL,
         "speed_limit": 0.1,
         "initial_pose": INITIAL_POSE,
+        "service_pose": SERVICE_POSE,
         "maps": maps(tmp_path),
     }
     try:
@@ -105,6 +107,12 @@ def test_the_world_a_nav2_user_sees(tmp_path: Path):
     assert seen["amcl_pose"][2] == "map" and seen["particles"] == 200
     assert seen["odom_moved_on_initialpose"] < 0.01
     assert seen["map_to_odom"] != pytest.approx([-2.0, -0.5], abs=0.05)
+    # amcl's services: set_initial_pose moves the estimate as initialpose does.
+    assert seen["set_initial_pose"] == pytest.approx(list(SERVICE_POSE), abs=0.01)
+    assert seen["empty_services"] == {
+        "request_nomotion_update": True,
+        "reinitialize_global_localization": True,
+    }
     # load_map: Nav2's codes, and a good map replaces the published one.
     loads = seen["load_map"]
     assert loads["empty"]["result"] == 1  # RESULT_MAP_DOES_NOT_EXIST
@@ -149,6 +157,7 @@ def test_namespaced_robots_publish_nav2s_tf_convention_by_default():
         "goal": GOAL,
         "speed_limit": 0.0,
         "initial_pose": INITIAL_POSE,
+        "service_pose": SERVICE_POSE,
         "maps": {},
     }
     try:

@@ -21,12 +21,13 @@ import rclpy
 from geometry_msgs.msg import PoseWithCovarianceStamped, Twist
 from nav2_msgs.action import NavigateToPose
 from nav2_msgs.msg import ParticleCloud, SpeedLimit
-from nav2_msgs.srv import LoadMap
+from nav2_msgs.srv import LoadMap, SetInitialPose
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.srv import GetMap
 from rclpy.action import ActionClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
 LATCHED = QoSProfile(
@@ -187,6 +188,26 @@ def main() -> int:
         if t.header.frame_id == "map"
     ]
     out["map_to_odom"] = [map_to_odom[-1].x, map_to_odom[-1].y] if map_to_odom else None
+
+    # -- amcl's services: set_initial_pose as initialpose; the two Empty ones answer --------
+    set_pose = node.create_client(SetInitialPose, f"{prefix}/set_initial_pose")
+    set_pose.wait_for_service(timeout_sec=10)
+    request = SetInitialPose.Request()
+    request.pose.header.frame_id = "map"
+    request.pose.pose.pose.position.x, request.pose.pose.pose.position.y = setup["service_pose"]
+    request.pose.pose.pose.orientation.w = 1.0
+    seen["amcl_pose"].clear()
+    answer = set_pose.call_async(request)
+    spin_until(answer.done, 10)
+    spin_until(lambda: bool(seen["amcl_pose"]), 5)
+    at = seen["amcl_pose"][-1].pose.pose.position if seen["amcl_pose"] else None
+    out["set_initial_pose"] = [at.x, at.y] if at else None
+    out["empty_services"] = {}
+    for name in ("request_nomotion_update", "reinitialize_global_localization"):
+        empty = node.create_client(Empty, f"{prefix}/{name}")
+        empty.wait_for_service(timeout_sec=10)
+        answer = empty.call_async(Empty.Request())
+        out["empty_services"][name] = spin_until(answer.done, 10)
 
     # -- map_server's services ------------------------------------------------------------
     get_map = node.create_client(GetMap, f"{prefix}/map_server/map")

@@ -13,7 +13,12 @@ What nav2_amcl (Jazzy) serves, on the ``amcl`` lifecycle node, over the stand-in
   the estimate's spread (error to the truth, a few centimetres at best);
 - ``particle_cloud`` (``nav2_msgs/ParticleCloud``, best effort as amcl's sensor-data
   QoS): :data:`PARTICLES` poses around the belief, drawn once from a seeded normal
-  distribution and scaled by the spread, equal weights.
+  distribution and scaled by the spread, equal weights;
+- the services ``set_initial_pose`` (``nav2_msgs/srv/SetInitialPose``: as
+  ``initialpose``), ``request_nomotion_update`` (``std_srvs/srv/Empty``: one correction
+  now, without motion) and ``reinitialize_global_localization`` (``std_srvs/srv/Empty``:
+  answered; **simplified**: no global search, the estimate keeps converging from where
+  it is, as the stand-in's estimate always does).
 """
 
 from __future__ import annotations
@@ -25,8 +30,10 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import PoseWithCovarianceStamped
 from nav2_msgs.msg import Particle, ParticleCloud
+from nav2_msgs.srv import SetInitialPose
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from std_srvs.srv import Empty
 
 from navseq.geometry import Pose2D
 from navseq.ros2.messages import pose2d_of, pose_msg
@@ -87,6 +94,18 @@ class LocalizationTopics:
             10,
             callback_group=group,
         )
+        amcl.create_service(
+            SetInitialPose, "set_initial_pose", self._on_set_initial_pose, callback_group=group
+        )
+        amcl.create_service(
+            Empty, "request_nomotion_update", self._on_nomotion_update, callback_group=group
+        )
+        amcl.create_service(
+            Empty,
+            "reinitialize_global_localization",
+            self._on_global_localization,
+            callback_group=group,
+        )
 
     def publish(self) -> None:
         """The estimate, when it changed or its period is up (call after a step). Nothing
@@ -124,6 +143,25 @@ class LocalizationTopics:
             Particle(pose=pose_msg(p), weight=weight) for p in particles_around(pose, spread)
         ]
         self._cloud_pub.publish(cloud)
+
+    def _on_set_initial_pose(
+        self, request: SetInitialPose.Request, response: SetInitialPose.Response
+    ) -> SetInitialPose.Response:
+        self._on_initial_pose(request.pose)
+        return response
+
+    def _on_nomotion_update(self, request: Empty.Request, response: Empty.Response) -> Any:
+        with self._lock:
+            self._standin.localization.update_without_motion()
+        self._log.info("no-motion update: the estimate corrected once")
+        self.publish()
+        return response
+
+    def _on_global_localization(self, request: Empty.Request, response: Empty.Response) -> Any:
+        # A real amcl spreads its particles over the whole map; the stand-in has none to
+        # spread, and its estimate converges from anywhere (docs/ros2.md says so).
+        self._log.info("global localization requested: the estimate keeps converging")
+        return response
 
     def _on_initial_pose(self, message: PoseWithCovarianceStamped) -> None:
         frame = message.header.frame_id.lstrip("/")

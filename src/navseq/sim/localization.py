@@ -118,6 +118,13 @@ class Localization:
         self.updates += 1
         return True
 
+    def update_without_motion(self) -> None:
+        """amcl's ``request_nomotion_update``: one correction now, as if the robot had
+        driven far enough for an update."""
+        self._moved_d = self._moved_a = 0.0
+        self.estimate = _toward(self.estimate, self.true_map_to_odom(), self.gain)
+        self.updates += 1
+
     def set_pose(self, believed: Pose2D) -> None:
         """An initial pose: the robot now believes it is at ``believed`` (it does not move)."""
         self.estimate = compose(believed, inverse(self.odom_pose))
