@@ -30,7 +30,12 @@ import numpy as np
 
 from navseq.eta.drive import DriveModel, DrivenPath, Point, SpeedCap, drive_path
 
+#: What drives a leg on paper: :func:`drive_path`, or one that recalls legs driven before
+#: (:class:`navseq.eta.memo.RememberedDrives`).
+Drive = Callable[..., DrivenPath]
+
 if TYPE_CHECKING:
+    from navseq.eta.memo import RememberedDrives
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission, Waypoint
     from navseq.mission.robot import RobotProfile
@@ -190,6 +195,7 @@ def predict_mission(
     speed_cap: SpeedCap | None = None,
     task_times: TaskTimes | None = None,
     planned_visits: int = PLANNED_VISITS,
+    drive: Drive = drive_path,
 ) -> MissionPrediction:
     """The mission's visits predicted; ``start`` None: the first leg starts at the first
     waypoint (nothing to drive), as nothing says where the robot is.
@@ -221,7 +227,7 @@ def predict_mission(
         if points is None:
             return None
         path = [where, *points[1:-1], goal] if len(points) > 2 else [where, goal]
-        driven = drive_path(
+        driven = drive(
             path,
             model,
             start_heading=heading,
@@ -321,12 +327,27 @@ def predict_legs(
     start: Pose2D | None,
     *,
     task_times: TaskTimes | None = None,
+    drives: RememberedDrives | None = None,
 ) -> MissionPrediction:
-    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls)."""
-    model = DriveModel.of(robot)
-    costmap = getattr(legs, "costmap", None)
-    cap = costmap_speed_cap(costmap, model) if costmap is not None else None
-    return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls).
+
+    ``drives``: legs driven before on these legs for this robot
+    (:meth:`RememberedDrives.on`), recalled instead of driven again.
+    """
+    if drives is None:
+        model = DriveModel.of(robot)
+        costmap = getattr(legs, "costmap", None)
+        cap = costmap_speed_cap(costmap, model) if costmap is not None else None
+        return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    return predict_mission(
+        mission,
+        legs,
+        drives.model,
+        start,
+        speed_cap=drives.speed_cap,
+        task_times=task_times,
+        drive=drives,
+    )
 
 
 __all__ = [

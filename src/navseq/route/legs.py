@@ -151,19 +151,54 @@ def legs_of(mission: Mission, planner: Legs) -> list[dict[str, Any]]:
     pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
     if mission.loops != 1 and len(mission.waypoints) > 1:
         pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
-    legs = []
-    for (from_name, start), (to_name, goal), loop in pairs:
-        leg = planner.leg(start, goal)
-        legs.append(
-            {
-                "from": from_name,
-                "to": int(to_name),
-                "points": leg.points,
-                "length_m": leg.length_m,
-                "loop": loop,
-            }
+    return [
+        _drawn_leg(planner, from_name, start, int(to_name), goal, loop)
+        for (from_name, start), (to_name, goal), loop in pairs
+    ]
+
+
+def legs_after_edit(
+    before: list[dict[str, Any]], mission: Mission, planner: Legs, moved: set[int]
+) -> list[dict[str, Any]]:
+    """:func:`legs_of` ``mission``, given the legs of the same mission before the
+    waypoints ``moved`` (indices) moved: only the legs that touch them are planned (or
+    taken from the planner's cache) again. The mission must have the same waypoint count,
+    start pose and loops as the one ``before`` was made of."""
+    names = {str(index) for index in moved}
+    legs = list(before)
+    for position, leg in enumerate(before):
+        if leg["to"] not in moved and leg["from"] not in names:
+            continue
+        source = leg["from"]
+        if source == "start":
+            assert mission.start is not None
+            start = (mission.start.x, mission.start.y)
+        else:
+            waypoint = mission.waypoints[int(source)]
+            start = (waypoint.x, waypoint.y)
+        goal = mission.waypoints[leg["to"]]
+        legs[position] = _drawn_leg(
+            planner, source, start, leg["to"], (goal.x, goal.y), leg["loop"]
         )
     return legs
+
+
+def _drawn_leg(
+    planner: Legs,
+    from_name: str,
+    start: tuple[float, float],
+    to: int,
+    goal: tuple[float, float],
+    loop: bool,
+) -> dict[str, Any]:
+    leg = planner.leg(start, goal)
+    return {
+        "from": from_name,
+        "to": to,
+        "points": leg.points,
+        "length_m": leg.length_m,
+        "loop": loop,
+    }
 
 
 def route_summary(legs: list[dict[str, Any]], robot: RobotProfile) -> dict[str, Any]:

@@ -28,9 +28,10 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.eta.memo import RememberedDrives
 from navseq.executor.control import operator_reason
 from navseq.extras import MissingExtra
-from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
+from navseq.route.legs import LegPlanner, Legs, legs_after_edit, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     CheckedDraft,
@@ -43,6 +44,7 @@ from navseq.studio.documents import (
     problems_of,
     version_of,
 )
+from navseq.studio.edits import LastCheck, checked_after_edit, edited_mission, moved_waypoints
 from navseq.studio.mapview import MapView
 from navseq.studio.security import (
     COOKIE_NAME,
@@ -117,6 +119,11 @@ class Studio:
             tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
         ] = OrderedDict()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
+        # The last check (an edit is checked from it) and the one before the check going on.
+        self._last_check: LastCheck | None = None
+        self._last_check_before: LastCheck | None = None
+        self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
+        self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.run: StudioRun | None = None
 
     # -- where things are --------------------------------------------------------------
@@ -307,7 +314,7 @@ class Studio:
     def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
-        checked = self._checked(document)
+        moved, checked = self._checked_edit(document)
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
             "readable": checked.mission is not None,
@@ -316,6 +323,7 @@ class Studio:
             "estimated_duration": "",
         }
         mission = checked.mission
+        self._last_check = None
         if mission is None:
             return answer
         robot = choose_robot(None, mission)
@@ -326,11 +334,55 @@ class Studio:
                 planner = self.planner(checked.map_path, robot)
             except NavseqError:
                 return answer  # the map's own problem is in the list already
-            legs = legs_of(mission, planner)
+            last = self._last_check_before
+            if moved is not None and last is not None:
+                legs = legs_after_edit(last.legs, mission, planner, moved)
+            else:
+                legs = legs_of(mission, planner)
             answer["legs"] = legs
             answer.update(route_summary(legs, robot))
-            answer.update(_expected_duration(mission, planner, robot))
+            answer.update(_expected_duration(mission, planner, robot, self.drives(planner, robot)))
+            if isinstance(document, dict):
+                context = (map_stamp(checked.map_path), planner)
+                self._last_check = LastCheck(document, checked, context, legs)
         return answer
+
+    def _checked_edit(self, document: Any) -> tuple[set[int] | None, CheckedDraft]:
+        """The draft checked from the last check when it only moved some waypoints
+        (:mod:`navseq.studio.edits`; those waypoints, and None for a full check), else
+        checked whole."""
+        from navseq.commands.common import choose_robot, preflight_errors
+
+        last = self._last_check_before = self._last_check
+        if last is None or last.checked.map_path is None:
+            return None, self._checked(document)
+        moved = moved_waypoints(last.document, document)
+        if moved is None or not moved:
+            return None, self._checked(document)
+        map_path = last.checked.map_path
+        try:
+            stamp = map_stamp(map_path)
+        except OSError:
+            return None, self._checked(document)
+        mission = edited_mission(last, document, moved)
+        if mission is None:
+            return None, self._checked(document)
+        robot = choose_robot(None, mission)
+        if (stamp, self.planner(map_path, robot)) != last.context:
+            return None, self._checked(document)
+        costmap = self.costmap(map_path, robot)
+        errors = preflight_errors(mission, costmap, mission.start, None, robot)
+        self.edits_checked += 1
+        return moved, checked_after_edit(last, mission, errors, self.shown_name)
+
+    def drives(self, planner: LegPlanner, robot: RobotProfile) -> RememberedDrives:
+        """The legs driven on paper on ``planner``'s costmap for ``robot``, kept."""
+        with self._lock:
+            kept = self._drives.get(robot)
+            if kept is None or kept[0] is not planner:
+                kept = (planner, RememberedDrives.on(planner, robot))
+                self._drives[robot] = kept
+            return kept[1]
 
     def save(self, body: dict[str, Any]) -> dict[str, Any]:
         from navseq.mission.writer import write_mission
@@ -887,13 +939,16 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     return app
 
 
-def _expected_duration(mission: Mission, planner: Legs, robot: RobotProfile) -> dict[str, Any]:
+def _expected_duration(
+    mission: Mission, planner: Legs, robot: RobotProfile, drives: RememberedDrives | None = None
+) -> dict[str, Any]:
     """The mission's expected duration and upper bound (navseq.eta), as ``navseq plan``
-    says them; the legs come from the planner's cache, so an edit costs the driving."""
+    says them; the legs come from the planner's cache and the legs driven on paper from
+    ``drives``, so an edit costs the visits it changed."""
     from navseq.eta.predict import predict_legs
     from navseq.eta.text import format_duration
 
-    prediction = predict_legs(mission, planner, robot, mission.start)
+    prediction = predict_legs(mission, planner, robot, mission.start, drives=drives)
     expected, upper = prediction.expected_s, prediction.upper_s
     if expected is None:  # a patrol that loops forever
         text = f"~{format_duration(prediction.loop_expected_s)} a loop"
