@@ -77,22 +77,13 @@ class LegPlanner:
         """Metres between every two of ``places`` as :meth:`leg` plans them (``inf``
         where there is no path): one search from each place that stops once it reached
         the places after it, on one thread per core (the compiled search lets go of the
-        GIL). For ordering hundreds of waypoints, where a plan per pair took minutes."""
-        from concurrent.futures import ThreadPoolExecutor
-
+        GIL). For ordering hundreds of waypoints, where a plan per pair took minutes.
+        Pairs measured before on the same map for the same robot, by this planner or
+        another, are not searched again (:mod:`navseq.route.distances`)."""
+        from navseq.route.distances import distance_table
         from navseq.sim.planner import reach_lengths
 
-        count = len(places)
-        matrix = np.zeros((count, count))
-        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-            rows = pool.map(
-                lambda i: reach_lengths(self.costmap, places[i], list(places[i + 1 :])),
-                range(count - 1),
-            )
-            for i, lengths in enumerate(rows):
-                matrix[i, i + 1 :] = lengths
-                matrix[i + 1 :, i] = lengths
-        return matrix
+        return distance_table(self.costmap, places, reach_lengths, workers=os.cpu_count() or 1)
 
 
 class StraightLegs:
