@@ -115,6 +115,9 @@ class Studio:
         self._save_lock = threading.Lock()
         self._check_lock = threading.Lock()
         self._load_lock = threading.Lock()  # one reading of a map file at a time
+        self._open_lock = threading.Lock()  # one reading of the mission file at a time
+        # The opened file's answer, by (path, SHA-256, --map): not to be changed by callers.
+        self._opened: tuple[tuple[Path, str, str | None], dict[str, Any]] | None = None
         self._answers: OrderedDict[
             tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
         ] = OrderedDict()
@@ -196,25 +199,34 @@ class Studio:
                 "problems": [],
                 "allow_run": self.config.allow_run,
             }
-        document, errors = open_document(path, self.base_dir)
-        if document is None:
-            raise ApiError(
-                422,
-                f"{self.shown_name} cannot be opened",
-                problems=[problem.as_json() for problem in problems_of(errors)],
-            )
-        if map_text is not None:
-            document["map"] = map_text  # --map wins, as for navseq validate --map
-        return {
-            "name": self.shown_name,
-            "path": self.roots.relative(path),
-            "exists": True,
-            "version": version_of(path),
-            "units": UNITS,
-            "mission": document,
-            "problems": [problem.as_json() for problem in problems_of(errors)],
-            "allow_run": self.config.allow_run,
-        }
+        version = version_of(path)
+        # The file read once per content: a page load of a 5000-waypoint mission waited
+        # half a second for the loader (every load, and the warm-up's beside the first).
+        key = (path, version["sha256"], map_text)
+        with self._open_lock:
+            if self._opened is not None and self._opened[0] == key:
+                return {**self._opened[1], "version": version}
+            document, errors = open_document(path, self.base_dir)
+            if document is None:
+                raise ApiError(
+                    422,
+                    f"{self.shown_name} cannot be opened",
+                    problems=[problem.as_json() for problem in problems_of(errors)],
+                )
+            if map_text is not None:
+                document["map"] = map_text  # --map wins, as for navseq validate --map
+            answer = {
+                "name": self.shown_name,
+                "path": self.roots.relative(path),
+                "exists": True,
+                "version": version,
+                "units": UNITS,
+                "mission": document,
+                "problems": [problem.as_json() for problem in problems_of(errors)],
+                "allow_run": self.config.allow_run,
+            }
+            self._opened = (key, answer)
+            return answer
 
     def map_info(self, map_text: str | None) -> dict[str, Any]:
         path = self._map_path(map_text)
