@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import json
+import os
 import shutil
 from pathlib import Path
 from typing import Any
@@ -123,3 +124,24 @@ def test_a_changed_setting_checks_the_whole_draft(workspace: Path) -> None:
     assert answer["legs"][-1]["loop"] is True  # the way back to the first waypoint
     assert checker.edits_checked == 0
     assert answer == full_check(studio(workspace), patrol)
+
+
+def test_a_map_file_changed_on_disk_checks_the_whole_draft(tmp_path: Path) -> None:
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    mission = {
+        "navseq": 1,
+        "map": "maps/turtlebot3_world.yaml",
+        "waypoints": [{"x": x, "y": y, "yaw": 0} for x, y in TOUR],
+    }
+    (tmp_path / "mission.yaml").write_text(json.dumps(mission), encoding="utf-8")
+    checker = studio(tmp_path)
+    document = checker.mission()["mission"]
+    checker.check(document)
+    # The map saved again (map_server's YAML rewritten, say after mapping once more).
+    map_yaml = tmp_path / "maps/turtlebot3_world.yaml"
+    stat = map_yaml.stat()
+    os.utime(map_yaml, ns=(stat.st_atime_ns, stat.st_mtime_ns + 5_000_000_000))
+    document = copy.deepcopy(document)
+    document["waypoints"][3].update(x=0.6, y=-1.7)
+    assert checker.check(document) == full_check(studio(tmp_path), document)
+    assert checker.edits_checked == 0
