@@ -122,9 +122,7 @@ class Studio:
             tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
         ] = OrderedDict()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
-        # The last check (an edit is checked from it) and the one before the check going on.
-        self._last_check: LastCheck | None = None
-        self._last_check_before: LastCheck | None = None
+        self._last_check: LastCheck | None = None  # an edit is checked from it
         self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
         self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.run: StudioRun | None = None
@@ -326,7 +324,7 @@ class Studio:
     def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
-        moved, checked = self._checked_edit(document)
+        last, moved, checked = self._checked_edit(document)
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
             "readable": checked.mission is not None,
@@ -346,7 +344,6 @@ class Studio:
                 planner = self.planner(checked.map_path, robot)
             except NavseqError:
                 return answer  # the map's own problem is in the list already
-            last = self._last_check_before
             if moved is not None and last is not None:
                 legs = legs_after_edit(last.legs, mission, planner, moved)
             else:
@@ -359,33 +356,35 @@ class Studio:
                 self._last_check = LastCheck(document, checked, context, legs)
         return answer
 
-    def _checked_edit(self, document: Any) -> tuple[set[int] | None, CheckedDraft]:
-        """The draft checked from the last check when it only moved some waypoints
-        (:mod:`navseq.studio.edits`; those waypoints, and None for a full check), else
-        checked whole."""
+    def _checked_edit(
+        self, document: Any
+    ) -> tuple[LastCheck | None, set[int] | None, CheckedDraft]:
+        """The last check, and the draft checked from it when it only moved some
+        waypoints (:mod:`navseq.studio.edits`: those waypoints), else checked whole (None
+        for them)."""
         from navseq.commands.common import choose_robot, preflight_errors
 
-        last = self._last_check_before = self._last_check
+        last = self._last_check
         if last is None or last.checked.map_path is None:
-            return None, self._checked(document)
+            return last, None, self._checked(document)
         moved = moved_waypoints(last.document, document)
         if moved is None or not moved:
-            return None, self._checked(document)
+            return last, None, self._checked(document)
         map_path = last.checked.map_path
         try:
             stamp = map_stamp(map_path)
         except OSError:
-            return None, self._checked(document)
+            return last, None, self._checked(document)
         mission = edited_mission(last, document, moved)
         if mission is None:
-            return None, self._checked(document)
+            return last, None, self._checked(document)
         robot = choose_robot(None, mission)
         if (stamp, self.planner(map_path, robot)) != last.context:
-            return None, self._checked(document)
+            return last, None, self._checked(document)
         costmap = self.costmap(map_path, robot)
         errors = preflight_errors(mission, costmap, mission.start, None, robot)
         self.edits_checked += 1
-        return moved, checked_after_edit(last, mission, errors, self.shown_name)
+        return last, moved, checked_after_edit(last, mission, errors, self.shown_name)
 
     def drives(self, planner: LegPlanner, robot: RobotProfile) -> RememberedDrives:
         """The legs driven on paper on ``planner``'s costmap for ``robot``, kept."""
