@@ -80,6 +80,9 @@ def time_of_tasks(tasks: Iterable[Task]) -> TaskTime:
     return TaskTime(expected, upper)
 
 
+_NO_TASK_TIME = TaskTime()
+
+
 @dataclass(frozen=True)
 class VisitPrediction:
     """One visit: its leg driven (None: no path to it), dwell and tasks."""
@@ -232,12 +235,14 @@ def predict_mission(
     planned = 0
     paced_seconds, paced_metres = 0.0, 0.0  # the planned visits' driving and distance
 
+    def paced(goal: tuple[float, float], yaw: float) -> DrivenPath:
+        straight = math.dist(where, goal)
+        pace = paced_seconds / paced_metres if paced_metres > 0 else 1 / model.max_speed
+        return paced_leg(goal, straight, straight * pace, yaw)
+
     def driven_leg(visit: Visit, goal: tuple[float, float]) -> DrivenPath | None:
         nonlocal planned, paced_seconds, paced_metres
         straight = math.dist(where, goal)
-        if planned >= planned_visits:
-            pace = paced_seconds / paced_metres if paced_metres > 0 else 1 / model.max_speed
-            return paced_leg(goal, straight, straight * pace, visit.waypoint.yaw_rad)
         planned += 1
         points = legs.leg(where, goal).points
         if points is None:
@@ -262,19 +267,25 @@ def predict_mission(
         planned = 0  # the first visits of each loop are planned
         visits = []
         for index, waypoint in enumerate(mission.waypoints):
-            visit = Visit.of(mission, loop, index)
             goal = (waypoint.x, waypoint.y)
-            driven = driven_leg(visit, goal)
+            if planned >= planned_visits:
+                # Paced: only the waypoint's policy counts (no visit record to build:
+                # 4500 of them at each check of a 5000-waypoint mission in the studio).
+                policy = mission.policy_for(index)
+                driven: DrivenPath | None = paced(goal, waypoint.yaw_rad)
+            else:
+                visit = Visit.of(mission, loop, index)
+                policy = visit.policy
+                driven = driven_leg(visit, goal)
             if driven is not None:
                 where, heading, speed = driven.end_point, driven.end_heading, driven.end_speed
             else:
                 where, heading, speed = goal, waypoint.yaw_rad, 0.0
-            tasks = (
-                task_times(index, waypoint)
-                if task_times is not None
-                else time_of_tasks(visit.policy.tasks)
-            )
-            visits.append(VisitPrediction(loop, index, driven, visit.policy.dwell_s, tasks))
+            if task_times is not None:
+                tasks = task_times(index, waypoint)
+            else:
+                tasks = time_of_tasks(policy.tasks) if policy.tasks else _NO_TASK_TIME
+            visits.append(VisitPrediction(loop, index, driven, policy.dwell_s, tasks))
         return tuple(visits)
 
     first = loop_of(0) if count else ()

@@ -659,7 +659,9 @@ def map_stamp(path: Path) -> tuple[int, ...]:
 
         text = path.read_text(encoding="utf-8")
         refuse_deep_nesting(text, str(path))  # before PyYAML's composer recurses
-        image = yaml.safe_load(text).get("image")
+        # libyaml's reader where there is one: a check asks for the stamp a few times.
+        loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+        image = yaml.load(text, Loader=loader).get("image")
         image_path = path.parent / str(image)
         stamp.append(image_path.stat().st_mtime_ns)
     except Exception:  # the loader says what is wrong with a bad map; the YAML's stamp will do
