@@ -30,7 +30,12 @@ import numpy as np
 
 from navseq.eta.drive import DriveModel, DrivenPath, Point, SpeedCap, drive_path
 
+#: What drives a leg on paper: :func:`drive_path`, or one that recalls legs driven before
+#: (:class:`navseq.eta.memo.RememberedDrives`).
+Drive = Callable[..., DrivenPath]
+
 if TYPE_CHECKING:
+    from navseq.eta.memo import RememberedDrives
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission, Waypoint
     from navseq.mission.robot import RobotProfile
@@ -73,6 +78,9 @@ def time_of_tasks(tasks: Iterable[Task]) -> TaskTime:
         else:
             upper += math.inf if task.timeout_s is None else task.timeout_s
     return TaskTime(expected, upper)
+
+
+_NO_TASK_TIME = TaskTime()
 
 
 @dataclass(frozen=True)
@@ -158,11 +166,27 @@ class MissionPrediction:
         visits)."""
         key = (first, part)
         if key not in self._rests:
-            visits = self.first_loop if first else self.later_loop
-            each = np.array([_part_of(v, part) for v in visits], dtype=float)
+            each = self._parts(first, part)
             rest = np.cumsum(each[::-1])[::-1]
             self._rests[key] = np.append(rest[1:], 0.0)
         return self._rests[key]
+
+    def _parts(self, first: bool, part: Part) -> np.ndarray:
+        """:func:`_part_of` each visit of a loop, added up as it does (the same floats),
+        from columns read once: a check in the studio asks for all three parts of 5000."""
+        key = (first, "columns")
+        if key not in self._rests:
+            visits = self.first_loop if first else self.later_loop
+            self._rests[key] = np.array(
+                [(v.drive_s, v.dwell_s, v.tasks.expected_s, v.tasks.upper_s) for v in visits],
+                dtype=float,
+            ).reshape(-1, 4)
+        drive, dwell, expected, upper = self._rests[key].T
+        if part == "drive":
+            return drive
+        if part == "upper":
+            return drive + dwell + np.maximum(upper, expected)
+        return drive + dwell + expected
 
 
 #: Which seconds of a visit :meth:`MissionPrediction.after` adds up.
@@ -190,6 +214,7 @@ def predict_mission(
     speed_cap: SpeedCap | None = None,
     task_times: TaskTimes | None = None,
     planned_visits: int = PLANNED_VISITS,
+    drive: Drive = drive_path,
 ) -> MissionPrediction:
     """The mission's visits predicted; ``start`` None: the first leg starts at the first
     waypoint (nothing to drive), as nothing says where the robot is.
@@ -210,18 +235,20 @@ def predict_mission(
     planned = 0
     paced_seconds, paced_metres = 0.0, 0.0  # the planned visits' driving and distance
 
+    def paced(goal: tuple[float, float], yaw: float) -> DrivenPath:
+        straight = math.dist(where, goal)
+        pace = paced_seconds / paced_metres if paced_metres > 0 else 1 / model.max_speed
+        return paced_leg(goal, straight, straight * pace, yaw)
+
     def driven_leg(visit: Visit, goal: tuple[float, float]) -> DrivenPath | None:
         nonlocal planned, paced_seconds, paced_metres
         straight = math.dist(where, goal)
-        if planned >= planned_visits:
-            pace = paced_seconds / paced_metres if paced_metres > 0 else 1 / model.max_speed
-            return paced_leg(goal, straight, straight * pace, visit.waypoint.yaw_rad)
         planned += 1
         points = legs.leg(where, goal).points
         if points is None:
             return None
         path = [where, *points[1:-1], goal] if len(points) > 2 else [where, goal]
-        driven = drive_path(
+        driven = drive(
             path,
             model,
             start_heading=heading,
@@ -240,19 +267,25 @@ def predict_mission(
         planned = 0  # the first visits of each loop are planned
         visits = []
         for index, waypoint in enumerate(mission.waypoints):
-            visit = Visit.of(mission, loop, index)
             goal = (waypoint.x, waypoint.y)
-            driven = driven_leg(visit, goal)
+            if planned >= planned_visits:
+                # Paced: only the waypoint's policy counts (no visit record to build:
+                # 4500 of them at each check of a 5000-waypoint mission in the studio).
+                policy = mission.policy_for(index)
+                driven: DrivenPath | None = paced(goal, waypoint.yaw_rad)
+            else:
+                visit = Visit.of(mission, loop, index)
+                policy = visit.policy
+                driven = driven_leg(visit, goal)
             if driven is not None:
                 where, heading, speed = driven.end_point, driven.end_heading, driven.end_speed
             else:
                 where, heading, speed = goal, waypoint.yaw_rad, 0.0
-            tasks = (
-                task_times(index, waypoint)
-                if task_times is not None
-                else time_of_tasks(visit.policy.tasks)
-            )
-            visits.append(VisitPrediction(loop, index, driven, visit.policy.dwell_s, tasks))
+            if task_times is not None:
+                tasks = task_times(index, waypoint)
+            else:
+                tasks = time_of_tasks(policy.tasks) if policy.tasks else _NO_TASK_TIME
+            visits.append(VisitPrediction(loop, index, driven, policy.dwell_s, tasks))
         return tuple(visits)
 
     first = loop_of(0) if count else ()
@@ -332,12 +365,27 @@ def predict_legs(
     start: Pose2D | None,
     *,
     task_times: TaskTimes | None = None,
+    drives: RememberedDrives | None = None,
 ) -> MissionPrediction:
-    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls)."""
-    model = DriveModel.of(robot)
-    costmap = getattr(legs, "costmap", None)
-    cap = costmap_speed_cap(costmap, model) if costmap is not None else None
-    return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls).
+
+    ``drives``: legs driven before on these legs for this robot
+    (:meth:`RememberedDrives.on`), recalled instead of driven again.
+    """
+    if drives is None:
+        model = DriveModel.of(robot)
+        costmap = getattr(legs, "costmap", None)
+        cap = costmap_speed_cap(costmap, model) if costmap is not None else None
+        return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    return predict_mission(
+        mission,
+        legs,
+        drives.model,
+        start,
+        speed_cap=drives.speed_cap,
+        task_times=task_times,
+        drive=drives,
+    )
 
 
 __all__ = [
