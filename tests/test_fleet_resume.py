@@ -161,3 +161,18 @@ def test_a_resume_that_cannot_continue_the_run_is_refused_and_changes_nothing(
     assert_clean_error(done)
     assert said in done.stderr
     assert (run / "fleet-report.json").read_bytes() == report
+
+
+def test_a_second_resume_of_a_fleet_run_in_use_is_refused(
+    finished_run: Path, tmp_path: Path
+) -> None:
+    from navseq.run.runlock import RunLock
+
+    fleet, run = copy_of(finished_run, tmp_path)
+    lock = RunLock(run).acquire()  # as a resume running now holds it
+    try:
+        done = navseq("run", "--fleet", fleet, "--resume", run, cwd=tmp_path)
+    finally:
+        lock.release()
+    assert_clean_error(done)
+    assert "another navseq run" in done.stderr

@@ -75,14 +75,24 @@ def run(args: argparse.Namespace) -> int:
         picture=not args.no_picture,
         resume=_run_folder(args.resume),
     )
-    # A resume continues the run's own split, each robot from its journal.
-    prepared = prepare_fleet_run if request.resume is None else prepare_fleet_resume
-    fleet_run = prepared(request)
-    for member in fleet_run.members:
-        if member.session is not None:
-            for note in member.session.notes:
-                print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
-    status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+    lock = None
+    if request.resume is not None and request.resume.is_dir():
+        from navseq.run.runlock import RunLock
+
+        # One resume of a fleet run at a time: two would both drive (and report) it.
+        lock = RunLock(request.resume).acquire()
+    try:
+        # A resume continues the run's own split, each robot from its journal.
+        prepared = prepare_fleet_run if request.resume is None else prepare_fleet_resume
+        fleet_run = prepared(request)
+        for member in fleet_run.members:
+            if member.session is not None:
+                for note in member.session.notes:
+                    print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
+        status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+    finally:
+        if lock is not None:
+            lock.release()
     _print_summary(fleet_run, report)
     return status
 
