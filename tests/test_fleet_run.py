@@ -86,7 +86,8 @@ def test_options_a_fleet_run_cannot_honour_are_refused(tmp_path: Path) -> None:
     for extra, named in (
         (("--navigator", "ros1"), "--navigator ros1"),
         (("--start", "0,0,0"), "--start"),
-        (("--resume", tmp_path / "journal.jsonl"), "--resume"),
+        (("--resume", tmp_path / "run", "--out", tmp_path / "other"), "--out"),
+        (("--resume", tmp_path / "journal.jsonl"), "is not a folder"),
     ):
         done = navseq("run", "--fleet", FLEET, *extra, cwd=tmp_path)
         assert_clean_error(done)

@@ -81,7 +81,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--resume",
         type=Path,
         metavar="JOURNAL",
-        help="continue the run recorded in this journal.jsonl (reached waypoints are not re-run)",
+        help="continue the run recorded in this journal.jsonl (reached waypoints are not re-run); "
+        "with --fleet, the fleet run folder to continue",
     )
     parser.add_argument(
         "--no-preflight",

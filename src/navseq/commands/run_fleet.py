@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
@@ -24,7 +25,6 @@ if TYPE_CHECKING:
 _FLEET_REFUSES = {
     "start": ("--start", "each robot's start: comes from the fleet file"),
     "robot": ("--robot", "each robot's model (robot:) comes from the fleet file"),
-    "resume": ("--resume", "resuming a fleet run is not supported yet: run the fleet again"),
     "from_waypoint": ("--from", "the fleet's split chooses each robot's waypoints"),
     "to_waypoint": ("--to", "the fleet's split chooses each robot's waypoints"),
     "only": ("--only", "the fleet's split chooses each robot's waypoints"),
@@ -46,6 +46,12 @@ def refuse_options(args: argparse.Namespace) -> None:
     for dest, (flag, why) in _FLEET_REFUSES.items():
         if getattr(args, dest, None) not in (None, False, ()):
             raise NavseqError(f"{why}; leave {flag} out with --fleet", source=flag)
+    if getattr(args, "resume", None) is not None and getattr(args, "out", None) is not None:
+        raise NavseqError(
+            "a resumed fleet run writes into its own run folder (--resume RUN_DIR); "
+            "leave --out out",
+            source="--out",
+        )
     if hasattr(args, "loops"):
         raise NavseqError(
             "a fleet runs each robot's share once; leave --loops out", source="--loops"
@@ -53,29 +59,51 @@ def refuse_options(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from navseq.fleet.resume import prepare_fleet_resume
     from navseq.fleet.run import FleetRunRequest, prepare_fleet_run
 
     refuse_options(args)
     from navseq.extras import require_extra
 
     require_extra("plan", "--fleet")
-    fleet_run = prepare_fleet_run(
-        FleetRunRequest(
-            fleet=args.fleet,
-            mission=args.mission,
-            map=args.map,
-            folder=args.out,
-            realtime=args.realtime,
-            picture=not args.no_picture,
-        )
+    request = FleetRunRequest(
+        fleet=args.fleet,
+        mission=args.mission,
+        map=args.map,
+        folder=args.out,
+        realtime=args.realtime,
+        picture=not args.no_picture,
+        resume=_run_folder(args.resume),
     )
-    for member in fleet_run.members:
-        if member.session is not None:
-            for note in member.session.notes:
-                print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
-    status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+    lock = None
+    if request.resume is not None and request.resume.is_dir():
+        from navseq.run.runlock import RunLock
+
+        # One resume of a fleet run at a time: two would both drive (and report) it.
+        lock = RunLock(request.resume).acquire()
+    try:
+        # A resume continues the run's own split, each robot from its journal.
+        prepared = prepare_fleet_run if request.resume is None else prepare_fleet_resume
+        fleet_run = prepared(request)
+        for member in fleet_run.members:
+            if member.session is not None:
+                for note in member.session.notes:
+                    print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
+        status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+    finally:
+        if lock is not None:
+            lock.release()
     _print_summary(fleet_run, report)
     return status
+
+
+def _run_folder(given: Path | None) -> Path | None:
+    """``--resume``'s fleet run folder (its ``fleet-run.json`` named is taken as it)."""
+    from navseq.fleet.manifest import MANIFEST_NAME
+
+    if given is not None and given.name == MANIFEST_NAME and given.is_file():
+        return given.parent
+    return given
 
 
 def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any]]:

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 class FleetPlan:
     fleet: Fleet
     grid: OccupancyGrid | None
-    distances: FleetDistances
+    distances: FleetDistances | None  # None: a resumed run's, whose split is kept
     split: Split
 
 

@@ -31,17 +31,30 @@ def member_summary(member: Member) -> dict[str, Any]:
         "folder": None,
     }
     outcome = member.outcome
+    finished = member.finished
+    if finished is not None:  # complete before a resume: as its journal says
+        row["mission_time_s"] = round(finished.time_s, 1)
+        row["distance_m"] = round(finished.distance_m, 2)
+        row["exit_status"] = _EXIT_OK if finished.all_reached else _EXIT_NOT_ALL
+        row["folder"] = str(finished.folder)
     if outcome is not None:
         result = outcome.result
+        # The whole share: a resumed run's result holds the visits before the resume.
+        counts = result.outcome_counts()
+        for key in ("reached", "skipped", "failed"):
+            row[key] = next((n for o, n in counts.items() if o.value == key), 0)
         row["mission_time_s"] = round(result.duration_s, 1)
         row["distance_m"] = round(result.distance_m, 2)
         row["exit_status"] = outcome.exit_status
         row["folder"] = str(outcome.folder) if outcome.folder is not None else None
+        # A resumed run's report is beside the first one (report-2.json ...).
+        report = outcome.report_path
+        row["report"] = None if report is None else str(report)
         if outcome.interrupted:
             row["interrupted"] = outcome.interrupted
     if member.error is not None:
         row["error"] = str(member.error)
-    if member.session is None:
+    if member.session is None and finished is None:
         row["exit_status"] = _EXIT_OK  # nothing to do is done
     return row
 
@@ -130,15 +143,19 @@ def fleet_picture_png(run: FleetRun) -> bytes:
         robot = member.robot
         label = f"{robot.name} ({member.counts['reached']}/{member.waypoints} reached)"
         navigator = member.navigator
-        if navigator is not None:
-            rows = list(navigator.trajectory)
+        # A resumed run: the path before the resume (from the journal), then this run's.
+        for rows in (member.earlier_trail, list(navigator.trajectory) if navigator else []):
             if rows:
                 ax.plot([r[1] for r in rows], [r[2] for r in rows], color=colour, lw=1.4)
         ax.plot([robot.start.x], [robot.start.y], marker="s", color=colour, ms=7, label=label)
         outcome = member.outcome
-        if outcome is None:
+        if outcome is not None:
+            visits = list(outcome.result.visits)
+        elif member.finished is not None:
+            visits = list(member.finished.visits)
+        else:
             continue
-        for visit in outcome.result.visits:
+        for visit in visits:
             reached = visit.outcome is WaypointOutcome.REACHED
             ax.plot(
                 [visit.x],

@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from navseq.eta.live import EtaEstimator
     from navseq.executor.control import MissionControl
     from navseq.executor.events import MissionEvent
+    from navseq.executor.result import WaypointResult
     from navseq.fleet.lockstep import FleetClock, MemberNavigator
     from navseq.fleet.planning import FleetPlan
     from navseq.run.outcome import RunOutcome
@@ -43,6 +44,18 @@ class FleetRunRequest:
     realtime: float | None = None
     time_limit_s: float = 2.0  # for the split
     picture: bool = True
+    resume: Path | None = None  # a fleet run folder to continue (navseq.fleet.resume)
+
+
+@dataclass(frozen=True)
+class FinishedShare:
+    """A robot whose share a resumed run found complete: its figures from its journal."""
+
+    time_s: float
+    distance_m: float
+    all_reached: bool
+    folder: Path
+    visits: tuple[WaypointResult, ...]
 
 
 @dataclass
@@ -65,6 +78,9 @@ class Member:
     # The run's ETA, taken on the robot's own thread once its run has made it (a display
     # asking the session first would make a second one that hears no event).
     eta: EtaEstimator | None = None
+    # A resumed run's: the share an earlier run completed, and the path driven before.
+    finished: FinishedShare | None = None
+    earlier_trail: list[tuple[float, float, float]] = field(default_factory=list)
 
     def hear(self, event: MissionEvent) -> None:
         """A mission listener: the member's state as a live display shows it."""
@@ -169,13 +185,17 @@ def _control() -> MissionControl:
 
 def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     """Plan, check and make ready; raises NavseqError / MissionErrors (every problem at
-    once) before anything moves. The run folder is made here."""
+    once) before anything moves. The run folder is made here, with its
+    ``fleet-run.json`` (what :func:`navseq.fleet.resume.prepare_fleet_resume` needs)."""
     from navseq.fleet.lockstep import FleetClock
+    from navseq.fleet.manifest import manifest_of, write_manifest
     from navseq.fleet.planning import plan_fleet
     from navseq.run.folder import create_run_folder, default_run_folder
     from navseq.sim.fleet_world import FleetRobot as SimRobot
     from navseq.sim.fleet_world import FleetWorld
 
+    if request.resume is not None:
+        raise ValueError("a resume is prepared by navseq.fleet.resume.prepare_fleet_resume")
     plan = plan_fleet(
         request.fleet,
         request.mission,
@@ -195,6 +215,7 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     )
     try:
         members = _members(plan, world, clock, folder)
+        write_manifest(folder, manifest_of(request.fleet, request.mission, request.map, plan.split))
     except BaseException:
         if made_here:  # a refused run leaves nothing behind
             _remove_tree(folder)
@@ -253,4 +274,4 @@ def _remove_tree(folder: Path) -> None:
     shutil.rmtree(folder, ignore_errors=True)
 
 
-__all__ = ["FleetRun", "FleetRunRequest", "Member", "prepare_fleet_run"]
+__all__ = ["FinishedShare", "FleetRun", "FleetRunRequest", "Member", "prepare_fleet_run"]

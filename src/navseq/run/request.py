@@ -150,11 +150,10 @@ class RunRequest:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise _refuse(name, f"must be a number of seconds above 0, not {value}")
-        if self.resume is not None:
-            if self.outputs is None or not self.outputs.journal:
-                raise _refuse("outputs", "a resume appends to its journal: ask for one")
-            if isinstance(self.navigator, UseNavigator):
-                raise _refuse("navigator", "a resume continues with the journal's navigator kind")
+        # A face's own navigator (a fleet's robot) may resume too: the face made it as the
+        # journal's run had it; the journal's kind and settings are then not used.
+        if self.resume is not None and (self.outputs is None or not self.outputs.journal):
+            raise _refuse("outputs", "a resume appends to its journal: ask for one")
         wants_journal = self.outputs is not None and self.outputs.journal
         if wants_journal and self.resume is None and not isinstance(self.mission, Path):
             raise _refuse(

@@ -90,9 +90,14 @@ def continue_as_journaled(
     where = f"{history.path}:1"
     _refuse_another_part(request, recorded, where)
     notes = _Notes()
-    journaled_kind = str(recorded.get("navigator") or DEFAULT_KIND)
     navigator = request.navigator
-    assert not isinstance(navigator, UseNavigator)  # refused by RunRequest
+    if isinstance(navigator, UseNavigator):
+        # The face's own navigator (a fleet's robot), made as the journaled run had it,
+        # with the face's outputs: only the mission's part, loops, map and start follow.
+        return _continued_options(request, recorded, where, notes, navigator, own=True), (
+            notes.lines
+        )
+    journaled_kind = str(recorded.get("navigator") or DEFAULT_KIND)
     given_kind = kind_of(navigator).name if navigator is not None else None
     kind = known_kind(notes.settle("--navigator", given_kind, journaled_kind))
     given = (
@@ -108,7 +113,25 @@ def continue_as_journaled(
             values[option.name] = notes.settle(
                 option.info.flag, given.get(option.name), recorded[option.name]
             )
+    return _continued_options(request, recorded, where, notes, settings_from(kind, values)), (
+        notes.lines
+    )
+
+
+def _continued_options(
+    request: RunRequest,
+    recorded: dict[str, Any],
+    where: str,
+    notes: _Notes,
+    navigator: Any,
+    *,
+    own: bool = False,
+) -> RunRequest:
+    """``request`` with ``navigator`` and the journal's outputs (unless ``own``: the
+    face's), loops, map, start and part."""
     outputs = request.outputs or Outputs()
+    if own:
+        recorded = {**recorded, "no_picture": outputs.picture is False, "record": False}
     no_picture = None if outputs.picture is None else not outputs.picture
     picture = not notes.settle("--no-picture", no_picture, bool(recorded.get("no_picture", False)))
     # A recorded run goes on recording, into a new file beside the first (run-2.mcap).
@@ -119,12 +142,18 @@ def continue_as_journaled(
     try:
         loops = notes.settle("--loops", request.loops, _journal_loops(recorded))
         map_path = notes.settle("--map", request.map, _journal_map(recorded))
-        start = notes.settle("--start", request.start, _journal_start(recorded))
+        # The face's own navigator's robot is where the face put it (a fleet: where its
+        # journal last saw it), not a choice to note.
+        start = (
+            request.start
+            if own and request.start is not None
+            else notes.settle("--start", request.start, _journal_start(recorded))
+        )
     except (TypeError, ValueError) as error:
         raise NavseqError(f"the journal's run option {error}", source=where) from None
-    continued = dataclasses.replace(
+    return dataclasses.replace(
         request,
-        navigator=settings_from(kind, values),
+        navigator=navigator,
         navigator_options={},
         outputs=dataclasses.replace(
             outputs, picture=picture, record=record, record_format=record_format
@@ -136,7 +165,6 @@ def continue_as_journaled(
         last=recorded.get("to_waypoint"),
         only=recorded.get("only"),
     )
-    return continued, notes.lines
 
 
 def _journal_loops(recorded: dict[str, Any]) -> int | str | None:

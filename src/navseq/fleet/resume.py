@@ -1,0 +1,273 @@
+"""``navseq run --fleet FLEET --resume RUN_DIR``: a fleet run continued where it stopped.
+
+The run folder's ``fleet-run.json`` (:mod:`navseq.fleet.manifest`) names the fleet file
+the run started with (refused if another or changed one is given) and keeps its split:
+every robot goes on with its own share, from its own journal, by the one-robot resume
+rules (:mod:`navseq.run.resume`: the active waypoint again, reached and skipped ones
+not; a changed mission file or a damaged journal refused). A robot whose share was
+complete stays done, parked where its journal last saw it; the others start from
+there too. Every robot's problem is said at once (exit 2) before anything moves or is
+written; the fleet report and picture then cover both parts of the run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from navseq.errors import NavseqError, error_text
+
+if TYPE_CHECKING:
+    from navseq.executor.result import WaypointResult
+    from navseq.fleet.lockstep import FleetClock
+    from navseq.fleet.manifest import FleetManifest
+    from navseq.fleet.model import Fleet, FleetRobot
+    from navseq.fleet.planning import FleetPlan
+    from navseq.fleet.run import FleetRun, FleetRunRequest, Member
+    from navseq.geometry import Pose2D
+    from navseq.journal.state import JournalState
+    from navseq.sim.fleet_world import FleetWorld
+
+
+@dataclass(frozen=True)
+class RobotJournal:
+    """What one robot's folder says: its journal read, where it was, whether it is done."""
+
+    robot: FleetRobot
+    journal: Path
+    mission: Path
+    state: JournalState
+    pose: Pose2D
+    done: bool
+
+
+def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
+    """The fleet run in ``request.resume`` made ready to go on; raises NavseqError /
+    MissionErrors (every robot's problem at once) before anything moves."""
+    from navseq.fleet.checks import raise_all
+    from navseq.fleet.lockstep import FleetClock
+    from navseq.fleet.manifest import read_manifest
+    from navseq.fleet.planning import FleetPlan
+    from navseq.fleet.run import FleetRun
+    from navseq.sim.fleet_world import FleetRobot as SimRobot
+    from navseq.sim.fleet_world import FleetWorld
+    from navseq.sim.occupancy import load_map
+
+    assert request.resume is not None
+    folder = request.resume
+    manifest = read_manifest(folder)
+    fleet = _same_fleet(request, manifest)
+    if fleet.map is None:
+        raise NavseqError("the simulator needs a map: give --map MAP.yaml", source=str(folder))
+    grid = load_map(fleet.map)
+    split = manifest.split(fleet)
+    plan = FleetPlan(fleet, grid, None, split)
+    problems: list[NavseqError] = []
+    journals: dict[str, RobotJournal] = {}
+    for share in split.shares:
+        if share.order:
+            try:
+                journals[share.robot.name] = _robot_journal(folder, share.robot)
+            except NavseqError as error:
+                problems.append(
+                    NavseqError(error_text(error), source=f"robot '{share.robot.name}'")
+                )
+    raise_all(problems)
+    poses = {name: found.pose for name, found in journals.items()}
+    world = FleetWorld(
+        grid,
+        [SimRobot(r.name, poses.get(r.name, r.start), r.profile) for r in fleet.robots],
+    )
+    going_on = [name for name, found in journals.items() if not found.done]
+    clock = FleetClock(world, going_on, realtime=request.realtime)
+    members = _members(plan, world, clock, folder, journals)
+    return FleetRun(plan, world, clock, folder, members, picture=request.picture)
+
+
+def _same_fleet(request: FleetRunRequest, manifest: FleetManifest) -> Fleet:
+    """The fleet file the run started with (its digest), read with the run's mission and map."""
+    import dataclasses
+
+    from navseq.files import require_file
+    from navseq.fleet.fleet_format import inspect_fleet
+    from navseq.fleet.manifest import file_digest
+
+    require_file(request.fleet, "FLEET")
+    if file_digest(request.fleet) != manifest.fleet_sha256:
+        raise NavseqError(
+            f"is not the fleet file the run in {request.resume} started with "
+            f"({manifest.fleet}, unchanged); a resume continues that run's split: give that "
+            "file as it was, or start a new run without --resume",
+            source=str(request.fleet),
+        )
+    mission = request.mission or manifest.mission
+    if mission is not None and manifest.mission is not None and _differ(mission, manifest.mission):
+        raise NavseqError(
+            f"the run started with the mission {manifest.mission}; leave MISSION out with "
+            "--resume, or give that file",
+            source=str(mission),
+        )
+    if mission is not None:
+        require_file(mission, "MISSION")
+    fleet, problems = inspect_fleet(request.fleet, mission)
+    problems.raise_if_any()
+    assert fleet is not None
+    map_path = request.map or manifest.map
+    if map_path is not None:
+        require_file(map_path, "--map")
+        fleet = dataclasses.replace(fleet, map=map_path)
+    missing = sorted(set(manifest.shares) ^ set(fleet.robot_names()))
+    if missing:  # only a hand-edited fleet-run.json gets here: the digest matched
+        raise NavseqError(
+            f"the run's robots and the fleet file's differ ({', '.join(missing)})",
+            source=str(request.fleet),
+        )
+    return fleet
+
+
+def _differ(given: Path, recorded: Path) -> bool:
+    try:
+        return given.resolve() != recorded.resolve()
+    except OSError:
+        return True
+
+
+def _robot_journal(folder: Path, robot: FleetRobot) -> RobotJournal:
+    """A robot's journal by the one-robot rules: read, its mission unchanged, done or not."""
+    from navseq.journal.state import NothingToResume
+    from navseq.run.resume import read_resume
+
+    own = folder / robot.name
+    journal = own / "journal.jsonl"
+    mission = own / "mission.yaml"
+    for path in (journal, mission):
+        if not path.is_file():
+            raise NavseqError(
+                "is missing; the fleet run cannot be resumed without every robot's journal "
+                "and share (mission.yaml) as the run left them",
+                source=str(path),
+            )
+    try:
+        _, _, state = read_resume(journal, mission)
+        done = False
+    except NothingToResume as finished:
+        found = finished.state
+        if found is None:
+            raise
+        state, done = found, True
+    return RobotJournal(robot, journal, mission, state, _last_pose(journal, robot), done)
+
+
+def _last_pose(journal: Path, robot: FleetRobot) -> Pose2D:
+    """Where the journal last saw the robot (it journals the pose at every stop), or its
+    fleet start when it never moved."""
+    from navseq.executor.events import WaypointProgress
+    from navseq.geometry import Pose2D
+    from navseq.journal.reader import journal_events
+
+    last = None
+    for event in journal_events(journal):
+        if isinstance(event, WaypointProgress):
+            last = event
+    return robot.start if last is None else Pose2D(last.x, last.y, last.yaw)
+
+
+def _members(
+    plan: FleetPlan,
+    world: FleetWorld,
+    clock: FleetClock,
+    folder: Path,
+    journals: dict[str, RobotJournal],
+) -> list[Member]:
+    """A resumed session per robot still at work; done and idle robots as they were."""
+    from navseq.errors import MissionErrors
+    from navseq.fleet.checks import raise_all
+    from navseq.fleet.lockstep import MemberNavigator
+    from navseq.fleet.run import Member
+    from navseq.run.request import Outputs, RunRequest, UseNavigator
+    from navseq.run.session import prepare
+
+    members: list[Member] = []
+    problems: list[NavseqError] = []
+    for share in plan.split.shares:
+        robot = share.robot
+        found = journals.get(robot.name)
+        if found is None:
+            members.append(Member(robot, None, None, 0, state="idle"))
+            continue
+        if found.done:
+            members.append(_done_member(found, len(share.order)))
+            continue
+        navigator = MemberNavigator(world, robot.name, clock)
+        try:
+            session = prepare(
+                RunRequest(
+                    mission=found.mission,
+                    navigator=UseNavigator(
+                        navigator,
+                        {"kind": "sim", "robot": robot.profile.name, "fleet_robot": robot.name},
+                        grid=plan.grid,
+                    ),
+                    start=found.pose,
+                    outputs=Outputs(folder=found.journal.parent, picture=False),
+                    resume=found.journal,
+                )
+            )
+        except MissionErrors as errors:  # pre-flight's, each said with the robot's name
+            problems.extend(
+                NavseqError(error_text(error), source=f"robot '{robot.name}'")
+                for error in errors.errors
+            )
+            continue
+        except NavseqError as error:
+            problems.append(NavseqError(error_text(error), source=f"robot '{robot.name}'"))
+            continue
+        member = Member(robot, session, navigator, len(share.order))
+        log = found.state.visits.log  # the visits finished for good; the rest run again
+        member.counts.update(_counts([] if log is None else log.held()))
+        member.earlier_trail = _trail(found.state)
+        members.append(member)
+    raise_all(problems)
+    return members
+
+
+def _done_member(found: RobotJournal, waypoints: int) -> Member:
+    """A robot whose share was complete: its figures from its journal; it stays parked."""
+    from navseq.fleet.run import FinishedShare, Member
+
+    visits = found.state.visits.held()
+    counts = _counts(visits)
+    member = Member(found.robot, None, None, waypoints, state="done")
+    member.counts.update(counts)
+    member.finished = FinishedShare(
+        time_s=found.state.previous_duration,
+        distance_m=sum(visit.distance_driven for visit in visits),
+        all_reached=counts["reached"] == waypoints,
+        folder=found.journal.parent,
+        visits=tuple(visits),
+    )
+    member.earlier_trail = _trail(found.state)
+    return member
+
+
+def _counts(visits: list[WaypointResult]) -> dict[str, int]:
+    """Reached / skipped / failed of these visits."""
+    counts = {"reached": 0, "skipped": 0, "failed": 0}
+    for visit in visits:
+        outcome = visit.outcome.value
+        if outcome in counts:
+            counts[outcome] += 1
+    return counts
+
+
+def _trail(state: JournalState) -> list[tuple[float, float, float]]:
+    """The path the journal recorded (its corners), for the fleet picture."""
+    import math
+
+    return [
+        (row[0], row[1], row[2]) for row in state.recorder.track.rows() if not math.isnan(row[1])
+    ]
+
+
+__all__ = ["prepare_fleet_resume"]
