@@ -53,10 +53,12 @@ waypoints:
 """,
     "header.csv": "x,y,z,qx,qy,qz,qw\n1,2,0,0,0,0,1\n\n3,4,0,0,0,0.7,0.7\n",
 }
+# examples/ also holds files that are not missions: a fleet file and a docks file.
+NOT_MISSIONS = {"fleet.yaml", "turtlebot3_docks.yaml"}
 SAMPLES = {
     path.name: path.read_bytes()
     for path in sorted(EXAMPLES.iterdir())
-    if path.suffix in (".yaml", ".launch", ".csv")
+    if path.suffix in (".yaml", ".launch", ".csv") and path.name not in NOT_MISSIONS
 }
 SAMPLES.update({name: text.encode() for name, text in EXTRA_SAMPLES.items()})
 
