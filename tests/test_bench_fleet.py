@@ -4,6 +4,7 @@ reachable waypoint reached, no collision and no deadlock abort."""
 from __future__ import annotations
 
 import pytest
+
 from bench_support import load_benchmark
 
 
