@@ -11,7 +11,8 @@ and priority inheritance, in the spirit of PIBT (Okumura et al., 2022):
   the rank of the robot it gives way to, just below it, so robots in the way of its
   way aside give way in turn.
 - **Blocked.** A robot that pursues a goal (or its way aside) and has not moved for
-  ``blocked_after`` seconds, or whose server waits for a robot, is blocked. Its *route*
+  ``blocked_after`` seconds (or only turned on the spot for ``turning_patience``), or
+  whose server waits for a robot, is blocked. Its *route*
   is the plan it follows, or, when the robots leave it no plan, the plan on the bare
   map: where it would go were the others not there.
 - **Giving way.** Every lower-ranked robot whose footprint could touch the blocked
@@ -22,7 +23,9 @@ and priority inheritance, in the spirit of PIBT (Okumura et al., 2022):
   it up again once the robot it gave way to has finished or its route has moved away.
   An idle robot gives way the same way, and stays where it went.
 - **Inversion.** When a lower-ranked robot in the way has no refuge (it is in a dead
-  end), the blocked robot gives way to it instead, if that robot has somewhere to go.
+  end), the blocked robot gives way to it instead, if that robot has somewhere to go;
+  and when a robot giving way finds the robot it makes way for in its way aside, that
+  one steps out of it.
 - **Patience.** A blocked robot for which some robot is giving way, or that waits for
   a higher-ranked one, has its server's patience (``blocked_patience``) restarted: the
   fleet is dealing with it. A conflict nobody can resolve still ends ABORTED.
@@ -234,6 +237,7 @@ class _Watch:
 
     anchor: Pose2D
     moved_at: float = 0.0
+    travelled_at: float = 0.0  # when it last moved 2 cm (turning on the spot is no way on)
     map_route: np.ndarray | None = None  # route on the bare map, while it has no plan
     map_route_at: float = -math.inf
 
@@ -243,6 +247,7 @@ class RightOfWay:
 
     period = 0.25  # s of simulated time between two decisions
     blocked_after = 1.0  # s at rest while pursuing a target: blocked
+    turning_patience = 5.0  # s turning on the spot, getting nowhere: blocked too
     # m beyond touching circumscribed circles within which a robot is in a route's way:
     # the planner keeps the robot's own radius from another robot's footprint grown by
     # ``robot_margin``, measured from cell edges, so a robot that near still blocks plans.
@@ -273,11 +278,12 @@ class RightOfWay:
     def _note_motion(self, poses: list[Pose2D], now: float) -> None:
         for watch, pose in zip(self._watch, poses, strict=True):
             anchor = watch.anchor
-            if math.hypot(pose.x - anchor.x, pose.y - anchor.y) > 0.02 or (
-                abs(math.remainder(pose.yaw - anchor.yaw, math.tau)) > 0.05
-            ):
+            travelled = math.hypot(pose.x - anchor.x, pose.y - anchor.y) > 0.02
+            if travelled or abs(math.remainder(pose.yaw - anchor.yaw, math.tau)) > 0.05:
                 watch.anchor = pose
                 watch.moved_at = now
+            if travelled:
+                watch.travelled_at = now
 
     def _pursuing(self, index: int) -> bool:
         server = self.fleet.servers[index]
@@ -308,7 +314,10 @@ class RightOfWay:
         if not self._pursuing(index):
             return False
         server = self.fleet.servers[index]
-        at_rest = now - self._watch[index].moved_at >= self.blocked_after
+        watch = self._watch[index]
+        at_rest = now - watch.moved_at >= self.blocked_after or (
+            now - watch.travelled_at >= self.turning_patience
+        )
         return at_rest or (not server.giving_way and server.waits_for_robot)
 
     def _route(self, index: int, pose: Pose2D, now: float) -> np.ndarray | None:
@@ -362,7 +371,14 @@ class RightOfWay:
                 if other != index and self._in_band(other, index, route, poses)
             ]
             helped = False
+            giving_way_to = self._yields[index].to if index in self._yields else None
             for other in sorted(in_way, key=self._rank):
+                if other == giving_way_to:
+                    # The robot this one makes way for blocks its way aside: it steps
+                    # out of that way instead (a cycle of giving way, which ends as
+                    # soon as either is through).
+                    helped = self._send_aside(other, index, route, poses, now) or helped
+                    continue
                 if self._rank(other) < rank:
                     helped = True  # a higher-ranked robot: wait for it
                     continue
