@@ -328,7 +328,7 @@ def test_nav2_simple_commander_script_runs_unchanged_but_its_poses(
     assert [(goal["action"], goal["status"]) for goal in ended] == [
         (action, status) for action, status, _ in example.goals
     ], witness.ended
-    for goal, (_, _, spot) in zip(ended, example.goals):
+    for goal, (_, _, spot) in zip(ended, example.goals, strict=True):
         pose = goal["pose"]
         assert isinstance(pose, list), goal
         x, y = arena(spot)

@@ -17,6 +17,7 @@ import json
 import math
 import signal
 import sys
+from collections.abc import Callable
 
 import rclpy
 from action_msgs.msg import GoalStatus, GoalStatusArray
@@ -71,7 +72,7 @@ def main() -> int:
             round(math.remainder(oyaw + byaw, math.tau), 3),
         ]
 
-    def on_status(action: str):  # noqa: ANN202 (a callback per action)
+    def on_status(action: str) -> Callable[[GoalStatusArray], None]:
         def callback(message: GoalStatusArray) -> None:
             for status in message.status_list:
                 goal = bytes(status.goal_info.goal_id.uuid)
