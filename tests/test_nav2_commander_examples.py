@@ -263,7 +263,7 @@ class Script:
         return "\n".join(self.lines[-20:] + self._stderr[-30:])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def nav2_env() -> Iterator[Path]:
     reason = nav2_missing_reason()
     if reason is not None:
