@@ -81,3 +81,44 @@ def test_orders_get_the_same_distances_either_way(costmap: Costmap) -> None:
     assert np.allclose(at_once, per_pair, rtol=0.02)
     straight = distances_between(places, StraightLegs())
     assert np.allclose(straight, distances_between(places, straight_line))
+
+
+def test_distances_measured_once_are_reused_by_another_planner_on_the_same_map_and_robot(
+    costmap: Costmap,
+) -> None:
+    """The studio's second Order… (or a second ``plan --order`` in one process) searches
+    only from places it never measured, and finds the same metres as a fresh search."""
+    from navseq.route.distances import known_distances
+
+    places = free_places(costmap, 12, seed=11)
+    first = LegPlanner(costmap).distances(places)
+    known = known_distances(costmap)
+    searched = known.searched
+    # Another costmap built alike (the same map and robot): the same kept distances.
+    again = Costmap.from_grid(load_map(TURTLEBOT3_MAP), costmap.params)
+    reordered = places[::-1]
+    assert LegPlanner(again).distances(reordered) == pytest.approx(first[::-1, ::-1])
+    assert known.searched == searched  # not one search more
+    # One place moved: one search, from it to the others.
+    moved = [*places[:-1], free_places(costmap, 13, seed=11)[-1]]
+    assert moved[-1] not in places
+    measured = LegPlanner(again).distances(moved)
+    assert known.searched == searched + 1
+    assert measured[:-1, :-1] == pytest.approx(first[:-1, :-1])
+    assert measured[-1, :-1] == pytest.approx(reach_lengths(costmap, moved[-1], moved[:-1]))
+
+
+def test_another_robot_on_the_same_map_measures_anew(costmap: Costmap) -> None:
+    from dataclasses import replace
+
+    from navseq.route.distances import known_distances
+
+    places = free_places(costmap, 6, seed=5)
+    LegPlanner(costmap).distances(places)
+    wider = Costmap.from_grid(
+        costmap.grid,
+        replace(costmap.params, circumscribed_radius=costmap.params.circumscribed_radius + 0.05),
+    )
+    LegPlanner(wider).distances(places)
+    assert known_distances(wider) is not known_distances(costmap)
+    assert known_distances(wider).searched == len(places) - 1

@@ -28,8 +28,10 @@ apply in one click (the studio's "move to the nearest free spot").
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from weakref import WeakKeyDictionary
 
 import numpy as np
 from scipy import ndimage
@@ -90,7 +92,7 @@ def check_mission(
     if numbers is None:  # a part's mission knows its file numbers
         numbers = mission.numbers if mission.numbers is not None else range(len(mission))
     robot = robot or mission.robot or DEFAULT_PROFILE
-    free = _FreeRegions(costmap, robot)
+    free = free_regions(costmap, robot)
     problems: list[NavseqError] = []
 
     start_region: int | None = None
@@ -127,9 +129,7 @@ def check_mission(
         subject = waypoint.label(index)
         position = _format_position(waypoint.x, waypoint.y)
         if region is None:
-            placement = _placement_problem(
-                free, waypoint.x, waypoint.y, "the robot cannot turn there", reference
-            )
+            placement = free.placement(waypoint.x, waypoint.y, reference)
             assert placement is not None  # region None: the robot cannot be there
             problems.append(
                 MisplacedError(
@@ -230,12 +230,66 @@ def _format_position(x: float, y: float) -> str:
     return f"at ({x:.2f}, {y:.2f})"
 
 
+#: The free regions of the costmaps still in use, per robot: labelling a 2000 x 2000 map
+#: takes 40 ms, and the studio checks the same map after every edit. A costmap is never
+#: changed once built (frozen), so what is worked out from it stays true while it lives.
+_KEPT: WeakKeyDictionary[Costmap, dict[RobotProfile, _FreeRegions]] = WeakKeyDictionary()
+_KEPT_LOCK = threading.Lock()
+#: Verdicts kept per costmap and robot (points looked at closely, placements): past
+#: this many, they are forgotten and worked out again.
+_VERDICTS_KEPT = 200_000
+
+
+def free_regions(costmap: Costmap, robot: RobotProfile) -> _FreeRegions:
+    """The free regions of ``costmap`` for ``robot``, made once per costmap and robot."""
+    with _KEPT_LOCK:
+        per_robot = _KEPT.setdefault(costmap, {})
+        regions = per_robot.get(robot)
+    if regions is None:
+        regions = _FreeRegions(costmap, robot)
+        with _KEPT_LOCK:
+            regions = per_robot.setdefault(robot, regions)
+    return regions
+
+
 @dataclass
 class _FreeRegions:
-    """Connected components of the cells the planner may cross, and the robot's room."""
+    """Connected components of the cells the planner may cross, and the robot's room.
+
+    Verdicts about single points (a point near an obstacle looked at closely, the nearest
+    free spot) are kept by their coordinates: after an edit in the studio, a check of
+    5000 waypoints looks again only at the ones that moved.
+    """
 
     costmap: Costmap
     robot: RobotProfile
+    _regions: dict[tuple[float, float], int | None] = field(default_factory=dict, repr=False)
+    _placements: dict[tuple[float, float, int | None], _Placement | None] = field(
+        default_factory=dict, repr=False
+    )
+
+    def placement(self, x: float, y: float, from_region: int | None) -> _Placement | None:
+        """:func:`_placement_problem` of a waypoint (the robot must turn there), kept."""
+        key = (x, y, from_region)
+        if key not in self._placements:
+            if len(self._placements) > _VERDICTS_KEPT:
+                self._placements.clear()
+            self._placements[key] = _placement_problem(
+                self, x, y, "the robot cannot turn there", from_region
+            )
+        return self._placements[key]
+
+    def _region_looked_at(self, x: float, y: float) -> int | None:
+        """The free region of a point near an obstacle, unknown space or the map edge
+        (None: the robot cannot stand and turn there), kept."""
+        key = (x, y)
+        if key not in self._regions:
+            if len(self._regions) > _VERDICTS_KEPT:
+                self._regions.clear()
+            self._regions[key] = (
+                self.region_at(x, y) if _placement_problem(self, x, y, "", None) is None else None
+            )
+        return self._regions[key]
 
     def __post_init__(self) -> None:
         self.free = self.costmap.free_mask()
@@ -272,13 +326,7 @@ class _FreeRegions:
         )
         labels = self.labels[rows, cols]
         return [
-            int(label)
-            if ok
-            else (
-                self.region_at(w.x, w.y)
-                if _placement_problem(self, w.x, w.y, "", None) is None
-                else None
-            )
+            int(label) if ok else self._region_looked_at(w.x, w.y)
             for w, ok, label in zip(waypoints, clear.tolist(), labels.tolist(), strict=True)
         ]
 

@@ -30,7 +30,12 @@ import numpy as np
 
 from navseq.eta.drive import DriveModel, DrivenPath, Point, SpeedCap, drive_path
 
+#: What drives a leg on paper: :func:`drive_path`, or one that recalls legs driven before
+#: (:class:`navseq.eta.memo.RememberedDrives`).
+Drive = Callable[..., DrivenPath]
+
 if TYPE_CHECKING:
+    from navseq.eta.memo import RememberedDrives
     from navseq.geometry import Pose2D
     from navseq.mission.model import Mission, Waypoint
     from navseq.mission.robot import RobotProfile
@@ -158,11 +163,27 @@ class MissionPrediction:
         visits)."""
         key = (first, part)
         if key not in self._rests:
-            visits = self.first_loop if first else self.later_loop
-            each = np.array([_part_of(v, part) for v in visits], dtype=float)
+            each = self._parts(first, part)
             rest = np.cumsum(each[::-1])[::-1]
             self._rests[key] = np.append(rest[1:], 0.0)
         return self._rests[key]
+
+    def _parts(self, first: bool, part: Part) -> np.ndarray:
+        """:func:`_part_of` each visit of a loop, added up as it does (the same floats),
+        from columns read once: a check in the studio asks for all three parts of 5000."""
+        key = (first, "columns")
+        if key not in self._rests:
+            visits = self.first_loop if first else self.later_loop
+            self._rests[key] = np.array(
+                [(v.drive_s, v.dwell_s, v.tasks.expected_s, v.tasks.upper_s) for v in visits],
+                dtype=float,
+            ).reshape(-1, 4)
+        drive, dwell, expected, upper = self._rests[key].T
+        if part == "drive":
+            return drive
+        if part == "upper":
+            return drive + dwell + np.maximum(upper, expected)
+        return drive + dwell + expected
 
 
 #: Which seconds of a visit :meth:`MissionPrediction.after` adds up.
@@ -190,6 +211,7 @@ def predict_mission(
     speed_cap: SpeedCap | None = None,
     task_times: TaskTimes | None = None,
     planned_visits: int = PLANNED_VISITS,
+    drive: Drive = drive_path,
 ) -> MissionPrediction:
     """The mission's visits predicted; ``start`` None: the first leg starts at the first
     waypoint (nothing to drive), as nothing says where the robot is.
@@ -221,7 +243,7 @@ def predict_mission(
         if points is None:
             return None
         path = [where, *points[1:-1], goal] if len(points) > 2 else [where, goal]
-        driven = drive_path(
+        driven = drive(
             path,
             model,
             start_heading=heading,
@@ -332,12 +354,27 @@ def predict_legs(
     start: Pose2D | None,
     *,
     task_times: TaskTimes | None = None,
+    drives: RememberedDrives | None = None,
 ) -> MissionPrediction:
-    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls)."""
-    model = DriveModel.of(robot)
-    costmap = getattr(legs, "costmap", None)
-    cap = costmap_speed_cap(costmap, model) if costmap is not None else None
-    return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    """``mission`` predicted on ``legs`` (a planner's costmap slows the robot near walls).
+
+    ``drives``: legs driven before on these legs for this robot
+    (:meth:`RememberedDrives.on`), recalled instead of driven again.
+    """
+    if drives is None:
+        model = DriveModel.of(robot)
+        costmap = getattr(legs, "costmap", None)
+        cap = costmap_speed_cap(costmap, model) if costmap is not None else None
+        return predict_mission(mission, legs, model, start, speed_cap=cap, task_times=task_times)
+    return predict_mission(
+        mission,
+        legs,
+        drives.model,
+        start,
+        speed_cap=drives.speed_cap,
+        task_times=task_times,
+        drive=drives,
+    )
 
 
 __all__ = [

@@ -73,26 +73,37 @@ class LegPlanner:
                 self._cache.popitem(last=False)
         return leg
 
+    def plan_ahead(self, pairs: Sequence[tuple[tuple[float, float], tuple[float, float]]]) -> None:
+        """Plan the legs of ``pairs`` (start, goal) not in the cache yet, on one thread per
+        core (the compiled search lets go of the GIL): the first check of a mission of
+        5000 waypoints on a 2000 x 2000 map plans 5000 legs."""
+        from concurrent.futures import ThreadPoolExecutor
+
+        with self._lock:
+            missing = list(
+                dict.fromkeys(
+                    (start, goal)
+                    for start, goal in pairs
+                    if (start[0], start[1], goal[0], goal[1]) not in self._cache
+                )
+            )
+        if len(missing) < 2:
+            return
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            for _ in pool.map(lambda pair: self.leg(*pair), missing):
+                pass
+
     def distances(self, places: Sequence[tuple[float, float]]) -> np.ndarray:
         """Metres between every two of ``places`` as :meth:`leg` plans them (``inf``
         where there is no path): one search from each place that stops once it reached
         the places after it, on one thread per core (the compiled search lets go of the
-        GIL). For ordering hundreds of waypoints, where a plan per pair took minutes."""
-        from concurrent.futures import ThreadPoolExecutor
-
+        GIL). For ordering hundreds of waypoints, where a plan per pair took minutes.
+        Pairs measured before on the same map for the same robot, by this planner or
+        another, are not searched again (:mod:`navseq.route.distances`)."""
+        from navseq.route.distances import distance_table
         from navseq.sim.planner import reach_lengths
 
-        count = len(places)
-        matrix = np.zeros((count, count))
-        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-            rows = pool.map(
-                lambda i: reach_lengths(self.costmap, places[i], list(places[i + 1 :])),
-                range(count - 1),
-            )
-            for i, lengths in enumerate(rows):
-                matrix[i, i + 1 :] = lengths
-                matrix[i + 1 :, i] = lengths
-        return matrix
+        return distance_table(self.costmap, places, reach_lengths, workers=os.cpu_count() or 1)
 
 
 class StraightLegs:
@@ -100,6 +111,9 @@ class StraightLegs:
 
     def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg:
         return Leg(start, goal, [start, goal], round(math.dist(start, goal), 3))
+
+    def plan_ahead(self, pairs: Sequence[tuple[tuple[float, float], tuple[float, float]]]) -> None:
+        """Nothing to plan: a straight line is drawn when asked for."""
 
     def distances(self, places: Sequence[tuple[float, float]]) -> np.ndarray:
         """Metres between every two of ``places`` in straight lines."""
@@ -111,6 +125,11 @@ class Legs(Protocol):
     """What plans a leg: a :class:`LegPlanner` on a costmap, or :class:`StraightLegs`."""
 
     def leg(self, start: tuple[float, float], goal: tuple[float, float]) -> Leg: ...
+
+    def plan_ahead(self, pairs: Sequence[tuple[tuple[float, float], tuple[float, float]]]) -> None:
+        """Plan these legs now, side by side where it can (the next :meth:`leg` asks
+        find them made)."""
+        ...
 
     def distances(self, places: Sequence[tuple[float, float]]) -> np.ndarray:
         """Metres between every two of ``places`` (``inf``: no path)."""
@@ -151,19 +170,55 @@ def legs_of(mission: Mission, planner: Legs) -> list[dict[str, Any]]:
     pairs = [(a, b, False) for a, b in itertools.pairwise(places)]
     if mission.loops != 1 and len(mission.waypoints) > 1:
         pairs.append((places[-1], places[-len(mission.waypoints)], True))  # back to the first
-    legs = []
-    for (from_name, start), (to_name, goal), loop in pairs:
-        leg = planner.leg(start, goal)
-        legs.append(
-            {
-                "from": from_name,
-                "to": int(to_name),
-                "points": leg.points,
-                "length_m": leg.length_m,
-                "loop": loop,
-            }
+    planner.plan_ahead([(start, goal) for (_, start), (_, goal), _ in pairs])
+    return [
+        _drawn_leg(planner, from_name, start, int(to_name), goal, loop)
+        for (from_name, start), (to_name, goal), loop in pairs
+    ]
+
+
+def legs_after_edit(
+    before: list[dict[str, Any]], mission: Mission, planner: Legs, moved: set[int]
+) -> list[dict[str, Any]]:
+    """:func:`legs_of` ``mission``, given the legs of the same mission before the
+    waypoints ``moved`` (indices) moved: only the legs that touch them are planned (or
+    taken from the planner's cache) again. The mission must have the same waypoint count,
+    start pose and loops as the one ``before`` was made of."""
+    names = {str(index) for index in moved}
+    legs = list(before)
+    for position, leg in enumerate(before):
+        if leg["to"] not in moved and leg["from"] not in names:
+            continue
+        source = leg["from"]
+        if source == "start":
+            assert mission.start is not None
+            start = (mission.start.x, mission.start.y)
+        else:
+            waypoint = mission.waypoints[int(source)]
+            start = (waypoint.x, waypoint.y)
+        goal = mission.waypoints[leg["to"]]
+        legs[position] = _drawn_leg(
+            planner, source, start, leg["to"], (goal.x, goal.y), leg["loop"]
         )
     return legs
+
+
+def _drawn_leg(
+    planner: Legs,
+    from_name: str,
+    start: tuple[float, float],
+    to: int,
+    goal: tuple[float, float],
+    loop: bool,
+) -> dict[str, Any]:
+    leg = planner.leg(start, goal)
+    return {
+        "from": from_name,
+        "to": to,
+        "points": leg.points,
+        "length_m": leg.length_m,
+        "loop": loop,
+    }
 
 
 def route_summary(legs: list[dict[str, Any]], robot: RobotProfile) -> dict[str, Any]:

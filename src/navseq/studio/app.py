@@ -28,9 +28,10 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.eta.memo import RememberedDrives
 from navseq.executor.control import operator_reason
 from navseq.extras import MissingExtra
-from navseq.route.legs import LegPlanner, Legs, legs_of, route_summary
+from navseq.route.legs import LegPlanner, Legs, legs_after_edit, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     CheckedDraft,
@@ -43,6 +44,7 @@ from navseq.studio.documents import (
     problems_of,
     version_of,
 )
+from navseq.studio.edits import LastCheck, checked_after_edit, edited_mission, moved_waypoints
 from navseq.studio.mapview import MapView
 from navseq.studio.security import (
     COOKIE_NAME,
@@ -114,10 +116,16 @@ class Studio:
         self._save_lock = threading.Lock()
         self._check_lock = threading.Lock()
         self._load_lock = threading.Lock()  # one reading of a map file at a time
+        self._open_lock = threading.Lock()  # one reading of the mission file at a time
+        # The opened file's answer, by (path, SHA-256, --map): not to be changed by callers.
+        self._opened: tuple[tuple[Path, str, str | None], dict[str, Any]] | None = None
         self._answers: OrderedDict[
             tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
         ] = OrderedDict()
         self.robot: RobotProfile | None = None  # the last checked draft's robot
+        self._last_check: LastCheck | None = None  # an edit is checked from it
+        self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
+        self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.run: StudioRun | None = None
 
     # -- where things are --------------------------------------------------------------
@@ -190,25 +198,34 @@ class Studio:
                 "problems": [],
                 "allow_run": self.config.allow_run,
             }
-        document, errors = open_document(path, self.base_dir)
-        if document is None:
-            raise ApiError(
-                422,
-                f"{self.shown_name} cannot be opened",
-                problems=[problem.as_json() for problem in problems_of(errors)],
-            )
-        if map_text is not None:
-            document["map"] = map_text  # --map wins, as for navseq validate --map
-        return {
-            "name": self.shown_name,
-            "path": self.roots.relative(path),
-            "exists": True,
-            "version": version_of(path),
-            "units": UNITS,
-            "mission": document,
-            "problems": [problem.as_json() for problem in problems_of(errors)],
-            "allow_run": self.config.allow_run,
-        }
+        version = version_of(path)
+        # The file read once per content: a page load of a 5000-waypoint mission waited
+        # half a second for the loader (every load, and the warm-up's beside the first).
+        key = (path, version["sha256"], map_text)
+        with self._open_lock:
+            if self._opened is not None and self._opened[0] == key:
+                return {**self._opened[1], "version": version}
+            document, errors = open_document(path, self.base_dir)
+            if document is None:
+                raise ApiError(
+                    422,
+                    f"{self.shown_name} cannot be opened",
+                    problems=[problem.as_json() for problem in problems_of(errors)],
+                )
+            if map_text is not None:
+                document["map"] = map_text  # --map wins, as for navseq validate --map
+            answer = {
+                "name": self.shown_name,
+                "path": self.roots.relative(path),
+                "exists": True,
+                "version": version,
+                "units": UNITS,
+                "mission": document,
+                "problems": [problem.as_json() for problem in problems_of(errors)],
+                "allow_run": self.config.allow_run,
+            }
+            self._opened = (key, answer)
+            return answer
 
     def map_info(self, map_text: str | None) -> dict[str, Any]:
         path = self._map_path(map_text)
@@ -320,7 +337,7 @@ class Studio:
     def _check(self, document: Any) -> dict[str, Any]:
         from navseq.commands.common import choose_robot
 
-        checked = self._checked(document)
+        last, moved, checked = self._checked_edit(document)
         answer: dict[str, Any] = {
             "problems": [problem.as_json() for problem in checked.problems],
             "readable": checked.mission is not None,
@@ -329,6 +346,7 @@ class Studio:
             "estimated_duration": "",
         }
         mission = checked.mission
+        self._last_check = None
         if mission is None:
             return answer
         robot = choose_robot(None, mission)
@@ -339,11 +357,56 @@ class Studio:
                 planner = self.planner(checked.map_path, robot)
             except NavseqError:
                 return answer  # the map's own problem is in the list already
-            legs = legs_of(mission, planner)
+            if moved is not None and last is not None:
+                legs = legs_after_edit(last.legs, mission, planner, moved)
+            else:
+                legs = legs_of(mission, planner)
             answer["legs"] = legs
             answer.update(route_summary(legs, robot))
-            answer.update(_expected_duration(mission, planner, robot))
+            answer.update(_expected_duration(mission, planner, robot, self.drives(planner, robot)))
+            if isinstance(document, dict):
+                context = (map_stamp(checked.map_path), planner)
+                self._last_check = LastCheck(document, checked, context, legs)
         return answer
+
+    def _checked_edit(
+        self, document: Any
+    ) -> tuple[LastCheck | None, set[int] | None, CheckedDraft]:
+        """The last check, and the draft checked from it when it only moved some
+        waypoints (:mod:`navseq.studio.edits`: those waypoints), else checked whole (None
+        for them)."""
+        from navseq.commands.common import choose_robot, preflight_errors
+
+        last = self._last_check
+        if last is None or last.checked.map_path is None:
+            return last, None, self._checked(document)
+        moved = moved_waypoints(last.document, document)
+        if moved is None or not moved:
+            return last, None, self._checked(document)
+        map_path = last.checked.map_path
+        try:
+            stamp = map_stamp(map_path)
+        except OSError:
+            return last, None, self._checked(document)
+        mission = edited_mission(last, document, moved)
+        if mission is None:
+            return last, None, self._checked(document)
+        robot = choose_robot(None, mission)
+        if (stamp, self.planner(map_path, robot)) != last.context:
+            return last, None, self._checked(document)
+        costmap = self.costmap(map_path, robot)
+        errors = preflight_errors(mission, costmap, mission.start, None, robot)
+        self.edits_checked += 1
+        return last, moved, checked_after_edit(last, mission, errors, self.shown_name)
+
+    def drives(self, planner: LegPlanner, robot: RobotProfile) -> RememberedDrives:
+        """The legs driven on paper on ``planner``'s costmap for ``robot``, kept."""
+        with self._lock:
+            kept = self._drives.get(robot)
+            if kept is None or kept[0] is not planner:
+                kept = (planner, RememberedDrives.on(planner, robot))
+                self._drives[robot] = kept
+            return kept[1]
 
     def save(self, body: dict[str, Any]) -> dict[str, Any]:
         from navseq.mission.writer import write_mission
@@ -900,13 +963,16 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     return app
 
 
-def _expected_duration(mission: Mission, planner: Legs, robot: RobotProfile) -> dict[str, Any]:
+def _expected_duration(
+    mission: Mission, planner: Legs, robot: RobotProfile, drives: RememberedDrives | None = None
+) -> dict[str, Any]:
     """The mission's expected duration and upper bound (navseq.eta), as ``navseq plan``
-    says them; the legs come from the planner's cache, so an edit costs the driving."""
+    says them; the legs come from the planner's cache and the legs driven on paper from
+    ``drives``, so an edit costs the visits it changed."""
     from navseq.eta.predict import predict_legs
     from navseq.eta.text import format_duration
 
-    prediction = predict_legs(mission, planner, robot, mission.start)
+    prediction = predict_legs(mission, planner, robot, mission.start, drives=drives)
     expected, upper = prediction.expected_s, prediction.upper_s
     if expected is None:  # a patrol that loops forever
         text = f"~{format_duration(prediction.loop_expected_s)} a loop"

@@ -212,6 +212,10 @@ class CheckedDraft:
     mission: Mission | None  # None when the file's own problems stop it reading
     problems: list[Problem]
     map_path: Path | None
+    # The draft as it was written for the loader, and the (gone) file it was written to:
+    # what problems' lines are mapped back with (navseq.studio.edits checks an edit).
+    drafted: DraftText | None = None
+    draft_path: Path | None = None
 
 
 def check_draft(
@@ -253,7 +257,7 @@ def check_draft(
         path.write_text(drafted.text, encoding="utf-8")
         mission, errors = mission_file_problems(path, costmaps=costmaps, tasks=tasks)
         problems = problems_of(errors, drafted=drafted, draft_path=path, shown_as=shown_as)
-    return CheckedDraft(mission, problems, map_path)
+    return CheckedDraft(mission, problems, map_path, drafted, path)
 
 
 def _masks_resolved(filters: Any, roots: FileRoots, base_dir: Path) -> Any:

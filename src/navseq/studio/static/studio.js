@@ -731,9 +731,17 @@ function rowsInSight() {
 function renderList() {
   const list = $("waypoints"), n = S.doc.waypoints.length;
   const [first, last] = rowsInSight();
+  const kept = S.rows && S.rows[0] === first && S.rows[1] === last && S.rows[2] === n && list.children.length === last - first;
   S.rows = [first, last, n];
   list.style.paddingTop = `${first * ROW_H}px`;
   list.style.paddingBottom = `${(n - last) * ROW_H}px`;
+  if (kept) {
+    // The same rows in sight: each brought up to date in place, touching only what changed,
+    // so that the row with the focus keeps it (moving the focus to a new row made the
+    // browser lay the page out again: 120 ms of a typed change at 5000 waypoints).
+    for (let i = first; i < last; i++) updateRow(list.children[i - first], i, n);
+    return;
+  }
   const made = [];
   for (let i = first; i < last; i++) made.push(waypointRow(i, n));
   list.replaceChildren(...made);
@@ -767,28 +775,17 @@ $("waypoints").addEventListener("focusin", (e) => {
   if (el && el !== document.activeElement) el.focus({ preventScroll: true });
 });
 function waypointRow(i, n) {
-  const w = S.doc.waypoints[i];
   const li = document.createElement("li");
   li.dataset.testid = "waypoint-row";
   li.dataset.index = String(i);
-  li.setAttribute("aria-setsize", String(n));
-  li.setAttribute("aria-posinset", String(i + 1));
   li.draggable = true;
-  if (i === S.selected) li.classList.add("selected");
-  if (problemsOf(i).length) li.classList.add("bad");
-  const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
-  const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
   // The row's waypoint is a button (Tab reaches it, Enter or Space selects it); ▲ ▼ ✕
   // are named for a screen reader by what they do, not by their glyph.
   li.innerHTML = `<button type="button" class="pick"><span class="num"></span><span class="label"></span><span class="state"></span></button>
     <button type="button" class="up">▲</button><button type="button" class="down">▼</button><button type="button" class="del">✕</button>`;
   li.querySelector(".num").textContent = i + 1;
-  li.querySelector(".label").textContent = `${w.name ? w.name + " " : ""}${xy}`;
-  li.querySelector(".state").textContent = state;
-  if (hasTasks(i)) li.querySelector(".state").before(taskFlag(i));
   const [pick, up, down, del] = li.querySelectorAll("button");
   pick.dataset.focus = `row-${i}`;
-  if (i === S.selected) pick.setAttribute("aria-current", "true");
   for (const [button, part, what] of [[up, "up", "move waypoint # up"], [down, "down", "move waypoint # down"], [del, "del", "delete waypoint #"]]) {
     button.dataset.focus = `row-${i}-${part}`;
     button.setAttribute("aria-label", what.replace("#", String(i + 1)));
@@ -797,12 +794,38 @@ function waypointRow(i, n) {
   up.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i - 1); };
   down.onclick = (e) => { e.stopPropagation(); moveWaypoint(i, i + 1); };
   del.onclick = (e) => { e.stopPropagation(); removeWaypoint(i); };
-  li.onclick = () => { S.selected = i; S.listedSelection = i; render(); if (okPoint(w)) map.panTo(ll(w.x, w.y)); };
+  li.onclick = () => {
+    S.selected = i; S.listedSelection = i; render();
+    const w = S.doc.waypoints[i];  // looked up now: undo replaces the document
+    if (okPoint(w)) map.panTo(ll(w.x, w.y));
+  };
   li.ondragstart = (e) => { e.dataTransfer.setData("text/plain", String(i)); };
   li.ondragover = (e) => { e.preventDefault(); li.classList.add("drop-target"); };
   li.ondragleave = () => li.classList.remove("drop-target");
   li.ondrop = (e) => { e.preventDefault(); moveWaypoint(Number(e.dataTransfer.getData("text/plain")), i); };
+  updateRow(li, i, n);
   return li;
+}
+// What a row shows of waypoint i (of n), set only where it differs from what it shows.
+function updateRow(li, i, n) {
+  const w = S.doc.waypoints[i];
+  const attribute = (el, name, value) => {
+    if (value === null) { if (el.hasAttribute(name)) el.removeAttribute(name); } else if (el.getAttribute(name) !== value) el.setAttribute(name, value);
+  };
+  const text = (el, value) => { if (el.textContent !== value) el.textContent = value; };
+  attribute(li, "aria-setsize", String(n));
+  attribute(li, "aria-posinset", String(i + 1));
+  li.classList.toggle("selected", i === S.selected);
+  li.classList.toggle("bad", problemsOf(i).length > 0);
+  const state = S.run && S.run.waypoints[i] ? S.run.waypoints[i] : "";
+  const xy = okPoint(w) ? `(${w.x.toFixed(2)}, ${w.y.toFixed(2)}, ${w.yaw ?? 0}°)` : "(?)";
+  text(li.querySelector(".label"), `${w.name ? w.name + " " : ""}${xy}`);
+  const stateEl = li.querySelector(".state");
+  text(stateEl, state);
+  const flag = li.querySelector(".task-flag"), wanted = hasTasks(i) ? taskFlag(i) : null;
+  if (flag && (!wanted || flag.title !== wanted.title)) flag.remove();
+  if (wanted && (!flag || flag.title !== wanted.title)) stateEl.before(wanted);
+  attribute(li.querySelector(".pick"), "aria-current", i === S.selected ? "true" : null);
 }
 // The forms are built once for their set of fields and then updated in place: rebuilding
 // them at every edit replaced the input being typed in, so Enter or Tab dropped the focus

@@ -1,0 +1,147 @@
+"""The studio's check after an edit (navseq.studio.edits): the same answer as a check of
+the whole draft, for any sequence of edits, while only what moved is worked out again."""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from navseq.studio.app import Studio, StudioConfig
+from navseq.studio.security import FileRoots
+
+REPO = Path(__file__).resolve().parents[1]
+# Free spots of the TurtleBot3 arena around its pillars, in a tour.
+TOUR = [
+    (-2.0, -0.5),
+    (-0.55, -1.75),
+    (1.75, -0.55),
+    (0.55, 0.55),
+    (0.0, 1.75),
+    (-1.75, 0.55),
+    (-0.55, -0.55),
+    (-0.55, 0.55),
+    (0.55, -0.55),
+    (0.78, -1.07),
+]
+# Where an edit may put a waypoint: free, in a pillar, near a wall, outside the map,
+# cut off from the arena (outside its wall).
+SPOTS = [*TOUR, (1.0, 0.0), (-1.1, -1.1), (0.0, 1.0), (9.0, 9.0), (-2.6, 0.0), (2.4, 2.4)]
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("edits")
+    shutil.copytree(REPO / "maps", base / "maps")
+    mission = {
+        "navseq": 1,
+        "map": "maps/turtlebot3_world.yaml",
+        "start": {"x": -2.0, "y": -0.5, "yaw": 0},
+        "waypoints": [{"x": x, "y": y, "yaw": 0} for x, y in TOUR[1:]],
+    }
+    (base / "mission.yaml").write_text(json.dumps(mission), encoding="utf-8")
+    return base
+
+
+def studio(workspace: Path) -> Studio:
+    roots = FileRoots([workspace], workspace)
+    return Studio(StudioConfig("t", roots, mission_path=workspace / "mission.yaml"))
+
+
+def full_check(checker: Studio, document: dict[str, Any]) -> dict[str, Any]:
+    """The draft checked whole: nothing kept from an earlier check of it."""
+    checker._last_check = None
+    checker._answers.clear()
+    return checker.check(document)
+
+
+edit = st.tuples(
+    st.integers(0, len(TOUR) - 2),  # which waypoint
+    st.sampled_from(SPOTS),
+    st.sampled_from([None, 0, 90, -135]),  # a new yaw, or the same
+    st.sampled_from([None, {"dwell": 2}, {"pass_through": 0.3}, {"dwell": -1}]),
+)
+
+
+@settings(
+    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(edits=st.lists(st.lists(edit, min_size=1, max_size=3), min_size=1, max_size=4))
+def test_a_check_after_edits_answers_as_a_check_of_the_whole_draft(
+    workspace: Path, edits: list[list[tuple[int, tuple[float, float], int | None, Any]]]
+) -> None:
+    incremental, whole = studio(workspace), studio(workspace)
+    document = incremental.mission()["mission"]
+    assert incremental.check(document) == full_check(whole, document)
+    for changes in edits:
+        document = copy.deepcopy(document)
+        for index, (x, y), yaw, extra in changes:
+            waypoint = document["waypoints"][index]
+            waypoint.update(x=x, y=y)
+            if yaw is not None:
+                waypoint["yaw"] = yaw
+            if extra is not None:
+                waypoint.update(extra)
+        assert incremental.check(document) == full_check(whole, document)
+
+
+def test_a_moved_waypoint_changes_its_legs_and_drives_again_no_visit_before_it(
+    workspace: Path,
+) -> None:
+    checker = studio(workspace)
+    document = checker.mission()["mission"]
+    first = checker.check(document)
+    drives = next(iter(checker._drives.values()))[1]
+    assert not first["problems"]
+    assert drives.driven == len(TOUR) - 1  # every visit driven on paper once
+    document = copy.deepcopy(document)
+    document["waypoints"][3].update(x=0.6, y=-1.7)
+    answer = checker.check(document)
+    changed = [
+        k for k, (a, b) in enumerate(zip(first["legs"], answer["legs"], strict=True)) if a != b
+    ]
+    assert changed == [3, 4]  # the legs to and from it (leg 0 comes from the start)
+    assert checker.edits_checked == 1
+    # The three visits before it are recalled; from it on, each visit starts where the
+    # robot stopped at the one before, which may move by a hair (it latches onto its goal).
+    assert 2 <= drives.driven - (len(TOUR) - 1) <= len(TOUR) - 1 - 3
+    assert answer == full_check(studio(workspace), document)
+
+
+def test_a_changed_setting_checks_the_whole_draft(workspace: Path) -> None:
+    checker = studio(workspace)
+    document = checker.mission()["mission"]
+    checker.check(document)
+    patrol = {**copy.deepcopy(document), "loops": 2}
+    answer = checker.check(patrol)
+    assert answer["legs"][-1]["loop"] is True  # the way back to the first waypoint
+    assert checker.edits_checked == 0
+    assert answer == full_check(studio(workspace), patrol)
+
+
+def test_a_map_file_changed_on_disk_checks_the_whole_draft(tmp_path: Path) -> None:
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    mission = {
+        "navseq": 1,
+        "map": "maps/turtlebot3_world.yaml",
+        "waypoints": [{"x": x, "y": y, "yaw": 0} for x, y in TOUR],
+    }
+    (tmp_path / "mission.yaml").write_text(json.dumps(mission), encoding="utf-8")
+    checker = studio(tmp_path)
+    document = checker.mission()["mission"]
+    checker.check(document)
+    # The map saved again (map_server's YAML rewritten, say after mapping once more).
+    map_yaml = tmp_path / "maps/turtlebot3_world.yaml"
+    stat = map_yaml.stat()
+    os.utime(map_yaml, ns=(stat.st_atime_ns, stat.st_mtime_ns + 5_000_000_000))
+    document = copy.deepcopy(document)
+    document["waypoints"][3].update(x=0.6, y=-1.7)
+    assert checker.check(document) == full_check(studio(tmp_path), document)
+    assert checker.edits_checked == 0
