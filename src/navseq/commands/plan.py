@@ -67,8 +67,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         choices=ORDERS,
         default="file",
         help="file: the waypoints as the file has them (default); shortest: the order that "
-        "takes the least time, turns counted (waypoint 1, or the start pose, stays first; a patrol stays a "
-        "closed tour)",
+        "takes the least time, turns counted (waypoint 1, or the start pose, stays first; a "
+        "patrol stays a closed tour)",
     )
     parser.add_argument(
         "--keep-last",
