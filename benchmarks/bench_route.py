@@ -52,6 +52,7 @@ from navseq.route.order import NO_PATH_M, distance_matrix, shortest_tour, tour_l
 from navseq.route.travel import travel_seconds
 from navseq.sim.costmap import Costmap
 from navseq.sim.mapgen import warehouse_map
+from navseq.sim.occupancy import OccupancyGrid
 from navseq.sinks.summary import print_table
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -154,7 +155,7 @@ def the_maps(names: list[str]) -> dict[str, Costmap]:
     return maps
 
 
-def _big_map():  # type: ignore[no-untyped-def]
+def _big_map() -> OccupancyGrid:
     from bench_studio import big_map
 
     return big_map()
