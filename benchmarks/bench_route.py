@@ -1,30 +1,34 @@
-"""``navseq plan --order shortest``: how much shorter, and how long it takes to find.
+"""``navseq plan --order shortest``: how much quicker, and how long it takes to find.
 
 Waypoints are put at random free spots of a map (where the robot fits with 0.3 m to
-spare, in the map's largest connected region), in the order they were drawn — as a
-user clicking a map, or a list copied from somewhere, has them. Side by side, over the
-same planned lengths (the planner on the robot's costmap):
+spare, in the map's largest connected region), each with a random yaw, in the order they
+were drawn — as a user clicking a map, or a list copied from somewhere, has them. The
+routes are compared by their travel time (:mod:`navseq.route.travel`: planned length at
+the robot's top speed plus the turns in place at each waypoint), the cost navseq orders
+by, side by side over the same matrix:
 
 - **file order**: the route as drawn;
 - **nearest neighbour**: from waypoint 1 always to the nearest waypoint not yet
   visited — what a hand-written reordering usually does;
 - **navseq**: :func:`navseq.route.order.shortest_tour` (OR-tools: cheapest arc, then
-  guided local search for ``--time-limit`` seconds).
+  guided local search for ``--time-limit`` seconds);
+- **reference**: the same solver given ``--reference`` seconds (0: not run), the
+  long solve navseq's tour is measured against.
 
 Every route starts at waypoint 1 and ends anywhere (an open route, as ``navseq plan
 --order shortest`` finds it for a mission without a start pose). The table gives the
-mean over ``--seeds`` random missions of the route lengths, navseq's length as a
-fraction of the other two, the time to measure every distance and the solver's time.
-The distances are measured two ways, side by side on the same places: one A* plan per
-pair (what navseq did before: n²/2 plans) and one search per waypoint that stops once
-it reached the waypoints after it (what navseq does: ``LegPlanner.distances``), both on
-one thread per core (the compiled search lets go of the GIL); per-pair plans only up to
-``--pairs-up-to`` waypoints, and the two matrices must agree within 2 %. The maps: the
-TurtleBot3 arena, a warehouse (400 x 600 cells) and, with ``--big``, 2000 x 2000 cells
-of warehouses side by side (benchmarks/bench_studio.py's).
+mean over ``--seeds`` random missions. The distances are measured two ways, side by side
+on the same places: one A* plan per pair (what navseq did before: n²/2 plans; only up to
+``--pairs-up-to`` waypoints) and one search per waypoint that stops once it reached the
+waypoints after it, with each route's headings (what navseq does:
+``LegPlanner.routes``), both on one thread per core; the two must agree within 2 %.
+The maps (``--maps``): the TurtleBot3 arena, a generated warehouse (400 x 600 cells),
+Nav2's warehouse map (nav2_bringup's, 1006 x 1674 cells at 3 cm, where
+``scripts/install-nav2.sh`` put it) and 2000 x 2000 cells of generated warehouses side by
+side (benchmarks/bench_studio.py's).
 
-    .venv/bin/python benchmarks/bench_route.py [--sizes 10 30 100 200] [--seeds 3] \\
-        [--time-limit 2] [--big]
+    .venv/bin/python benchmarks/bench_route.py [--sizes 100 200] [--seeds 1] \\
+        [--time-limit 1] [--reference 30] [--maps arena warehouse nav2-warehouse big]
 """
 
 from __future__ import annotations
@@ -41,22 +45,28 @@ from rich.markup import escape
 from rich.table import Table
 
 from navseq.commands.common import costmap_for_map, costmap_for_robot
+from navseq.eta.drive import DriveModel
+from navseq.mission.robot import DEFAULT_PROFILE
 from navseq.route.legs import LegPlanner, lengths
-from navseq.route.order import distance_matrix, distances_between, shortest_tour, tour_length
+from navseq.route.order import NO_PATH_M, distance_matrix, shortest_tour, tour_length
+from navseq.route.travel import travel_seconds
 from navseq.sim.costmap import Costmap
 from navseq.sim.mapgen import warehouse_map
+from navseq.sim.occupancy import OccupancyGrid
 from navseq.sinks.summary import print_table
 
 ROOT = Path(__file__).resolve().parents[1]
+NAV2_WAREHOUSE = Path("/opt/nav2/share/nav2_bringup/maps/warehouse.yaml")
 
 
 @dataclass
 class Row:
     map_name: str
     size: int
-    file_m: list[float]
-    nearest_m: list[float]
-    navseq_m: list[float]
+    file_s: list[float]
+    nearest_s: list[float]
+    navseq_s: list[float]
+    reference_s: list[float]
     pairs_s: list[float]
     searches_s: list[float]
     solver_s: list[float]
@@ -86,28 +96,69 @@ def nearest_neighbour(matrix: np.ndarray) -> list[int]:
 
 
 def measure(
-    name: str, costmap: Costmap, size: int, seeds: int, time_limit_s: float, pairs_up_to: int
+    name: str,
+    costmap: Costmap,
+    size: int,
+    seeds: int,
+    time_limit_s: float,
+    reference_s: float,
+    pairs_up_to: int,
 ) -> Row:
-    row = Row(name, size, [], [], [], [], [], [])
+    row = Row(name, size, [], [], [], [], [], [], [])
+    model = DriveModel.of(DEFAULT_PROFILE)
     for seed in range(seeds):
         places = free_spots(costmap, size, seed)
-        # Each measured on a planner of its own (its cache would answer the second).
+        yaws = np.random.default_rng(seed).uniform(-np.pi, np.pi, size).tolist()
+        # Each measured on a costmap of its own: the distances kept per map and robot
+        # (route/distances.py) would answer the second from the first.
+        fresh = Costmap.from_grid(costmap.grid, costmap.params)
         began = time.perf_counter()
-        matrix = distances_between(places, LegPlanner(costmap, size * size))
+        table = LegPlanner(fresh, size * size).routes(places, model.lookahead)
         row.searches_s.append(time.perf_counter() - began)
         if size <= pairs_up_to:
             began = time.perf_counter()
             pairs = distance_matrix(places, lengths(LegPlanner(costmap, size * size)))
             row.pairs_s.append(time.perf_counter() - began)
             # Equal-cost routes may differ in cells, hardly in length.
-            assert np.allclose(matrix, pairs, rtol=0.02), "the two ways disagree"
+            assert np.allclose(table.metres, pairs, rtol=0.02), "the two ways disagree"
+        seconds = travel_seconds(table, yaws, model)
+        matrix = np.where(np.isfinite(seconds), seconds, NO_PATH_M)
         began = time.perf_counter()
         tour = shortest_tour(matrix, closed=False, time_limit_s=time_limit_s)
         row.solver_s.append(time.perf_counter() - began)
-        row.file_m.append(tour_length(matrix, list(range(size)), closed=False))
-        row.nearest_m.append(tour_length(matrix, nearest_neighbour(matrix), closed=False))
-        row.navseq_m.append(tour_length(matrix, tour, closed=False))
+        row.file_s.append(tour_length(matrix, list(range(size)), closed=False))
+        row.nearest_s.append(tour_length(matrix, nearest_neighbour(matrix), closed=False))
+        row.navseq_s.append(tour_length(matrix, tour, closed=False))
+        if reference_s > 0:
+            reference = shortest_tour(matrix, closed=False, time_limit_s=reference_s)
+            row.reference_s.append(tour_length(matrix, reference, closed=False))
     return row
+
+
+def the_maps(names: list[str]) -> dict[str, Costmap]:
+    makers = {
+        "arena": ("TurtleBot3 arena (384 x 384)", lambda: costmap_for_map(
+            ROOT / "maps" / "turtlebot3_world.yaml")),
+        "warehouse": ("generated warehouse (400 x 600)", lambda: costmap_for_robot(
+            warehouse_map(1))),
+        "nav2-warehouse": ("Nav2 warehouse (1006 x 1674)", lambda: costmap_for_map(
+            NAV2_WAREHOUSE)),
+        "big": ("warehouses (2000 x 2000)", lambda: costmap_for_robot(_big_map())),
+    }  # fmt: skip
+    maps = {}
+    for name in names:
+        if name == "nav2-warehouse" and not NAV2_WAREHOUSE.is_file():
+            print(f"skipped: {NAV2_WAREHOUSE} is not installed (scripts/install-nav2.sh)")
+            continue
+        title, make = makers[name]
+        maps[title] = make()
+    return maps
+
+
+def _big_map() -> OccupancyGrid:
+    from bench_studio import big_map
+
+    return big_map()
 
 
 def main() -> None:
@@ -115,43 +166,49 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[10, 30, 100])
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--time-limit", type=float, default=2.0)
+    parser.add_argument("--reference", type=float, default=0.0, metavar="S")
     parser.add_argument("--pairs-up-to", type=int, default=100)
-    parser.add_argument("--big", action="store_true", help="also the 2000 x 2000 map")
+    parser.add_argument(
+        "--maps",
+        nargs="+",
+        default=["arena", "warehouse"],
+        choices=["arena", "warehouse", "nav2-warehouse", "big"],
+    )
     args = parser.parse_args()
-    maps = {
-        "turtlebot3_world (384 x 384)": costmap_for_map(ROOT / "maps" / "turtlebot3_world.yaml"),
-        "warehouse (400 x 600)": costmap_for_robot(warehouse_map(1)),
-    }
-    if args.big:
-        from bench_studio import big_map
-
-        maps["warehouses (2000 x 2000)"] = costmap_for_robot(big_map())
-    table = Table(title=f"shortest visiting order, mean of {args.seeds} random missions")
+    maps = the_maps(args.maps)
+    table = Table(title=f"quickest visiting order, mean of {args.seeds} random missions")
     for header in (
         "map",
         "waypoints",
-        "file order [m]",
-        "nearest neighbour [m]",
-        "navseq [m]",
-        "navseq / file",
+        "file order [s]",
+        "nearest neighbour [s]",
+        f"navseq ({args.time_limit:g} s) [s]",
         "navseq / nearest",
+        f"navseq / reference ({args.reference:g} s)",
         "plan per pair [s]",
         "search per waypoint [s]",
         "solver [s]",
     ):
         table.add_column(escape(header), justify="left" if header == "map" else "right")
+    mean = statistics.fmean
     for name, costmap in maps.items():
         for size in args.sizes:
-            row = measure(name, costmap, size, args.seeds, args.time_limit, args.pairs_up_to)
-            mean = statistics.fmean
+            row = measure(
+                name, costmap, size, args.seeds, args.time_limit, args.reference, args.pairs_up_to
+            )
+            ratio = (
+                f"{mean(n / r for n, r in zip(row.navseq_s, row.reference_s, strict=True)):.4f}"
+                if row.reference_s
+                else "-"
+            )
             table.add_row(
                 name,
                 str(size),
-                f"{mean(row.file_m):.1f}",
-                f"{mean(row.nearest_m):.1f}",
-                f"{mean(row.navseq_m):.1f}",
-                f"{mean(n / f for n, f in zip(row.navseq_m, row.file_m, strict=True)):.2f}",
-                f"{mean(n / f for n, f in zip(row.navseq_m, row.nearest_m, strict=True)):.2f}",
+                f"{mean(row.file_s):.1f}",
+                f"{mean(row.nearest_s):.1f}",
+                f"{mean(row.navseq_s):.1f}",
+                f"{mean(n / f for n, f in zip(row.navseq_s, row.nearest_s, strict=True)):.2f}",
+                ratio,
                 f"{mean(row.pairs_s):.2f}" if row.pairs_s else "-",
                 f"{mean(row.searches_s):.2f}",
                 f"{mean(row.solver_s):.2f}",

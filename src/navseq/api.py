@@ -153,8 +153,9 @@ def order_waypoints(
     keep_last: bool = False,
     time_limit_s: float = 2.0,
 ) -> Mission:
-    """``mission`` with its waypoints in the order that drives the least, as ``navseq plan
-    --order shortest`` finds it; every other setting as it was.
+    """``mission`` with its waypoints in the order the robot drives in the least time
+    (turns at the waypoints included), as ``navseq plan --order shortest`` finds it;
+    every other setting as it was.
 
     Lengths are the paths planned on ``map`` (default: the mission's ``map:``) for
     ``robot``, or straight lines without a map. The start pose, else waypoint 1, stays
@@ -167,8 +168,9 @@ def order_waypoints(
     from navseq.route.order import shortest_order
 
     map_path = Path(map) if map is not None else mission.map
-    legs = legs_on_map(map_path, choose_robot(robot, mission), filters=mission.filters)
-    ordering = shortest_order(mission, legs, time_limit_s, keep_last=keep_last)
+    profile = choose_robot(robot, mission)
+    legs = legs_on_map(map_path, profile, filters=mission.filters)
+    ordering = shortest_order(mission, legs, time_limit_s, keep_last=keep_last, robot=profile)
     return ordering.apply(mission)
 
 

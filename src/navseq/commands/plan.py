@@ -4,7 +4,9 @@ Every leg planned on the robot's costmap (the planner the simulator drives with;
 studio draws the same legs), with its length beside the straight line and the time the
 robot takes to drive it (:mod:`navseq.eta`: speeds, accelerations, turns, stops); the
 route's total, and the mission's expected duration and upper bound. With ``--order shortest`` the
-waypoints are put in the order that drives the least (:mod:`navseq.route.order`) and
+waypoints are put in the order the robot drives in least time, turns at the waypoints
+included (:mod:`navseq.route.order`, :mod:`navseq.route.travel`; progress on stderr
+when it is a terminal, Ctrl-C ends with exit 130 and nothing written) and
 the route is shown in that order; ``--out FILE`` writes the mission so ordered (navseq
 YAML, never over an existing file unless ``--force``).
 
@@ -65,8 +67,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         choices=ORDERS,
         default="file",
         help="file: the waypoints as the file has them (default); shortest: the order that "
-        "drives the least (waypoint 1, or the start pose, stays first; a patrol stays a "
-        "closed tour)",
+        "takes the least time, turns counted (waypoint 1, or the start pose, stays first; a "
+        "patrol stays a closed tour)",
     )
     parser.add_argument(
         "--keep-last",
@@ -133,9 +135,18 @@ def run(args: argparse.Namespace) -> int:
     order = list(range(len(mission.waypoints)))
     ordered = mission
     if args.order == "shortest":
+        from navseq.commands.order_progress import order_progress
         from navseq.route.order import shortest_order
 
-        ordering = shortest_order(mission, legs, args.time_limit, keep_last=args.keep_last)
+        with order_progress() as progress:  # on stderr, only when it is a terminal
+            ordering = shortest_order(
+                mission,
+                legs,
+                args.time_limit,
+                keep_last=args.keep_last,
+                robot=robot,
+                progress=progress,
+            )
         order, ordered = list(ordering.order), ordering.apply(mission)
     route = legs_of(ordered, legs) if ordered is not mission else in_file_order
     if args.out is not None:

@@ -22,6 +22,7 @@ import numpy as np
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
+    from navseq.route.travel import RouteTable
     from navseq.sim.costmap import Costmap
 
 
@@ -89,9 +90,12 @@ class LegPlanner:
             )
         if len(missing) < 2:
             return
-        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1)
+        try:
             for _ in pool.map(lambda pair: self.leg(*pair), missing):
                 pass
+        finally:  # on Ctrl-C, the plans not started are dropped, not waited for
+            pool.shutdown(wait=True, cancel_futures=True)
 
     def distances(self, places: Sequence[tuple[float, float]]) -> np.ndarray:
         """Metres between every two of ``places`` as :meth:`leg` plans them (``inf``
@@ -104,6 +108,18 @@ class LegPlanner:
         from navseq.sim.planner import reach_lengths
 
         return distance_table(self.costmap, places, reach_lengths, workers=os.cpu_count() or 1)
+
+    def routes(
+        self, places: Sequence[tuple[float, float]], anchor_m: float, *, progress: Any = None
+    ) -> RouteTable:
+        """:meth:`distances` with the headings each route leaves and arrives with, for
+        ordering by time (:mod:`navseq.route.travel`); ``progress(done, total)`` after
+        each search."""
+        from navseq.route.travel import route_table
+
+        return route_table(
+            self.costmap, places, anchor_m, workers=os.cpu_count() or 1, progress=progress
+        )
 
 
 class StraightLegs:
@@ -119,6 +135,14 @@ class StraightLegs:
         """Metres between every two of ``places`` in straight lines."""
         points = np.asarray(places, dtype=float).reshape(-1, 2)
         return np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
+
+    def routes(
+        self, places: Sequence[tuple[float, float]], anchor_m: float, *, progress: Any = None
+    ) -> RouteTable:
+        """Straight lines between every two of ``places``, with their directions."""
+        from navseq.route.travel import straight_routes
+
+        return straight_routes(places)
 
 
 class Legs(Protocol):

@@ -16,13 +16,21 @@ What stays where it is, so that the new order is a mission the user still recogn
 
 Pairs with no path between them cost :data:`NO_PATH_M` each: the solver avoids them
 where it can, and the caller says which legs have no path.
+
+Given the robot, the order is the one that takes the least time: the planned lengths at
+its top speed plus the turns at each waypoint (:mod:`navseq.route.travel` says how a
+turn, which depends on the waypoint before, is put on one leg). Without it, the one
+that drives the fewest metres.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
-from collections.abc import Callable, Sequence
+import signal
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
@@ -33,6 +41,7 @@ from navseq.extras import require_extra
 
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
+    from navseq.mission.robot import RobotProfile
 
 #: Waypoints at most: the distances take one search per waypoint over the map, and the
 #: solver a matrix of n² of them.
@@ -90,6 +99,17 @@ def distance_matrix(
     return matrix
 
 
+class OrderProgress(Protocol):
+    """What shows a long ordering's progress (``navseq plan``'s bar)."""
+
+    def searching(self, done: int, total: int) -> None:
+        """``done`` of ``total`` searches for the distances are over."""
+
+    def solving(self, best: float | None, limit_s: float) -> None:
+        """The solver searches (for ``limit_s`` at most); ``best`` is the cost of the
+        best order so far (None: none yet)."""
+
+
 @runtime_checkable
 class Distances(Protocol):
     """What measures every distance at once (a :class:`~navseq.route.legs.LegPlanner`:
@@ -112,12 +132,16 @@ def shortest_order(
     time_limit_s: float = 2.0,
     *,
     keep_last: bool = False,
+    robot: RobotProfile | None = None,
+    progress: OrderProgress | None = None,
 ) -> Ordering:
     """The order of ``mission``'s waypoints that drives the least (see the module doc).
 
     ``keep_last``: the file's last waypoint stays last (the robot ends at its dock).
     ``length`` measures a leg, or (a :class:`Distances`, such as a leg planner) all of
-    them at once.
+    them at once. ``robot``: order by the time that robot takes, turns included, where
+    ``length`` measures routes with their headings (:class:`navseq.route.travel.Routes`);
+    otherwise by metres. ``progress`` hears of the searches and the solver.
     """
     require_extra("plan", "the shortest order")
     waypoints = [(w.x, w.y) for w in mission.waypoints]
@@ -135,9 +159,14 @@ def shortest_order(
     fixed = (0 if from_start else 1) + (1 if keep_last else 0)
     if len(places) - fixed <= 1:
         return Ordering(tuple(range(len(waypoints))))  # nothing to choose
-    matrix = distances_between(places, length)
+    matrix = _costs(mission, places, length, robot, progress)
     last = len(places) - 1 if keep_last else None
-    tour = shortest_tour(matrix, closed=closed, last=last, time_limit_s=time_limit_s)
+    shown = None if progress is None else (lambda best: progress.solving(best, time_limit_s))
+    if shown is not None:
+        shown(None)
+    tour = shortest_tour(
+        matrix, closed=closed, last=last, time_limit_s=time_limit_s, on_solution=shown
+    )
     as_in_file = list(range(len(places)))
     # An order no shorter than the file's (a patrol run the other way round, a tie) is
     # no reason to change what the user wrote.
@@ -145,6 +174,37 @@ def shortest_order(
         tour = as_in_file
     shift = 1 if from_start else 0
     return Ordering(tuple(node - shift for node in tour if node >= shift))
+
+
+def _costs(
+    mission: Mission,
+    places: Sequence[Place],
+    length: LegLength | Distances,
+    robot: RobotProfile | None,
+    progress: OrderProgress | None,
+) -> np.ndarray:
+    """The solver's arc costs: seconds with turns when the robot is known and ``length``
+    gives headings, metres otherwise."""
+    from navseq.route.travel import Routes, travel_seconds
+
+    searching = None if progress is None else progress.searching
+    if robot is None or not isinstance(length, Routes):
+        if searching is not None:
+            searching(0, 1)
+        matrix = distances_between(places, length)
+        if searching is not None:
+            searching(1, 1)
+        return matrix
+    from navseq.eta.drive import DriveModel
+
+    model = DriveModel.of(robot)
+    table = length.routes(places, model.lookahead, progress=searching)
+    yaws: list[float | None] = [mission.start.yaw] if len(places) > len(mission.waypoints) else []
+    for index, waypoint in enumerate(mission.waypoints):
+        stops = mission.policy_for(index).pass_through_m is None
+        yaws.append(waypoint.yaw_rad if stops or index == len(mission.waypoints) - 1 else None)
+    seconds = travel_seconds(table, yaws, model)
+    return np.where(np.isfinite(seconds), seconds, NO_PATH_M)
 
 
 def _routing_model(costs: np.ndarray, end: int) -> tuple[Any, Any]:
@@ -171,6 +231,38 @@ def _routing_model(costs: np.ndarray, end: int) -> tuple[Any, Any]:
     return manager, routing
 
 
+@contextlib.contextmanager
+def _interruptible(routing: Any, on_solution: Callable[[float], None] | None) -> Iterator[None]:
+    """The solve with each order found reported and Ctrl-C caught: the solver runs in C++,
+    where Python's KeyboardInterrupt cannot reach it, and an exception raised in its
+    callback would not unwind it cleanly. A SIGINT is noted instead, the search finished
+    at the next order found, and KeyboardInterrupt raised once the solver returned."""
+    interrupted = threading.Event()
+    best = [math.inf]
+
+    def found() -> None:
+        if interrupted.is_set():
+            routing.solver().FinishCurrentSearch()
+            return
+        cost = routing.CostVar().Value() / _MM
+        if on_solution is not None and cost < best[0]:  # guided local search wanders
+            best[0] = cost
+            on_solution(cost)
+
+    routing.AddAtSolutionCallback(found)
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main else None
+    if main:
+        signal.signal(signal.SIGINT, lambda *_: interrupted.set())
+    try:
+        yield
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
+    if interrupted.is_set():
+        raise KeyboardInterrupt
+
+
 def tour_length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
     """Metres along ``tour`` (indices into ``matrix``), back to its first when ``closed``."""
     ends = [*tour[1:], tour[0]] if closed else tour[1:]
@@ -178,11 +270,19 @@ def tour_length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
 
 
 def shortest_tour(
-    matrix: np.ndarray, *, closed: bool, last: int | None = None, time_limit_s: float = 2.0
+    matrix: np.ndarray,
+    *,
+    closed: bool,
+    last: int | None = None,
+    time_limit_s: float = 2.0,
+    on_solution: Callable[[float], None] | None = None,
 ) -> list[int]:
     """The order of the places of ``matrix`` (metres from each to each) that drives the
     least: node 0 first, every node once, node ``last`` last if given, and back to node 0
-    when ``closed`` (a fixed last node makes the way back a constant: the route ends there)."""
+    when ``closed`` (a fixed last node makes the way back a constant: the route ends there).
+    ``on_solution`` hears the cost of each better order the solver finds. Ctrl-C in the
+    main thread ends the search at its next order found (or its time limit) and raises
+    KeyboardInterrupt then."""
     from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
     count = len(matrix)
@@ -203,7 +303,8 @@ def shortest_tour(
         routing_enums_pb2.LocalSearchMetaheuristic.GUIDED_LOCAL_SEARCH
     )
     parameters.time_limit.FromMilliseconds(max(1, round(time_limit_s * 1000)))
-    solution = routing.SolveWithParameters(parameters)
+    with _interruptible(routing, on_solution):
+        solution = routing.SolveWithParameters(parameters)
     if solution is None:
         # The first tour alone outlasted the limit (thousands of places, a loaded
         # machine: the studio gives the solver 1 s): it is taken however long it takes,
@@ -228,6 +329,7 @@ __all__ = [
     "MAX_WAYPOINTS",
     "NO_PATH_M",
     "Distances",
+    "OrderProgress",
     "Ordering",
     "distance_matrix",
     "distances_between",

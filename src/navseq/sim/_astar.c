@@ -10,6 +10,7 @@
  *   heuristic_scale : a lower bound on every finite traversal cost
  *
  * distances(cost, width, lut, start, targets) -> bytes (float64 per target)
+ * routes(cost, width, lut, start, targets, anchor_cells) -> bytes (3 float64 per target)
  *
  *   targets : int64 flat cell indices; the result is each one's length in cells along
  *             the cheapest route from start (inf when there is none), from one search
@@ -230,7 +231,8 @@ done:
  * beside its cost as the search goes. */
 static Outcome reach(const uint8_t *cost, int64_t height, int64_t width, const double *lut,
                      int64_t start, uint8_t *wanted, int64_t remaining, double *best,
-                     double *length, uint8_t *closed) {
+                     double *length, uint8_t *closed, int32_t *parent, int32_t *anchor,
+                     double anchor_cells) {
     static const int d_row[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
     static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
     const double diagonal = sqrt(2.0);
@@ -238,6 +240,7 @@ static Outcome reach(const uint8_t *cost, int64_t height, int64_t width, const d
     for (int64_t i = 0; i < n; i++) best[i] = length[i] = INFINITY;
     Heap heap = {NULL, 0, 0};
     best[start] = length[start] = 0.0;
+    if (parent != NULL) parent[start] = anchor[start] = (int32_t)start;
     if (heap_push(&heap, (Entry){0.0, 0.0, start}) < 0) return OUT_OF_MEMORY;
     while (heap.size > 0 && remaining > 0) {
         Entry entry = heap_pop(&heap);
@@ -262,6 +265,12 @@ static Outcome reach(const uint8_t *cost, int64_t height, int64_t width, const d
             if (g < best[next]) {
                 best[next] = g;
                 length[next] = length[cell] + step;
+                if (parent != NULL) {
+                    /* The departure anchor: the last cell of the route within
+                     * anchor_cells of the start (the cell itself while it is that near). */
+                    parent[next] = (int32_t)cell;
+                    anchor[next] = length[next] <= anchor_cells ? (int32_t)next : anchor[cell];
+                }
                 if (heap_push(&heap, (Entry){g, g, next}) < 0) {
                     free(heap.items);
                     return OUT_OF_MEMORY;
@@ -329,7 +338,7 @@ static PyObject *distances(PyObject *self, PyObject *args) {
     }
     if (!isinf(lut[cost[start]])) {
         outcome = reach(cost, n / width, width, lut, start, wanted, remaining, best, length,
-                        closed);
+                        closed, NULL, NULL, 0.0);
     } else {
         for (int64_t i = 0; i < n; i++) length[i] = INFINITY;
     }
@@ -351,6 +360,114 @@ finish:
     return result;
 }
 
+/* routes(): as distances(), plus where each route leaves and arrives: per target three
+ * float64 — the length in cells, the departure anchor (the route's last cell within
+ * anchor_cells of the start) and the arrival anchor (the route's first cell within
+ * anchor_cells of the target), as flat cell indices; -1 for both anchors when there is
+ * no route. The headings a robot leaves and arrives with are the directions start ->
+ * departure anchor and arrival anchor -> target. */
+static PyObject *routes(PyObject *self, PyObject *args) {
+    Py_buffer cost_buffer, lut_buffer, target_buffer;
+    Py_ssize_t width, start;
+    double anchor_cells;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*ny*ny*d", &cost_buffer, &width, &lut_buffer, &start,
+                          &target_buffer, &anchor_cells))
+        return NULL;
+    PyObject *result = NULL;
+    double *best = NULL, *length = NULL;
+    uint8_t *closed = NULL, *wanted = NULL;
+    int32_t *parent = NULL, *anchor = NULL;
+    Py_ssize_t n = cost_buffer.len;
+    Py_ssize_t count = target_buffer.len / (Py_ssize_t)sizeof(int64_t);
+    const int64_t *targets = target_buffer.buf;
+    if (width <= 0 || n % width != 0) {
+        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+        goto finish;
+    }
+    if (n > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "grids above 2**31 cells are not supported");
+        goto finish;
+    }
+    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
+        target_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
+        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, targets int64 values");
+        goto finish;
+    }
+    if (start < 0 || start >= n) {
+        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
+        goto finish;
+    }
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (targets[i] < 0 || targets[i] >= n) {
+            PyErr_SetString(PyExc_IndexError, "target cell outside the grid");
+            goto finish;
+        }
+    }
+    best = malloc((size_t)n * sizeof(double));
+    length = malloc((size_t)n * sizeof(double));
+    parent = malloc((size_t)n * sizeof(int32_t));
+    anchor = malloc((size_t)n * sizeof(int32_t));
+    closed = calloc((size_t)n, 1);
+    wanted = calloc((size_t)n, 1);
+    result = PyBytes_FromStringAndSize(NULL, 3 * count * (Py_ssize_t)sizeof(double));
+    if (best == NULL || length == NULL || parent == NULL || anchor == NULL || closed == NULL ||
+        wanted == NULL || result == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto finish;
+    }
+    const uint8_t *cost = cost_buffer.buf;
+    const double *lut = lut_buffer.buf;
+    double *out = (double *)PyBytes_AS_STRING(result);
+    Outcome outcome = FOUND;
+    Py_BEGIN_ALLOW_THREADS
+    int64_t remaining = 0;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (!wanted[targets[i]] && !isinf(lut[cost[targets[i]]])) {
+            wanted[targets[i]] = 1;
+            remaining++;
+        }
+    }
+    if (!isinf(lut[cost[start]])) {
+        outcome = reach(cost, n / width, width, lut, start, wanted, remaining, best, length,
+                        closed, parent, anchor, anchor_cells);
+    } else {
+        for (int64_t i = 0; i < n; i++) length[i] = INFINITY;
+    }
+    for (Py_ssize_t i = 0; i < count; i++) {
+        int64_t target = targets[i];
+        double total = length[target];
+        out[3 * i] = total;
+        if (isinf(total) || !closed[target]) {
+            out[3 * i] = INFINITY;
+            out[3 * i + 1] = out[3 * i + 2] = -1.0;
+            continue;
+        }
+        int64_t back = target;
+        while (back != start && total - length[back] < anchor_cells) back = parent[back];
+        out[3 * i + 1] = (double)anchor[target];
+        out[3 * i + 2] = (double)back;
+    }
+    Py_END_ALLOW_THREADS
+    if (outcome == OUT_OF_MEMORY) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+
+finish:
+    free(best);
+    free(length);
+    free(parent);
+    free(anchor);
+    free(closed);
+    free(wanted);
+    PyBuffer_Release(&cost_buffer);
+    PyBuffer_Release(&lut_buffer);
+    PyBuffer_Release(&target_buffer);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"search", search, METH_VARARGS,
      "search(cost, width, lut, start, goal, heuristic_scale) -> (total, cells) or None\n\n"
@@ -358,6 +475,9 @@ static PyMethodDef methods[] = {
     {"distances", distances, METH_VARARGS,
      "distances(cost, width, lut, start, targets) -> bytes of float64 lengths in cells\n\n"
      "One Dijkstra search from start until every target is reached (inf: unreachable)."},
+    {"routes", routes, METH_VARARGS,
+     "routes(cost, width, lut, start, targets, anchor_cells) -> bytes of float64 triples\n\n"
+     "As distances, with each route's departure and arrival anchor cells (-1: no route)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -162,6 +162,119 @@ def reach_lengths(
     return lengths
 
 
+def reach_routes(
+    costmap: Costmap,
+    start: tuple[float, float],
+    goals: list[tuple[float, float]],
+    anchor_m: float,
+    *,
+    use_compiled: bool | None = None,
+) -> np.ndarray:
+    """:func:`reach_lengths` with the headings: per goal a row of metres, the heading
+    (rad) the route leaves ``start`` with and the heading it arrives with (``inf`` and
+    NaN, NaN where there is no route). Each heading is the direction from one end to the
+    route's cell ``anchor_m`` along it (about the controller's lookahead: what a robot
+    turns to before it drives off, and drives in as it arrives); NaN for a goal in
+    ``start``'s own cell."""
+    grid = costmap.grid
+    cost = np.ascontiguousarray(costmap.planning_cost, dtype=np.uint8)
+    lut = np.ascontiguousarray(_TRAVERSAL_LUT, dtype=np.float64)
+    width = cost.shape[1]
+    rows = np.full((len(goals), 3), np.nan)
+    rows[:, 0] = np.inf
+    row, col = grid.world_to_cell(*start)
+    if not grid.in_bounds(row, col) or cost[row, col] >= INSCRIBED:
+        return rows
+    targets = np.full(len(goals), -1, dtype=np.int64)
+    for index, goal in enumerate(goals):
+        goal_row, goal_col = grid.world_to_cell(*goal)
+        if grid.in_bounds(goal_row, goal_col) and cost[goal_row, goal_col] < INSCRIBED:
+            targets[index] = goal_row * width + goal_col
+    known = np.flatnonzero(targets >= 0)
+    if use_compiled and _compiled_astar is None:
+        raise RuntimeError("the compiled A* (navseq.sim._astar) is not built")
+    compiled = _compiled_astar is not None if use_compiled is None else use_compiled
+    origin = row * width + col
+    anchor_cells = anchor_m / grid.resolution
+    if compiled:
+        raw = _compiled_astar.routes(
+            cost, width, lut, origin, targets[known].tobytes(), anchor_cells
+        )
+        found = np.frombuffer(raw, dtype=np.float64).reshape(-1, 3)
+    else:
+        found = _routes_python(cost, width, lut, origin, targets[known], anchor_cells)
+    reached = np.isfinite(found[:, 0])
+    rows[known, 0] = found[:, 0] * grid.resolution
+    here = grid.cells_to_world(np.array([row]), np.array([col]))[0]
+    ends = grid.cells_to_world(*np.divmod(targets[known], width))
+    for column, (tails, heads) in enumerate(
+        ((np.broadcast_to(here, ends.shape), found[:, 1]), (found[:, 2], ends)), start=1
+    ):
+        tail_xy = _anchor_xy(grid, tails, width)
+        head_xy = _anchor_xy(grid, heads, width)
+        delta = head_xy - tail_xy
+        moved = reached & (np.hypot(delta[:, 0], delta[:, 1]) > 0)
+        rows[known[moved], column] = np.arctan2(delta[moved, 1], delta[moved, 0])
+    return rows
+
+
+def _anchor_xy(grid: object, cells: np.ndarray, width: int) -> np.ndarray:
+    """World x, y of flat cell indices given as floats (or points already, shape (N, 2))."""
+    array = np.asarray(cells)
+    if array.ndim == 2:
+        return array
+    flat = np.where(array >= 0, array, 0).astype(np.int64)
+    return grid.cells_to_world(*np.divmod(flat, width))  # type: ignore[attr-defined]
+
+
+def _routes_python(
+    cost: np.ndarray, width: int, lut: np.ndarray, start: int, targets: np.ndarray, anchor: float
+) -> np.ndarray:
+    """The readable twin of ``_astar.c``'s ``routes``: per target its length in cells,
+    departure anchor and arrival anchor cells (-1 when there is no route)."""
+    traversal = lut[cost.ravel()].tolist()
+    height = cost.size // width
+    wanted = {int(target) for target in targets}
+    best, length = {start: 0.0}, {start: 0.0}
+    parent, leaves = {start: start}, {start: start}
+    closed: set[int] = set()
+    queue = [(0.0, start)]
+    inf = math.inf
+    while queue and wanted:
+        g, cell = heapq.heappop(queue)
+        if cell in closed:
+            continue
+        closed.add(cell)
+        wanted.discard(cell)
+        row, col = divmod(cell, width)
+        here = traversal[cell]
+        for dr, dc, step in _STEPS:
+            r, c = row + dr, col + dc
+            if not (0 <= r < height and 0 <= c < width):
+                continue
+            neighbour = r * width + c
+            there = traversal[neighbour]
+            if there == inf or neighbour in closed:
+                continue
+            candidate = g + step * 0.5 * (here + there)
+            if candidate < best.get(neighbour, inf):
+                best[neighbour] = candidate
+                length[neighbour] = length[cell] + step
+                parent[neighbour] = cell
+                leaves[neighbour] = neighbour if length[neighbour] <= anchor else leaves[cell]
+                heapq.heappush(queue, (candidate, neighbour))
+    found = np.full((len(targets), 3), -1.0)
+    found[:, 0] = inf
+    for index, target in enumerate(int(t) for t in targets):
+        if target not in closed:
+            continue
+        back = target
+        while back != start and length[target] - length[back] < anchor:
+            back = parent[back]
+        found[index] = (length[target], leaves[target], back)
+    return found
+
+
 def _compiled_reach(
     cost: np.ndarray, width: int, lut: np.ndarray, start: int, targets: np.ndarray
 ) -> np.ndarray:

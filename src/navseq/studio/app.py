@@ -516,7 +516,9 @@ class Studio:
         legs: Legs = StraightLegs()
         if checked.map_path is not None and checked.map_path.is_file():
             legs = self.planner(checked.map_path, robot)
-        ordering = shortest_order(mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last)
+        ordering = shortest_order(
+            mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last, robot=robot
+        )
         return {
             "order": list(ordering.order),
             "length_m": route_length(legs_of(ordering.apply(mission), legs)),
