@@ -35,7 +35,8 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
 - topics ``odom`` (``nav_msgs/Odometry``, drifting with ``--odom-drift``), ``tf``
   (``map -> odom`` the localisation's estimate, ``odom -> base_footprint``),
   ``tf_static`` (``base_footprint -> base_link -> base_scan``), ``plan``
-  and the controller's copy of it, ``received_global_plan`` (``nav_msgs/Path``), ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
+  and the controller's copy of it, ``received_global_plan`` (``nav_msgs/Path``),
+  ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
   ``/clock`` when ``--speed`` is not 1 (subscribed instead with ``--follow-clock``);
 - Nav2's world around the robot: ``map_server`` (``map``, ``map_server/map``,
   ``map_server/load_map``: :mod:`navseq.ros2.map_server`), ``amcl`` (``initialpose``
