@@ -42,6 +42,13 @@ def test_every_gap_is_an_interface_of_the_bringup_with_a_reason() -> None:
             assert isinstance(reason, str) and len(reason) > 10, name
 
 
+def test_gaps_served_where_a_package_is_installed_are_gaps() -> None:
+    data = _data()
+    for kind, names in data.get("served_where_installed", {}).items():
+        for name in names:
+            assert name in data["gaps"][kind], f"{name!r} is served everywhere: not a gap"
+
+
 def test_docs_print_every_gap_with_its_reason() -> None:
     text = DOCS.read_text()
     for kind in KINDS:
@@ -91,5 +98,16 @@ def test_the_stand_in_serves_a_default_bringups_interfaces_but_the_known_gaps() 
             name: wanted for name, wanted in expected.items() if served[kind].get(name) != wanted
         }
         assert not missing, f"{kind} not served with Nav2's type: {missing}"
-        closed = sorted(name for name in gaps if served[kind].get(name) == data[kind][name])
+        optional = data.get("served_where_installed", {}).get(kind, {})
+        closed = sorted(
+            name
+            for name in gaps
+            if served[kind].get(name) == data[kind][name] and name not in optional
+        )
+        wrong_type = {
+            name: served[kind][name]
+            for name in optional
+            if name in served[kind] and served[kind][name] != data[kind][name]
+        }
+        assert not wrong_type, f"{kind} served without Nav2's type: {wrong_type}"
         assert not closed, f"{kind} served now: remove them from the gaps: {closed}"

@@ -11,6 +11,14 @@ What RViz's costmap displays and ``nav2_simple_commander``'s ``getGlobalCostmap(
 - ``local_costmap/...`` the same for a 3 m × 3 m window about the robot (nav2_bringup's
   rolling window) in the odom frame, twice a second. It is cut from the global costmap:
   the stand-in has no sensors, so both see the map (and the other robots);
+- ``*/costmap_updates`` (``map_msgs/OccupancyGridUpdate``) and ``*/costmap_raw_updates``
+  (``nav2_msgs/CostmapUpdate``), reliable and transient local as Nav2's
+  ``Costmap2DPublisher`` has them: after a costmap's first full message, the cells inside
+  the bounds of what changed, when the costmap changed but kept its size, resolution and
+  origin (a rolling window that moved, or a new map of another size, is sent in full
+  only). ``costmap_updates`` only where map_msgs is installed (the log says when it is
+  not). The full costmap is published as well, so a display that reads only the full
+  topic stays right;
 - ``*/published_footprint`` (``geometry_msgs/PolygonStamped``): the robot's outline
   where it stands, in each costmap's frame;
 - ``*/get_costmap`` (``nav2_msgs/srv/GetCostmap``): the costmap now.
@@ -27,6 +35,7 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import Point32, PolygonStamped
 from nav2_msgs.msg import Costmap as CostmapMsg
+from nav2_msgs.msg import CostmapUpdate
 from nav2_msgs.srv import GetCostmap
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from rclpy.node import Node
@@ -36,6 +45,11 @@ from navseq.geometry import Pose2D, compose, inverse
 from navseq.ros2.messages import pose_msg
 from navseq.ros2.standin import Nav2StandIn
 from navseq.sim.costmap import occupancy_values
+
+try:  # Nav2's build has map_msgs; a minimal ROS 2 (the test machine's) may not
+    from map_msgs.msg import OccupancyGridUpdate
+except ImportError:  # pragma: no cover - depends on the ROS 2 install
+    OccupancyGridUpdate = None
 
 LOCAL_SIZE_M = 3.0  # nav2_bringup's local_costmap width and height
 LOCAL_PERIOD = 0.5  # s: nav2_bringup's local_costmap publish_frequency, 2 Hz
@@ -76,14 +90,27 @@ class CostmapTopics:
         self._odom_frame = odom_frame
         self._global_version: int | None = None
         self._publishers: dict[str, tuple[Any, Any, Any]] = {}
+        self._update_publishers: dict[str, tuple[Any | None, Any]] = {}
+        self._last_sent: dict[str, CostWindow] = {}  # each costmap as last published
         for name in ("global_costmap", "local_costmap"):
             self._publishers[name] = (
                 node.create_publisher(OccupancyGridMsg, f"{name}/costmap", LATCHED),
                 node.create_publisher(CostmapMsg, f"{name}/costmap_raw", LATCHED),
                 node.create_publisher(PolygonStamped, f"{name}/published_footprint", 10),
             )
+            self._update_publishers[name] = (
+                None
+                if OccupancyGridUpdate is None
+                else node.create_publisher(OccupancyGridUpdate, f"{name}/costmap_updates", LATCHED),
+                node.create_publisher(CostmapUpdate, f"{name}/costmap_raw_updates", LATCHED),
+            )
             node.create_service(
                 GetCostmap, f"{name}/get_costmap", self._get_costmap(name), callback_group=group
+            )
+        if OccupancyGridUpdate is None:
+            node.get_logger().info(
+                "*/costmap_updates not served: map_msgs is not installed "
+                "(the changed cells are on */costmap_raw_updates)"
             )
         node.create_timer(LOCAL_PERIOD, self.publish, callback_group=group)
 
@@ -106,11 +133,29 @@ class CostmapTopics:
             grid, raw, _ = self._publishers[name]
             grid.publish(occupancy_msg(window, stamp))
             raw.publish(costmap_msg(window, stamp))
+            self._publish_update(name, window, stamp)
         for name, at, frame in (
             ("global_costmap", pose, self._map_frame),
             ("local_costmap", odom_pose, self._odom_frame),
         ):
             self._publishers[name][2].publish(footprint_msg(footprint, at, frame, stamp))
+
+    def _publish_update(self, name: str, window: CostWindow, stamp: Any) -> None:
+        """The changed part of ``name`` since it was last published, if any."""
+        previous = self._last_sent.get(name)
+        # The global window is the live costmap: keep a copy to compare the next one with.
+        self._last_sent[name] = CostWindow(
+            window.cost.copy(), window.resolution, window.origin, window.frame
+        )
+        if previous is None or not _same_area(previous, window):
+            return
+        bounds = changed_bounds(previous.cost, window.cost)
+        if bounds is None:
+            return
+        grid_update, raw_update = self._update_publishers[name]
+        if grid_update is not None:
+            grid_update.publish(occupancy_update_msg(window, bounds, stamp))
+        raw_update.publish(costmap_update_msg(window, bounds, stamp))
 
     def _get_costmap(self, name: str) -> Callable[[Any, Any], Any]:
         def answer(_request: Any, response: Any) -> Any:
@@ -145,6 +190,53 @@ class CostmapTopics:
         corner = compose(grid.origin, Pose2D(left * grid.resolution, top * grid.resolution, 0.0))
         in_odom = compose(inverse(localization.estimate), corner)
         return CostWindow(window, grid.resolution, in_odom, self._odom_frame)
+
+
+#: Changed cells: column and row of the lower-left one, width and height (in cells).
+Bounds = tuple[int, int, int, int]
+
+
+def _same_area(first: CostWindow, second: CostWindow) -> bool:
+    return (
+        first.cost.shape == second.cost.shape
+        and first.resolution == second.resolution
+        and first.origin == second.origin
+        and first.frame == second.frame
+    )
+
+
+def changed_bounds(before: np.ndarray, after: np.ndarray) -> Bounds | None:
+    """The smallest box of cells holding every cell that differs, or None."""
+    rows, cols = np.nonzero(before != after)
+    if rows.size == 0:
+        return None
+    x, y = int(cols.min()), int(rows.min())
+    return x, y, int(cols.max()) - x + 1, int(rows.max()) - y + 1
+
+
+def _cut(window: CostWindow, bounds: Bounds) -> np.ndarray:
+    x, y, width, height = bounds
+    return np.ascontiguousarray(window.cost[y : y + height, x : x + width], dtype=np.uint8)
+
+
+def occupancy_update_msg(window: CostWindow, bounds: Bounds, stamp: Any) -> Any:
+    assert OccupancyGridUpdate is not None
+    message = OccupancyGridUpdate()
+    message.header.frame_id = window.frame
+    message.header.stamp = stamp
+    message.x, message.y, message.width, message.height = bounds
+    values = np.ascontiguousarray(occupancy_values(_cut(window, bounds)))
+    message.data = array.array("b", values.tobytes())
+    return message
+
+
+def costmap_update_msg(window: CostWindow, bounds: Bounds, stamp: Any) -> CostmapUpdate:
+    message = CostmapUpdate()
+    message.header.frame_id = window.frame
+    message.header.stamp = stamp
+    message.x, message.y, message.size_x, message.size_y = bounds
+    message.data = array.array("B", _cut(window, bounds).tobytes())
+    return message
 
 
 def occupancy_msg(window: CostWindow, stamp: Any) -> OccupancyGridMsg:

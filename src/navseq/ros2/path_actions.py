@@ -9,7 +9,9 @@ What a Nav2 client that plans, smooths and follows paths itself asks (nav2_simpl
   goal in turn; the planner's error codes (2xx, and 3xx through poses, in the same order;
   ``NO_VIAPOINTS_GIVEN`` without goals, ``TF_ERROR`` for a pose in a frame the node
   does not know, ``INVALID_PLANNER`` for another planner id);
-- ``smooth_path`` (smoother ``simple_smoother``): :mod:`navseq.sim.smoother`;
+- ``smooth_path`` (smoother ``simple_smoother``): :mod:`navseq.sim.smoother`; the
+  smoothed path also on ``plan_smoothed`` (``nav_msgs/Path``, depth 1, as Nav2's
+  smoother server publishes it: once smoothed, before the collision check);
   ``was_completed`` false when it did not settle (the path comes back unchanged);
   ``SMOOTHED_PATH_IN_COLLISION`` when ``check_for_collisions`` finds the robot's
   footprint on an obstacle along it; ``INVALID_PATH`` for an empty path;
@@ -31,6 +33,7 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathThroughPoses, ComputePathToPose, FollowPath, SmoothPath
+from nav_msgs.msg import Path
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
@@ -74,6 +77,7 @@ class PathActions:
         self._stamp = stamp
         self._frame = frame
         self._log = node.get_logger()
+        self._smoothed_pub = node.create_publisher(Path, "plan_smoothed", 1)
         handlers: list[tuple[Any, str, Callable[[Any], Any]]] = [
             (ComputePathToPose, "compute_path_to_pose", self._compute_path),
             (ComputePathThroughPoses, "compute_path_through_poses", self._compute_through),
@@ -198,6 +202,10 @@ class PathActions:
             for (x, y), yaw in zip(smoothed.points, yaws, strict=True)
         ]
         result.path.poses = [pose_stamped(pose, self._frame, stamp) for pose in smoothed_poses]
+        allowed = seconds_of(request.max_smoothing_duration)
+        timed_out = allowed > 0 and seconds_of(result.smoothing_duration) > allowed
+        if not timed_out:  # Nav2's smoother throws on a timeout, before publishing
+            self._smoothed_pub.publish(result.path)
         if request.check_for_collisions:
             with self._lock:
                 collides = self._standin.world.body.collides
@@ -207,8 +215,7 @@ class PathActions:
                 result.error_msg = f"the smoothed path collides at ({hit.x:.2f}, {hit.y:.2f})"
                 handle.abort()
                 return result
-        allowed = seconds_of(request.max_smoothing_duration)
-        if allowed > 0 and seconds_of(result.smoothing_duration) > allowed:
+        if timed_out:
             result.error_code = SmoothPath.Result.TIMEOUT
             result.error_msg = "smoothing took longer than max_smoothing_duration"
             handle.abort()

@@ -35,7 +35,8 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
 - topics ``odom`` (``nav_msgs/Odometry``, drifting with ``--odom-drift``), ``tf``
   (``map -> odom`` the localisation's estimate, ``odom -> base_footprint``),
   ``tf_static`` (``base_footprint -> base_link -> base_scan``), ``plan``
-  (``nav_msgs/Path``), ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
+  and the controller's copy of it, ``received_global_plan`` (``nav_msgs/Path``),
+  ``goal_pose`` (RViz's "Goal Pose": a ``navigate_to_pose`` goal),
   ``/clock`` when ``--speed`` is not 1 (subscribed instead with ``--follow-clock``);
 - Nav2's world around the robot: ``map_server`` (``map``, ``map_server/map``,
   ``map_server/load_map``: :mod:`navseq.ros2.map_server`), ``amcl`` (``initialpose``
@@ -240,6 +241,9 @@ class SimNode:
         self._tf_pub = node.create_publisher(TFMessage, tf_topic, 100)
         self._tf_static_pub = node.create_publisher(TFMessage, tf_static_topic, TRANSIENT_LOCAL)
         self._plan_pub = node.create_publisher(Path, "plan", 1)
+        # The controller server's copy of the plan it takes (Nav2's controller plugins
+        # publish it in setPlan, depth 1): here each new plan the controller follows.
+        self._received_plan_pub = node.create_publisher(Path, "received_global_plan", 1)
         self._clock_pub = (
             node.create_publisher(Clock, "/clock", 10) if config.publishes_clock else None
         )
@@ -469,7 +473,9 @@ class SimNode:
         odom.twist.twist.angular.z = float(w)
         self._odom_pub.publish(odom)
         if new_plan and plan is not None:
-            self._plan_pub.publish(path_msg(plan, goal, MAP_FRAME, stamp))
+            plan_message = path_msg(plan, goal, MAP_FRAME, stamp)
+            self._plan_pub.publish(plan_message)
+            self._received_plan_pub.publish(plan_message)
         self._velocities.publish()
         self._localization.publish()
         self._scan.publish_if_due()
