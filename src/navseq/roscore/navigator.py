@@ -38,6 +38,7 @@ from navseq.roscore.server import ServerWatch, server_lost_text
 
 CANCEL_WAIT = 2.0  # s of wall time to wait for the server's answer to a cancel on close
 SERVER_POLL = 0.02  # s of wall time between looks for the server at the start
+CLOCK_TICK_WAIT = 5.0  # s of wall time for a returned server's clock to tick
 REJECTED_STATUS = "REJECTED"
 
 
@@ -149,8 +150,25 @@ class NavigatorCore:
                     self._on_drop()
             return [ServerLost(server_lost_text(self.action, why_lost))]
         if change == "back":
+            self._await_clock_tick()
             return [ServerBack()]
         return []
+
+    def _await_clock_tick(self) -> None:
+        """On ``/clock``, wait (wall time, bounded) for the clock to tick once after the
+        server came back. A restarted simulator serves its action before its new clock
+        runs: a goal resent at once would be stamped on the old clock and failed by the
+        jump back that follows. Seen now, the jump fails nothing (no goal is out)."""
+        if not self.client.clock_wakes():
+            return
+        stale = self.client.now()
+        deadline = time.monotonic() + CLOCK_TICK_WAIT
+        while self.client.now() == stale and time.monotonic() < deadline:
+            self.client.check_running()
+            time.sleep(SERVER_POLL)
+        jump = self._clock_watch.look(self.client.now())
+        if jump is not None:
+            self.client.warn(f"ROS time jumped back {jump.seconds:.1f} s (the server restarted)")
 
     def has_news(self) -> bool:
         """An event is queued, or the server was just lost or is back."""
