@@ -286,36 +286,9 @@ def _reach_python(
     cost: np.ndarray, width: int, lut: np.ndarray, start: int, targets: np.ndarray
 ) -> np.ndarray:
     """Dijkstra until every target is closed; the readable twin of ``_astar.c``'s
-    ``distances``: each target's length in cells along its cheapest route."""
-    traversal = lut[cost.ravel()].tolist()
-    height = cost.size // width
-    wanted = {int(target) for target in targets}
-    best, length = {start: 0.0}, {start: 0.0}
-    closed: set[int] = set()
-    queue = [(0.0, start)]
-    inf = math.inf
-    while queue and wanted:
-        g, cell = heapq.heappop(queue)
-        if cell in closed:
-            continue
-        closed.add(cell)
-        wanted.discard(cell)
-        row, col = divmod(cell, width)
-        here = traversal[cell]
-        for dr, dc, step in _STEPS:
-            r, c = row + dr, col + dc
-            if not (0 <= r < height and 0 <= c < width):
-                continue
-            neighbour = r * width + c
-            there = traversal[neighbour]
-            if there == inf or neighbour in closed:
-                continue
-            candidate = g + step * 0.5 * (here + there)
-            if candidate < best.get(neighbour, inf):
-                best[neighbour] = candidate
-                length[neighbour] = length[cell] + step
-                heapq.heappush(queue, (candidate, neighbour))
-    return np.array([length.get(int(t), inf) if int(t) in closed else inf for t in targets])
+    ``distances``: each target's length in cells along its cheapest route (the lengths
+    of :func:`_routes_python`, without anchors)."""
+    return _routes_python(cost, width, lut, start, targets, anchor=0.0)[:, 0]
 
 
 _STEPS = tuple(
