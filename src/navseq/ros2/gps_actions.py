@@ -25,20 +25,18 @@ from typing import Any
 
 from geographic_msgs.msg import GeoPose
 from nav2_msgs.action import FollowGPSWaypoints
-from nav2_msgs.msg import MissedWaypoint
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 
 from navseq.geometry import Pose2D, quaternion_to_yaw
 from navseq.mission.geodesy import Datum, GeoPoint, check_latitude, check_longitude
 from navseq.ros2.lifecycle import Nav2Lifecycle
-from navseq.ros2.messages import finish_goal, pose_stamped
 from navseq.ros2.standin import Ending, Nav2StandIn, Outcome, WaypointRun
+from navseq.ros2.waypoint_goals import see_waypoints_through
 
 ACTION = "follow_gps_waypoints"
 LIFECYCLE_ACTION = "follow_waypoints"  # the same server node: waypoint_follower
 TASK_EXECUTOR_FAILED = 601
-FEEDBACK_PERIOD = 0.1  # s of wall time between two feedback messages
 
 
 def map_pose_of(datum: Datum, geo_pose: GeoPose) -> Pose2D | str:
@@ -111,8 +109,9 @@ class GpsWaypointActions:
         stop_on_failure = bool(self._node.get_parameter("stop_on_failure").value)
         poses = self._poses(list(request.gps_poses))
         run: WaypointRun | None = None
+        refused: Ending | None = None
         if isinstance(poses, str):
-            ending = Ending(Outcome.ABORTED, TASK_EXECUTOR_FAILED, poses)
+            refused = Ending(Outcome.ABORTED, TASK_EXECUTOR_FAILED, poses)
             self._log.warning(f"{ACTION}: goal ABORTED: {poses}")
         else:
             with self._lock:
@@ -122,30 +121,18 @@ class GpsWaypointActions:
                     start_index=int(request.goal_index),
                     stop_on_failure=stop_on_failure,
                 )
-        result = FollowGPSWaypoints.Result()
         if run is not None:
             self._log.info(f"{ACTION}: {len(run.poses)} GPS waypoints")
-            while not run.done.wait(FEEDBACK_PERIOD):
-                if handle.is_cancel_requested:
-                    with self._lock:
-                        self._standin.cancel_waypoints(run)
-                    break
-                handle.publish_feedback(FollowGPSWaypoints.Feedback(current_waypoint=run.current))
-            assert run.ending is not None
-            ending = run.ending
-            stamp = self._stamp()
-            result.missed_waypoints = [
-                MissedWaypoint(
-                    index=missed.index,
-                    goal=pose_stamped(missed.pose, self._frame, stamp),
-                    error_code=int(missed.error_code),
-                )
-                for missed in run.missed
-            ]
-        result.error_code = int(ending.error_code)
-        result.error_msg = ending.error_msg
-        finish_goal(handle, ending.outcome.value)
-        return result
+        return see_waypoints_through(
+            handle,
+            run,
+            refused,
+            standin=self._standin,
+            lock=self._lock,
+            action=FollowGPSWaypoints,
+            frame=self._frame,
+            stamp=self._stamp,
+        )
 
     def _serve_from_ll(self, group: Any) -> Any:
         """navsat_transform's ``fromLL`` with the datum, if robot_localization is there."""

@@ -110,7 +110,6 @@ from nav2_msgs.action import (
     NavigateThroughPoses,
     NavigateToPose,
 )
-from nav2_msgs.msg import MissedWaypoint
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import Odometry, Path
 from rclpy.action import ActionServer, CancelResponse
@@ -157,6 +156,7 @@ from navseq.ros2.standin import (
     WaypointRun,
 )
 from navseq.ros2.velocity_topics import VelocityTopics
+from navseq.ros2.waypoint_goals import see_waypoints_through
 from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.options import SimConfig
@@ -592,11 +592,12 @@ class SimNode:
     def _execute_waypoints(self, handle: Any) -> Any:
         request = handle.request
         stop_on_failure = bool(self.node.get_parameter("stop_on_failure").value)
+        run: WaypointRun | None = None
+        refused: Ending | None = None
         with self._lock:
             poses = self._poses_in_map(list(request.poses))
             if isinstance(poses, str):
-                run: WaypointRun | None = None
-                ending = Ending(Outcome.ABORTED, 601, poses)  # TASK_EXECUTOR_FAILED
+                refused = Ending(Outcome.ABORTED, 601, poses)  # TASK_EXECUTOR_FAILED
             else:
                 run = self.standin.follow(
                     poses,
@@ -604,30 +605,18 @@ class SimNode:
                     start_index=int(request.goal_index),
                     stop_on_failure=stop_on_failure,
                 )
-        result = FollowWaypoints.Result()
         if run is not None:
             self.log.info(f"follow_waypoints: {len(run.poses)} waypoints")
-            while not run.done.wait(FEEDBACK_PERIOD):
-                if handle.is_cancel_requested:
-                    with self._lock:
-                        self.standin.cancel_waypoints(run)
-                    break
-                handle.publish_feedback(FollowWaypoints.Feedback(current_waypoint=run.current))
-            assert run.ending is not None
-            ending = run.ending
-            stamp = self._stamp()
-            result.missed_waypoints = [
-                MissedWaypoint(
-                    index=missed.index,
-                    goal=pose_stamped(missed.pose, MAP_FRAME, stamp),
-                    error_code=int(missed.error_code),
-                )
-                for missed in run.missed
-            ]
-        result.error_code = int(ending.error_code)
-        result.error_msg = ending.error_msg
-        finish_goal(handle, ending.outcome.value)
-        return result
+        return see_waypoints_through(
+            handle,
+            run,
+            refused,
+            standin=self.standin,
+            lock=self._lock,
+            action=FollowWaypoints,
+            frame=MAP_FRAME,
+            stamp=self._stamp,
+        )
 
     # -- topics and services -------------------------------------------------------------
 
