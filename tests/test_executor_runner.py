@@ -259,3 +259,31 @@ def test_sigint_is_caught_during_the_run_even_when_ignored_before_and_restored_a
     finally:
         signal.signal(signal.SIGINT, previous)
     assert stopped.value.exit_code == 130 and cancels
+
+
+class _SignalledWhileSending(ScriptedNavigator):
+    """A navigator whose second send is hit by ``signum`` halfway: after the goal went
+    out to the server, before the navigator recorded it (the window a real action
+    client has between sending and storing the goal's handle)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__()
+        self.signum = signum
+
+    def send_goal(self, goal):  # type: ignore[no-untyped-def]
+        if len(self.sent_goals) == 1:
+            self.sent_goals.append(goal)  # on its way ...
+            signal.raise_signal(self.signum)
+            self.sent_goals.pop()  # ... and recorded below as any send is
+        super().send_goal(goal)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_in_the_middle_of_a_send_still_cancels_that_goal(signum: int) -> None:
+    nav = _SignalledWhileSending(signum)
+    with pytest.raises(MissionInterrupted) as raised:
+        run_mission(line_mission(3), nav, tick=0.1)
+    assert raised.value.signal_name == signal.Signals(signum).name
+    assert len(nav.sent_goals) == 2
+    assert nav.cancels and nav.cancels[0][1] == nav.sent_goals[-1].goal_id
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handlers put back

@@ -13,6 +13,11 @@ before it raises, so a second signal that follows at once finds no gap. *Deferri
 signals are only counted; an operator who insists (signals twice more) may give up a
 step that may be given up, such as drawing the picture (:meth:`SignalGuard.abortable`),
 never the report. :meth:`SignalGuard.restore` puts the original handlers back.
+
+A signal raised in the middle of a navigator call could leave a goal sent but not yet
+recorded as sent: the cancel that follows would then not know it, and the robot would
+drive on. :meth:`SignalGuard.held` marks such calls: a signal that arrives inside is
+raised as soon as the call is over, with the goal's book in order.
 Handlers can only be set in the main thread; elsewhere the guard does nothing, and a
 guard made with ``install=False`` never sets any (a run hosted by a library, a fleet or
 a worker thread: signals are the host's business there).
@@ -55,10 +60,13 @@ class SignalGuard:
         self.received: list[str] = []
         self._original: dict[int, Any] = {}
         self._abort_at: int | None = None
+        self._armed = False
+        self._held: list[int] = []  # signals that came inside a held() block
 
     def arm(self) -> SignalGuard:
         """From now on a shutdown signal raises (and defers the ones after it)."""
         if self._save_originals():
+            self._armed = True
             for signum in SHUTDOWN_SIGNALS:
                 signal.signal(signum, self._raise)
         return self
@@ -66,9 +74,33 @@ class SignalGuard:
     def defer(self) -> SignalGuard:
         """From now on shutdown signals are only counted."""
         if self._save_originals():
+            self._armed = False
             for signum in SHUTDOWN_SIGNALS:
                 signal.signal(signum, self._count)
         return self
+
+    @contextlib.contextmanager
+    def held(self) -> Iterator[None]:
+        """Inside, a shutdown signal waits: it is raised when the block ends (a block
+        that raised first keeps its own exception, and the guard then defers)."""
+        if not self._armed or not self._save_originals():
+            yield
+            return
+        for signum in SHUTDOWN_SIGNALS:
+            signal.signal(signum, self._hold)
+        try:
+            yield
+        except BaseException:
+            self.defer()
+            raise
+        if not self._held:
+            self.arm()
+            return
+        first, self._held = self._held[0], []
+        self.defer()
+        if first == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Terminated(signal.Signals(first).name)
 
     def restore(self) -> None:
         """Put back the handlers the process had before the guard."""
@@ -100,6 +132,10 @@ class SignalGuard:
         if signum == signal.SIGINT:
             raise KeyboardInterrupt
         raise Terminated(name)
+
+    def _hold(self, signum: int, frame: FrameType | None) -> None:
+        self.received.append(signal.Signals(signum).name)
+        self._held.append(signum)
 
     def _count(self, signum: int, frame: FrameType | None) -> None:
         self.received.append(signal.Signals(signum).name)

@@ -15,6 +15,7 @@ driving.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 from collections import deque
 from collections.abc import Generator, Iterable, Iterator
@@ -127,7 +128,7 @@ def run_mission(
     try:
         server_up = navigator.wait_for_server(server_wait)
         if server_up:
-            _drive(executor, _Outside(navigator, tasks), tick, control)
+            _drive(executor, _Outside(navigator, tasks, guard), tick, control)
     except KeyboardInterrupt:
         guard.defer()  # also for a KeyboardInterrupt not raised by the guard
         result = _abort(executor, navigator, "interrupted: SIGINT", tasks)
@@ -222,20 +223,31 @@ def _default_tasks() -> TaskRunner:
 
 
 class _Outside:
-    """What the executor's commands act on: the navigator and the task runner."""
+    """What the executor's commands act on: the navigator and the task runner.
 
-    def __init__(self, navigator: Navigator, tasks: TaskRunner) -> None:
+    Sending and cancelling a goal run with the run's shutdown signals held (``guard``):
+    a Ctrl-C halfway through a send would leave a goal on its way that the navigator
+    has no handle of yet, which the cancel that follows could not reach.
+    """
+
+    def __init__(
+        self, navigator: Navigator, tasks: TaskRunner, guard: SignalGuard | None = None
+    ) -> None:
         self.navigator = navigator
         self.tasks = tasks
+        self.guard = guard
         self.local_events: list[NavEvent] = []  # events the runner itself reports
 
     def apply(self, commands: list[Command]) -> None:
         navigator = self.navigator
+        held = self.guard.held if self.guard is not None else contextlib.nullcontext
         for command in commands:
             if isinstance(command, SendGoal):
-                navigator.send_goal(command.goal)
+                with held():
+                    navigator.send_goal(command.goal)
             elif isinstance(command, CancelGoal):
-                navigator.cancel_goal()
+                with held():
+                    navigator.cancel_goal()
             elif isinstance(command, ClearCostmaps):
                 navigator.clear_costmaps()
             elif isinstance(command, StartTask):
@@ -243,9 +255,11 @@ class _Outside:
             elif isinstance(command, CancelTask):
                 self.tasks.cancel(command.task_id)
             elif isinstance(command, RunRecovery):
-                self._run_recovery(command)
+                with held():
+                    self._run_recovery(command)
             elif isinstance(command, CancelRecovery):
-                _cancel_recovery(navigator)
+                with held():
+                    _cancel_recovery(navigator)
 
     def _run_recovery(self, command: RunRecovery) -> None:
         """Hand the recovery to the navigator; one that runs none (a navigator of the
