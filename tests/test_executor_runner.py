@@ -287,3 +287,13 @@ def test_a_signal_in_the_middle_of_a_send_still_cancels_that_goal(signum: int) -
     assert len(nav.sent_goals) == 2
     assert nav.cancels and nav.cancels[0][1] == nav.sent_goals[-1].goal_id
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handlers put back
+
+
+def test_a_clock_that_jumped_back_gives_no_negative_waypoint_time() -> None:
+    from navseq.executor.result import WaypointOutcome
+    from navseq.executor.visit import Visit
+
+    visit = Visit.of(line_mission(2), 0, 0)
+    visit.first_sent_at = 120.0  # sent on the old simulator's clock ...
+    result = visit.finish(3.0, WaypointOutcome.SKIPPED, "skipped", passed_through=False)
+    assert result.duration == 0.0  # ... ended on the restarted one's

@@ -104,7 +104,8 @@ class Visit:
         result.outcome = outcome
         result.reason = reason
         result.passed_through = passed_through
-        result.duration = (end - start) if (start is not None and end is not None) else 0.0
+        # max: a clock that jumped back (a restarted simulator) must not give a negative time
+        result.duration = max(0.0, end - start) if (start is not None and end is not None) else 0.0
         return result
 
 
