@@ -93,6 +93,7 @@ class StudioConfig:
     out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
     hosts: frozenset[str] = LOCAL_NAMES  # what a request's Host may say (allowed_hosts)
     allow_run: bool = False  # --allow-run: runs may start the mission's run: programs
+    fleet_path: Path | None = None  # --fleet: the fleet file the page runs (studio/fleet_*.py)
 
 
 class ApiError(Exception):
@@ -127,6 +128,9 @@ class Studio:
         self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
         self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.run: StudioRun | None = None
+        from navseq.studio.fleet_runs import FleetDesk
+
+        self.fleets = FleetDesk(config.fleet_path, config.out_base)  # fleet runs (fleet_api)
 
     # -- where things are --------------------------------------------------------------
 
@@ -565,18 +569,17 @@ class Studio:
         )
 
     def runs(self) -> dict[str, Any]:
+        from navseq.studio.fleet_replay import fleet_runs_listed
         from navseq.studio.replay import run_folders, run_summary
 
         roots = self.run_roots
         searched = [self.config.out_base / "navseq-out"]
         searched += [folder / "navseq-out" for folder in self.roots.folders]
-        return {
-            "runs": [
-                run_summary(folder, roots.relative(folder))
-                for folder in run_folders(searched)
-                if roots.contains(folder)
-            ]
-        }
+        singles = [folder for folder in run_folders(searched) if roots.contains(folder)]
+        # A fleet run is one entry; its robots' folders are not listed as runs of their own.
+        fleets, singles = fleet_runs_listed(searched, singles, roots)
+        runs = fleets + [run_summary(folder, roots.relative(folder)) for folder in singles]
+        return {"runs": sorted(runs, key=lambda run: run["modified_s"], reverse=True)}
 
     def replay(self, folder_text: str | None) -> dict[str, Any]:
         from navseq.studio.replay import replay_of
@@ -613,6 +616,8 @@ class Studio:
         with self._lock:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
+            if self.fleets.busy:
+                raise ApiError(409, "a fleet run is going on; stop it first")
         checked = self._checked(body.get("mission"), tasks=tasks)
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
@@ -659,6 +664,7 @@ class Studio:
         run = self.run
         if run is not None:
             run.stop_and_wait(reason)
+        self.fleets.close()
 
 
 def map_stamp(path: Path) -> tuple[int, ...]:
@@ -937,6 +943,8 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
 
         return StreamingResponse(stream(), media_type="text/event-stream")
 
+    from navseq.studio.fleet_api import fleet_routes
+
     routes = [
         Route("/", index),
         Route("/api/mission", answer(studio.mission)),
@@ -959,6 +967,7 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/run/events", run_events),
         Route("/api/run/confirm", confirm_task, methods=["POST"]),
         Route("/api/run/{action}", run_request, methods=["POST"]),
+        *fleet_routes(studio),
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
     app = Starlette(routes=routes)

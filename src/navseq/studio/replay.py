@@ -158,6 +158,9 @@ def replay_of(
         "mission": document_of(mission, base_dir) if mission is not None else None,
         "report": _latest_report(folder),
         "duration_s": round(last_t - start_t, 3) if start_t is not None else 0.0,
+        # The run's clock at its first event: a fleet's robots share one clock, and their
+        # timelines are laid on it by this (navseq.studio.fleet_replay).
+        "clock_start_s": round(start_t, 3) if start_t is not None else 0.0,
         "finish_reason": state.finish_reason,
         "damaged_lines": state.damaged_lines,
         "footprint_m": [[float(x), float(y)] for x, y in robot.footprint],
