@@ -52,6 +52,7 @@ def fleet_files(studio: Studio) -> dict[str, Any]:
     return {
         "fleets": sorted(roots.relative(path) for path in found),
         "chosen": None if chosen is None else roots.relative(chosen),
+        "running": studio.fleets.busy,  # a page (re)loaded while it runs watches it
     }
 
 
