@@ -14,7 +14,7 @@ import json
 import math
 import threading
 from collections import OrderedDict
-from collections.abc import AsyncIterator, Awaitable, Callable
+from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -30,12 +30,10 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from navseq.errors import NavseqError
 from navseq.eta.memo import RememberedDrives
 from navseq.executor.control import operator_reason
-from navseq.extras import MissingExtra
 from navseq.route.legs import LegPlanner, Legs, legs_after_edit, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     CheckedDraft,
-    DraftRefused,
     check_draft,
     document_of,
     empty_document,
@@ -45,6 +43,8 @@ from navseq.studio.documents import (
     version_of,
 )
 from navseq.studio.edits import LastCheck, checked_after_edit, edited_mission, moved_waypoints
+from navseq.studio.http import LIVE_PERIOD_S, MAX_REALTIME, ApiError, Handler, api, read_json
+from navseq.studio.http import MAX_BODY_BYTES as MAX_BODY_BYTES  # where tests look for it
 from navseq.studio.mapview import MapView
 from navseq.studio.security import (
     COOKIE_NAME,
@@ -66,18 +66,12 @@ if TYPE_CHECKING:
     from navseq.studio.runs import StudioRun
 
 STATIC = Path(__file__).parent / "static"
-#: Largest request body taken (a mission of several thousand waypoints fits).
-MAX_BODY_BYTES = 2_000_000
-#: How often the live view is sent while a run goes on (s): at most 20 updates/s.
-LIVE_PERIOD_S = 0.05
 #: What the page offers to import: every format navseq's loader reads.
 MISSION_SUFFIXES = (".yaml", ".yml", ".launch", ".xml", ".csv")
 #: Files listed at most for the import choice.
 MAX_FILES_LISTED = 500
 #: Check answers kept for drafts seen again (the opened mission on each page load, undo).
 CHECK_ANSWERS_KEPT = 16
-#: Pace choices the page offers: None is as fast as the CPU goes.
-MAX_REALTIME = 1000.0
 #: Seconds the route solver searches for the page's "shortest order" (a click, not a batch).
 ORDER_TIME_LIMIT_S = 1.0
 
@@ -94,15 +88,6 @@ class StudioConfig:
     hosts: frozenset[str] = LOCAL_NAMES  # what a request's Host may say (allowed_hosts)
     allow_run: bool = False  # --allow-run: runs may start the mission's run: programs
     fleet_path: Path | None = None  # --fleet: the fleet file the page runs (studio/fleet_*.py)
-
-
-class ApiError(Exception):
-    """An answer other than 200, with the JSON to send."""
-
-    def __init__(self, status: int, message: str, **extra: Any) -> None:
-        super().__init__(message)
-        self.status = status
-        self.body = {"error": message, **extra}
 
 
 class Studio:
@@ -789,61 +774,6 @@ def _with_security_headers(send: Send) -> Send:
         await send(message)
 
     return sending
-
-
-async def read_json(request: Request, limit: int = MAX_BODY_BYTES) -> dict[str, Any]:
-    """The request's JSON object; 413 past ``limit`` bytes, 415 for a body not declared
-    JSON (a cross-site form may send ``text/plain`` without asking), 400 for anything
-    not JSON."""
-    declared = request.headers.get("content-length")
-    if declared is not None and declared.isdigit() and int(declared) > limit:
-        raise ApiError(413, f"the request body is over the limit of {limit} bytes")
-    declared_type = request.headers.get("content-type", "").split(";", 1)[0].strip().lower()
-    if declared_type != "application/json":
-        raise ApiError(415, "the request body must be JSON (content-type: application/json)")
-    chunks: list[bytes] = []
-    size = 0
-    async for chunk in request.stream():
-        size += len(chunk)
-        if size > limit:
-            raise ApiError(413, f"the request body is over the limit of {limit} bytes")
-        chunks.append(chunk)
-    try:
-        body = json.loads(b"".join(chunks).decode("utf-8"))
-    except UnicodeDecodeError:
-        raise ApiError(400, "the request body is not UTF-8 text") from None
-    except (ValueError, RecursionError) as error:
-        raise ApiError(400, f"the request body is not valid JSON: {error}") from None
-    if not isinstance(body, dict):
-        raise ApiError(400, "the request body must be a JSON object")
-    return body
-
-
-Handler = Callable[[Request], Awaitable[Response]]
-
-
-def api(handler: Handler) -> Handler:
-    """Turn the studio's errors into 4xx JSON answers (never a traceback to the page)."""
-
-    async def wrapped(request: Request) -> Response:
-        try:
-            response = await handler(request)
-        except ApiError as error:
-            response = JSONResponse(error.body, status_code=error.status)
-        except DraftRefused as error:
-            response = JSONResponse({"error": str(error)}, status_code=400)
-        except MissingExtra as error:  # not the draft's fault: the install lacks a part
-            response = JSONResponse({"error": str(error)}, status_code=501)
-        except NavseqError as error:
-            problems = problems_of([error])
-            response = JSONResponse(
-                {"error": str(error), "problems": [problem.as_json() for problem in problems]},
-                status_code=422,
-            )
-        response.headers["cache-control"] = "no-store"
-        return response
-
-    return wrapped
 
 
 def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:

@@ -20,8 +20,8 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response, StreamingResponse
 from starlette.routing import Route
 
-from navseq.studio.app import LIVE_PERIOD_S, MAX_REALTIME, ApiError, api, read_json
 from navseq.studio.fleet_runs import MAX_FLEETS_LISTED, StudioFleetRun, is_fleet_file
+from navseq.studio.http import LIVE_PERIOD_S, MAX_REALTIME, ApiError, api, read_json
 from navseq.text import printable
 
 if TYPE_CHECKING:

@@ -51,6 +51,7 @@ $("fleet-run").onclick = async () => {
     fleetButtons();
     return;
   }
+  fleetSay("");
   say(`fleet running; outputs in ${answer.data.folder}`);
   openFleet("live", null);
   watchFleet();
@@ -77,7 +78,7 @@ function watchFleet() {
 function drawFleetLive(run) {
   const robots = run.robots.map((r) => ({
     name: r.name, colour: r.colour, state: r.state,
-    current: r.current, label: r.current_label, statuses: r.waypoint_states,
+    current: r.current, label: r.current !== null ? r.waypoint_labels[r.current] || "" : "", statuses: r.waypoint_states,
     points: r.waypoint_points, reached: r.reached, skipped: r.skipped, failed: r.failed, of: r.waypoints,
     trail: r.trail, head: null, pose: r.pose ? [r.pose.x_m, r.pose.y_m, r.pose.yaw_deg] : null,
     footprint: r.footprint_m, plan: r.plan,
