@@ -212,3 +212,26 @@ def test_the_replay_api_reads_fleet_run_folders_only(workspace: Path) -> None:
     assert robot.status_code == 404 and "fleet-run.json" in robot.json()["error"]
     assert client.get("/api/fleet/replay", params={"folder": "../../.."}).status_code == 422
     assert client.get("/api/fleet/replay").status_code == 400
+
+
+def test_a_robot_with_no_share_is_replayed_parked_where_the_fleet_put_it(tmp_path: Path) -> None:
+    shutil.copytree(REPO / "maps", tmp_path / "maps")
+    fleet = tmp_path / "pair.yaml"
+    fleet.write_text(
+        "navseq_fleet: 1\nmap: maps/turtlebot3_world.yaml\n"
+        "mission: {waypoints: [{name: p, x: -1.0, y: -0.5, yaw: 0}]}\nrobots:\n"
+        "  - {name: a, start: {x: -2.0, y: -0.5, yaw: 0}}\n"
+        "  - {name: b, start: {x: 0.5, y: 2.0, yaw: -90}}\n"
+        "waypoints:\n  p: {robots: [a]}\n"
+    )
+    out = tmp_path / "navseq-out/pair"
+    done = navseq("run", "--fleet", fleet, "--out", out, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    replay = fleet_replay_of(out, "pair", tmp_path, lambda path: True)
+    a, b = replay["robots"]
+    assert a["replay"] is not None and a["parked"] is None
+    assert b["replay"] is None and b["report"]["waypoints"] == 0
+    assert b["parked"]["pose"] == pytest.approx([0.5, 2.0, -90.0])
+    assert len(b["parked"]["footprint_m"]) >= 3
+    # Not readable (outside the studio's folders): no pose rather than a guess.
+    assert fleet_replay_of(out, "pair", tmp_path, lambda path: False)["robots"][1]["parked"] is None

@@ -13,6 +13,7 @@ the fleet's, and the page plays all of them with one slider. Each robot keeps th
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -148,6 +149,7 @@ def fleet_replay_of(
             except NavseqError as error:
                 raise NavseqError(f"robot '{printable(name)}': {error}") from None
         replays.append(replay)
+    parked = _parked_robots(folder, may_read)
     starts = [r["clock_start_s"] for r in replays if r is not None and r["poses"]]
     origin = min(starts, default=0.0)
     duration = 0.0
@@ -157,6 +159,8 @@ def fleet_replay_of(
             "colour": robot_colour(place),
             "report": rows.get(name),
             "replay": None,
+            # A robot with no share has no journal: it stayed where the fleet file put it.
+            "parked": parked.get(name) if replay is None else None,
         }
         if replay is not None:
             shift = round(replay["clock_start_s"] - origin, 3)
@@ -171,6 +175,34 @@ def fleet_replay_of(
         "report": report,
         "duration_s": round(duration, 3),
         "robots": robots,
+    }
+
+
+def _parked_robots(folder: Path, may_read: Callable[[Path], bool]) -> dict[str, dict[str, Any]]:
+    """Each robot's start pose and footprint from the run's fleet file, when the studio
+    may read it and it is the file that was run (its sha256 in ``fleet-run.json``)."""
+    from navseq.fleet.fleet_format import inspect_fleet
+    from navseq.fleet.manifest import file_digest
+
+    manifest = read_json(folder / FLEET_MANIFEST) or {}
+    text = manifest.get("fleet")
+    if not isinstance(text, str):
+        return {}
+    path = Path(text)
+    try:
+        if not (may_read(path) and file_digest(path) == manifest.get("fleet_sha256")):
+            return {}
+        fleet, _ = inspect_fleet(path)
+    except (NavseqError, OSError):
+        return {}
+    if fleet is None:
+        return {}
+    return {
+        robot.name: {
+            "pose": [robot.start.x, robot.start.y, math.degrees(robot.start.yaw)],
+            "footprint_m": [[float(x), float(y)] for x, y in robot.profile.footprint],
+        }
+        for robot in fleet.robots
     }
 
 

@@ -132,7 +132,11 @@ function replayedRobot(robot, t) {
   const R = robot.replay;
   const row = robot.report || {};
   const base = { name: robot.name, colour: robot.colour, trail: [], head: null, pose: null, plan: [], footprint: [] };
-  if (!R) return { ...base, state: "idle", current: null, label: "", statuses: [], points: [], reached: 0, skipped: 0, failed: 0, of: row.waypoints || 0 };
+  if (!R) {
+    const parked = robot.parked;  // no share: where the fleet file put it, all along
+    return { ...base, state: "idle", current: null, label: "", statuses: [], points: [], reached: 0, skipped: 0, failed: 0, of: row.waypoints || 0,
+      pose: parked ? parked.pose : null, footprint: parked ? parked.footprint_m : [] };
+  }
   const wps = (R.mission || {}).waypoints || [];
   const si = lastAt(R.states, t, "t");
   const state = si === null ? { current: null, status: "waiting" } : R.states[si];
