@@ -235,3 +235,48 @@ def test_a_robot_with_no_share_is_replayed_parked_where_the_fleet_put_it(tmp_pat
     assert len(b["parked"]["footprint_m"]) >= 3
     # Not readable (outside the studio's folders): no pose rather than a guess.
     assert fleet_replay_of(out, "pair", tmp_path, lambda path: False)["robots"][1]["parked"] is None
+
+
+def test_a_resumed_fleet_run_replays_forward_through_the_resume(tmp_path: Path) -> None:
+    """The simulator's clock starts at 0 again in a resumed run: the replay lays the
+    resumed part after the part before, so every robot's timeline goes forward."""
+    import signal
+
+    from cli_support import TURTLEBOT3_MAP, journal_events, journal_records, start_navseq, wait_for
+
+    (tmp_path / "mission.yaml").write_text(
+        "navseq: 1\nwaypoints:\n"
+        "  - {name: east-dock, x: 1.75, y: -0.55, yaw: 90}\n"
+        "  - {name: inner-east, x: 0.55, y: 0.55, yaw: 180}\n"
+        "  - {name: north-dock, x: 0.0, y: 1.75, yaw: 180}\n"
+    )
+    fleet = tmp_path / "fleet.yaml"
+    fleet.write_text(
+        f"navseq_fleet: 1\nmission: mission.yaml\nmap: {TURTLEBOT3_MAP}\nrobots:\n"
+        "  - {name: b, start: {x: 2.0, y: 0.5, yaw: 180}}\n"
+    )
+    run = tmp_path / "run"
+    process = start_navseq("run", "--fleet", fleet, "--out", run, "--realtime", "2", cwd=tmp_path)
+    try:
+        journal = run / "b" / "journal.jsonl"
+        wait_for(
+            lambda: journal.exists() and journal_events(journal, "WaypointFinished"),
+            60,
+            "robot b's first arrival",
+        )
+        process.send_signal(signal.SIGINT)
+        process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert navseq("run", "--fleet", fleet, "--resume", run, cwd=tmp_path).returncode == 0
+    raw = [r["t"] for r in journal_records(run / "b" / "journal.jsonl") if "t" in r]
+    assert any(b < a for a, b in itertools.pairwise(raw))  # the clock went back at the resume
+    replay = fleet_replay_of(run, "run", tmp_path, lambda path: True)["robots"][0]["replay"]
+    times = [pose[0] for pose in replay["poses"]]
+    assert times == sorted(times) and len(times) >= 4
+    changes = [state["t"] for state in replay["states"]]
+    assert changes == sorted(changes)
+    report = json.loads((run / "fleet-report.json").read_text())
+    assert replay["duration_s"] == pytest.approx(report["makespan_s"], abs=0.5)
