@@ -280,3 +280,16 @@ def test_a_resumed_fleet_run_replays_forward_through_the_resume(tmp_path: Path) 
     assert changes == sorted(changes)
     report = json.loads((run / "fleet-report.json").read_text())
     assert replay["duration_s"] == pytest.approx(report["makespan_s"], abs=0.5)
+
+
+def test_navseq_studio_refuses_a_missing_fleet_or_one_outside_root_in_one_line(
+    workspace: Path,
+) -> None:
+    missing = navseq("studio", "--fleet", "nope.yaml", "--no-browser", cwd=workspace)
+    assert missing.returncode == 2 and "Traceback" not in missing.stderr
+    assert missing.stderr.strip() == "navseq studio: --fleet: no such file: nope.yaml"
+    outside = navseq(
+        "studio", "--fleet", "examples/fleet.yaml", "--root", "maps", "--no-browser", cwd=workspace
+    )
+    assert outside.returncode == 2 and "Traceback" not in outside.stderr
+    assert outside.stderr.startswith("navseq studio: --fleet: ") and "--root" in outside.stderr

@@ -79,8 +79,13 @@ def run(args: argparse.Namespace) -> int:
         require_file(fleet, "--fleet")
     mission: Path | None = args.mission
     fleet_mission, fleet_map = _fleet_files(fleet) if fleet is not None else (None, None)
-    if mission is None and fleet_mission is not None:
-        mission = fleet_mission  # the fleet's mission, in the editor
+    # Without MISSION, the fleet's mission is opened in the editor (where --root allows).
+    if (
+        mission is None
+        and fleet_mission is not None
+        and (args.root is None or fleet_mission.is_relative_to(args.root.resolve()))
+    ):
+        mission = fleet_mission
     if mission is not None and mission.exists():
         require_file(mission, "MISSION")
     elif mission is not None and mission.suffix.lower() not in (".yaml", ".yml"):
