@@ -47,6 +47,13 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "(default: the mission's and the map's folders)",
     )
     parser.add_argument(
+        "--fleet",
+        type=Path,
+        metavar="FLEET",
+        help="a fleet file to run from the page (all its robots on the embedded simulator, "
+        "watched live); without MISSION its mission is opened",
+    )
+    parser.add_argument(
         "--allow-run",
         action="store_true",
         help="let the runs started from the page start the mission's run: tasks' programs "
@@ -67,7 +74,18 @@ def run(args: argparse.Namespace) -> int:
     from navseq.studio.security import FileRoots
     from navseq.studio.server import serve
 
+    fleet: Path | None = getattr(args, "fleet", None)
+    if fleet is not None:
+        require_file(fleet, "--fleet")
     mission: Path | None = args.mission
+    fleet_mission, fleet_map = _fleet_files(fleet) if fleet is not None else (None, None)
+    # Without MISSION, the fleet's mission is opened in the editor (where --root allows).
+    if (
+        mission is None
+        and fleet_mission is not None
+        and (args.root is None or fleet_mission.is_relative_to(args.root.resolve()))
+    ):
+        mission = fleet_mission
     if mission is not None and mission.exists():
         require_file(mission, "MISSION")
     elif mission is not None and mission.suffix.lower() not in (".yaml", ".yml"):
@@ -87,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
         folders = [args.root]
     else:
         folders = [base]
+        if fleet is not None:  # the fleet file and its map, for the page to read
+            folders.append(fleet.resolve().parent)
+            if fleet_map is not None:
+                folders.append(fleet_map.parent)
         if args.map is not None:
             folders.append(args.map.resolve().parent)
         elif mission is not None and mission.exists():
@@ -97,8 +119,12 @@ def run(args: argparse.Namespace) -> int:
     map_path = None
     if args.map is not None:
         map_path = roots.resolve(str(args.map.resolve()), "--map")
+    elif mission is None and fleet_map is not None and roots.contains(fleet_map):
+        map_path = fleet_map  # a fleet with its mission inline: the page shows its map
     if mission is not None:
         roots.resolve(str(mission.resolve()), "MISSION")  # refused outside --root
+    if fleet is not None:
+        roots.resolve(str(fleet.resolve()), "--fleet")  # refused outside --root
     from navseq.studio.security import allowed_hosts
 
     config = StudioConfig(
@@ -108,8 +134,28 @@ def run(args: argparse.Namespace) -> int:
         map_path=map_path,
         hosts=allowed_hosts(args.host),
         allow_run=args.allow_run,
+        fleet_path=fleet.resolve() if fleet is not None else None,
     )
     return serve(config, args.host, args.port, open_browser=not args.no_browser)
+
+
+def _fleet_files(fleet: Path) -> tuple[Path | None, Path | None]:
+    """The fleet file's mission file (None: inline or unreadable) and its map, as far as
+    the file reads; its problems are the page's to show when it is run."""
+    from navseq.errors import NavseqError
+    from navseq.fleet.fleet_format import inspect_fleet
+
+    try:
+        loaded, _ = inspect_fleet(fleet)
+    except NavseqError:
+        return None, None
+    if loaded is None:
+        return None, None
+    mission = loaded.mission_path
+    return (
+        mission.resolve() if mission is not None and mission.is_file() else None,
+        None if loaded.map is None else Path(loaded.map).resolve(),
+    )
 
 
 def _mission_map_folder(mission: Path) -> Path | None:

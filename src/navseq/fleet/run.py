@@ -14,6 +14,7 @@ trail in its own colour) into ``RUN/``.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -81,6 +82,9 @@ class Member:
     # A resumed run's: the share an earlier run completed, and the path driven before.
     finished: FinishedShare | None = None
     earlier_trail: list[tuple[float, float, float]] = field(default_factory=list)
+    # More mission listeners for the robot's run (the studio's live view), beside hear;
+    # added before the run starts, called on the robot's own thread.
+    listeners: list[Callable[[MissionEvent], None]] = field(default_factory=list)
 
     def hear(self, event: MissionEvent) -> None:
         """A mission listener: the member's state as a live display shows it."""
@@ -147,7 +151,9 @@ class FleetRun:
     def _run_member(self, member: Member) -> None:
         assert member.session is not None
         try:
-            member.outcome = member.session.run([member.hear], control=member.control)
+            member.outcome = member.session.run(
+                [member.hear, *member.listeners], control=member.control
+            )
         except BaseException as error:  # reported by the face; the others go on
             member.error = error
             member.state = "error"

@@ -14,7 +14,7 @@ import json
 import math
 import threading
 from collections import OrderedDict
-from collections.abc import AsyncIterator, Awaitable, Callable
+from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -30,12 +30,10 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from navseq.errors import NavseqError
 from navseq.eta.memo import RememberedDrives
 from navseq.executor.control import operator_reason
-from navseq.extras import MissingExtra
 from navseq.route.legs import LegPlanner, Legs, legs_after_edit, legs_of, route_summary
 from navseq.studio.documents import (
     UNITS,
     CheckedDraft,
-    DraftRefused,
     check_draft,
     document_of,
     empty_document,
@@ -45,6 +43,8 @@ from navseq.studio.documents import (
     version_of,
 )
 from navseq.studio.edits import LastCheck, checked_after_edit, edited_mission, moved_waypoints
+from navseq.studio.http import LIVE_PERIOD_S, MAX_REALTIME, ApiError, Handler, api, read_json
+from navseq.studio.http import MAX_BODY_BYTES as MAX_BODY_BYTES  # where tests look for it
 from navseq.studio.mapview import MapView
 from navseq.studio.security import (
     COOKIE_NAME,
@@ -66,18 +66,12 @@ if TYPE_CHECKING:
     from navseq.studio.runs import StudioRun
 
 STATIC = Path(__file__).parent / "static"
-#: Largest request body taken (a mission of several thousand waypoints fits).
-MAX_BODY_BYTES = 2_000_000
-#: How often the live view is sent while a run goes on (s): at most 20 updates/s.
-LIVE_PERIOD_S = 0.05
 #: What the page offers to import: every format navseq's loader reads.
 MISSION_SUFFIXES = (".yaml", ".yml", ".launch", ".xml", ".csv")
 #: Files listed at most for the import choice.
 MAX_FILES_LISTED = 500
 #: Check answers kept for drafts seen again (the opened mission on each page load, undo).
 CHECK_ANSWERS_KEPT = 16
-#: Pace choices the page offers: None is as fast as the CPU goes.
-MAX_REALTIME = 1000.0
 #: Seconds the route solver searches for the page's "shortest order" (a click, not a batch).
 ORDER_TIME_LIMIT_S = 1.0
 
@@ -93,15 +87,7 @@ class StudioConfig:
     out_base: Path = field(default_factory=Path.cwd)  # navseq-out/ goes here
     hosts: frozenset[str] = LOCAL_NAMES  # what a request's Host may say (allowed_hosts)
     allow_run: bool = False  # --allow-run: runs may start the mission's run: programs
-
-
-class ApiError(Exception):
-    """An answer other than 200, with the JSON to send."""
-
-    def __init__(self, status: int, message: str, **extra: Any) -> None:
-        super().__init__(message)
-        self.status = status
-        self.body = {"error": message, **extra}
+    fleet_path: Path | None = None  # --fleet: the fleet file the page runs (studio/fleet_*.py)
 
 
 class Studio:
@@ -127,6 +113,9 @@ class Studio:
         self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
         self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.run: StudioRun | None = None
+        from navseq.studio.fleet_runs import FleetDesk
+
+        self.fleets = FleetDesk(config.fleet_path, config.out_base)  # fleet runs (fleet_api)
 
     # -- where things are --------------------------------------------------------------
 
@@ -565,18 +554,17 @@ class Studio:
         )
 
     def runs(self) -> dict[str, Any]:
+        from navseq.studio.fleet_replay import fleet_runs_listed
         from navseq.studio.replay import run_folders, run_summary
 
         roots = self.run_roots
         searched = [self.config.out_base / "navseq-out"]
         searched += [folder / "navseq-out" for folder in self.roots.folders]
-        return {
-            "runs": [
-                run_summary(folder, roots.relative(folder))
-                for folder in run_folders(searched)
-                if roots.contains(folder)
-            ]
-        }
+        singles = [folder for folder in run_folders(searched) if roots.contains(folder)]
+        # A fleet run is one entry; its robots' folders are not listed as runs of their own.
+        fleets, singles = fleet_runs_listed(searched, singles, roots)
+        runs = fleets + [run_summary(folder, roots.relative(folder)) for folder in singles]
+        return {"runs": sorted(runs, key=lambda run: run["modified_s"], reverse=True)}
 
     def replay(self, folder_text: str | None) -> dict[str, Any]:
         from navseq.studio.replay import replay_of
@@ -613,6 +601,8 @@ class Studio:
         with self._lock:
             if self.run is not None and self.run.alive:
                 raise ApiError(409, "a run is going on; stop it first")
+            if self.fleets.busy:
+                raise ApiError(409, "a fleet run is going on; stop it first")
         checked = self._checked(body.get("mission"), tasks=tasks)
         if checked.problems:
             # navseq run refuses them too (pre-flight); said here against the draft.
@@ -659,6 +649,7 @@ class Studio:
         run = self.run
         if run is not None:
             run.stop_and_wait(reason)
+        self.fleets.close()
 
 
 def map_stamp(path: Path) -> tuple[int, ...]:
@@ -785,61 +776,6 @@ def _with_security_headers(send: Send) -> Send:
     return sending
 
 
-async def read_json(request: Request, limit: int = MAX_BODY_BYTES) -> dict[str, Any]:
-    """The request's JSON object; 413 past ``limit`` bytes, 415 for a body not declared
-    JSON (a cross-site form may send ``text/plain`` without asking), 400 for anything
-    not JSON."""
-    declared = request.headers.get("content-length")
-    if declared is not None and declared.isdigit() and int(declared) > limit:
-        raise ApiError(413, f"the request body is over the limit of {limit} bytes")
-    declared_type = request.headers.get("content-type", "").split(";", 1)[0].strip().lower()
-    if declared_type != "application/json":
-        raise ApiError(415, "the request body must be JSON (content-type: application/json)")
-    chunks: list[bytes] = []
-    size = 0
-    async for chunk in request.stream():
-        size += len(chunk)
-        if size > limit:
-            raise ApiError(413, f"the request body is over the limit of {limit} bytes")
-        chunks.append(chunk)
-    try:
-        body = json.loads(b"".join(chunks).decode("utf-8"))
-    except UnicodeDecodeError:
-        raise ApiError(400, "the request body is not UTF-8 text") from None
-    except (ValueError, RecursionError) as error:
-        raise ApiError(400, f"the request body is not valid JSON: {error}") from None
-    if not isinstance(body, dict):
-        raise ApiError(400, "the request body must be a JSON object")
-    return body
-
-
-Handler = Callable[[Request], Awaitable[Response]]
-
-
-def api(handler: Handler) -> Handler:
-    """Turn the studio's errors into 4xx JSON answers (never a traceback to the page)."""
-
-    async def wrapped(request: Request) -> Response:
-        try:
-            response = await handler(request)
-        except ApiError as error:
-            response = JSONResponse(error.body, status_code=error.status)
-        except DraftRefused as error:
-            response = JSONResponse({"error": str(error)}, status_code=400)
-        except MissingExtra as error:  # not the draft's fault: the install lacks a part
-            response = JSONResponse({"error": str(error)}, status_code=501)
-        except NavseqError as error:
-            problems = problems_of([error])
-            response = JSONResponse(
-                {"error": str(error), "problems": [problem.as_json() for problem in problems]},
-                status_code=422,
-            )
-        response.headers["cache-control"] = "no-store"
-        return response
-
-    return wrapped
-
-
 def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     """The studio as an ASGI app (``TestClient(create_app(...))`` in tests)."""
     studio = studio if studio is not None else Studio(config)
@@ -937,6 +873,8 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
 
         return StreamingResponse(stream(), media_type="text/event-stream")
 
+    from navseq.studio.fleet_api import fleet_routes
+
     routes = [
         Route("/", index),
         Route("/api/mission", answer(studio.mission)),
@@ -959,6 +897,7 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/run/events", run_events),
         Route("/api/run/confirm", confirm_task, methods=["POST"]),
         Route("/api/run/{action}", run_request, methods=["POST"]),
+        *fleet_routes(studio),
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
     app = Starlette(routes=routes)

@@ -123,13 +123,19 @@ def replay_of(
     plans: list[dict[str, Any]] = []
     start_t: float | None = None
     last_t = 0.0
+    # A resumed run's clock may start again (the simulator's does, at 0): its part is laid
+    # after the part before, so that the timeline goes forward through every resume.
+    offset = 0.0
     for event in events():
+        if isinstance(event, ev.MissionStarted) and event.resumed_from is not None:
+            offset = max(offset, last_t - event.t)
+        at = event.t + offset
         if start_t is None:
-            start_t = event.t
-        last_t = event.t
+            start_t = at
+        last_t = at
         before = (fold.current, fold.loop, fold.status)
         fold(event)
-        t = round(event.t - start_t, 3)
+        t = round(at - start_t, 3)
         # Only poses the robot reported: a goal (WaypointStarted) is where it was sent,
         # not where it was, and drawn as a pose it cut the trail through walls.
         if isinstance(event, ev.WaypointProgress):
@@ -158,6 +164,9 @@ def replay_of(
         "mission": document_of(mission, base_dir) if mission is not None else None,
         "report": _latest_report(folder),
         "duration_s": round(last_t - start_t, 3) if start_t is not None else 0.0,
+        # The run's clock at its first event: a fleet's robots share one clock, and their
+        # timelines are laid on it by this (navseq.studio.fleet_replay).
+        "clock_start_s": round(start_t, 3) if start_t is not None else 0.0,
         "finish_reason": state.finish_reason,
         "damaged_lines": state.damaged_lines,
         "footprint_m": [[float(x), float(y)] for x, y in robot.footprint],

@@ -1408,14 +1408,17 @@ async function loadRuns() {
     const o = document.createElement("option");
     o.value = run.folder;
     const verdict = run.reached != null ? ` · ${run.reached}/${run.visits} reached` : run.reason ? ` · ${run.reason}` : "";
-    o.textContent = `${run.folder}${verdict}`;
+    o.textContent = `${run.folder}${run.fleet ? ` · fleet of ${run.robots} robots` : ""}${verdict}`;
+    if (run.fleet) o.dataset.fleet = "true";  // replayed by fleet.js
     select.appendChild(o);
   }
   select.value = chosen;
 }
 $("runs-refresh").onclick = loadRuns;
 $("runs").onchange = async (e) => {
-  if (!e.target.value) { closeReplay(); return; }
+  if (!e.target.value) { closeReplay(); if (FLEET.mode === "replay") closeFleet(); return; }
+  if (e.target.selectedOptions[0].dataset.fleet) { closeReplay(); openFleetReplay(e.target.value); return; }
+  if (FLEET.mode === "replay") closeFleet();
   const answer = await api("GET", `/api/replay?folder=${encodeURIComponent(e.target.value)}`);
   if (!answer.ok) { say(answer.data.error, true); return; }
   stopReplayPlay();
