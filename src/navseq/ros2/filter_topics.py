@@ -14,8 +14,8 @@ filters publishes around them, so that RViz and a Nav2 client see the same zones
   ``speed_costmap_filter_info``; a second filter of a kind gets ``_2`` and so on;
 - ``speed_limit`` (``nav2_msgs/SpeedLimit``), as Nav2's SpeedFilter publishes it: the
   limit under the robot (percent or m/s, as the filter's type says; 0 for none),
-  published when it changes, checked at the local costmap's update rate. The node's
-  own controller server hears it like any other ``speed_limit``.
+  published when it changes, checked five times a second. The node's own controller
+  server hears it like any other ``speed_limit``.
 
 Simplified: no lifecycle nodes of these servers' names (the topics come from the
 simulator's node), and a mask is published once, as loaded, not re-read.
@@ -38,8 +38,8 @@ from navseq.ros2.messages import grid_msg
 from navseq.ros2.standin import Nav2StandIn
 from navseq.sim.occupancy import load_map
 
-#: Seconds between two looks at the robot's speed zone: nav2_bringup's local costmap
-#: updates at 5 Hz, and the SpeedFilter runs in its updates.
+#: Seconds between two looks at the robot's speed zone (Nav2's SpeedFilter looks in its
+#: costmap's updates: 5 Hz in nav2_bringup's local costmap, 1 Hz in the global one).
 SPEED_CHECK_PERIOD = 0.2
 #: SpeedLimit's "no limit", as Nav2's SpeedFilter publishes it.
 NO_SPEED_LIMIT = 0.0
