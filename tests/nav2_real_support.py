@@ -44,7 +44,7 @@ def nav2_missing_reason() -> str | None:
 class RealNav2:
     """A running real Nav2 bringup; ``env`` is the environment of its clients."""
 
-    def __init__(self, map_yaml: Path, log_dir: Path) -> None:
+    def __init__(self, map_yaml: Path, log_dir: Path, *launch_args: str) -> None:
         prefix = nav2_prefix()
         assert prefix is not None, nav2_missing_reason()
         self.env = ros2_environment(prefix)
@@ -55,7 +55,13 @@ class RealNav2:
         self.log_path = log_dir / "nav2-launch.log"
         self._log = self.log_path.open("w")
         self.process = subprocess.Popen(
-            ["ros2", "launch", str(NAV2_DIR / "nav2_loopback.launch.py"), f"map:={map_yaml}"],
+            [
+                "ros2",
+                "launch",
+                str(NAV2_DIR / "nav2_loopback.launch.py"),
+                f"map:={map_yaml}",
+                *launch_args,  # e.g. keepout_mask:=..., speed_mask:=...
+            ],
             env=self.env,
             stdout=self._log,
             stderr=subprocess.STDOUT,

@@ -3,6 +3,7 @@
 # the real-Nav2 tests (tests/nav2_real_support.py) do not depend on where shared/ lies.
 #
 #   ros2 launch nav2_loopback.launch.py map:=/path/map.yaml [params_file:=...]
+#       [keepout_mask:=/path/keepout.yaml] [speed_mask:=/path/speed.yaml]
 #
 # Starts: static TFs base_footprint->base_link->base_scan, nav2_loopback_sim (fakes odom, TF
 # map->odom->base_footprint, /scan and /clock from cmd_vel), map_server, planner_server,
@@ -50,13 +51,18 @@ def _nodes(context):
             }
         )
 
-    def node(pkg, exe, name, extra=None, remap=()):
+    keepout = LaunchConfiguration("keepout_mask").perform(context)
+    speed = LaunchConfiguration("speed_mask").perform(context)
+    filters_params = _filters_params(keepout, speed)
+
+    def node(pkg, exe, name, extra=None, remap=(), filtered=False):
+        files = [params] + ([filters_params] if filtered and filters_params else [])
         return Node(
             package=pkg,
             executable=exe,
             name=name,
             output="screen",
-            parameters=[params, dict(sim, **(extra or {}))],
+            parameters=[*files, dict(sim, **(extra or {}))],
             remappings=list(remap),
             arguments=args,
         )
@@ -113,9 +119,10 @@ def _nodes(context):
                 "controller_server",
                 ctrl_over,
                 remap=[("cmd_vel", "cmd_vel_nav")],
+                filtered=True,
             ),
             node("nav2_smoother", "smoother_server", "smoother_server"),
-            node("nav2_planner", "planner_server", "planner_server"),
+            node("nav2_planner", "planner_server", "planner_server", filtered=True),
             node(
                 "nav2_behaviors",
                 "behavior_server",
@@ -129,6 +136,7 @@ def _nodes(context):
             if have_wpf
             else []
         )
+        + _filter_servers(node, keepout, speed)
         + [
             # no collision_monitor here: the smoothed command goes straight to the robot
             node(
@@ -147,6 +155,85 @@ def _nodes(context):
     )
 
 
+# Costmap filters (keepout_mask:=..., speed_mask:=...): each mask served by a map_server
+# and a costmap_filter_info_server under the names of nav2_bringup's params after Jazzy
+# (keepout_filter_mask / keepout_costmap_filter_info, speed_filter_mask /
+# speed_costmap_filter_info; speed: the speed-filter tutorial's base 100, multiplier -1),
+# and the KeepoutFilter in both costmaps, the SpeedFilter in the global one.
+FILTERS = {
+    "keepout": ("nav2_costmap_2d::KeepoutFilter", 0, 0.0, 1.0),
+    "speed": ("nav2_costmap_2d::SpeedFilter", 1, 100.0, -1.0),
+}
+
+
+def _filters_params(keepout, speed):
+    """A parameter file adding the filters to both costmaps; None without masks."""
+    import tempfile
+
+    kinds = [kind for kind, mask in (("keepout", keepout), ("speed", speed)) if mask]
+    if not kinds:
+        return None
+    lines = []
+    for costmap in ("global_costmap", "local_costmap"):
+        mine = [kind for kind in kinds if costmap == "global_costmap" or kind == "keepout"]
+        if not mine:
+            continue
+        lines += [f"{costmap}:", f"  {costmap}:", "    ros__parameters:"]
+        lines.append("      filters: [" + ", ".join(f'"{k}_filter"' for k in mine) + "]")
+        for kind in mine:
+            lines += [
+                f"      {kind}_filter:",
+                f'        plugin: "{FILTERS[kind][0]}"',
+                "        enabled: true",
+                f'        filter_info_topic: "/{kind}_costmap_filter_info"',
+            ]
+    handle, path = tempfile.mkstemp(prefix="nav2-filters-", suffix=".yaml")
+    with os.fdopen(handle, "w") as file:
+        file.write("\n".join(lines) + "\n")
+    return path
+
+
+def _filter_servers(node, keepout, speed):
+    nodes, names = [], []
+    for kind, mask in (("keepout", keepout), ("speed", speed)):
+        if not mask:
+            continue
+        _, filter_type, base, multiplier = FILTERS[kind]
+        nodes.append(
+            node(
+                "nav2_map_server",
+                "map_server",
+                f"{kind}_filter_mask_server",
+                {"yaml_filename": mask, "topic_name": f"/{kind}_filter_mask", "frame_id": "map"},
+            )
+        )
+        nodes.append(
+            node(
+                "nav2_map_server",
+                "costmap_filter_info_server",
+                f"{kind}_costmap_filter_info_server",
+                {
+                    "type": filter_type,
+                    "filter_info_topic": f"/{kind}_costmap_filter_info",
+                    "mask_topic": f"/{kind}_filter_mask",
+                    "base": base,
+                    "multiplier": multiplier,
+                },
+            )
+        )
+        names += [f"{kind}_filter_mask_server", f"{kind}_costmap_filter_info_server"]
+    if names:
+        nodes.append(
+            node(
+                "nav2_lifecycle_manager",
+                "lifecycle_manager",
+                "lifecycle_manager_costmap_filters",
+                {"autostart": True, "node_names": names},
+            )
+        )
+    return nodes
+
+
 def generate_launch_description():
     # nav2_bringup's params; or NAV2_PARAMS (e.g. src/navigation2/nav2_bringup/params/...)
     params = os.environ.get("NAV2_PARAMS") or os.path.join(
@@ -162,6 +249,8 @@ def generate_launch_description():
                 description='rpp (Regulated Pure Pursuit) or "yaml" (keep the file\'s)',
             ),
             DeclareLaunchArgument("log_level", default_value="info"),
+            DeclareLaunchArgument("keepout_mask", default_value=""),
+            DeclareLaunchArgument("speed_mask", default_value=""),
             OpaqueFunction(function=_nodes),
         ]
     )

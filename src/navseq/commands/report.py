@@ -189,6 +189,7 @@ def journaled_mission(state: JournalState) -> Mission:
     from navseq.errors import NavseqError
     from navseq.journal.writer import mission_digest
     from navseq.mission import load_mission
+    from navseq.mission.geo_records import filters_from_record
 
     source = Path(state.mission_source)
     require_file(source, f"the journal's mission file ({state.path})")
@@ -202,6 +203,10 @@ def journaled_mission(state: JournalState) -> Mission:
     started = state.mission_started
     if started is not None:
         mission = dataclasses.replace(mission, loops=started.loops)
+    # The zones the run drove with (--keepout / --speed-mask), not only the file's.
+    filters = filters_from_record(state.run_options.get("filters"), f"{state.path}:1")
+    if filters is not None:
+        mission = dataclasses.replace(mission, filters=filters)
     return mission
 
 
@@ -273,6 +278,16 @@ def _picture(state: JournalState, mission: Mission, result: MissionResult) -> by
         except NavseqError as error:
             print(
                 f"navseq report: drawing without the map ({printable(str(error))})",
+                file=sys.stderr,
+            )
+    if grid is not None and mission.filters:
+        from navseq.sim.filters import with_filters
+
+        try:
+            grid = with_filters(grid, mission.filters)
+        except NavseqError as error:
+            print(
+                f"navseq report: drawing without the zones ({printable(str(error))})",
                 file=sys.stderr,
             )
     recorder = state.recorder

@@ -8,6 +8,7 @@ import argparse
 from pathlib import Path
 
 from navseq.commands.common import parse_pose
+from navseq.commands.filter_options import add_sim_filter_options, sim_filters_of
 from navseq.sim.options import SimConfig, checked_config
 
 
@@ -88,6 +89,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add_datum_argument(parser)
     add_world_arguments(parser)
+    add_sim_filter_options(parser)
 
 
 def add_datum_argument(parser: argparse.ArgumentParser) -> None:
@@ -149,4 +151,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         initial_pose=args.initial_pose,
         ros1=ros1,
         datum=getattr(args, "datum", ""),
+        filters=sim_filters_of(args),
     )

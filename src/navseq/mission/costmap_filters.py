@@ -134,4 +134,11 @@ def read_filters(
     return tuple(filters)
 
 
-__all__ = ["FILTER_KEYS", "CostmapFilter", "FilterType", "read_filters"]
+def filters_summary(filters: tuple[CostmapFilter, ...]) -> str:
+    """``keepout zones of keepout.yaml, speed zones of speed.yaml`` (a simulator's ready line)."""
+    return ", ".join(
+        f"{'keepout' if spec.is_keepout else 'speed'} zones of {spec.mask.name}" for spec in filters
+    )
+
+
+__all__ = ["FILTER_KEYS", "CostmapFilter", "FilterType", "filters_summary", "read_filters"]

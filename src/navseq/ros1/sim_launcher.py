@@ -45,6 +45,7 @@ from typing import IO, Any
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.mission.costmap_filters import CostmapFilter, filters_summary
 from navseq.sim.options import SimConfig
 
 CALLER_ID = "/navseq_sim"
@@ -113,9 +114,20 @@ def node_specs(config: SimConfig, start: Pose2D, robot: str) -> list[NodeSpec]:
                 "robot": robot,
                 "base_frame": f"{prefix}base_footprint",
                 "other_robots": others,
+                "filters": [filter_param(spec) for spec in config.filters],
             },
         ),
     ]
+
+
+def filter_param(spec: CostmapFilter) -> dict[str, Any]:
+    """One costmap filter as an item of the move_base stand-in's ``~filters``."""
+    return {
+        "mask": str(spec.mask.resolve()),
+        "type": int(spec.type),
+        "base": float(spec.base),
+        "multiplier": float(spec.multiplier),
+    }
 
 
 def robot_param_value(option: str | None) -> str:
@@ -436,7 +448,8 @@ def _serve(
     print(
         f"navseq sim: ready: {action} on {config.map_yaml}, robot at "
         f"({start.x:.2f}, {start.y:.2f}), speed x{config.speed:g}"
-        + (" (/clock published: use_sim_time is true)" if config.sim_time else ""),
+        + (" (/clock published: use_sim_time is true)" if config.sim_time else "")
+        + (f", {filters_summary(config.filters)}" if config.filters else ""),
         flush=True,
     )
     while not stop.wait(0.2):

@@ -41,6 +41,12 @@ uses; ``~inflation_radius``, ``~cost_scaling_factor``, ``~xy_goal_tolerance`` an
 ``~yaw_goal_tolerance``, when set, still override the profile's values. Give the robot
 node the same ``~robot``: this node plans and stops for the outline it is told of.
 
+Nav2's costmap filters, which move_base has not, come from ``~filters`` (a mission's
+``filters:`` list: ``mask``, ``type``, ``base``, ``multiplier``; ``navseq sim --ros1
+--keepout/--speed-mask/--filters`` sets it): a keepout zone is an obstacle of the
+costmap (never planned through; a goal in it aborts) and a speed zone limits the
+controller, as on the in-process simulator and the ROS 2 stand-in.
+
 It knows the robot only through ROS: its pose from TF (``~global_frame`` ->
 ``~base_frame``) and its velocity from ``odom``, so it drives navseq's sim robot node,
 or a real base, alike. The map comes from ``~map`` (a map_server YAML) or, when that is
@@ -86,6 +92,7 @@ from std_srvs.srv import Empty, EmptyRequest, EmptyResponse
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D, compose
+from navseq.mission.costmap_filters import CostmapFilter, filters_summary
 from navseq.ros1.conversions import (
     grid_from_msg,
     grid_to_msg,
@@ -97,6 +104,7 @@ from navseq.ros1.fleet import OtherRobots, other_robots_param
 from navseq.ros1.params import bool_param, float_param, param_error, str_param
 from navseq.ros1.robot_param import describe_settings, sim_settings_param
 from navseq.sim.costmap import INSCRIBED, LETHAL, NO_INFORMATION, Costmap, CostmapParams
+from navseq.sim.filters import with_filters
 from navseq.sim.footprint import Footprint
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.occupancy import OccupancyGrid, load_map
@@ -173,6 +181,7 @@ class NavNodeConfig:
     other_robots: tuple[str, ...]
     race_window: float = 0.0
     race_probability: float = 1.0
+    filters: tuple[CostmapFilter, ...] = ()  # ~filters: Nav2 keepout and speed masks
 
     @property
     def footprint(self) -> Footprint:
@@ -211,6 +220,7 @@ class NavNodeConfig:
             other_robots=other_robots_param(base_frame),
             race_window=float_param("race_window", 0.0),
             race_probability=float_param("race_probability", 1.0),
+            filters=filters_param("filters"),
         )
         for name in ("controller_frequency", "feedback_rate", "pose_timeout"):
             if not getattr(config, name) > 0:
@@ -246,6 +256,25 @@ def navstack_params(config: NavNodeConfig) -> dict[str, Any]:
         f"{LOCAL_PLANNER}/acc_lim_x": limits.acc_v,
         f"{LOCAL_PLANNER}/acc_lim_theta": limits.acc_w,
     }
+
+
+def filters_param(name: str) -> tuple[CostmapFilter, ...]:
+    """``~filters``: Nav2 costmap filters as a mission's ``filters:`` list, e.g.
+    ``[{mask: /maps/keepout.yaml, type: 0}, {mask: /maps/speed.yaml, type: 1, base: 100,
+    multiplier: -1}]`` (mask paths absolute, or relative to the working directory)."""
+    from navseq.mission import fields
+    from navseq.mission.costmap_filters import read_filters
+    from navseq.mission.located import from_plain
+    from navseq.mission.navseq_format import read_map_path
+
+    value = rospy.get_param(f"~{name}", [])
+    where = f"param {rospy.resolve_name('~' + name)}"
+    return read_filters(
+        from_plain(value, where),
+        where,
+        lambda node, what: read_map_path(node, what, None),
+        fields.number,
+    )
 
 
 def wait_for_map(topic: str) -> OccupancyGrid:
@@ -587,6 +616,7 @@ def main(argv: list[str] | None = None) -> int:
         for name, value in navstack_params(config).items():
             rospy.set_param(f"~{name}", value)
         grid = load_map(config.map_yaml) if config.map_yaml else wait_for_map("map")
+        grid = with_filters(grid, config.filters)  # a mask that cannot be read ends here
         node = SimNavNode(config, grid)
     except NavseqError as error:
         rospy.logfatal("%s", error)
@@ -604,6 +634,8 @@ def main(argv: list[str] | None = None) -> int:
         config.nav.xy_tolerance,
         config.nav.yaw_tolerance,
     )
+    if config.filters:
+        rospy.loginfo("costmap filters: %s", filters_summary(config.filters))
     node.spin()
     return 0
 

@@ -45,6 +45,11 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
   :mod:`navseq.ros2.scan_topic`), the velocity chain ``cmd_vel_nav`` ->
   ``cmd_vel_smoothed`` -> ``cmd_vel`` with ``speed_limit``, and teleop on ``cmd_vel``
   while no goal runs (:mod:`navseq.ros2.velocity_topics`);
+- Nav2's costmap filters given by ``--keepout``, ``--speed-mask`` or ``--filters``: a
+  keepout zone is lethal in both costmaps (never planned through; a goal deeper in it
+  than the planner's tolerance aborts), a speed zone limits the controller; the masks,
+  their filter info and the speed filter's ``speed_limit`` are published
+  (:mod:`navseq.ros2.filter_topics`);
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``);
   every clear-costmap call is logged (``global_costmap: cleared``), so a client's
@@ -125,11 +130,13 @@ from tf2_msgs.msg import TFMessage
 from navseq.commands.sim_options import add_arguments, config_from_args
 from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
+from navseq.mission.costmap_filters import filters_summary
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
 from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
+from navseq.ros2.filter_topics import FilterTopics
 from navseq.ros2.gps_actions import GpsWaypointActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.localization_topics import LocalizationTopics
@@ -157,6 +164,7 @@ from navseq.ros2.standin import (
 )
 from navseq.ros2.velocity_topics import VelocityTopics
 from navseq.ros2.waypoint_goals import see_waypoints_through
+from navseq.sim.filters import with_filters
 from navseq.sim.fleet import WARN_PERIOD, SeenRobots, missing_warning
 from navseq.sim.occupancy import load_map
 from navseq.sim.options import SimConfig
@@ -192,7 +200,7 @@ class SimNode:
         self.node = node
         self.config = config
         self.lifecycle = lifecycle
-        grid = load_map(config.map_yaml)
+        grid = with_filters(load_map(config.map_yaml), config.filters)
         settings = SimSettings.of(config.robot)
         start = (
             config.start if config.start is not None else default_start(grid, settings.footprint)
@@ -208,6 +216,7 @@ class SimNode:
         self.standin = Nav2StandIn(
             world, replan_period=config.replan_period, odom_drift=config.odom_drift
         )
+        self.standin.filters = config.filters
         self.others = (
             SeenRobots(config.other_robots, OTHER_POSE_TOLERANCE, settings.footprint, MAP_FRAME)
             if config.other_robots
@@ -343,6 +352,10 @@ class SimNode:
             others=lambda: self._other_poses,
         )
         self._velocities = VelocityTopics(node, self.standin, self._lock, group)
+        self._filters = FilterTopics(
+            node, self.standin, self._lock, group, filters=config.filters, stamp=self._stamp,
+            frame=MAP_FRAME,
+        )  # fmt: skip
         stamp = self._stamp()
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor,
         # the laser on it.
@@ -720,6 +733,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             + (" (/clock published: use_sim_time:=true)" if config.publishes_clock else "")
             + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else "")
             + (f", docks {', '.join(d.name for d in config.docks)}" if config.docks else "")
+            + (f", {filters_summary(config.filters)}" if config.filters else "")
             + (
                 f", re-plan period {config.replan_period:g} s on preemption"
                 if config.replan_period > 0

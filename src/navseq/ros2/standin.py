@@ -65,7 +65,9 @@ import numpy.typing as npt
 
 from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
+from navseq.mission.costmap_filters import CostmapFilter
 from navseq.sim.behaviors import BehaviorServer
+from navseq.sim.filters import with_filters
 from navseq.sim.localization import Localization
 from navseq.sim.navserver import CONTROL_FAILED, NavState
 from navseq.sim.occupancy import OccupancyGrid
@@ -250,6 +252,8 @@ class Nav2StandIn:
         self.smoother = VelocitySmoother()
         self.speed_limit = SpeedLimit(server.params.limits.max_v)
         self.commands = Commands()
+        # The costmap filters laid over every map the world gets (``replace_map``).
+        self.filters: tuple[CostmapFilter, ...] = ()
 
     # -- goals -----------------------------------------------------------------------
 
@@ -431,7 +435,8 @@ class Nav2StandIn:
     def replace_map(self, grid: OccupancyGrid) -> str | None:
         """A new map replaces the world's (planner, costmaps, the body's walls); a
         warning when the robot now overlaps an obstacle of it (it cannot move then)."""
-        self.world.replace_map(grid)
+        # Nav2's filter masks come from their own map servers: a new map keeps them.
+        self.world.replace_map(with_filters(grid, self.filters))
         pose = self.world.robot.pose
         if self.world.body.collides(pose):
             return (

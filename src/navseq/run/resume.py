@@ -3,7 +3,8 @@
 A resume reads the journal (:func:`read_resume`), refuses a mission file that changed
 since and a part of the mission other than the one the run started with, and continues
 with the run's recorded options (:func:`continue_as_journaled`): navigator kind and its
-journaled settings, picture, loop count, map and start pose. An option the request
+journaled settings, picture, loop count, map, start pose and costmap filters (and
+refuses a mission whose GPS datum is not the journal's). An option the request
 gives again with another value wins, and is said in a note, so that an operator never
 changes a patrol by accident. :func:`run_options` is what a new run records for that.
 """
@@ -24,6 +25,7 @@ if TYPE_CHECKING:
     from navseq.executor.resume import ResumePoint
     from navseq.geometry import Pose2D
     from navseq.journal.writer import JournalState
+    from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.navigators.registry import NavigatorKind
 
@@ -151,8 +153,10 @@ def _continued_options(
         )
     except (TypeError, ValueError) as error:
         raise NavseqError(f"the journal's run option {error}", source=where) from None
+    filters = _continued_filters(request, recorded, where, notes)
     return dataclasses.replace(
         request,
+        filters=filters,
         navigator=navigator,
         navigator_options={},
         outputs=dataclasses.replace(
@@ -165,6 +169,43 @@ def _continued_options(
         last=recorded.get("to_waypoint"),
         only=recorded.get("only"),
     )
+
+
+def _continued_filters(
+    request: RunRequest, recorded: dict[str, Any], where: str, notes: _Notes
+) -> tuple[CostmapFilter, ...] | None:
+    """The costmap filters the journaled run drove with (its --keepout / --speed-mask or
+    the mission's), unless the request gives others: then those, and a note."""
+    from navseq.mission.geo_records import describe_filters, filters_from_record
+
+    journaled = filters_from_record(recorded.get("filters"), where)
+    if request.filters is None or journaled is None:
+        return request.filters if request.filters is not None else journaled
+    if request.filters != journaled:
+        notes.lines.append(
+            f"resuming with --keepout/--speed-mask {describe_filters(request.filters)} "
+            f"instead of the journal's {describe_filters(journaled)}"
+        )
+    return request.filters
+
+
+def refuse_another_datum(mission: Mission, history: JournalState) -> None:
+    """A resume converts GPS waypoints with the datum the journaled run used, or stops:
+    the journal's positions are positions through it."""
+    from navseq.mission.geo_records import datum_record, same_datum
+
+    recorded = history.run_options.get("datum", _UNRECORDED)
+    if recorded is _UNRECORDED or same_datum(mission.datum, recorded):
+        return  # a journal written before navseq recorded the datum: nothing to hold to
+    raise NavseqError(
+        f"the mission's datum {datum_record(mission.datum)} is not the journal's "
+        f"{recorded}: its GPS waypoints would land elsewhere; resume with the mission "
+        "the run started with, or start a new run without --resume",
+        source="--resume",
+    )
+
+
+_UNRECORDED = object()
 
 
 def _journal_loops(recorded: dict[str, Any]) -> int | str | None:
@@ -232,6 +273,8 @@ def run_options(
     ``request`` is the run's, its navigator settings resolved; ``mission`` the one run
     (its loop count as given); ``start`` the start pose the run settled on.
     """
+    from navseq.mission.geo_records import datum_record, filters_record
+
     settings = request.navigator
     outputs = request.outputs or Outputs()
     return {
@@ -246,7 +289,17 @@ def run_options(
         "loops": mission.loops,
         "map": str(Path(map_path).resolve()) if map_path is not None else None,
         "start": None if start is None else pose_degrees(start),
+        # What the waypoints and zones were: the filters driven with, the GPS datum.
+        "filters": filters_record(mission.filters),
+        "datum": datum_record(mission.datum),
     }
 
 
-__all__ = ["PART_OPTIONS", "continue_as_journaled", "known_kind", "read_resume", "run_options"]
+__all__ = [
+    "PART_OPTIONS",
+    "continue_as_journaled",
+    "known_kind",
+    "read_resume",
+    "refuse_another_datum",
+    "run_options",
+]

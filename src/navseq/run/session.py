@@ -523,6 +523,10 @@ def prepare(request: RunRequest) -> Session:
     if resume is not None:
         # Refuse a journal the mission cannot continue before anything is appended to it.
         from navseq.executor.machine import MissionExecutor
+        from navseq.run.resume import refuse_another_datum
+
+        assert history is not None
+        refuse_another_datum(mission, history)
 
         MissionExecutor(mission, resume=resume)
     map_path = request.map if request.map is not None else mission.map

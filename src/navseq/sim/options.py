@@ -16,6 +16,7 @@ from pathlib import Path
 from navseq.errors import NavseqError
 from navseq.files import require_file
 from navseq.geometry import Pose2D
+from navseq.mission.costmap_filters import CostmapFilter
 from navseq.mission.geodesy import Datum, GeoPoint, check_latitude, check_longitude
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.docks import Dock, read_docks_file
@@ -61,6 +62,8 @@ class SimConfig:
     tf_convention: str = "nav2"  # one of TF_CONVENTIONS
     odom_drift: float = 0.0  # odometry error per metre driven (ROS 2 stand-in)
     initial_pose: str = "estimate"  # one of INITIAL_POSE_MODES (ROS 2 stand-in)
+    # Nav2 costmap filters (--keepout, --speed-mask, --filters): keepout and speed zones
+    filters: tuple[CostmapFilter, ...] = ()
 
     @property
     def frame_prefix(self) -> str:
@@ -203,6 +206,7 @@ def checked_config(
     initial_pose: str = "estimate",
     ros1: bool = False,
     datum: str = "",
+    filters: tuple[CostmapFilter, ...] = (),
 ) -> SimConfig:
     """The checked settings from the values the options hold; every bad value is a
     NavseqError naming its option.
@@ -235,7 +239,20 @@ def checked_config(
         tf_convention=tf_convention_of(tf_convention, ros1=ros1),
         odom_drift=odom_drift_of(float(odom_drift), ros1=ros1),
         initial_pose=initial_pose_of(initial_pose, ros1=ros1),
+        filters=filters_checked(map_yaml, filters),
     )
+
+
+def filters_checked(
+    map_yaml: Path, filters: tuple[CostmapFilter, ...]
+) -> tuple[CostmapFilter, ...]:
+    """``filters`` once their masks have been read onto the map: a mask that cannot be
+    read is refused here, naming it, not when a node starts."""
+    if filters:
+        from navseq.sim.filters import load_filtered_map
+
+        load_filtered_map(map_yaml, filters)
+    return filters
 
 
 def docks_of(path: Path | None, *, ros1: bool = False) -> tuple[Dock, ...]:

@@ -34,6 +34,8 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
                   "recoveries_run": [{"number", "kind", "amount", "attempt", "outcome",
                                       "duration_s", "detail"}]}],
       "files": {"journal", "picture", ...},
+      "filters": [{"mask", "type", "base", "multiplier"}],  # Nav2 costmap filters
+      "datum": {"latitude", "longitude", "altitude", "yaw_deg"} | null,  # GPS datum
       "part": {"from", "to", "only", "numbers", "of"} | null,  # navseq run adds these
       "clock": {"navigator_s", "wall_s", "real_time_factor"}   # (not navseq report)
     }
@@ -63,7 +65,10 @@ per mission waypoint, its visits over every loop: counts, summed time and distan
 count every visit. Versions 2 and 3 had neither ``waypoints`` nor
 ``visits_listed`` and listed every visit; readers of reports (``navseq report``) accept both.
 Version 4 had no ``clock`` (how fast the navigator's clock ran, see
-:func:`navseq.sinks.json_events.clock_record`).
+:func:`navseq.sinks.json_events.clock_record`). Version 8 added ``filters`` (the Nav2
+costmap filters the run drove with: each ``{"mask", "type", "base", "multiplier"}``,
+``--keepout`` / ``--speed-mask`` or the mission's) and ``datum`` (``{"latitude",
+"longitude", "altitude", "yaw_deg"}`` its GPS waypoints were converted with, or null).
 """
 
 from __future__ import annotations
@@ -89,6 +94,7 @@ from navseq.executor.result import (
 )
 from navseq.files import write_atomically
 from navseq.geometry import Pose2D
+from navseq.mission.geo_records import datum_record, filters_record
 from navseq.mission.model import Mission
 
 if TYPE_CHECKING:
@@ -99,7 +105,7 @@ try:  # a dependency, but a ROS install of the package may not have it (see repo
 except ImportError:  # pragma: no cover - the tests run with it installed
     orjson = None  # type: ignore[assignment]
 
-SCHEMA_VERSION = 7
+SCHEMA_VERSION = 8
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -286,6 +292,8 @@ def build_report(
         },
         "visits": [_visit_dict(visit) for visit in result.visits],
         "files": dict(files or {}),
+        "filters": filters_record(mission.filters),
+        "datum": datum_record(mission.datum),
     }
 
 
