@@ -44,6 +44,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from navseq.ros2.standin import Nav2StandIn
 from navseq.sim.collision_monitor import (
     ACTION_NAMES,
+    ActionType,
     MonitorPolygon,
     Verdict,
     nav2_bringup_polygons,
@@ -95,11 +96,12 @@ class CollisionMonitorTopics:
         with self._lock:
             stage = self._standin.monitor
             changes, stage.monitor.changes = stage.monitor.changes, []
+            polygons = stage.monitor.polygons
             points = stage.points if stage.checked else None
             stage.checked = False
         for verdict in changes:
             self._state_pub.publish(state_msg(verdict))
-            self._log.info(said(verdict))
+            self._log.info(said(verdict, polygons))
         if points is not None and self._marker_pub.get_subscription_count() > 0:
             self._marker_pub.publish(points_marker(points, self._base_frame))
 
@@ -120,11 +122,22 @@ class CollisionMonitorTopics:
             self._standin.command_smoothed(float(message.linear.x), float(message.angular.z))
 
 
-def said(verdict: Verdict) -> str:
+def said(verdict: Verdict, polygons: tuple[MonitorPolygon, ...]) -> str:
     """Nav2's log line for a new state."""
-    if verdict.polygon:
-        return f"Robot to {verdict.action.name.lower()} due to {verdict.polygon} polygon"
-    return "Robot to continue normal operation"
+    polygon = next((p for p in polygons if p.name == verdict.polygon), None)
+    if polygon is None:
+        return "Robot to continue normal operation"
+    if verdict.action is ActionType.SLOWDOWN:
+        return (
+            f"Robot to slowdown for {polygon.slowdown_ratio * 100:f} percents due to "
+            f"{polygon.name} polygon"
+        )
+    if verdict.action is ActionType.APPROACH:
+        return (
+            f"Robot to approach for {polygon.time_before_collision:f} seconds away from collision"
+        )
+    verb = "limit speed" if verdict.action is ActionType.LIMIT else "stop"
+    return f"Robot to {verb} due to {polygon.name} polygon"
 
 
 def state_msg(verdict: Verdict) -> CollisionMonitorState:
