@@ -50,7 +50,6 @@ from navseq.sim.collision_monitor import (
     nav2_bringup_polygons,
 )
 
-PERIOD = 0.05  # s of wall time between two looks at the monitor's state (a step)
 CIRCLE_SIDES = 32
 QUIET = 0.5  # s of wall time after our own cmd_vel_smoothed before outside commands count
 
@@ -88,11 +87,10 @@ class CollisionMonitorTopics:
         node.create_subscription(
             Twist, "cmd_vel_smoothed", self._on_smoothed, 10, callback_group=group
         )
-        node.create_timer(PERIOD, self.publish, callback_group=group)
 
     def publish(self) -> None:
         """The state when the acting polygon changed; the points when commands went
-        through."""
+        through (call after a simulation step)."""
         with self._lock:
             stage = self._standin.monitor
             changes, stage.monitor.changes = stage.monitor.changes, []

@@ -3,7 +3,8 @@
 What a default Jazzy bringup's costmaps publish for each layer that keeps cells
 (:mod:`navseq.sim.costmap_layers` says what each holds in the stand-in), with the same
 publisher as the costmaps themselves (:mod:`navseq.ros2.costmap_topics`: reliable,
-transient local; the full layer, then the changed cells):
+transient local; a layer in full, then the cells that changed in it, as Nav2's
+publisher sends a layer):
 
 - ``global_costmap/static_layer`` (``nav_msgs/OccupancyGrid``), ``…_raw``
   (``nav2_msgs/Costmap``), ``…_raw_updates`` (``nav2_msgs/CostmapUpdate``) and
@@ -11,7 +12,7 @@ transient local; the full layer, then the changed cells):
   in the map frame, again when ``map_server/load_map`` replaces it;
 - ``global_costmap/obstacle_layer*`` the same for the laser's marks on the map's cells,
   and ``local_costmap/voxel_layer*`` for them in the local costmap's 3 m window (odom
-  frame), every half second when they changed;
+  frame), every half second: in full when the window moved, else the changed cells;
 - ``local_costmap/voxel_grid`` (``nav2_msgs/VoxelGrid``, nav2_bringup's
   ``publish_voxel_map``): the voxel layer's columns; ``local_costmap/clearing_endpoints``
   (``sensor_msgs/PointCloud2``, x y z float32, odom frame): the ends of the rays the
@@ -86,16 +87,18 @@ class LayerPublisher:
         self.stamp: Callable[[], Any] = lambda: None
 
     def publish(self, window: CostWindow, stamp: Any) -> None:
-        """``window`` in full and the cells changed since the last one, if it changed."""
+        """``window`` in full when it covers other cells than the last one (or is the
+        first), else the box of cells that changed, if any — as Nav2's publisher does
+        without ``always_send_full_costmap``."""
         previous = self._last
+        self._last = CostWindow(window.cost.copy(), window.resolution, window.origin, window.frame)
         if previous is not None and same_area(previous, window):
             bounds = changed_bounds(previous.cost, window.cost)
-            if bounds is None:
-                return
-            self._raw_updates.publish(costmap_update_msg(window, bounds, stamp))
-            if self._updates is not None:
-                self._updates.publish(occupancy_update_msg(window, bounds, stamp))
-        self._last = CostWindow(window.cost.copy(), window.resolution, window.origin, window.frame)
+            if bounds is not None:
+                self._raw_updates.publish(costmap_update_msg(window, bounds, stamp))
+                if self._updates is not None:
+                    self._updates.publish(occupancy_update_msg(window, bounds, stamp))
+            return
         self._grid.publish(occupancy_msg(window, stamp))
         self._raw.publish(costmap_msg(window, stamp))
 
@@ -159,7 +162,9 @@ class CostmapLayers:
             ranges = ray_cast(world.grid, world.robot.pose, self._spec, world.body.others)
             self._hits = scan_hits(ranges, self._spec, self._standin.localization.believed_pose)
             static = self._static_window() if new_map else None
-            obstacle, voxel = self._obstacle_window(), self._voxel_window()
+            marks = obstacle_layer(world.grid, self._hits)
+            obstacle = CostWindow(marks, world.grid.resolution, world.grid.origin, self._map_frame)
+            voxel = self._voxel_window(marks)
             to_odom = inverse(self._standin.localization.estimate)
             hits = self._hits
         stamp = self._stamp()
@@ -188,9 +193,12 @@ class CostmapLayers:
         cost = obstacle_layer(grid, self._hits)
         return CostWindow(cost, grid.resolution, grid.origin, self._map_frame)
 
-    def _voxel_window(self) -> CostWindow:
+    def _voxel_window(self, marks: np.ndarray | None = None) -> CostWindow:
+        """The voxel layer: the marks (``obstacle_layer``'s, made now if not given) in
+        the local window."""
         grid = self._standin.world.grid
-        marks = obstacle_layer(grid, self._hits)
+        if marks is None:
+            marks = obstacle_layer(grid, self._hits)
         return local_window(marks, grid, self._standin.localization, self._odom_frame, fill=0)
 
     # -- messages ----------------------------------------------------------------------

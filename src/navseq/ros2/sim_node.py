@@ -491,6 +491,7 @@ class SimNode:
             self._plan_pub.publish(plan_message)
             self._received_plan_pub.publish(plan_message)
         self._velocities.publish()
+        self._monitor.publish()
         self._localization.publish()
         self._scan.publish_if_due()
         if topic_ending is not None:
