@@ -39,11 +39,11 @@ def client(sim: SimProcess, verb: str, *options: str) -> dict[str, Any]:
     return dict(json.loads(done.stdout.strip().splitlines()[-1]))
 
 
-def _sim(start: str) -> Iterator[SimProcess]:
+def _sim(start: str, *more: str) -> Iterator[SimProcess]:
     prefix = ros2_prefix()
     assert prefix is not None
     node = SimProcess(
-        ros2_environment(prefix), "--map", str(MAP), f"--start={start}", "--speed", SPEED
+        ros2_environment(prefix), "--map", str(MAP), f"--start={start}", "--speed", SPEED, *more
     )
     yield node
     err = node.stop()
@@ -59,6 +59,28 @@ def sim() -> Iterator[SimProcess]:
 @pytest.fixture
 def sim_facing_pillar() -> Iterator[SimProcess]:
     yield from _sim(FACING_PILLAR)
+
+
+# A Nav2 params file's collision_monitor section with a stop polygon (Nav2's docs' example
+# shape): 0.4 m ahead of the robot, 0.6 m wide.
+STOP_PARAMS = """
+collision_monitor:
+  ros__parameters:
+    polygons: ["PolygonStop"]
+    PolygonStop:
+      type: "polygon"
+      points: "[[0.4, 0.3], [0.4, -0.3], [0.0, -0.3], [0.0, 0.3]]"
+      action_type: "stop"
+      min_points: 4
+      enabled: True
+"""
+
+
+@pytest.fixture
+def sim_with_stop_polygon(tmp_path: Path) -> Iterator[SimProcess]:
+    params = tmp_path / "nav2_params.yaml"
+    params.write_text(STOP_PARAMS)
+    yield from _sim(FACING_PILLAR, "--ros-args", "--params-file", str(params))
 
 
 def test_layers_hold_the_map_and_the_lasers_marks_and_a_published_footprint_counts(
@@ -115,3 +137,13 @@ def test_the_collision_monitor_slows_a_command_at_an_obstacle_and_toggle_off_pas
     off = seen["speeds_off"]
     assert off and sum(s == pytest.approx(0.2) for s in off) > 0.8 * len(off)
     assert seen["marker_points"] > 0
+
+
+def test_a_stop_polygon_from_a_params_file_stops_the_robot_before_the_obstacle(
+    sim_with_stop_polygon: SimProcess,
+) -> None:
+    seen = client(sim_with_stop_polygon, "monitor", "--seconds", "6")
+    assert seen["states_on"][0] == [1, "PolygonStop"]  # STOP
+    speeds = seen["speeds_on"]
+    assert speeds[0] == pytest.approx(0.2) and speeds[-1] == 0.0
+    assert all(s in (pytest.approx(0.2), 0.0) for s in speeds)  # no slowing: a stop

@@ -19,8 +19,9 @@ on the ``collision_monitor`` lifecycle node:
 The polygons are the node's parameters under Nav2's names (``polygons``, and for each
 ``type`` polygon / circle, ``action_type``, ``points`` or ``footprint_topic``,
 ``radius``, ``min_points``, ``slowdown_ratio``, ``linear_limit``, ``angular_limit``,
-``time_before_collision``, ``simulation_time_step``, ``enabled``), so nav2_bringup's
-params file given with ``--ros-args --params-file`` configures it; without them,
+``time_before_collision``, ``simulation_time_step``, ``enabled``), so a Nav2 params
+file given to ``python -m navseq.ros2.sim_node`` with ``--ros-args --params-file``
+configures it; without them,
 nav2_bringup's ``FootprintApproach``. A circle is checked as a 32-sided polygon. While
 the node is not active nothing passes on: the robot stops, as without Nav2's monitor.
 """
