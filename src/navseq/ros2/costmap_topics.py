@@ -20,7 +20,10 @@ What RViz's costmap displays and ``nav2_simple_commander``'s ``getGlobalCostmap(
   not). The full costmap is published as well, so a display that reads only the full
   topic stays right;
 - ``*/published_footprint`` (``geometry_msgs/PolygonStamped``): the robot's outline
-  where it stands, in each costmap's frame;
+  where it stands, in each costmap's frame; ``*/footprint`` (``geometry_msgs/Polygon``,
+  subscribed as Nav2's costmaps do) replaces that costmap's outline (the robot frame's
+  points), and the local one is the collision monitor's ``FootprintApproach`` polygon.
+  The body, the planner and the controller keep the robot profile's;
 - ``*/get_costmap`` (``nav2_msgs/srv/GetCostmap``): the costmap now.
 """
 
@@ -33,7 +36,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from geometry_msgs.msg import Point32, PolygonStamped
+from geometry_msgs.msg import Point32, Polygon, PolygonStamped
 from nav2_msgs.msg import Costmap as CostmapMsg
 from nav2_msgs.msg import CostmapUpdate
 from nav2_msgs.srv import GetCostmap
@@ -45,6 +48,7 @@ from navseq.geometry import Pose2D, compose, inverse
 from navseq.ros2.messages import pose_msg
 from navseq.ros2.standin import Nav2StandIn
 from navseq.sim.costmap import occupancy_values
+from navseq.sim.occupancy import OccupancyGrid
 
 try:  # Nav2's build has map_msgs; a minimal ROS 2 (the test machine's) may not
     from map_msgs.msg import OccupancyGridUpdate
@@ -92,6 +96,10 @@ class CostmapTopics:
         self._publishers: dict[str, tuple[Any, Any, Any]] = {}
         self._update_publishers: dict[str, tuple[Any | None, Any]] = {}
         self._last_sent: dict[str, CostWindow] = {}  # each costmap as last published
+        # A footprint published on a costmap's ``footprint`` topic replaces the profile's
+        # for that costmap (None: the profile's), as Nav2's setRobotFootprintPolygon does.
+        self._footprints: dict[str, np.ndarray | None] = {}
+        self._log = node.get_logger()
         for name in ("global_costmap", "local_costmap"):
             self._publishers[name] = (
                 node.create_publisher(OccupancyGridMsg, f"{name}/costmap", LATCHED),
@@ -107,6 +115,9 @@ class CostmapTopics:
             node.create_service(
                 GetCostmap, f"{name}/get_costmap", self._get_costmap(name), callback_group=group
             )
+            node.create_subscription(
+                Polygon, f"{name}/footprint", self._on_footprint(name), 10, callback_group=group
+            )
         if OccupancyGridUpdate is None:
             node.get_logger().info(
                 "*/costmap_updates not served: map_msgs is not installed "
@@ -118,7 +129,6 @@ class CostmapTopics:
         """Both footprints and the local costmap; the global one when it changed."""
         with self._lock:
             server = self._standin.world.server
-            body = self._standin.world.body
             changed = server.costmap_version != self._global_version
             self._global_version = server.costmap_version
             windows = {"local_costmap": self._local_window()}
@@ -127,7 +137,7 @@ class CostmapTopics:
             # Where the robot believes it is: the transforms the node publishes.
             localization = self._standin.localization
             pose, odom_pose = localization.believed_pose, localization.odom_pose
-            footprint = body.footprint.polygon
+            footprints = {name: self.footprint(name) for name in self._publishers}
         stamp = self._stamp()
         for name, window in windows.items():
             grid, raw, _ = self._publishers[name]
@@ -138,7 +148,27 @@ class CostmapTopics:
             ("global_costmap", pose, self._map_frame),
             ("local_costmap", odom_pose, self._odom_frame),
         ):
-            self._publishers[name][2].publish(footprint_msg(footprint, at, frame, stamp))
+            self._publishers[name][2].publish(footprint_msg(footprints[name], at, frame, stamp))
+
+    def footprint(self, name: str) -> np.ndarray:
+        """The outline costmap ``name`` holds (robot frame): one published on its
+        ``footprint`` topic, else the robot profile's (call with the lock)."""
+        given = self._footprints.get(name)
+        return self._standin.world.body.footprint.polygon if given is None else given
+
+    def _on_footprint(self, name: str) -> Callable[[Any], None]:
+        def take(message: Any) -> None:
+            points = np.array([(p.x, p.y) for p in message.points], dtype=float).reshape(-1, 2)
+            if len(points) < 3:
+                self._log.warning(f"{name}/footprint ignored: fewer than 3 points")
+                return
+            with self._lock:
+                self._footprints[name] = points
+                if name == "local_costmap":  # the collision monitor's footprint_topic
+                    self._standin.monitor.monitor.footprint = points
+            self._log.info(f"{name}: footprint of {len(points)} points")
+
+        return take
 
     def _publish_update(self, name: str, window: CostWindow, stamp: Any) -> None:
         """The changed part of ``name`` since it was last published, if any."""
@@ -147,7 +177,7 @@ class CostmapTopics:
         self._last_sent[name] = CostWindow(
             window.cost.copy(), window.resolution, window.origin, window.frame
         )
-        if previous is None or not _same_area(previous, window):
+        if previous is None or not same_area(previous, window):
             return
         bounds = changed_bounds(previous.cost, window.cost)
         if bounds is None:
@@ -175,28 +205,39 @@ class CostmapTopics:
         """The rolling window about the robot, cut from the global costmap (cells off the
         map unknown), its origin given in the odom frame."""
         costmap = self._standin.world.server.costmap
-        grid, localization = costmap.grid, self._standin.localization
-        cells = round(LOCAL_SIZE_M / grid.resolution)
-        believed = localization.believed_pose
-        row, col = grid.world_to_cell(believed.x, believed.y)
-        top, left = row - cells // 2, col - cells // 2
-        window = np.full((cells, cells), 255, dtype=np.uint8)
-        rows = slice(max(top, 0), min(top + cells, grid.height))
-        cols = slice(max(left, 0), min(left + cells, grid.width))
-        if rows.start < rows.stop and cols.start < cols.stop:
-            window[rows.start - top : rows.stop - top, cols.start - left : cols.stop - left] = (
-                costmap.cost[rows, cols]
-            )
-        corner = compose(grid.origin, Pose2D(left * grid.resolution, top * grid.resolution, 0.0))
-        in_odom = compose(inverse(localization.estimate), corner)
-        return CostWindow(window, grid.resolution, in_odom, self._odom_frame)
+        return local_window(
+            costmap.cost, costmap.grid, self._standin.localization, self._odom_frame, fill=255
+        )
+
+
+def local_window(
+    cost: np.ndarray, grid: OccupancyGrid, localization: Any, frame: str, *, fill: int
+) -> CostWindow:
+    """nav2_bringup's rolling window (``LOCAL_SIZE_M`` square) about the robot's believed
+    pose, cut from ``cost`` (cells of ``grid``; ``fill`` off the map), its origin given in
+    the odom frame ``frame`` through ``localization``'s estimate."""
+    cells = round(LOCAL_SIZE_M / grid.resolution)
+    believed = localization.believed_pose
+    row, col = grid.world_to_cell(believed.x, believed.y)
+    top, left = row - cells // 2, col - cells // 2
+    window = np.full((cells, cells), fill, dtype=np.uint8)
+    rows = slice(max(top, 0), min(top + cells, grid.height))
+    cols = slice(max(left, 0), min(left + cells, grid.width))
+    if rows.start < rows.stop and cols.start < cols.stop:
+        window[rows.start - top : rows.stop - top, cols.start - left : cols.stop - left] = cost[
+            rows, cols
+        ]
+    corner = compose(grid.origin, Pose2D(left * grid.resolution, top * grid.resolution, 0.0))
+    in_odom = compose(inverse(localization.estimate), corner)
+    return CostWindow(window, grid.resolution, in_odom, frame)
 
 
 #: Changed cells: column and row of the lower-left one, width and height (in cells).
 Bounds = tuple[int, int, int, int]
 
 
-def _same_area(first: CostWindow, second: CostWindow) -> bool:
+def same_area(first: CostWindow, second: CostWindow) -> bool:
+    """Whether two windows cover the same cells (an update can say what changed)."""
     return (
         first.cost.shape == second.cost.shape
         and first.resolution == second.resolution

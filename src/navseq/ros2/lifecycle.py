@@ -76,12 +76,59 @@ _FINALIZED = State.PRIMARY_STATE_FINALIZED
 
 
 class _ManagedServer(LifecycleNode):
-    """A Nav2 server's lifecycle: every transition succeeds; the state is all it keeps."""
+    """A Nav2 server's lifecycle: every transition succeeds; the state is all it keeps.
+
+    Nodes it owns (:meth:`own`: the planner's and the controller's costmaps, as in Nav2)
+    take each of its transitions with it, whoever asked for it.
+    """
+
+    owned: list[_ManagedServer]
 
     @property
     def state_id(self) -> int:
         # The state machine's own record (changed by change_state calls from outside too).
         return int(self._state_machine.current_state[0])
+
+    def own(self, node: _ManagedServer) -> None:
+        if not hasattr(self, "owned"):
+            self.owned = []
+        self.owned.append(node)
+
+    def _follow(self, source: int | None, trigger: str) -> None:
+        for node in getattr(self, "owned", []):
+            _move(node, node.state_id if source is None else source, getattr(node, trigger))
+
+    def on_configure(self, state: Any) -> TransitionCallbackReturn:
+        self._follow(_UNCONFIGURED, "trigger_configure")
+        return super().on_configure(state)
+
+    def on_activate(self, state: Any) -> TransitionCallbackReturn:
+        self._follow(_INACTIVE, "trigger_activate")
+        return super().on_activate(state)
+
+    def on_deactivate(self, state: Any) -> TransitionCallbackReturn:
+        self._follow(_ACTIVE, "trigger_deactivate")
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: Any) -> TransitionCallbackReturn:
+        self._follow(_INACTIVE, "trigger_cleanup")
+        return super().on_cleanup(state)
+
+    def on_shutdown(self, state: Any) -> TransitionCallbackReturn:
+        self._follow(None, "trigger_shutdown")
+        return super().on_shutdown(state)
+
+
+def managed_node(
+    name: str, namespace: str | None, parameters: Sequence[Parameter]
+) -> _ManagedServer:
+    """A lifecycle node of the kind the Nav2 servers are (for nodes a server owns)."""
+    return _ManagedServer(
+        name,
+        namespace=namespace or None,
+        parameter_overrides=list(parameters),
+        automatically_declare_parameters_from_overrides=True,
+    )
 
 
 class Nav2Lifecycle:
@@ -220,4 +267,10 @@ def _ok(result: Any) -> bool:
     return bool(result == TransitionCallbackReturn.SUCCESS)
 
 
-__all__ = ["ACTION_SERVERS", "LOCALIZATION_NODES", "NAVIGATION_NODES", "Nav2Lifecycle"]
+__all__ = [
+    "ACTION_SERVERS",
+    "LOCALIZATION_NODES",
+    "NAVIGATION_NODES",
+    "Nav2Lifecycle",
+    "managed_node",
+]

@@ -133,6 +133,9 @@ from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.costmap_filters import filters_summary
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
+from navseq.ros2.collision_monitor import CollisionMonitorTopics
+from navseq.ros2.costmap_layers import CostmapLayers
+from navseq.ros2.costmap_nodes import nav2_costmap_nodes
 from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
@@ -176,6 +179,7 @@ from navseq.text import printable
 NODE_NAME = "navseq_sim"
 MAP_FRAME = "map"
 FEEDBACK_PERIOD = 0.1  # s of wall time between two feedback messages of a goal
+BASE_LINK_Z = 0.010  # m: a TurtleBot3's base_link above base_footprint
 # Wall seconds without another robot's transforms before it is left out. Its node
 # publishes /tf every step (20 Hz); a second covers a busy CPU, not a dead node.
 OTHER_POSE_TOLERANCE = 1.0
@@ -356,6 +360,16 @@ class SimNode:
             node, self.standin, self._lock, group, filters=config.filters, stamp=self._stamp,
             frame=MAP_FRAME,
         )  # fmt: skip
+        # -- costmap layers and the collision monitor (issue 20) --
+        self._layers = CostmapLayers(
+            node, self.standin, self._lock, group, stamp=self._stamp, map_frame=MAP_FRAME,
+            odom_frame=self.odom_frame, sensor_height=BASE_LINK_Z + self._scan.spec.height,
+        )  # fmt: skip
+        self._monitor = CollisionMonitorTopics(
+            servers["collision_monitor"], self.standin, self._lock, group,
+            active=lambda: lifecycle.is_active("collision_monitor"),
+            own_smoothed=lambda: self._velocities.last_smoothed, base_frame=self.base_frame,
+        )  # fmt: skip
         stamp = self._stamp()
         # robot_state_publisher's part of a TurtleBot3's tree: the body above the floor,
         # the laser on it.
@@ -363,7 +377,7 @@ class SimNode:
         base_link.header.frame_id = self.base_frame
         base_link.header.stamp = stamp
         base_link.child_frame_id = self.base_link
-        base_link.transform.translation.z = 0.010
+        base_link.transform.translation.z = BASE_LINK_Z
         base_link.transform.rotation.w = 1.0
         scan = base_scan_transform(self.base_link, self.base_scan, stamp, self._scan.spec)
         self._tf_static_pub.publish(TFMessage(transforms=[base_link, scan]))
@@ -490,6 +504,7 @@ class SimNode:
             self._plan_pub.publish(plan_message)
             self._received_plan_pub.publish(plan_message)
         self._velocities.publish()
+        self._monitor.publish()
         self._localization.publish()
         self._scan.publish_if_due()
         if topic_ending is not None:
@@ -710,7 +725,10 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         overrides = [Parameter("use_sim_time", value=True)] if config.sim_time else []
         node = Node(NODE_NAME, namespace=config.namespace or None, parameter_overrides=overrides)
         lifecycle = Nav2Lifecycle(config.namespace, nav2_server_parameters(config.robot))
-        helpers = [*lifecycle.nodes, *nav2_costmap_nodes(config.robot, config.namespace)]
+        helpers = [
+            *lifecycle.nodes,
+            *nav2_costmap_nodes(config.robot, config.namespace, lifecycle),
+        ]
         try:
             sim = SimNode(node, config, lifecycle)
         except NavseqError as error:
@@ -792,27 +810,6 @@ def velocity_smoother_parameters(limits: SmootherLimits) -> list[Parameter]:
         Parameter("max_accel", value=[limits.accel_v, 0.0, limits.accel_w]),
         Parameter("max_decel", value=[-limits.decel_v, 0.0, -limits.decel_w]),
         Parameter("velocity_timeout", value=limits.timeout),
-    ]
-
-
-def nav2_costmap_nodes(robot: RobotProfile, namespace: str | None) -> list[Node]:
-    """``global_costmap/global_costmap`` and ``local_costmap/local_costmap``, holding the
-    robot's outline and inflation where Nav2's costmaps keep them."""
-    ns = f"/{namespace.strip('/')}" if namespace and namespace.strip("/") else ""
-    outline = "[" + ", ".join(f"[{x:g}, {y:g}]" for x, y in robot.footprint) + "]"
-    costmap = [
-        Parameter("footprint", value=outline),
-        Parameter("inflation_layer.inflation_radius", value=robot.inflation_radius),
-        Parameter("inflation_layer.cost_scaling_factor", value=robot.cost_scaling_factor),
-    ]
-    return [
-        Node(
-            name,
-            namespace=f"{ns}/{name}",
-            parameter_overrides=costmap,
-            automatically_declare_parameters_from_overrides=True,
-        )
-        for name in ("global_costmap", "local_costmap")
     ]
 
 

@@ -67,6 +67,7 @@ from navseq.errors import NavseqError
 from navseq.geometry import Pose2D
 from navseq.mission.costmap_filters import CostmapFilter
 from navseq.sim.behaviors import BehaviorServer
+from navseq.sim.collision_monitor import CollisionMonitor, MonitorStage, nav2_bringup_polygons
 from navseq.sim.filters import with_filters
 from navseq.sim.localization import Localization
 from navseq.sim.navserver import CONTROL_FAILED, NavState
@@ -201,6 +202,10 @@ class Commands:
     nav: tuple[float, float] = (0.0, 0.0)
     smoothed: tuple[float, float] = (0.0, 0.0)
     driving: bool = False
+    # What the collision monitor passed on to the base (``cmd_vel``), and whether it
+    # came from outside on ``cmd_vel_smoothed`` (teleop through the monitor) this step.
+    out: tuple[float, float] = (0.0, 0.0)
+    monitored_teleop: bool = False
 
 
 @dataclass(frozen=True)
@@ -254,6 +259,12 @@ class Nav2StandIn:
         self.commands = Commands()
         # The costmap filters laid over every map the world gets (``replace_map``).
         self.filters: tuple[CostmapFilter, ...] = ()
+        # Nav2's collision monitor between the smoother and the base (nav2_bringup's
+        # FootprintApproach polygon on the robot's footprint, the laser as its source).
+        self.monitor = MonitorStage(
+            CollisionMonitor(nav2_bringup_polygons(), world.footprint.polygon)
+        )
+        self._smoothed_teleop: tuple[float, float, float] | None = None  # v, w, time
 
     # -- goals -----------------------------------------------------------------------
 
@@ -391,10 +402,13 @@ class Nav2StandIn:
         self.commands.driving = smoother.active(self.time) and (
             nav is not None or smoother.output != (0.0, 0.0)
         )
+        self.commands.monitored_teleop = False
         if self.commands.driving:
             self.commands.smoothed = smoother.step(self.time, world.dt)
-            world.drive(*self.commands.smoothed)
+            self.commands.out = self.monitor.filter(*self.commands.smoothed, world, self.time)
+            world.drive(*self.commands.out)
         else:
+            self._monitored_teleop()
             body.step(world.dt)  # idle: a teleop command, or braking to rest
         self.localization.moved(body.pose)
         self.time += world.dt
@@ -415,7 +429,32 @@ class Nav2StandIn:
         ):
             return False
         self.world.body.command(v, w)
+        self._smoothed_teleop = None  # on cmd_vel, past the monitor
         return True
+
+    def command_smoothed(self, v: float, w: float) -> bool:
+        """A command from outside on ``cmd_vel_smoothed``: teleop through the collision
+        monitor, as Nav2's monitor takes it; ignored (False) while the chain drives."""
+        if not self.command(v, w):
+            return False
+        self._smoothed_teleop = (v, w, self.time)
+        return True
+
+    def _monitored_teleop(self) -> None:
+        """Pass the latest ``cmd_vel_smoothed`` teleop command through the monitor to
+        the body (each step: what the monitor sees changes as the robot moves)."""
+        teleop = self._smoothed_teleop
+        if teleop is None:
+            return
+        v, w, at = teleop
+        if self.time - at > self.world.body.cmd_vel_timeout:
+            self._smoothed_teleop = None
+            self.commands.out = (0.0, 0.0)
+            self.world.body.command(0.0, 0.0)  # the commands stopped coming: brake
+            return
+        self.commands.out = self.monitor.filter(v, w, self.world, self.time)
+        self.commands.monitored_teleop = True
+        self.world.body.command(*self.commands.out)
 
     def teleport(self, pose: Pose2D) -> str | None:
         """Put the robot at ``pose`` (and the belief with it); why not, if it cannot be."""

@@ -6,7 +6,9 @@ depth 1 as Nav2's publishers):
 
 - ``cmd_vel_nav``: the controller's (or a behaviour's) command, after the speed limit;
 - ``cmd_vel_smoothed``: the velocity smoother's output;
-- ``cmd_vel``: what the collision monitor passes on to the base (the same command).
+- ``cmd_vel``: what the collision monitor passes on to the base
+  (:mod:`navseq.ros2.collision_monitor`); also when a command from outside came on
+  ``cmd_vel_smoothed`` (teleop through the monitor).
 
 Each is published every step while the chain drives, and once more as zero when it
 stops. ``speed_limit`` (``nav2_msgs/SpeedLimit``, as the controller server subscribes
@@ -47,7 +49,9 @@ class VelocityTopics:
         self._smoothed_pub = node.create_publisher(Twist, "cmd_vel_smoothed", 1)
         self._cmd_pub = node.create_publisher(Twist, "cmd_vel", 1)
         self._was_driving = False
+        self._was_teleop = False
         self._last_own_cmd = -float("inf")
+        self._last_smoothed = -float("inf")
         node.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 10, callback_group=group)
         node.create_subscription(
             SpeedLimit, "speed_limit", self._on_speed_limit, 10, callback_group=group
@@ -57,15 +61,27 @@ class VelocityTopics:
         """This step's commands (call after a simulation step)."""
         with self._lock:
             commands = self._standin.commands
-            driving, nav, smoothed = commands.driving, commands.nav, commands.smoothed
+            driving, nav, smoothed, out = (
+                commands.driving,
+                commands.nav,
+                commands.smoothed,
+                commands.out,
+            )
+            teleop = commands.monitored_teleop
+        if teleop or self._was_teleop:
+            # cmd_vel_smoothed from outside: only the monitor's output is ours.
+            self._last_own_cmd = time.monotonic()
+            self._cmd_pub.publish(twist(*(out if teleop else (0.0, 0.0))))
+            self._was_teleop = teleop
         if not (driving or self._was_driving):
             return
         if not driving:
-            nav = smoothed = (0.0, 0.0)
+            nav = smoothed = out = (0.0, 0.0)
         self._last_own_cmd = time.monotonic()
         self._nav_pub.publish(twist(*nav))
         self._smoothed_pub.publish(twist(*smoothed))
-        self._cmd_pub.publish(twist(*smoothed))
+        self._last_smoothed = self._last_own_cmd
+        self._cmd_pub.publish(twist(*out))
         self._was_driving = driving
 
     def stop(self) -> None:
@@ -85,6 +101,12 @@ class VelocityTopics:
             limit.set(bool(message.percentage), float(message.speed_limit))
             now = limit.limit
         self._log.info("speed_limit: " + ("none" if now is None else f"{now:.3f} m/s"))
+
+    @property
+    def last_smoothed(self) -> float:
+        """When (monotonic s) the chain last published ``cmd_vel_smoothed``: what is
+        heard there within ``TELEOP_QUIET`` of it is our own command echoed back."""
+        return self._last_smoothed
 
 
 __all__ = ["TELEOP_QUIET", "VelocityTopics", "twist"]

@@ -72,6 +72,11 @@ class SimulatedBase:
         """Where the other robots are now (map frame) and their outlines; replaces the last."""
         self._others = list(others)
 
+    @property
+    def others(self) -> list[tuple[Pose2D, Footprint]]:
+        """The other robots as last set (the simulated laser sees them too)."""
+        return self._others
+
     def collides(self, pose: Pose2D) -> bool:
         """True when the footprint at ``pose`` overlaps an obstacle, unknown space, the edge,
         or another robot."""

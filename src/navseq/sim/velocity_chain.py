@@ -17,9 +17,7 @@ smooths once per simulation step (20 Hz, nav2_bringup's ``smoothing_frequency``)
 or an absolute one in m/s; 0 lifts the limit. As Regulated Pure Pursuit lowers its
 desired speed, a limited command keeps its curvature (the turn rate scales with it).
 
-The collision monitor passes commands on unchanged in the stand-in (nav2_bringup's
-only polygon is ``FootprintApproach``, and the simulated body refuses to touch
-anything anyway).
+The collision monitor, the chain's last stage, is :mod:`navseq.sim.collision_monitor`.
 """
 
 from __future__ import annotations
