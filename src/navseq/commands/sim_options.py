@@ -86,6 +86,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "and name: {type, frame, pose: [x, y, yaw]}, or a dock database file): "
         "dock_robot goals by id drive to them",
     )
+    parser.add_argument(
+        "--route-graph",
+        type=Path,
+        metavar="FILE",
+        help="(--ros2) the route server's graph, in Nav2's GeoJSON route graph format "
+        "(Point features: nodes; LineString features: one-way edges startid -> endid): "
+        "compute_route and compute_and_track_route plan on it",
+    )
     add_datum_argument(parser)
     add_world_arguments(parser)
 
@@ -149,4 +157,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         initial_pose=args.initial_pose,
         ros1=ros1,
         datum=getattr(args, "datum", ""),
+        route_graph=getattr(args, "route_graph", None),
     )
