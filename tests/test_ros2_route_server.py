@@ -26,9 +26,11 @@ GRAPH = REPO / "examples" / "turtlebot3_route_graph.geojson"
 CLIENTS = Path(__file__).with_name("ros2_route_clients.py")
 
 
-def run_client(sim: SimProcess, verb: str, *args: str) -> dict:
+def run_client(sim: SimProcess, verb: str, *poses: str, **options: str) -> dict:
+    """Options first, then ``--``: poses like ``-1.0,-0.5`` are not options."""
+    flags = [part for key, value in options.items() for part in (f"--{key}", value)]
     done = subprocess.run(
-        [sys.executable, str(CLIENTS), verb, *args],
+        [sys.executable, str(CLIENTS), *flags, verb, "--", *poses],
         env=sim.env,
         capture_output=True,
         text=True,
@@ -93,13 +95,13 @@ def test_tracking_a_route_while_follow_path_drives_it_ends_at_the_goal(sim: SimP
 def test_the_graph_is_drawn_and_a_bad_graph_file_leaves_none(sim: SimProcess, tmp_path) -> None:
     bad = tmp_path / "bad.geojson"
     bad.write_text('{"type": "FeatureCollection", "features": []}')
-    seen = run_client(sim, "graph", "--file", str(bad))
+    seen = run_client(sim, "graph", file=str(bad))
     assert seen["nodes_drawn"] == 12
     assert seen["success"] is False
     nothing = run_client(sim, "route", "1", "10")
     # Nav2 Jazzy clears the graph before loading: goals then end with a default result.
     assert (nothing["status"], nothing["error_code"]) == ("ABORTED", 0)
-    again = run_client(sim, "graph", "--file", str(GRAPH))
+    again = run_client(sim, "graph", file=str(GRAPH))
     assert again["success"] is True and again["nodes_drawn_after"] == 12
 
 

@@ -25,6 +25,8 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
   ``published_footprint``, the local ones) and ``get_costmap`` services
   (:mod:`navseq.ros2.costmap_topics`), their region clears and ``get_cost``, and the
   planner's ``is_path_valid`` (:mod:`navseq.ros2.costmap_services`);
+- bt_navigator's ``behavior_tree_log`` and its trees' ``controller_selector`` and
+  ``planner_selector`` (:mod:`navseq.ros2.bt_topics`);
 - the route server's ``compute_route`` and ``compute_and_track_route`` on the graph of
   ``--route-graph`` (:mod:`navseq.ros2.route_server`);
 - opennav_docking's ``dock_robot`` / ``undock_robot`` on the docks of ``--docks``
@@ -129,6 +131,7 @@ from navseq.errors import NavseqError, error_text
 from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
+from navseq.ros2.bt_topics import BtTopics
 from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
@@ -317,6 +320,7 @@ class SimNode:
             node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
             stamp=self._stamp, frame=MAP_FRAME,
         )  # fmt: skip
+        self._bt = BtTopics(node, self.standin, self._lock, group, stamp=self._stamp)
         self._routes = RouteServer(
             node, self.standin, self._lock, group, lifecycle, graph=config.route_graph,
             in_map=self._in_map, stamp=self._stamp, frame=MAP_FRAME,

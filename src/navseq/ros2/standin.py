@@ -250,6 +250,10 @@ class Nav2StandIn:
         self.smoother = VelocitySmoother()
         self.speed_limit = SpeedLimit(server.params.limits.max_v)
         self.commands = Commands()
+        # The navigator goal the tree started last (bt_navigator's log follows it), and
+        # what refuses a goal before it moves: the selectors' unknown plugin ids.
+        self.last_started: NavTask | None = None
+        self.refusal: Callable[[Navigator], Ending | None] | None = None
 
     # -- goals -----------------------------------------------------------------------
 
@@ -274,9 +278,17 @@ class Nav2StandIn:
                 )
             )
             return task
+        self.last_started = task
         running = active is not None and active.ending is None
         if active is not None:
             active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by a new goal"))
+        refused = self.refusal(navigator) if self.refusal is not None else None
+        if refused is not None:  # the tree took the goal; its planner or controller fails
+            if active is not None:
+                self.active = None
+                self._stop()
+            task.end(refused)
+            return task
         self.active = task
         server = self.world.server
         if (
