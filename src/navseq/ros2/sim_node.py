@@ -315,6 +315,8 @@ class SimNode:
             in_map=self._in_map,
             stamp=self._stamp,
             frame=MAP_FRAME,
+            base_frame=self.base_link,
+            odom_frame=self.odom_frame,
         )
         self._gps = GpsWaypointActions(
             node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
