@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+import subprocess
+
 import pytest
 
 from test_ros2_route_server import run_client, start_sim
@@ -50,3 +52,31 @@ def test_an_unknown_controller_selection_fails_goals_as_nav2s_controller_server_
         err = sim.stop()
     assert seen["results"] == [["ABORTED", 101]]  # FollowPath INVALID_CONTROLLER
     assert "controller_selector: 'Nope' is not a plugin of controller_server" in err
+
+
+def test_a_selection_published_with_the_ros2_cli_is_taken() -> None:
+    sim = start_sim()
+    try:
+        done = subprocess.run(
+            [
+                "ros2",
+                "topic",
+                "pub",
+                "--once",
+                "--qos-durability",
+                "transient_local",
+                "/controller_selector",
+                "std_msgs/msg/String",
+                "{data: FollowPath}",
+            ],
+            env=sim.env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert done.returncode == 0, done.stderr
+        seen = run_client(sim, "btlog", "-1.0,-0.5")
+    finally:
+        err = sim.stop()
+    assert "controller_selector: FollowPath selected" in err
+    assert seen["results"] == [["SUCCEEDED", 0]]

@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import re
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -113,3 +114,24 @@ def test_without_a_graph_goals_abort_as_nav2s_do() -> None:
         err = node.stop()
     assert (seen["status"], seen["error_code"]) == ("ABORTED", 0)
     assert "No graph set! Aborting request." in err
+
+
+def test_ros2_action_send_goal_computes_a_route(sim: SimProcess) -> None:
+    done = subprocess.run(
+        [
+            "ros2",
+            "action",
+            "send_goal",
+            "/compute_route",
+            "nav2_msgs/action/ComputeRoute",
+            "{start_id: 1, goal_id: 10}",
+        ],
+        env=sim.env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "Goal finished with status: SUCCEEDED" in done.stdout, done.stdout
+    node_ids = [int(n) for n in re.findall(r"nodeid: (\d+)", done.stdout)]
+    assert node_ids == [1, 2, 9, 10]
