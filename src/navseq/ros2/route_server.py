@@ -334,12 +334,13 @@ class RouteServer:
         nodes.color.r = 1.0
         edges = _marker(self._frame, stamp, "route_graph_edges", Marker.LINE_LIST, 0.05)
         edges.color.g, edges.color.a = 1.0, 0.5
-        for number, node in enumerate(graph.nodes.values() if graph is not None else (), 1):
-            nodes.points.append(_point(node))
-            markers.append(_label(self._frame, stamp, "route_graph_node_ids", number, node))
-        for edge in graph.edges if graph is not None else ():
-            start, end = graph.nodes[edge.start], graph.nodes[edge.end]  # type: ignore[union-attr]
-            edges.points.extend([_point(start), _point(end)])
+        if graph is not None:  # no graph: empty markers, which clear a display's old graph
+            for number, node in enumerate(graph.nodes.values(), 1):
+                nodes.points.append(_point(node))
+                markers.append(_label(self._frame, stamp, "route_graph_node_ids", number, node))
+            for edge in graph.edges:
+                start, end = graph.nodes[edge.start], graph.nodes[edge.end]
+                edges.points.extend([_point(start), _point(end)])
         markers.extend([edges, nodes])
         self._graph_pub.publish(MarkerArray(markers=markers))
 
