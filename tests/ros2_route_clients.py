@@ -9,6 +9,10 @@ stdout line: what it saw. Verbs:
 - ``track START GOAL``: ``compute_and_track_route`` as navigation2's ``example_route.py``
   drives it: each rerouted feedback's path goes to ``follow_path``; the feedback's node
   ids, both results and the robot's final pose (``map -> odom -> base`` on ``/tf``);
+- ``interrupt START GOAL``: ``compute_and_track_route`` with nothing driving the robot:
+  after its first feedback a ``route_server/ReroutingService/reroute`` call, then a
+  second goal (which preempts the first), then a cancel of the second; the statuses and
+  the feedback's ``rerouted`` flags of each;
 - ``graph``: the ``route_graph`` markers (transient local) and a ``set_route_graph`` call
   with ``--file``;
 - ``btlog X,Y X,Y``: ``behavior_tree_log`` while two ``navigate_to_pose`` goals run one
@@ -43,6 +47,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
+from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
@@ -182,6 +187,39 @@ def track(node: Node, args: argparse.Namespace) -> dict:
     }
 
 
+def interrupt(node: Node, args: argparse.Namespace) -> dict:
+    tracker = client(node, ComputeAndTrackRoute, "compute_and_track_route", args.timeout)
+    rerouted: dict[int, list[bool]] = {1: [], 2: []}
+
+    def watch(goal_number: int) -> Any:
+        return lambda message: rerouted[goal_number].append(bool(message.feedback.rerouted))
+
+    def until(condition: Any) -> None:
+        end = time.monotonic() + args.timeout
+        while not condition() and time.monotonic() < end:
+            rclpy.spin_once(node, timeout_sec=0.05)
+
+    goal = route_goal(ComputeAndTrackRoute, *args.poses[:2])
+    first = wait(node, tracker.send_goal_async(goal, feedback_callback=watch(1)), args.timeout)
+    until(lambda: rerouted[1])
+    service = node.create_client(Trigger, "route_server/ReroutingService/reroute")
+    if not service.wait_for_service(timeout_sec=args.timeout):
+        raise SystemExit("no reroute service")
+    answer = wait(node, service.call_async(Trigger.Request()), args.timeout)
+    until(lambda: rerouted[1].count(True) >= 2)
+    second = wait(node, tracker.send_goal_async(goal, feedback_callback=watch(2)), args.timeout)
+    first_result = wait(node, first.get_result_async(), args.timeout)
+    until(lambda: rerouted[2])
+    wait(node, second.cancel_goal_async(), args.timeout)
+    second_result = wait(node, second.get_result_async(), args.timeout)
+    return {
+        "reroute_answer": bool(answer.success),
+        "first": STATUS.get(first_result.status, str(first_result.status)),
+        "second": STATUS.get(second_result.status, str(second_result.status)),
+        "rerouted": [rerouted[1], rerouted[2]],
+    }
+
+
 def graph(node: Node, args: argparse.Namespace) -> dict:
     markers: list[MarkerArray] = []
     node.create_subscription(MarkerArray, "route_graph", markers.append, LATCHED)
@@ -265,7 +303,14 @@ def dockposes(node: Node, args: argparse.Namespace) -> dict:
     return {"status": STATUS.get(result.status, str(result.status)), **seen}
 
 
-VERBS = {"route": route, "track": track, "graph": graph, "btlog": btlog, "dockposes": dockposes}
+VERBS = {
+    "route": route,
+    "track": track,
+    "interrupt": interrupt,
+    "graph": graph,
+    "btlog": btlog,
+    "dockposes": dockposes,
+}
 
 
 def main() -> int:

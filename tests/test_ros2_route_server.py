@@ -93,6 +93,15 @@ def test_tracking_a_route_while_follow_path_drives_it_ends_at_the_goal(sim: SimP
     assert math.dist(seen["pose"], [0.55, -1.55]) < 0.15
 
 
+def test_a_reroute_plans_again_a_new_goal_preempts_and_a_cancel_cancels(sim: SimProcess) -> None:
+    seen = run_client(sim, "interrupt", "1", "10")
+    assert seen["reroute_answer"] is True
+    first, second = seen["rerouted"]
+    assert first[0] is True and first.count(True) == 2  # the start; planned again
+    assert (seen["first"], seen["second"]) == ("ABORTED", "CANCELED")
+    assert second[0] is True
+
+
 def test_the_graph_is_drawn_and_a_bad_graph_file_leaves_none(sim: SimProcess, tmp_path) -> None:
     bad = tmp_path / "bad.geojson"
     bad.write_text('{"type": "FeatureCollection", "features": []}')
