@@ -92,3 +92,28 @@ def test_a_preempting_goal_goes_on_in_the_same_tree() -> None:
     replan = _changes(log.observe(second, 0.3))
     assert replan[0] == ("ComputePathToPose", 6, "IDLE", "RUNNING")
     assert all(name != "NavigateRecovery" for name, *_ in replan)
+
+
+def test_a_recovery_runs_the_root_recovery_branch_then_the_navigation_again() -> None:
+    log = TreeLog(clock=lambda: 0.0)
+    goal = _goal()
+    log.observe(goal, 0.0)
+    spinning = _changes(log.observe(goal, 0.3, "rotate"))
+    assert spinning[:3] == [
+        ("FollowPath", 12, "RUNNING", "FAILURE"),
+        ("FollowPath", 12, "FAILURE", "IDLE"),
+        ("FollowPath", 11, "RUNNING", "FAILURE"),
+    ]
+    assert spinning[-2:] == [
+        ("RecoveryActions", 22, "IDLE", "RUNNING"),
+        ("Spin", 26, "IDLE", "RUNNING"),
+    ]
+    assert log.observe(goal, 2.0, "rotate") == []  # no re-plan while the tree recovers
+    again = _changes(log.observe(goal, 2.5))
+    assert again[0] == ("Spin", 26, "RUNNING", "SUCCESS")
+    assert ("NavigateWithReplanning", 2, "IDLE", "RUNNING") in again
+    assert again[-3:] == [
+        ("FollowPath", 11, "IDLE", "RUNNING"),
+        ("FollowPath", 12, "IDLE", "RUNNING"),
+        ("RateController", 5, "SUCCESS", "RUNNING"),
+    ]

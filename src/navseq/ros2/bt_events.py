@@ -20,10 +20,12 @@ succeeds: the tree starts and plans, FollowPath runs, every rate-controller peri
 planner runs again, and at the end everything returns to IDLE. Like Nav2's
 bt_navigator, which flushes the log at each tick of a running tree only, the events
 after a goal's last tick (its SUCCESS or FAILURE and the halt to IDLE) are published
-with the next goal's first message. Failures log the failing action and the nodes above
-it as FAILURE (the recovery subtree the stand-in runs in its own way is not logged); a
-cancel halts every node to IDLE. A goal that preempts one of the same navigator goes on
-in the same tree, with a re-plan.
+with the next goal's first message. When the stand-in's navigation server runs one of
+its recovery behaviours, FollowPath fails and the root's recovery branch runs the
+RoundRobin child it stands for (clear costmaps: ClearingActions, rotate: Spin, back
+up: BackUp), then the navigation starts again. A failed goal logs the failing action and
+the nodes above it as FAILURE; a cancel halts every node to IDLE. A goal that preempts
+one of the same navigator goes on in the same tree, with a re-plan.
 """
 
 from __future__ import annotations
@@ -35,6 +37,24 @@ from dataclasses import dataclass
 from navseq.ros2.standin import Navigator, NavTask, Outcome
 
 IDLE, RUNNING, SUCCESS, FAILURE = "IDLE", "RUNNING", "SUCCESS", "FAILURE"
+#: The default trees' recovery branch, depth first (its first node's uid: Tree.recovery_base).
+RECOVERY_BRANCH = (
+    "Sequence",
+    "Fallback",
+    "WouldAControllerRecoveryHelp",
+    "WouldAPlannerRecoveryHelp",
+    "RecoveryFallback",
+    "GoalUpdated",
+    "RecoveryActions",
+    "ClearingActions",
+    "ClearLocalCostmap-Subtree",
+    "ClearGlobalCostmap-Subtree",
+    "Spin",
+    "Wait",
+    "BackUp",
+)
+#: The stand-in's recovery behaviours as the RoundRobin's children they stand for.
+RECOVERY_ACTIONS = {"clear_costmap": "ClearingActions", "rotate": "Spin", "back_up": "BackUp"}
 
 
 @dataclass(frozen=True)
@@ -67,6 +87,11 @@ class Tree:
     follow_recovery: TreeNode
     follow: TreeNode
     period: float  # s: the rate controller's
+    recovery_base: int  # uid of the recovery branch's Sequence; its nodes follow
+
+    def recovery_node(self, name: str) -> TreeNode:
+        """A node of the recovery branch (``Sequence`` ... ``BackUp``) by name."""
+        return TreeNode(name, self.recovery_base + RECOVERY_BRANCH.index(name))
 
 
 def _common(rate_uid: int = 5) -> dict[str, TreeNode]:
@@ -86,6 +111,7 @@ TO_POSE_TREE = Tree(
     follow_recovery=TreeNode("FollowPath", 11),
     follow=TreeNode("FollowPath", 12),
     period=1.0,
+    recovery_base=16,
 )
 THROUGH_POSES_TREE = Tree(
     **_common(),
@@ -99,6 +125,7 @@ THROUGH_POSES_TREE = Tree(
     follow_recovery=TreeNode("FollowPath", 13),
     follow=TreeNode("FollowPath", 14),
     period=1.0 / 0.333,
+    recovery_base=18,
 )
 TREES = {Navigator.TO_POSE: TO_POSE_TREE, Navigator.THROUGH_POSES: THROUGH_POSES_TREE}
 
@@ -120,15 +147,18 @@ class TreeLog:
         self._clock = clock
         self._task: NavTask | None = None
         self._seen: NavTask | None = None  # the last goal the tree started for
+        self._recovery: str | None = None  # the recovery behaviour running
         self._tree: Tree | None = None
         self._planned_at = 0.0
         self._status: dict[TreeNode, str] = {}
         self._out: list[StatusChange] = []
         self._held: list[StatusChange] = []
 
-    def observe(self, started: NavTask | None, now: float) -> list[StatusChange]:
-        """The events to publish now, given the navigator goal started last and the
-        simulated time ``now``."""
+    def observe(
+        self, started: NavTask | None, now: float, recovery: str | None = None
+    ) -> list[StatusChange]:
+        """The events to publish now, given the navigator goal started last, the
+        simulated time ``now`` and the recovery behaviour the stand-in runs for it."""
         task = self._task
         if task is not None and task.ending is not None:
             if (
@@ -150,12 +180,11 @@ class TreeLog:
             and started.navigator in TREES
         ):
             self._start(started, now)
-        elif (
-            self._task is not None
-            and self._tree is not None
-            and now - self._planned_at >= self._tree.period - 1e-9
-        ):
-            self._plan(now, first=False)
+        elif self._task is not None and self._tree is not None:
+            if recovery != self._recovery:
+                self._recover(self._tree, recovery, now)
+            elif recovery is None and now - self._planned_at >= self._tree.period - 1e-9:
+                self._plan(now, first=False)
         if self._task is None:
             return []
         ready = [*self._held, *self._take()]
@@ -167,6 +196,7 @@ class TreeLog:
     def _start(self, task: NavTask, now: float) -> None:
         self._seen = self._task = task
         self._tree = TREES[task.navigator]
+        self._recovery = None
         tree = self._tree
         self._set(tree.root, RUNNING)
         self._set(tree.controller_selector, SUCCESS)
@@ -204,6 +234,53 @@ class TreeLog:
             self._set(tree.follow_recovery, RUNNING)
             self._set(tree.follow, RUNNING)
         self._set(tree.rate, RUNNING)
+
+    def _recover(self, tree: Tree, recovery: str | None, now: float) -> None:
+        """The navigation failed and a recovery runs (the root's recovery branch, its
+        RoundRobin's child for the stand-in's behaviour), or the one running ended and
+        the navigation starts again."""
+        node = tree.recovery_node
+        if self._recovery is not None:
+            action = node(RECOVERY_ACTIONS.get(self._recovery, "ClearingActions"))
+            for done in (
+                action,
+                node("RecoveryActions"),
+                node("RecoveryFallback"),
+                node("Sequence"),
+            ):
+                self._set(done, SUCCESS)
+            self._halt(tree, [node(name) for name in reversed(RECOVERY_BRANCH)])
+            self._recovery = None
+            self._set(tree.controller_selector, SUCCESS)
+            self._set(tree.planner_selector, SUCCESS)
+            self._set(tree.rate, RUNNING)
+            self._plan_start(tree)
+            self._set(tree.pipeline, RUNNING)
+            self._plan_done(tree, first=True)
+            self._planned_at = now
+        if recovery is None:
+            return
+        self._set(tree.follow, FAILURE)
+        self._set(tree.follow, IDLE)
+        self._set(tree.follow_recovery, FAILURE)
+        self._set(tree.pipeline, FAILURE)
+        self._halt(
+            tree,
+            (tree.controller_selector, tree.planner_selector, tree.rate, tree.follow_recovery),
+        )
+        self._set(tree.pipeline, IDLE)
+        self._set(node("Sequence"), RUNNING)
+        self._set(node("WouldAControllerRecoveryHelp"), SUCCESS)
+        self._set(node("Fallback"), SUCCESS)
+        self._set(node("RecoveryFallback"), RUNNING)
+        self._set(node("GoalUpdated"), FAILURE)
+        self._set(node("RecoveryActions"), RUNNING)
+        action = node(RECOVERY_ACTIONS.get(recovery, "ClearingActions"))
+        self._set(action, RUNNING)
+        if action.name == "ClearingActions":
+            self._set(node("ClearLocalCostmap-Subtree"), SUCCESS)
+            self._set(node("ClearGlobalCostmap-Subtree"), SUCCESS)
+        self._recovery = recovery
 
     def _end(self, task: NavTask) -> None:
         tree = self._tree
@@ -246,6 +323,7 @@ class TreeLog:
             tree.planner_selector,
             tree.rate,
             tree.pipeline,
+            *(tree.recovery_node(name) for name in reversed(RECOVERY_BRANCH)),
         )
 
     def _halt(self, tree: Tree, nodes: Sequence[TreeNode]) -> None:

@@ -76,7 +76,10 @@ class BtTopics:
 
     def _publish(self) -> None:
         with self._lock:
-            events = self._tree.observe(self._standin.last_started, self._standin.time)
+            standin = self._standin
+            running = standin.active is not None and standin.active is standin.last_started
+            recovery = standin.world.server.recovery_kind if running else None
+            events = self._tree.observe(standin.last_started, standin.time, recovery)
         if not events:
             return
         message = BehaviorTreeLog()
