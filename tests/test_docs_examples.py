@@ -88,6 +88,16 @@ RULES: tuple[Rule, ...] = (
         "tests/test_ros2_docking.py::test_ros2_action_send_goal_docks_and_undocks",
     ),
     Rule(
+        r"navseq sim --ros2 .*--route-graph|^ros2 action send_goal /compute_route",
+        "ros",
+        "tests/test_ros2_route_server.py::test_ros2_action_send_goal_computes_a_route",
+    ),
+    Rule(
+        r"^ros2 topic pub .*/controller_selector",
+        "ros",
+        "tests/test_ros2_bt_topics.py::test_a_selection_published_with_the_ros2_cli_is_taken",
+    ),
+    Rule(
         r"navseq sim --ros2",
         "ros",
         "tests/test_ros2_cli.py::test_navseq_sim_ros2_serves_until_a_signal_and_exits_0",

@@ -103,6 +103,7 @@ LIFECYCLE_NODES = [
     "controller_server",
     "smoother_server",
     "planner_server",
+    "route_server",
     "behavior_server",
     "velocity_smoother",
     "collision_monitor",

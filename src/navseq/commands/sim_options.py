@@ -87,6 +87,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "and name: {type, frame, pose: [x, y, yaw]}, or a dock database file): "
         "dock_robot goals by id drive to them",
     )
+    parser.add_argument(
+        "--route-graph",
+        type=Path,
+        metavar="FILE",
+        help="(--ros2) the route server's graph, in Nav2's GeoJSON route graph format "
+        "(Point features: nodes; LineString features: one-way edges startid -> endid): "
+        "compute_route and compute_and_track_route plan on it",
+    )
     add_datum_argument(parser)
     add_world_arguments(parser)
     add_sim_filter_options(parser)
@@ -152,4 +160,5 @@ def config_from_args(args: argparse.Namespace, *, ros1: bool = False) -> SimConf
         ros1=ros1,
         datum=getattr(args, "datum", ""),
         filters=sim_filters_of(args),
+        route_graph=getattr(args, "route_graph", None),
     )

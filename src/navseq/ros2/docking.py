@@ -18,15 +18,25 @@ timeout 30 s; undock tolerances 0.05 m and 0.1 rad) a docking goal goes as in Na
    there — through the stand-in's own bt_navigator, as Nav2's docking server is a
    ``navigate_to_pose`` client, so another client's navigation goal preempts it. A
    failed navigation or one longer than ``max_staging_time``: ``FAILED_TO_STAGE``;
-3. **perception** (``INITIAL_PERCEPTION``): the dock is where the docks file says (the
-   stand-in has no detector; Nav2's ``detected_dock_pose`` is not needed);
+3. **perception** (``INITIAL_PERCEPTION``): the dock is where the docks file says.
+   nav2_bringup's dock plugin takes the dock's pose from an external detector
+   (``use_external_detection_pose``) on ``detected_dock_pose``; the stand-in plays that
+   detector (:meth:`DockingServer.sighting`): while the robot perceives and approaches
+   the dock it sees the dock relative to its true pose (``base_link``, no noise, no
+   marker offsets), and the docking server's filtered estimate of it
+   (``filtered_dock_pose``) is that sighting in the ``odom`` frame (nav2_bringup's
+   ``fixed_frame``) through Nav2's pose filter (``filter_coef`` 0.1): with
+   ``--odom-drift`` it carries the localisation's error, as a detection does;
 4. **approach** (``CONTROLLING``): the robot drives to the dock pose at the docking
    controller's 0.15 m/s, turning toward it (a simple heading law, not Nav2's graceful
    controller), until it is within ``docking_threshold``. A footprint collision on the
    way, farther than ``dock_collision_threshold`` (0.3 m) from the dock, or no dock
    within ``dock_approach_timeout``: ``FAILED_TO_CONTROL``. Nav2 retries up to
    ``max_retries`` (3) from the staging pose; the stand-in does not retry
-   (``num_retries`` stays 0);
+   (``num_retries`` stays 0). Each cycle the controller's projected trajectory
+   (``docking_trajectory``: ``projection_time`` 5 s in ``simulation_step`` 0.1 s,
+   :meth:`DockingServer.trajectory`) is the heading law run ahead from the robot, in
+   ``base_link``, undocking too;
 5. **charging** (``WAIT_FOR_CHARGE``): nav2_bringup's dock reads no battery, so docked
    is charging: SUCCEEDED, ``success`` true.
 
@@ -48,7 +58,7 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from navseq.geometry import Pose2D
+from navseq.geometry import Pose2D, compose, inverse, normalize_angle
 from navseq.ros2.standin import Nav2StandIn, Navigator, NavTask, Outcome
 from navseq.sim.docks import DOCK_TYPES, Dock
 
@@ -78,6 +88,41 @@ class DockError(enum.IntEnum):
 
 
 @dataclass(frozen=True)
+class Sighting:
+    """The dock as the detector sees it (in the robot's base frame) and the docking
+    server's filtered estimate of it (in the odom frame)."""
+
+    detected: Pose2D
+    filtered: Pose2D
+
+
+class PoseFilter:
+    """Nav2's ``PoseFilter``: each measurement moves the estimate ``coef`` of the way to
+    it; one after more than ``timeout`` seconds without any restarts it."""
+
+    def __init__(self, coef: float = 0.1, timeout: float = 1.0) -> None:
+        self.coef = coef
+        self.timeout = timeout
+        self.pose: Pose2D | None = None
+        self._stamp = -math.inf
+
+    def update(self, measurement: Pose2D, now: float) -> Pose2D:
+        old = self.pose
+        if old is None or now - self._stamp > self.timeout or not 0.0 < self.coef < 1.0:
+            self.pose = measurement
+        else:
+            k = self.coef
+            turn = normalize_angle(measurement.yaw - old.yaw)
+            self.pose = Pose2D(
+                old.x + k * (measurement.x - old.x),
+                old.y + k * (measurement.y - old.y),
+                normalize_angle(old.yaw + k * turn),
+            )
+        self._stamp = now
+        return self.pose
+
+
+@dataclass(frozen=True)
 class DockingParams:
     """nav2_bringup's ``docking_server`` parameters (Jazzy ``nav2_params.yaml``)."""
 
@@ -91,6 +136,10 @@ class DockingParams:
     linear_speed: float = 0.15  # m/s: the controller's v_linear_min = v_linear_max
     heading_gain: float = 3.0  # 1/s: the controller's k_phi
     max_angular_speed: float = 1.0  # rad/s
+    filter_coef: float = 0.1  # simple_charging_dock's
+    external_detection_timeout: float = 1.0  # s
+    projection_time: float = 5.0  # s: the controller's trajectory ahead
+    simulation_step: float = 0.1  # s
 
 
 @dataclass
@@ -146,6 +195,7 @@ class DockingServer:
         self.active: DockingGoal | None = None
         self.docked_at: Pose2D | None = None  # the dock pose of the last docking
         self.dock_type = ""  # the last docking's type, for undocking
+        self.filter = PoseFilter(self.params.filter_coef, self.params.external_detection_timeout)
 
     # -- goals -----------------------------------------------------------------------
 
@@ -161,6 +211,7 @@ class DockingServer:
     ) -> DockingGoal:
         """Start a docking goal (by ``dock_id``, else at ``dock_pose``)."""
         goal = self._start(DockingGoal(undock=False, started=now))
+        self.filter.pose = None  # a new docking's estimate starts from its first sighting
         if dock_id is not None:
             dock = self.docks.get(dock_id)
             if dock is None:
@@ -217,6 +268,40 @@ class DockingServer:
         if self.active is not None:
             self.active.end(Outcome.ABORTED, DockError.UNKNOWN, why, success=False)
             self.active = None
+
+    def sighting(self, now: float, robot: Pose2D, odom: Pose2D) -> Sighting | None:
+        """What the detector and the filter give while a docking perceives or approaches
+        its dock (None otherwise); ``robot`` the true pose, ``odom`` the odometry's."""
+        goal = self.active
+        if (
+            goal is None
+            or goal.undock
+            or goal.dock is None
+            or goal.state not in (DockState.INITIAL_PERCEPTION, DockState.CONTROLLING)
+        ):
+            return None
+        detected = compose(inverse(robot), goal.dock.pose)
+        return Sighting(detected, self.filter.update(compose(odom, detected), now))
+
+    def trajectory(self, robot: Pose2D) -> list[Pose2D] | None:
+        """The controller's projected trajectory from the robot (in its base frame) while
+        it drives to the dock or out of it; None otherwise."""
+        goal = self.active
+        if goal is None or goal.target is None or goal.state is not DockState.CONTROLLING:
+            return None
+        params = self.params
+        target = compose(inverse(robot), goal.target)
+        pose = Pose2D(0.0, 0.0, 0.0)
+        poses = [pose]
+        dt = params.simulation_step
+        for _ in range(round(params.projection_time / dt)):
+            if pose.distance_to(target) < params.docking_threshold:
+                break
+            v, w = self._toward(pose, target, backwards=goal.undock)
+            yaw = pose.yaw + w * dt
+            pose = Pose2D(pose.x + v * math.cos(yaw) * dt, pose.y + v * math.sin(yaw) * dt, yaw)
+            poses.append(pose)
+        return poses
 
     def staging_pose(self, pose: Pose2D) -> Pose2D:
         """``staging_x_offset`` along ``pose``'s heading (simple_charging_dock's rule)."""
@@ -388,4 +473,12 @@ class DockingServer:
         return False
 
 
-__all__ = ["DockError", "DockState", "DockingGoal", "DockingParams", "DockingServer"]
+__all__ = [
+    "DockError",
+    "DockState",
+    "DockingGoal",
+    "DockingParams",
+    "DockingServer",
+    "PoseFilter",
+    "Sighting",
+]

@@ -3,6 +3,11 @@
 carry them, there is no separate opennav_docking_msgs), ``docking_server/reload_database``
 (``nav2_msgs/srv/ReloadDockDatabase``) and the dock plugin's ``dock_pose`` and
 ``staging_pose`` topics (``geometry_msgs/PoseStamped``, published when a docking starts).
+While a docking perceives and approaches its dock, every feedback period: the
+simulated detector's ``detected_dock_pose`` (in ``base_link``) and the dock plugin's
+``filtered_dock_pose`` (in ``odom``), and while the docking controller drives (docking
+or undocking) its projected ``docking_trajectory`` (``nav_msgs/Path`` in ``base_link``);
+see :mod:`navseq.ros2.docking`.
 
 The rules are :class:`navseq.ros2.docking.DockingServer`'s (the stand-in steps it with
 the robot); this module translates goals, feedback (``state``, ``docking_time``,
@@ -16,12 +21,13 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Sequence
-from pathlib import Path
+from pathlib import Path as FilePath
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import DockRobot, UndockRobot
 from nav2_msgs.srv import ReloadDockDatabase
+from nav_msgs.msg import Path
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
@@ -53,8 +59,12 @@ class DockingActions:
         in_map: InMap,
         stamp: Callable[[], Any],
         frame: str,
+        base_frame: str = "base_link",
+        odom_frame: str = "odom",
     ) -> None:
         self._standin = standin
+        self._base_frame = base_frame
+        self._odom_frame = odom_frame
         self._lock = lock
         self._in_map = in_map
         self._stamp = stamp
@@ -64,6 +74,9 @@ class DockingActions:
         standin.drivers.append(self.server)
         self._dock_pose_pub = node.create_publisher(PoseStamped, "dock_pose", 1)
         self._staging_pose_pub = node.create_publisher(PoseStamped, "staging_pose", 1)
+        self._detected_pub = node.create_publisher(PoseStamped, "detected_dock_pose", 1)
+        self._filtered_pub = node.create_publisher(PoseStamped, "filtered_dock_pose", 1)
+        self._trajectory_pub = node.create_publisher(Path, "docking_trajectory", 1)
         self.servers = [
             ActionServer(
                 node,
@@ -143,6 +156,8 @@ class DockingActions:
                 handle.publish_feedback(
                     DockRobot.Feedback(state=int(state), docking_time=elapsed, num_retries=0)
                 )
+            if not ended:
+                self._publish_sensing()
             if ended:
                 break
         result = DockRobot.Result()
@@ -164,7 +179,27 @@ class DockingActions:
                 with self._lock:
                     self.server.cancel(goal)
                 break
+            self._publish_sensing()
         return self._finish(handle, goal, UndockRobot.Result())
+
+    def _publish_sensing(self) -> None:
+        """The detector's sighting, the filtered dock pose and the controller's
+        trajectory, for what the docking does now."""
+        with self._lock:
+            world, localization = self._standin.world, self._standin.localization
+            robot = world.robot.pose
+            sighting = self.server.sighting(self._standin.time, robot, localization.odom_pose)
+            trajectory = self.server.trajectory(robot)
+        stamp = self._stamp()
+        if sighting is not None:
+            self._detected_pub.publish(pose_stamped(sighting.detected, self._base_frame, stamp))
+            self._filtered_pub.publish(pose_stamped(sighting.filtered, self._odom_frame, stamp))
+        if trajectory is not None:
+            path = Path()
+            path.header.frame_id = self._base_frame
+            path.header.stamp = stamp
+            path.poses = [pose_stamped(pose, self._base_frame, stamp) for pose in trajectory]
+            self._trajectory_pub.publish(path)
 
     def _finish(self, handle: Any, goal: DockingGoal, result: Any) -> Any:
         result.success = goal.success
@@ -185,7 +220,7 @@ class DockingActions:
             response.success = False
             return response
         try:
-            docks = read_docks_file(Path(request.filepath))
+            docks = read_docks_file(FilePath(request.filepath))
         except NavseqError as error:
             self._log.error(f"docking_server: {error_text(error)}")
             response.success = False

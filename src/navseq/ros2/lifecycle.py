@@ -41,6 +41,7 @@ NAVIGATION_NODES = (
     "controller_server",
     "smoother_server",
     "planner_server",
+    "route_server",
     "behavior_server",
     "velocity_smoother",
     "collision_monitor",
@@ -65,6 +66,8 @@ ACTION_SERVERS = {
     "drive_on_heading": "behavior_server",
     "wait": "behavior_server",
     "assisted_teleop": "behavior_server",
+    "compute_route": "route_server",
+    "compute_and_track_route": "route_server",
     "dock_robot": "docking_server",
     "undock_robot": "docking_server",
 }

@@ -25,6 +25,10 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
   ``published_footprint``, the local ones) and ``get_costmap`` services
   (:mod:`navseq.ros2.costmap_topics`), their region clears and ``get_cost``, and the
   planner's ``is_path_valid`` (:mod:`navseq.ros2.costmap_services`);
+- bt_navigator's ``behavior_tree_log`` and its trees' ``controller_selector`` and
+  ``planner_selector`` (:mod:`navseq.ros2.bt_topics`);
+- the route server's ``compute_route`` and ``compute_and_track_route`` on the graph of
+  ``--route-graph`` (:mod:`navseq.ros2.route_server`);
 - opennav_docking's ``dock_robot`` / ``undock_robot`` on the docks of ``--docks``
   (:mod:`navseq.ros2.docking`, :mod:`navseq.ros2.docking_actions`);
 - the behaviour server's ``spin``, ``backup``, ``drive_on_heading``, ``wait`` and
@@ -133,6 +137,7 @@ from navseq.geometry import Pose2D, compose, pose2d_from_transform
 from navseq.mission.costmap_filters import filters_summary
 from navseq.mission.robot import RobotProfile
 from navseq.ros2.behavior_actions import BehaviorActions
+from navseq.ros2.bt_topics import BtTopics
 from navseq.ros2.collision_monitor import CollisionMonitorTopics
 from navseq.ros2.costmap_layers import CostmapLayers
 from navseq.ros2.costmap_nodes import nav2_costmap_nodes
@@ -155,6 +160,7 @@ from navseq.ros2.messages import (
     transform_stamped,
 )
 from navseq.ros2.path_actions import PathActions
+from navseq.ros2.route_server import RouteServer
 from navseq.ros2.scan_topic import ScanTopic, base_scan_transform
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
@@ -322,10 +328,17 @@ class SimNode:
             in_map=self._in_map,
             stamp=self._stamp,
             frame=MAP_FRAME,
+            base_frame=self.base_link,
+            odom_frame=self.odom_frame,
         )
         self._gps = GpsWaypointActions(
             node, self.standin, self._lock, group, datum=config.datum, lifecycle=lifecycle,
             stamp=self._stamp, frame=MAP_FRAME,
+        )  # fmt: skip
+        self._bt = BtTopics(node, self.standin, self._lock, group, stamp=self._stamp)
+        self._routes = RouteServer(
+            node, self.standin, self._lock, group, lifecycle, graph=config.route_graph,
+            in_map=self._in_map, stamp=self._stamp, frame=MAP_FRAME,
         )  # fmt: skip
         # -- Nav2's world: map_server, amcl, the laser, the velocity chain (issue 20) --
         servers = lifecycle.servers
@@ -752,6 +765,11 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             + (f", other robots {', '.join(config.other_robots)}" if config.other_robots else "")
             + (f", docks {', '.join(d.name for d in config.docks)}" if config.docks else "")
             + (f", {filters_summary(config.filters)}" if config.filters else "")
+            + (
+                f", route graph of {len(config.route_graph.nodes)} nodes"
+                if config.route_graph is not None
+                else ""
+            )
             + (
                 f", re-plan period {config.replan_period:g} s on preemption"
                 if config.replan_period > 0

@@ -265,6 +265,10 @@ class Nav2StandIn:
             CollisionMonitor(nav2_bringup_polygons(), world.footprint.polygon)
         )
         self._smoothed_teleop: tuple[float, float, float] | None = None  # v, w, time
+        # The navigator goal the tree started last (bt_navigator's log follows it), and
+        # what refuses a goal before it moves: the selectors' unknown plugin ids.
+        self.last_started: NavTask | None = None
+        self.refusal: Callable[[Navigator], Ending | None] | None = None
 
     # -- goals -----------------------------------------------------------------------
 
@@ -289,9 +293,17 @@ class Nav2StandIn:
                 )
             )
             return task
+        self.last_started = task
         running = active is not None and active.ending is None
         if active is not None:
             active.end(Ending(Outcome.ABORTED, ErrorCode.NONE, "preempted by a new goal"))
+        refused = self.refusal(navigator) if self.refusal is not None else None
+        if refused is not None:  # the tree took the goal; its planner or controller fails
+            if active is not None:
+                self.active = None
+                self._stop()
+            task.end(refused)
+            return task
         self.active = task
         server = self.world.server
         if (

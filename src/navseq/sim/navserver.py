@@ -192,6 +192,11 @@ class NavigationServer:
         self._remaining_at_recovery = math.inf
         self.recoveries_run = 0  # behaviours run for this goal (tests, reports)
 
+    @property
+    def recovery_kind(self) -> str | None:
+        """The recovery behaviour running now (one of RECOVERY_BEHAVIOURS), or None."""
+        return self._recovery.kind if self._recovery is not None else None
+
     def follow_path(self, points: np.ndarray, goal: Pose2D) -> None:
         """Follow ``points`` (N, 2) to ``goal`` as given, as Nav2's controller server does
         a ``FollowPath`` goal: no planning nor re-planning, no recovery behaviours; a

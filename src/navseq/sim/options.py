@@ -21,6 +21,7 @@ from navseq.mission.geodesy import Datum, GeoPoint, check_latitude, check_longit
 from navseq.mission.robot import DEFAULT_PROFILE, RobotProfile
 from navseq.sim.docks import Dock, read_docks_file
 from navseq.sim.fleet import other_robots_problem
+from navseq.sim.route_graph import RouteGraph, read_route_graph
 from navseq.text import printable
 
 # Name rules for one namespace token: letters, digits, underscores; ROS 2 refuses a digit
@@ -59,6 +60,7 @@ class SimConfig:
     rate: float = 20.0  # simulation steps per simulated second
     docks: tuple[Dock, ...] = ()  # the docking server's docks (--docks, ROS 2 only)
     datum: Datum | None = None  # --datum: follow_gps_waypoints' and fromLL's (ROS 2)
+    route_graph: RouteGraph | None = None  # --route-graph: the route server's (ROS 2)
     tf_convention: str = "nav2"  # one of TF_CONVENTIONS
     odom_drift: float = 0.0  # odometry error per metre driven (ROS 2 stand-in)
     initial_pose: str = "estimate"  # one of INITIAL_POSE_MODES (ROS 2 stand-in)
@@ -207,6 +209,7 @@ def checked_config(
     ros1: bool = False,
     datum: str = "",
     filters: tuple[CostmapFilter, ...] = (),
+    route_graph: Path | None = None,
 ) -> SimConfig:
     """The checked settings from the values the options hold; every bad value is a
     NavseqError naming its option.
@@ -236,6 +239,7 @@ def checked_config(
         replan_period=replan_period_of(float(replan_period), ros1=ros1),
         docks=docks_of(docks, ros1=ros1),
         datum=datum_of(datum) if datum else None,
+        route_graph=route_graph_of(route_graph, ros1=ros1),
         tf_convention=tf_convention_of(tf_convention, ros1=ros1),
         odom_drift=odom_drift_of(float(odom_drift), ros1=ros1),
         initial_pose=initial_pose_of(initial_pose, ros1=ros1),
@@ -265,6 +269,18 @@ def docks_of(path: Path | None, *, ros1: bool = False) -> tuple[Dock, ...]:
         )
     require_file(path, "--docks")
     return read_docks_file(path)
+
+
+def route_graph_of(path: Path | None, *, ros1: bool = False) -> RouteGraph | None:
+    """``--route-graph FILE``: Nav2's GeoJSON route graph (ROS 2's route server only)."""
+    if path is None:
+        return None
+    if ros1:
+        raise NavseqError(
+            "the route server is Nav2's (nav2_route): use it with --ros2", source="--route-graph"
+        )
+    require_file(path, "--route-graph")
+    return read_route_graph(path)
 
 
 def datum_of(text: str) -> Datum:
