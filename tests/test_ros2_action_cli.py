@@ -30,6 +30,7 @@ pytestmark = pytest.mark.ros2
 
 BRINGUP = Path(__file__).with_name("data") / "nav2_bringup_interfaces.yaml"
 DOCKS = EXAMPLES / "turtlebot3_docks.yaml"
+ROUTE_GRAPH = EXAMPLES / "turtlebot3_route_graph.geojson"
 CLI_TIMEOUT = 120  # wall s: the CLI's start, discovery and the goal at the stand-in's speed
 
 
@@ -97,6 +98,10 @@ GOALS = [
         f"{{gps_poses: [{{position: {{latitude: {LAT}, longitude: {LON}}}}}]}}",
         "SUCCEEDED",
     ),
+    ("compute_route", "ComputeRoute", "{start_id: 1, goal_id: 10}", "SUCCEEDED"),
+    # Tracking ends when the robot, driven by another client along the route, arrives;
+    # a goal to a node the graph lacks ends at once, as the route server's do.
+    ("compute_and_track_route", "ComputeAndTrackRoute", "{start_id: 1, goal_id: 99}", "ABORTED"),
 ]
 #: nav2_bringup's lifecycle nodes (navigation and localization).
 LIFECYCLE_NODES = [
@@ -122,7 +127,9 @@ def standin() -> Iterator[SimNode]:
     assert prefix is not None
     env = ros2_environment(prefix)
     args = ["--map", str(MAP), f"--start={START}", "--speed", SPEED]
-    node = SimNode(env, *args, "--docks", str(DOCKS), "--datum", DATUM)
+    node = SimNode(
+        env, *args, "--docks", str(DOCKS), "--datum", DATUM, "--route-graph", str(ROUTE_GRAPH)
+    )
     yield node
     err = node.stop()
     assert node.process.returncode == 0, err
