@@ -18,7 +18,6 @@ from typing import Any
 
 from geometry_msgs.msg import Twist
 from nav2_msgs.action import AssistedTeleop, BackUp, DriveOnHeading, Spin, Wait
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 from rclpy.qos import qos_profile_system_default
 from std_msgs.msg import Empty
@@ -55,18 +54,15 @@ class BehaviorActions:
         self._standin = standin
         self._lock = lock
         self._log = node.get_logger()
-        self.servers = [
-            ActionServer(
-                node,
-                action,
-                behavior.value,
-                execute_callback=self._executor(behavior, action),
-                goal_callback=lifecycle.gate(behavior.value, self._log.info),
-                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                callback_group=group,
-            )
-            for behavior, action in _ACTIONS.items()
-        ]
+        self.servers = lifecycle.action_servers(
+            node,
+            group,
+            self._log.info,
+            [
+                (action, behavior.value, self._executor(behavior, action))
+                for behavior, action in _ACTIONS.items()
+            ],
+        )
         node.create_subscription(
             Twist,
             "cmd_vel_teleop",

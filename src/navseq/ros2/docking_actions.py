@@ -28,7 +28,6 @@ from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import DockRobot, UndockRobot
 from nav2_msgs.srv import ReloadDockDatabase
 from nav_msgs.msg import Path
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
 from navseq.errors import NavseqError, error_text
@@ -77,21 +76,15 @@ class DockingActions:
         self._detected_pub = node.create_publisher(PoseStamped, "detected_dock_pose", 1)
         self._filtered_pub = node.create_publisher(PoseStamped, "filtered_dock_pose", 1)
         self._trajectory_pub = node.create_publisher(Path, "docking_trajectory", 1)
-        self.servers = [
-            ActionServer(
-                node,
-                action,
-                name,
-                execute_callback=execute,
-                goal_callback=lifecycle.gate(name, self._log.info),
-                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                callback_group=group,
-            )
-            for action, name, execute in (
+        self.servers = lifecycle.action_servers(
+            node,
+            group,
+            self._log.info,
+            [
                 (DockRobot, "dock_robot", self._execute_dock),
                 (UndockRobot, "undock_robot", self._execute_undock),
-            )
-        ]
+            ],
+        )
         node.create_service(
             ReloadDockDatabase,
             "docking_server/reload_database",

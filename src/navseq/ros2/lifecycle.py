@@ -25,12 +25,12 @@ while inactive: only their action goals are refused.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 from lifecycle_msgs.msg import State
 from nav2_msgs.srv import ManageLifecycleNodes
-from rclpy.action import GoalResponse
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -187,6 +187,29 @@ class Nav2Lifecycle:
             return GoalResponse.REJECT
 
         return take
+
+    def action_servers(
+        self,
+        node: Node,
+        group: Any,
+        log: Callable[[str], None],
+        handlers: Iterable[tuple[Any, str, Callable[[Any], Any]]],
+    ) -> list[ActionServer]:
+        """One action server per ``(action type, name, execute callback)``, as Nav2's
+        servers take goals: only while their lifecycle node is active (:meth:`gate`);
+        a cancel is always accepted."""
+        return [
+            ActionServer(
+                node,
+                action,
+                name,
+                execute_callback=execute,
+                goal_callback=self.gate(name, log),
+                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
+                callback_group=group,
+            )
+            for action, name, execute in handlers
+        ]
 
     # -- managers ----------------------------------------------------------------------
 

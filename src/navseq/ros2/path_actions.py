@@ -34,7 +34,6 @@ import numpy as np
 from geometry_msgs.msg import PoseStamped
 from nav2_msgs.action import ComputePathThroughPoses, ComputePathToPose, FollowPath, SmoothPath
 from nav_msgs.msg import Path
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 
 from navseq.geometry import Pose2D
@@ -84,18 +83,7 @@ class PathActions:
             (SmoothPath, "smooth_path", self._smooth),
             (FollowPath, "follow_path", self._follow),
         ]
-        self.servers = [
-            ActionServer(
-                node,
-                action,
-                name,
-                execute_callback=execute,
-                goal_callback=lifecycle.gate(name, self._log.info),
-                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                callback_group=group,
-            )
-            for action, name, execute in handlers
-        ]
+        self.servers = lifecycle.action_servers(node, group, self._log.info, handlers)
 
     # -- planner_server --------------------------------------------------------------
 

@@ -30,7 +30,6 @@ from nav2_msgs.msg import RouteEdge as RouteEdgeMsg
 from nav2_msgs.msg import RouteNode as RouteNodeMsg
 from nav2_msgs.srv import SetRouteGraph
 from nav_msgs.msg import Path as PathMsg
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_srvs.srv import Trigger
@@ -94,21 +93,15 @@ class RouteServer:
         self._stopping = threading.Event()
         self._graph_pub = node.create_publisher(MarkerArray, "route_graph", LATCHED)
         self._path_pub = node.create_publisher(PathMsg, "plan", 10)
-        self.servers = [
-            ActionServer(
-                node,
-                action,
-                name,
-                execute_callback=execute,
-                goal_callback=lifecycle.gate(name, self._log.info),
-                cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                callback_group=group,
-            )
-            for action, name, execute in (
+        self.servers = lifecycle.action_servers(
+            node,
+            group,
+            self._log.info,
+            [
                 (ComputeRoute, "compute_route", self._execute_compute),
                 (ComputeAndTrackRoute, "compute_and_track_route", self._execute_track),
-            )
-        ]
+            ],
+        )
         node.create_service(
             SetRouteGraph, "route_server/set_route_graph", self._set_graph, callback_group=group
         )

@@ -108,7 +108,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from types import FrameType
 from typing import Any
 
@@ -121,7 +121,6 @@ from nav2_msgs.action import (
 )
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import Odometry, Path
-from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
@@ -282,19 +281,21 @@ class SimNode:
                 self._clear_costmap_callback(service.partition("/")[0]),
                 callback_group=group,
             )
-        self._servers = [
-            self._nav_server(NavigateToPose, Navigator.TO_POSE, group),
-            self._nav_server(NavigateThroughPoses, Navigator.THROUGH_POSES, group),
-            ActionServer(
-                node,
-                FollowWaypoints,
-                "follow_waypoints",
-                execute_callback=self._execute_waypoints,
-                goal_callback=lifecycle.gate("follow_waypoints", self.log.info),
-                cancel_callback=_accept_cancel,
-                callback_group=group,
-            ),
-        ]
+        self._servers = lifecycle.action_servers(
+            node,
+            group,
+            self.log.info,
+            [
+                *(
+                    (action, navigator.value, self._navigation_executor(action, navigator))
+                    for action, navigator in (
+                        (NavigateToPose, Navigator.TO_POSE),
+                        (NavigateThroughPoses, Navigator.THROUGH_POSES),
+                    )
+                ),
+                (FollowWaypoints, "follow_waypoints", self._execute_waypoints),
+            ],
+        )
         self._behaviors = BehaviorActions(node, self.standin, self._lock, group, lifecycle)
         self._costmaps = CostmapTopics(
             node,
@@ -556,16 +557,8 @@ class SimNode:
 
     # -- navigate_to_pose / navigate_through_poses -------------------------------------
 
-    def _nav_server(self, action: Any, navigator: Navigator, group: Any) -> ActionServer:
-        return ActionServer(
-            self.node,
-            action,
-            navigator.value,
-            execute_callback=lambda handle: self._execute_navigation(handle, action, navigator),
-            goal_callback=self.lifecycle.gate(navigator.value, self.log.info),
-            cancel_callback=_accept_cancel,
-            callback_group=group,
-        )
+    def _navigation_executor(self, action: Any, navigator: Navigator) -> Callable[[Any], Any]:
+        return lambda handle: self._execute_navigation(handle, action, navigator)
 
     def _execute_navigation(self, handle: Any, action: Any, navigator: Navigator) -> Any:
         request = handle.request
@@ -710,10 +703,6 @@ class SimNode:
             return response
 
         return clear
-
-
-def _accept_cancel(_handle: Any) -> CancelResponse:
-    return CancelResponse.ACCEPT
 
 
 def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
