@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from navseq.fleet.run import FleetRun, FleetRunRequest, Member
     from navseq.geometry import Pose2D
     from navseq.journal.state import JournalState
+    from navseq.navigators.settings import NavigatorSettings
     from navseq.sim.fleet_world import FleetWorld
 
 
@@ -57,6 +58,12 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     assert request.resume is not None
     folder = request.resume
     manifest = read_manifest(folder)
+    if manifest.navigator == "sim" and request.navigator is not None:
+        raise NavseqError(
+            f"the run in {folder} ran on the embedded simulator; a resume goes on there: "
+            "leave --navigator out",
+            source="--navigator",
+        )
     fleet = _same_fleet(request, manifest)
     if fleet.map is None:
         raise NavseqError("the simulator needs a map: give --map MAP.yaml", source=str(folder))
@@ -74,6 +81,8 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
                     NavseqError(error_text(error), source=f"robot '{share.robot.name}'")
                 )
     raise_all(problems)
+    if manifest.navigator != "sim":
+        return _resume_on_stacks(request, manifest.navigator, plan, journals)
     poses = {name: found.pose for name, found in journals.items()}
     world = FleetWorld(
         grid,
@@ -83,6 +92,54 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     clock = FleetClock(world, going_on, realtime=request.realtime)
     members = _members(plan, world, clock, folder, journals)
     return FleetRun(plan, world, clock, folder, members, picture=request.picture)
+
+
+def _same_kind(request: FleetRunRequest, kind: str) -> NavigatorSettings:
+    """The settings to resume a run on ``kind``'s stacks with: the ones given (of that
+    kind), else the kind's defaults."""
+    from navseq.navigators.registry import kind_of, navigator_kind
+
+    given = request.navigator
+    if given is None:
+        settings: NavigatorSettings = navigator_kind(kind).settings()
+        return settings
+    if kind_of(given).name != kind:
+        raise NavseqError(
+            f"the run in {request.resume} ran on --navigator {kind}; a resume goes on with "
+            f"it: give --navigator {kind} (or leave --navigator out)",
+            source="--navigator",
+        )
+    return given
+
+
+def _resume_on_stacks(
+    request: FleetRunRequest, kind: str, plan: FleetPlan, journals: dict[str, RobotJournal]
+) -> FleetRun:
+    """A fleet run on ROS stacks continued: every stack connected again, each robot
+    from its journal (it is where its stack says, not where the journal last saw it)."""
+    from navseq.fleet.run import FleetRun
+    from navseq.fleet.stack_run import (
+        close_all,
+        connect_all,
+        make_coordinator,
+        robot_poses,
+        stack_members,
+    )
+
+    assert request.resume is not None
+    settings = _same_kind(request, kind)
+    connected = connect_all(plan, settings)
+    try:
+        poses = robot_poses(connected)
+        coordinator = make_coordinator(plan, connected)
+        members = stack_members(plan, connected, poses, request.resume, journals)
+    except BaseException:
+        close_all(connected)
+        raise
+    run = FleetRun(plan, coordinator, coordinator, request.resume, members, picture=request.picture)
+    run.coordinator = coordinator
+    run.on_close.append(lambda: close_all(connected))
+    return run
 
 
 def _same_fleet(request: FleetRunRequest, manifest: FleetManifest) -> Fleet:
@@ -197,7 +254,7 @@ def _members(
             members.append(Member(robot, None, None, 0, state="idle"))
             continue
         if found.done:
-            members.append(_done_member(found, len(share.order)))
+            members.append(done_member(found, len(share.order)))
             continue
         navigator = MemberNavigator(world, robot.name, clock)
         try:
@@ -224,15 +281,14 @@ def _members(
             problems.append(NavseqError(error_text(error), source=f"robot '{robot.name}'"))
             continue
         member = Member(robot, session, navigator, len(share.order))
-        log = found.state.visits.log  # the visits finished for good; the rest run again
-        member.counts.update(_counts([] if log is None else log.held()))
-        member.earlier_trail = _trail(found.state)
+        member.counts.update(earlier_counts(found))
+        member.earlier_trail = trail_of(found.state)
         members.append(member)
     raise_all(problems)
     return members
 
 
-def _done_member(found: RobotJournal, waypoints: int) -> Member:
+def done_member(found: RobotJournal, waypoints: int) -> Member:
     """A robot whose share was complete: its figures from its journal; it stays parked."""
     from navseq.fleet.run import FinishedShare, Member
 
@@ -247,8 +303,15 @@ def _done_member(found: RobotJournal, waypoints: int) -> Member:
         folder=found.journal.parent,
         visits=tuple(visits),
     )
-    member.earlier_trail = _trail(found.state)
+    member.earlier_trail = trail_of(found.state)
     return member
+
+
+def earlier_counts(found: RobotJournal) -> dict[str, int]:
+    """Reached / skipped / failed before the resume: the visits finished for good (the
+    rest run again)."""
+    log = found.state.visits.log
+    return _counts([] if log is None else log.held())
 
 
 def _counts(visits: list[WaypointResult]) -> dict[str, int]:
@@ -261,7 +324,7 @@ def _counts(visits: list[WaypointResult]) -> dict[str, int]:
     return counts
 
 
-def _trail(state: JournalState) -> list[tuple[float, float, float]]:
+def trail_of(state: JournalState) -> list[tuple[float, float, float]]:
     """The path the journal recorded (its corners), for the fleet picture."""
     import math
 
@@ -270,4 +333,4 @@ def _trail(state: JournalState) -> list[tuple[float, float, float]]:
     ]
 
 
-__all__ = ["prepare_fleet_resume"]
+__all__ = ["RobotJournal", "done_member", "earlier_counts", "prepare_fleet_resume", "trail_of"]
