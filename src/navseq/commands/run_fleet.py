@@ -81,6 +81,7 @@ def refuse_options(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.fleet.resume import prepare_fleet_resume
     from navseq.fleet.run import FleetRunRequest, prepare_fleet_run
+    from navseq.fleet.stack_run import prepare_stack_fleet_run
 
     refuse_options(args)
     from navseq.extras import require_extra
@@ -104,7 +105,13 @@ def run(args: argparse.Namespace) -> int:
         lock = RunLock(request.resume).acquire()
     try:
         # A resume continues the run's own split, each robot from its journal.
-        prepared = prepare_fleet_run if request.resume is None else prepare_fleet_resume
+        prepared = (
+            prepare_fleet_resume
+            if request.resume is not None
+            else prepare_stack_fleet_run
+            if request.navigator is not None
+            else prepare_fleet_run
+        )
         fleet_run = prepared(request)
         for note in fleet_run.notes:
             print(f"navseq run: {note}", file=sys.stderr)

@@ -226,9 +226,7 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     if request.resume is not None:
         raise ValueError("a resume is prepared by navseq.fleet.resume.prepare_fleet_resume")
     if request.navigator is not None:
-        from navseq.fleet.stack_run import prepare_stack_fleet_run
-
-        return prepare_stack_fleet_run(request)
+        raise ValueError("a run on ROS stacks is prepared by navseq.fleet.stack_run")
     plan = plan_fleet(
         request.fleet,
         request.mission,

@@ -30,9 +30,9 @@ from navseq.errors import NavseqError, error_text
 
 if TYPE_CHECKING:
     from navseq.fleet.coordinator import CoordinatedNavigator, FleetCoordinator
+    from navseq.fleet.journals import RobotJournal
     from navseq.fleet.model import FleetRobot
     from navseq.fleet.planning import FleetPlan
-    from navseq.fleet.resume import RobotJournal
     from navseq.fleet.run import FleetRun, FleetRunRequest, Member
     from navseq.geometry import Pose2D
     from navseq.navigators.settings import NavigatorSettings
@@ -223,7 +223,7 @@ def stack_members(
             members.append(Member(robot, None, navigator, 0, state="idle"))
             continue
         if found is not None and found.done:
-            from navseq.fleet.resume import done_member
+            from navseq.fleet.journals import done_member
 
             member = done_member(found, len(share.order))
             member.navigator = navigator
@@ -259,13 +259,14 @@ def stack_members(
             continue
         member = Member(robot, session, navigator, len(share.order))
         if found is not None:
-            from navseq.fleet.resume import earlier_counts, trail_of
+            from navseq.fleet.journals import earlier_counts, trail_of
 
             member.counts.update(earlier_counts(found))
             member.earlier_trail = trail_of(found.state)
         members.append(member)
     raise_all(problems)
     return members
+
 
 __all__ = [
     "STACK_KINDS",
