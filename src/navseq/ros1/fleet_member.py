@@ -5,6 +5,9 @@ navigator in the robot's namespace, before anything moves; a namespace no
 ``move_base`` server answers in is one :class:`~navseq.errors.NavseqError` (said with
 the other robots' problems, exit 2). All robots share this process's one rospy node.
 The robot's model, map and pre-flight come from the fleet file, not from the stack.
+Its frames are ROS 1's multi-robot convention (``launch/multi_robot.launch``, tf_prefix):
+``NS/base_footprint`` (or ``NS/base_link``) and ``NS/odom`` on the one ``/tf``, so the
+coordinator sees every robot, idle ones too.
 """
 
 from __future__ import annotations
@@ -20,8 +23,14 @@ def connect(
     """The robot's navigator, its server found; and the report's navigator section."""
     settings = with_defaults(settings)
     assert settings.action is not None and settings.settle is not None
+    prefix = f"{namespace.strip('/')}/" if namespace.strip("/") else ""
     navigator = Ros1Navigator(
-        settings.action, settings.frame, namespace=namespace, settle=settings.settle
+        settings.action,
+        settings.frame,
+        namespace=namespace,
+        settle=settings.settle,
+        base_frames=(f"{prefix}base_footprint", f"{prefix}base_link"),
+        odom_frame=f"{prefix}odom",
     )
     try:
         navigator.require_server(server_wait)
