@@ -97,7 +97,10 @@ class CoordinatedNavigator:
 
     def __getattr__(self, name: str) -> Any:
         # Only reached for what this class lacks: the wrapped navigator's extras.
-        return getattr(self.__dict__["inner"], name)
+        inner = self.__dict__.get("inner")
+        if inner is None:
+            raise AttributeError(name)
+        return getattr(inner, name)
 
     # -- the Navigator interface (the executor's thread) --------------------------------
 
