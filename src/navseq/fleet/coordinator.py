@@ -504,7 +504,8 @@ class FleetCoordinator:
             if over:
                 del self._yields[index]
                 if navigator.goal is None:
-                    continue  # an idle robot stays where it went
+                    navigator.release()  # an idle robot stays where it went, free again
+                    continue
                 self._watch[index].route = None
                 if other.busy and now - yielding.since <= self.yield_limit:
                     mine = self._route(index, poses[index], now)
