@@ -31,7 +31,7 @@ from navseq.navigators.base import Goal, GoalAccepted, GoalDone
 from navseq.signals import SignalGuard
 from navseq.sim.fleet_world import FleetRobot, FleetWorld
 from navseq.sim.footprint import footprints_overlap
-from test_right_of_way import corridor_between_rooms, rooms_with_one_door
+from test_right_of_way import corridor_between_rooms, junction, rooms_with_one_door
 
 
 @dataclass
@@ -228,3 +228,18 @@ def test_the_executors_cancel_while_coordinated_leaves_nothing_to_resend(mode: s
     sent = len(stack.sent)
     navigator.release()
     assert len(stack.sent) == sent  # nothing of the mission's is sent again
+
+
+def test_four_robots_cross_a_junction_to_the_opposite_ends():
+    ends = {
+        "west": Pose2D(0.8, 3.5, 0.0),
+        "east": Pose2D(6.2, 3.5, math.pi),
+        "south": Pose2D(3.5, 0.8, math.pi / 2),
+        "north": Pose2D(3.5, 6.2, -math.pi / 2),
+    }
+    opposite = {"west": "east", "east": "west", "south": "north", "north": "south"}
+    outcome = run_fleet(
+        junction(), [(name, ends[name], [ends[other]]) for name, other in opposite.items()]
+    )
+    assert all_reached(outcome), (outcome.statuses, outcome.texts)
+    assert outcome.overlaps == 0
