@@ -22,26 +22,42 @@ FLEET = """\
 navseq_fleet: 1
 map: corridor.yaml
 mission:
-  defaults: {goal_timeout: 240}
+  defaults: {{goal_timeout: 240}}
   waypoints:
-    - {name: east, x: 4.8, y: 1.2, yaw: 0}
-    - {name: west, x: 2.6, y: 1.2, yaw: 180}
+{waypoints}
 robots:
-  - {name: robot1, start: {x: 2.6, y: 1.2, yaw: 0}}
-  - {name: robot2, start: {x: 4.8, y: 1.2, yaw: 180}}
+  - {{name: robot1, start: {{x: {robot1[0]}, y: 1.2, yaw: 0}}}}
+  - {{name: robot2, start: {{x: {robot2[0]}, y: 1.2, yaw: 180}}}}
 waypoints:
-  east: {robots: [robot1]}
-  west: {robots: [robot2]}
+{rules}
 """
+
+# name: robot1's start x, robot2's start x, waypoints (name, x, yaw in degrees, robot)
+SCENARIOS = {
+    "swap": (2.6, 4.8, [("east", 4.8, 0, "robot1"), ("west", 2.6, 180, "robot2")]),
+    # robot2 has no share: it is parked on robot1's first waypoint
+    "parked": (1.2, 3.7, [("middle", 3.7, 0, "robot1"), ("far", 6.2, 0, "robot1")]),
+}
 
 
 @pytest.mark.flaky(reruns=1)  # two robots on real ROS 1 in real time: a loaded machine
-def test_two_robots_swap_the_ends_of_a_one_robot_corridor(
-    ros_master: RosMaster, tmp_path: Path
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
+def test_the_robots_give_way_and_every_waypoint_is_reached(
+    ros_master: RosMaster, tmp_path: Path, scenario: str
 ) -> None:
+    robot1_x, robot2_x, waypoints = SCENARIOS[scenario]
     corridor = save_map(corridor_between_rooms(), tmp_path / "corridor.yaml")
     fleet = tmp_path / "fleet.yaml"
-    fleet.write_text(FLEET)
+    fleet.write_text(
+        FLEET.format(
+            robot1=(robot1_x,),
+            robot2=(robot2_x,),
+            waypoints="\n".join(
+                f"    - {{name: {n}, x: {x}, y: 1.2, yaw: {yaw}}}" for n, x, yaw, _ in waypoints
+            ),
+            rules="\n".join(f"  {n}: {{robots: [{robot}]}}" for n, _, _, robot in waypoints),
+        )
+    )
     ros_master.start(
         [
             "roslaunch",
@@ -49,10 +65,10 @@ def test_two_robots_swap_the_ends_of_a_one_robot_corridor(
             "multi_robot.launch",
             f"map:={corridor}",
             "speed:=2",
-            "robot1_x:=2.6",
+            f"robot1_x:={robot1_x}",
             "robot1_y:=1.2",
             "robot1_yaw:=0",
-            "robot2_x:=4.8",
+            f"robot2_x:={robot2_x}",
             "robot2_y:=1.2",
             "robot2_yaw:=3.14159",
         ],
@@ -71,6 +87,7 @@ def test_two_robots_swap_the_ends_of_a_one_robot_corridor(
     assert (report["reached"], report["failed"], report["skipped"]) == (2, 0, 0), report
     assert report["robot_overlaps"] == 0, report
     assert report["coordinator"]["sent_aside"] >= 1, report
-    for robot in ("robot1", "robot2"):
-        assert "blocked" not in (out / robot / "journal.jsonl").read_text()
+    for row in report["robots"]:
+        if row["waypoints"]:
+            assert "blocked" not in (out / row["name"] / "journal.jsonl").read_text()
     assert "Traceback" not in navseq.output()
