@@ -188,6 +188,9 @@ def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any
             guard.restore()
     for member in errors:
         print(f"navseq run: {member.robot.name}: {member.error}", file=sys.stderr)
+    stopped = report.get("coordinator", {}).get("error")
+    if stopped:  # the runs went on without it: the report says what happened
+        print(f"navseq run: the fleet coordinator stopped: {stopped}", file=sys.stderr)
     return status, report
 
 

@@ -369,9 +369,12 @@ class FleetCoordinator:
             if navigator.mode == Mode.ASIDE and navigator.aside_driving:
                 navigator.inner.cancel_goal()
 
-    def summary(self) -> dict[str, int]:
-        """For the fleet report."""
-        return {"sent_aside": self.sent_aside, "held_back": self.held_back}
+    def summary(self) -> dict[str, object]:
+        """For the fleet report (``error``: why it stopped looking, when it did)."""
+        summary: dict[str, object] = {"sent_aside": self.sent_aside, "held_back": self.held_back}
+        if self.error is not None:
+            summary["error"] = f"{type(self.error).__name__}: {self.error}"
+        return summary
 
     # -- one look ------------------------------------------------------------------------
 
