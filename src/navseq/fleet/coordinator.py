@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -329,6 +330,8 @@ class FleetCoordinator:
         self.held_back = 0  # how often a robot was held back
         self.now = 0.0
         self.error: BaseException | None = None
+        #: The latest decisions, ``(t, text)``, for the fleet report (bounded).
+        self.decisions: deque[tuple[float, str]] = deque(maxlen=200)
 
     # -- the fleet run's side ----------------------------------------------------------
 
@@ -374,7 +377,11 @@ class FleetCoordinator:
         summary: dict[str, object] = {"sent_aside": self.sent_aside, "held_back": self.held_back}
         if self.error is not None:
             summary["error"] = f"{type(self.error).__name__}: {self.error}"
+        summary["decisions"] = [f"{t:.1f} s: {text}" for t, text in self.decisions]
         return summary
+
+    def _say(self, text: str) -> None:
+        self.decisions.append((self.now, text))
 
     # -- one look ------------------------------------------------------------------------
 
@@ -517,8 +524,10 @@ class FleetCoordinator:
                         # here, its goal off the stack, rather than for the stack to give up.
                         navigator.hold()
                         self._holds[index] = _Hold(yielding.to, now)
+                        self._say(f"{self.names[index]} waits aside for {self.names[yielding.to]}")
                         continue
                 navigator.release()
+                self._say(f"{self.names[index]} back on its way")
 
     def _end_holds(self, poses: list[Pose2D], now: float) -> None:
         for index, held in list(self._holds.items()):
@@ -539,6 +548,7 @@ class FleetCoordinator:
             if clear:
                 del self._holds[index]
                 navigator.release()
+                self._say(f"{self.names[index]} released")
 
     def _hold(self, index: int, for_: int, now: float) -> None:
         """Robot ``index`` waits, its goal off the stack, while ``for_`` clears its way."""
@@ -547,11 +557,13 @@ class FleetCoordinator:
             navigator.hold()
             self._holds[index] = _Hold(for_, now)
             self.held_back += 1
+            self._say(f"{self.names[index]} held back for {self.names[for_]}")
             self._watch[index].moved_at = self._watch[index].travelled_at = now
 
     def _clear_goals(self, poses: list[Pose2D], now: float) -> None:
-        """A goal just sent whose pose an idle robot stands on: that one moves aside
-        first (the stack would plan to a goal it cannot reach)."""
+        """A goal whose pose a standing robot (idle, or held back) is on: that one moves
+        aside first. A stack plans to the nearest free place instead of a goal another
+        robot covers, and says SUCCEEDED there, short of the goal."""
         for index in range(len(poses)):
             navigator = self._nav(index)
             goal = navigator.goal
@@ -559,7 +571,7 @@ class FleetCoordinator:
                 continue
             end = np.array([[goal.pose.x, goal.pose.y]])
             for other in range(len(poses)):
-                if other == index or self._nav(other).busy or other in self._yields:
+                if other == index or self._nav(other).pursuing or other in self._yields:
                     continue
                 if self._in_band(other, index, end, poses):
                     route = self._route(index, poses[index], now)
@@ -585,6 +597,8 @@ class FleetCoordinator:
             ]
             giving_way_to = self._yields[index].to if index in self._yields else None
             for other in sorted(in_way, key=self._rank):
+                if other in self._yields and self._yields[other].to == index:
+                    continue  # already on its way aside for this one
                 if other == giving_way_to:
                     self._send_aside(other, index, route, poses, now)
                     continue
@@ -593,8 +607,6 @@ class FleetCoordinator:
                     # its stack, which would otherwise give up on its goal.
                     self._hold(index, other, now)
                     break
-                if other in self._yields and self._yields[other].to == index:
-                    continue  # already on its way aside
                 if self._send_aside(other, index, route, poses, now):
                     self._hold(index, other, now)
                 elif self._nav(other).pursuing:
@@ -634,6 +646,10 @@ class FleetCoordinator:
             return False
         self._holds.pop(index, None)  # held for another robot: now it moves out of the way
         self._nav(index).aside(refuge)
+        self._say(
+            f"{self.names[index]} sent aside to ({refuge.x:.2f}, {refuge.y:.2f}) "
+            f"for {self.names[to]}"
+        )
         self._yields[index] = _Yield(to, now)
         watch = self._watch[index]
         watch.route, watch.moved_at, watch.travelled_at = None, now, now
