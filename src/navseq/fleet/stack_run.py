@@ -83,7 +83,8 @@ def connect_all(plan: FleetPlan, settings: NavigatorSettings) -> list[Connected]
         except NavseqError as error:
             problems.append(
                 NavseqError(
-                    f"namespace '{robot.namespace}': {error_text(error)}",
+                    f"namespace '{robot.namespace}' (the fleet file's namespace:, else the "
+                    f"robot's name): {error_text(error)}",
                     source=f"robot '{robot.name}'",
                 )
             )
