@@ -185,6 +185,11 @@ RULES: tuple[Rule, ...] = (
         "ros",
         "tests/test_ros_race.py::test_the_race_option_gives_a_client_that_sends_at_once_a_far_succeeded",
     ),
+    Rule(
+        r"--fleet .*--navigator (nav2|ros1)",
+        "ros",
+        "tests/test_fleet_ros.py::test_two_robots_swap_the_ends_of_a_one_robot_corridor",
+    ),
     Rule(r"--navigator ros1", "ros", "tests/test_cli_ros1.py::test_ros1_run_completes_and_reports"),
     Rule(
         r"--navigator nav2",

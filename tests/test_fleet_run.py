@@ -84,7 +84,9 @@ def test_a_bad_fleet_file_moves_nothing_and_writes_nothing(tmp_path: Path) -> No
 
 def test_options_a_fleet_run_cannot_honour_are_refused(tmp_path: Path) -> None:
     for extra, named in (
-        (("--navigator", "ros1"), "--navigator ros1"),
+        (("--navigator", "scripted"), "--navigator scripted"),
+        (("--navigator", "nav2", "--ns", "robot1"), "--ns"),
+        (("--navigator", "ros1", "--realtime", "1"), "--realtime"),
         (("--start", "0,0,0"), "--start"),
         (("--resume", tmp_path / "run", "--out", tmp_path / "other"), "--out"),
         (("--resume", tmp_path / "journal.jsonl"), "is not a folder"),

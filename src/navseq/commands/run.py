@@ -55,7 +55,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         "--fleet",
         type=Path,
         metavar="FLEET",
-        help="run a fleet's robots together on the embedded simulator (docs/fleet.md); "
+        help="run a fleet's robots together: on the embedded simulator, or with "
+        "--navigator nav2|ros1 on one namespaced stack per robot (docs/fleet.md); "
         "MISSION, if given, replaces the fleet file's mission:",
     )
     parser.add_argument(

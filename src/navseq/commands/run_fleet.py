@@ -19,7 +19,8 @@ from navseq.errors import NavseqError
 if TYPE_CHECKING:
     from rich.table import Table
 
-    from navseq.fleet.run import FleetRun
+    from navseq.fleet.run import FleetRun, Member
+    from navseq.navigators.settings import NavigatorSettings
 
 #: Options of a one-robot run that a fleet run takes from the fleet file, or lacks yet.
 _FLEET_REFUSES = {
@@ -33,16 +34,35 @@ _FLEET_REFUSES = {
 }
 
 
+#: Options of a kind that the fleet file settles for every robot.
+_STACK_REFUSES = {
+    "ns": ("--ns", "each robot's namespace comes from the fleet file (namespace:, else its name)"),
+    "from_ll": ("--from-ll", "a fleet's waypoints are converted with the mission's datum"),
+    "map_wait": ("--map-wait", "a fleet runs on its map file (map:), not on a stack's map"),
+}
+
+
 def refuse_options(args: argparse.Namespace) -> None:
     """What a fleet run cannot honour, refused before anything is read."""
+    from navseq.fleet.stack_run import STACK_KINDS
+
     navigator = getattr(args, "navigator", None)
-    if navigator not in (None, "sim"):
+    if navigator not in (None, "sim", *STACK_KINDS):
         raise NavseqError(
-            f"runs on the embedded simulator only for now; --navigator {navigator} with one "
-            "namespaced stack per robot is not supported yet (run navseq run --navigator "
-            f"{navigator} --ns NS on each robot's mission from navseq plan --fleet --out DIR)",
+            f"runs on the embedded simulator or on ROS stacks ({', '.join(STACK_KINDS)}), "
+            f"not on --navigator {navigator}",
             source="--fleet",
         )
+    if navigator in STACK_KINDS:
+        for dest, (flag, why) in _STACK_REFUSES.items():
+            if getattr(args, dest, None) is not None:
+                raise NavseqError(f"{why}; leave {flag} out with --fleet", source=flag)
+        if getattr(args, "realtime", None) is not None:
+            raise NavseqError(
+                f"paces the embedded simulator; --navigator {navigator} keeps its own time. "
+                "Leave --realtime out",
+                source="--realtime",
+            )
     for dest, (flag, why) in _FLEET_REFUSES.items():
         if getattr(args, dest, None) not in (None, False, ()):
             raise NavseqError(f"{why}; leave {flag} out with --fleet", source=flag)
@@ -61,6 +81,7 @@ def refuse_options(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from navseq.fleet.resume import prepare_fleet_resume
     from navseq.fleet.run import FleetRunRequest, prepare_fleet_run
+    from navseq.fleet.stack_run import prepare_stack_fleet_run
 
     refuse_options(args)
     from navseq.extras import require_extra
@@ -74,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
         realtime=args.realtime,
         picture=not args.no_picture,
         resume=_run_folder(args.resume),
+        navigator=_stack_settings(args),
     )
     lock = None
     if request.resume is not None and request.resume.is_dir():
@@ -83,8 +105,16 @@ def run(args: argparse.Namespace) -> int:
         lock = RunLock(request.resume).acquire()
     try:
         # A resume continues the run's own split, each robot from its journal.
-        prepared = prepare_fleet_run if request.resume is None else prepare_fleet_resume
+        prepared = (
+            prepare_fleet_resume
+            if request.resume is not None
+            else prepare_stack_fleet_run
+            if request.navigator is not None
+            else prepare_fleet_run
+        )
         fleet_run = prepared(request)
+        for note in fleet_run.notes:
+            print(f"navseq run: {note}", file=sys.stderr)
         for member in fleet_run.members:
             if member.session is not None:
                 for note in member.session.notes:
@@ -95,6 +125,23 @@ def run(args: argparse.Namespace) -> int:
             lock.release()
     _print_summary(fleet_run, report)
     return status
+
+
+def _stack_settings(args: argparse.Namespace) -> NavigatorSettings | None:
+    """``--navigator nav2|ros1`` and its options as the kind's settings (None: the
+    embedded simulator)."""
+    from navseq.fleet.stack_run import STACK_KINDS
+    from navseq.navigators.registry import command_line_options, navigator_kind, settings_from
+
+    name = getattr(args, "navigator", None)
+    if name not in STACK_KINDS:
+        return None
+    given = {
+        option.name: getattr(args, option.name)
+        for option in command_line_options()
+        if getattr(args, option.name, None) is not None
+    }
+    return settings_from(navigator_kind(name), given)
 
 
 def _run_folder(given: Path | None) -> Path | None:
@@ -141,6 +188,9 @@ def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any
             guard.restore()
     for member in errors:
         print(f"navseq run: {member.robot.name}: {member.error}", file=sys.stderr)
+    stopped = report.get("coordinator", {}).get("error")
+    if stopped:  # the runs went on without it: the report says what happened
+        print(f"navseq run: the fleet coordinator stopped: {stopped}", file=sys.stderr)
     return status, report
 
 
@@ -165,13 +215,20 @@ def _table(fleet_run: FleetRun) -> Table:
         table.add_row(
             escape(member.robot.name),
             escape(printable(member.current)),
-            escape(member.state),
+            escape(_state(member)),
             str(counts["reached"]),
             str(counts["skipped"]),
             str(counts["failed"]),
             str(member.waypoints),
         )
     return table
+
+
+def _state(member: Member) -> str:
+    """The member's state, and what the fleet coordinator does with it (ROS stacks)."""
+    mode = getattr(member.navigator, "mode", "free")
+    shown = {"held": "held back", "aside": "giving way"}
+    return member.state if mode not in shown else f"{member.state}, {shown[mode]}"
 
 
 def _fleet_eta(fleet_run: FleetRun) -> str:

@@ -2,9 +2,10 @@
 
 Written when a fleet run starts, before any robot moves: the fleet file (path and
 sha256, so a resume with another or a changed fleet file is refused), the mission and
-map the run used, and the split (each robot's waypoints, the planned makespan, the
-waypoints left out), so that a resume continues the same split instead of making a
-new one. Each robot's own progress is in its journal (``RUN/<robot>/journal.jsonl``).
+map the run used, the navigator kind (``sim``, ``nav2``, ``ros1``), and the split
+(each robot's waypoints, the planned makespan, the waypoints left out), so that a
+resume continues the same split instead of making a new one. Each robot's own
+progress is in its journal (``RUN/<robot>/journal.jsonl``).
 """
 
 from __future__ import annotations
@@ -32,6 +33,13 @@ class FleetManifest:
     map: Path | None  # None: the fleet file's map:
     shares: dict[str, tuple[tuple[int, ...], float, float]]  # robot: order, metres, seconds
     dropped: tuple[int, ...]
+    navigator: str = "sim"  # the kind the robots ran on: sim (one world), nav2, ros1
+
+    def with_navigator(self, kind: str) -> FleetManifest:
+        """This manifest for a run on ``kind``'s stacks (a resume runs on the same kind)."""
+        import dataclasses
+
+        return dataclasses.replace(self, navigator=kind)
 
     def split(self, fleet: Fleet) -> Split:
         """The run's split, for ``fleet`` (the same fleet file, checked by its digest)."""
@@ -53,6 +61,7 @@ class FleetManifest:
                 for name, (order, distance, time_s) in self.shares.items()
             },
             "dropped": list(self.dropped),
+            "navigator": self.navigator,
         }
 
 
@@ -120,6 +129,7 @@ def read_manifest(folder: Path) -> FleetManifest:
             map=None if doc["map"] is None else Path(doc["map"]),
             shares=shares,
             dropped=tuple(int(i) for i in doc["dropped"]),
+            navigator=str(doc.get("navigator", "sim")),  # runs before stacks: the simulator
         )
     except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise NavseqError(

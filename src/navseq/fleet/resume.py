@@ -12,34 +12,26 @@ written; the fleet report and picture then cover both parts of the run.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from navseq.errors import NavseqError, error_text
+from navseq.fleet.journals import (
+    RobotJournal,
+    done_member,
+    earlier_counts,
+    robot_journal,
+    trail_of,
+)
 
 if TYPE_CHECKING:
-    from navseq.executor.result import WaypointResult
     from navseq.fleet.lockstep import FleetClock
     from navseq.fleet.manifest import FleetManifest
-    from navseq.fleet.model import Fleet, FleetRobot
+    from navseq.fleet.model import Fleet
     from navseq.fleet.planning import FleetPlan
     from navseq.fleet.run import FleetRun, FleetRunRequest, Member
-    from navseq.geometry import Pose2D
-    from navseq.journal.state import JournalState
+    from navseq.navigators.settings import NavigatorSettings
     from navseq.sim.fleet_world import FleetWorld
-
-
-@dataclass(frozen=True)
-class RobotJournal:
-    """What one robot's folder says: its journal read, where it was, whether it is done."""
-
-    robot: FleetRobot
-    journal: Path
-    mission: Path
-    state: JournalState
-    pose: Pose2D
-    done: bool
 
 
 def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
@@ -57,6 +49,12 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     assert request.resume is not None
     folder = request.resume
     manifest = read_manifest(folder)
+    if manifest.navigator == "sim" and request.navigator is not None:
+        raise NavseqError(
+            f"the run in {folder} ran on the embedded simulator; a resume goes on there: "
+            "leave --navigator out",
+            source="--navigator",
+        )
     fleet = _same_fleet(request, manifest)
     if fleet.map is None:
         raise NavseqError("the simulator needs a map: give --map MAP.yaml", source=str(folder))
@@ -68,12 +66,14 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     for share in split.shares:
         if share.order:
             try:
-                journals[share.robot.name] = _robot_journal(folder, share.robot)
+                journals[share.robot.name] = robot_journal(folder, share.robot)
             except NavseqError as error:
                 problems.append(
                     NavseqError(error_text(error), source=f"robot '{share.robot.name}'")
                 )
     raise_all(problems)
+    if manifest.navigator != "sim":
+        return _resume_on_stacks(request, manifest.navigator, plan, journals)
     poses = {name: found.pose for name, found in journals.items()}
     world = FleetWorld(
         grid,
@@ -83,6 +83,54 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     clock = FleetClock(world, going_on, realtime=request.realtime)
     members = _members(plan, world, clock, folder, journals)
     return FleetRun(plan, world, clock, folder, members, picture=request.picture)
+
+
+def _same_kind(request: FleetRunRequest, kind: str) -> NavigatorSettings:
+    """The settings to resume a run on ``kind``'s stacks with: the ones given (of that
+    kind), else the kind's defaults."""
+    from navseq.navigators.registry import kind_of, navigator_kind
+
+    given = request.navigator
+    if given is None:
+        settings: NavigatorSettings = navigator_kind(kind).settings()
+        return settings
+    if kind_of(given).name != kind:
+        raise NavseqError(
+            f"the run in {request.resume} ran on --navigator {kind}; a resume goes on with "
+            f"it: give --navigator {kind} (or leave --navigator out)",
+            source="--navigator",
+        )
+    return given
+
+
+def _resume_on_stacks(
+    request: FleetRunRequest, kind: str, plan: FleetPlan, journals: dict[str, RobotJournal]
+) -> FleetRun:
+    """A fleet run on ROS stacks continued: every stack connected again, each robot
+    from its journal (it is where its stack says, not where the journal last saw it)."""
+    from navseq.fleet.run import FleetRun
+    from navseq.fleet.stack_run import (
+        close_all,
+        connect_all,
+        make_coordinator,
+        robot_poses,
+        stack_members,
+    )
+
+    assert request.resume is not None
+    settings = _same_kind(request, kind)
+    connected = connect_all(plan, settings)
+    try:
+        poses = robot_poses(connected)
+        coordinator = make_coordinator(plan, connected)
+        members = stack_members(plan, connected, poses, request.resume, journals)
+    except BaseException:
+        close_all(connected)
+        raise
+    run = FleetRun(plan, coordinator, coordinator, request.resume, members, picture=request.picture)
+    run.coordinator = coordinator
+    run.on_close.append(lambda: close_all(connected))
+    return run
 
 
 def _same_fleet(request: FleetRunRequest, manifest: FleetManifest) -> Fleet:
@@ -133,46 +181,6 @@ def _differ(given: Path, recorded: Path) -> bool:
         return True
 
 
-def _robot_journal(folder: Path, robot: FleetRobot) -> RobotJournal:
-    """A robot's journal by the one-robot rules: read, its mission unchanged, done or not."""
-    from navseq.journal.state import NothingToResume
-    from navseq.run.resume import read_resume
-
-    own = folder / robot.name
-    journal = own / "journal.jsonl"
-    mission = own / "mission.yaml"
-    for path in (journal, mission):
-        if not path.is_file():
-            raise NavseqError(
-                "is missing; the fleet run cannot be resumed without every robot's journal "
-                "and share (mission.yaml) as the run left them",
-                source=str(path),
-            )
-    try:
-        _, _, state = read_resume(journal, mission)
-        done = False
-    except NothingToResume as finished:
-        found = finished.state
-        if found is None:
-            raise
-        state, done = found, True
-    return RobotJournal(robot, journal, mission, state, _last_pose(journal, robot), done)
-
-
-def _last_pose(journal: Path, robot: FleetRobot) -> Pose2D:
-    """Where the journal last saw the robot (it journals the pose at every stop), or its
-    fleet start when it never moved."""
-    from navseq.executor.events import WaypointProgress
-    from navseq.geometry import Pose2D
-    from navseq.journal.reader import journal_events
-
-    last = None
-    for event in journal_events(journal):
-        if isinstance(event, WaypointProgress):
-            last = event
-    return robot.start if last is None else Pose2D(last.x, last.y, last.yaw)
-
-
 def _members(
     plan: FleetPlan,
     world: FleetWorld,
@@ -197,7 +205,7 @@ def _members(
             members.append(Member(robot, None, None, 0, state="idle"))
             continue
         if found.done:
-            members.append(_done_member(found, len(share.order)))
+            members.append(done_member(found, len(share.order)))
             continue
         navigator = MemberNavigator(world, robot.name, clock)
         try:
@@ -224,50 +232,11 @@ def _members(
             problems.append(NavseqError(error_text(error), source=f"robot '{robot.name}'"))
             continue
         member = Member(robot, session, navigator, len(share.order))
-        log = found.state.visits.log  # the visits finished for good; the rest run again
-        member.counts.update(_counts([] if log is None else log.held()))
-        member.earlier_trail = _trail(found.state)
+        member.counts.update(earlier_counts(found))
+        member.earlier_trail = trail_of(found.state)
         members.append(member)
     raise_all(problems)
     return members
-
-
-def _done_member(found: RobotJournal, waypoints: int) -> Member:
-    """A robot whose share was complete: its figures from its journal; it stays parked."""
-    from navseq.fleet.run import FinishedShare, Member
-
-    visits = found.state.visits.held()
-    counts = _counts(visits)
-    member = Member(found.robot, None, None, waypoints, state="done")
-    member.counts.update(counts)
-    member.finished = FinishedShare(
-        time_s=found.state.previous_duration,
-        distance_m=sum(visit.distance_driven for visit in visits),
-        all_reached=counts["reached"] == waypoints,
-        folder=found.journal.parent,
-        visits=tuple(visits),
-    )
-    member.earlier_trail = _trail(found.state)
-    return member
-
-
-def _counts(visits: list[WaypointResult]) -> dict[str, int]:
-    """Reached / skipped / failed of these visits."""
-    counts = {"reached": 0, "skipped": 0, "failed": 0}
-    for visit in visits:
-        outcome = visit.outcome.value
-        if outcome in counts:
-            counts[outcome] += 1
-    return counts
-
-
-def _trail(state: JournalState) -> list[tuple[float, float, float]]:
-    """The path the journal recorded (its corners), for the fleet picture."""
-    import math
-
-    return [
-        (row[0], row[1], row[2]) for row in state.recorder.track.rows() if not math.isnan(row[1])
-    ]
 
 
 __all__ = ["prepare_fleet_resume"]

@@ -27,8 +27,10 @@ if TYPE_CHECKING:
     from navseq.executor.control import MissionControl
     from navseq.executor.events import MissionEvent
     from navseq.executor.result import WaypointResult
+    from navseq.fleet.coordinator import CoordinatedNavigator, FleetCoordinator
     from navseq.fleet.lockstep import FleetClock, MemberNavigator
     from navseq.fleet.planning import FleetPlan
+    from navseq.navigators.settings import NavigatorSettings
     from navseq.run.outcome import RunOutcome
     from navseq.run.session import Session
     from navseq.sim.fleet_world import FleetWorld
@@ -46,6 +48,9 @@ class FleetRunRequest:
     time_limit_s: float = 2.0  # for the split
     picture: bool = True
     resume: Path | None = None  # a fleet run folder to continue (navseq.fleet.resume)
+    # None: the embedded simulator; a ROS kind's settings (nav2, ros1): one namespaced
+    # stack per robot (navseq.fleet.stack_run), their namespaces from the fleet file.
+    navigator: NavigatorSettings | None = None
 
 
 @dataclass(frozen=True)
@@ -65,7 +70,7 @@ class Member:
 
     robot: FleetRobot
     session: Session | None  # None: no waypoint fell to it; it stays parked
-    navigator: MemberNavigator | None
+    navigator: MemberNavigator | CoordinatedNavigator | None
     waypoints: int
     current: str = ""
     state: str = "waiting"
@@ -116,16 +121,25 @@ class Member:
 
 @dataclass
 class FleetRun:
-    """A fleet made ready: its plan, world, clock, folder and members."""
+    """A fleet made ready: its plan, world, clock, folder and members.
+
+    On ROS stacks the coordinator is both ``world`` (its ``now`` and ``collisions``) and
+    ``clock`` (``stepped`` after each look, ``leave``)."""
 
     plan: FleetPlan
-    world: FleetWorld
-    clock: FleetClock
+    world: FleetWorld | FleetCoordinator
+    clock: FleetClock | FleetCoordinator
     folder: Path
     members: list[Member]
     picture: bool = True
     #: The signal that stopped the run (SIGINT, SIGTERM ...), None while it was not.
     stopped_by: str | None = field(default=None, init=False)
+    #: On ROS stacks: who gives way among the robots (navseq.fleet.coordinator).
+    coordinator: FleetCoordinator | None = field(default=None, init=False)
+    #: Called once when the run is finished (the stacks' connections closed).
+    on_close: list[Callable[[], None]] = field(default_factory=list, init=False)
+    #: One line each for stderr, said before the robots move.
+    notes: list[str] = field(default_factory=list, init=False)
 
     def stop(self, signal_name: str) -> None:
         """End every robot's mission as an operator's cancel would (each cancels its goal,
@@ -146,7 +160,18 @@ class FleetRun:
             )
             thread.start()
             threads.append(thread)
+        if self.coordinator is not None:
+            running = [m.robot.name for m in self.members if m.session is not None]
+            self.coordinator.start(running, threads)
         return threads
+
+    def close(self) -> None:
+        """Stop the coordinator and close the stacks' connections (once)."""
+        if self.coordinator is not None:
+            self.coordinator.close()
+        closers, self.on_close = self.on_close, []
+        for closer in closers:
+            closer()
 
     def _run_member(self, member: Member) -> None:
         assert member.session is not None
@@ -169,7 +194,10 @@ class FleetRun:
         from navseq.fleet.products import fleet_picture_png, fleet_report
         from navseq.sinks.report import report_json
 
+        self.close()
         report = fleet_report(self)
+        if self.coordinator is not None:
+            report["coordinator"] = self.coordinator.summary()
         files: dict[str, str] = {}
         if self.picture:
             try:
@@ -202,6 +230,8 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
 
     if request.resume is not None:
         raise ValueError("a resume is prepared by navseq.fleet.resume.prepare_fleet_resume")
+    if request.navigator is not None:
+        raise ValueError("a run on ROS stacks is prepared by navseq.fleet.stack_run")
     plan = plan_fleet(
         request.fleet,
         request.mission,

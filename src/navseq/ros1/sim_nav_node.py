@@ -526,6 +526,11 @@ class SimNavNode:
             self._pose_missing_since = None
             period = 1.0 / self.config.controller_frequency
             dt = period if self._last_step is None else (now - self._last_step).to_sec()
+            if dt <= 0.0:
+                # /clock has not moved since the last cycle (a loaded machine runs two
+                # cycles in one tick): nothing to integrate, and the server's safety
+                # check would brake a moving robot over zero-length steps for ever.
+                return
             self._last_step = now
             v, w = self._velocity
             cmd_v, cmd_w = self.server.compute_velocity(pose, v, w, min(max(dt, 0.0), 5 * period))
