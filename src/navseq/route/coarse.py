@@ -45,6 +45,10 @@ TARGET_BLOCKS = 25_000
 #: block further): pairs nearer than that are measured exactly, and the graph's ends get
 #: exact ways to a ring of nodes around each place.
 NEAR_BLOCKS = 4.0
+#: Cells looked at along each edge of the graph for its cost.
+SAMPLES_PER_EDGE = 5
+#: Places nearer than this (m, in a straight line) get an exact plan between them.
+PLAN_WITHIN_M = 3.0
 #: Coarse routes are taken when one exact search per place would expand more cells than
 #: this in all (about three seconds on two cores).
 EXACT_CELLS_AT_MOST = 20_000_000
@@ -122,8 +126,18 @@ def build_graph(cost: np.ndarray, lut: np.ndarray, block: int) -> CoarseGraph:
     tail_rc = np.stack(np.divmod(node_cell[tail], width), axis=1)
     head_rc = np.stack(np.divmod(node_cell[head], width), axis=1)
     length = np.hypot(*(head_rc - tail_rc).T.astype(float))
-    node_traversal = traversal.ravel()[node_cell]
-    edge_cost = length * 0.5 * (node_traversal[tail] + node_traversal[head])
+    # An edge costs its length times the traversal cost of cells along it (sampled;
+    # the cells where it cuts a corner through a wall counted at the dearest cost).
+    samples = np.linspace(0.0, 1.0, SAMPLES_PER_EDGE)[:, None]
+    sample_rows = np.rint(tail_rc[:, 0] + samples * (head_rc[:, 0] - tail_rc[:, 0])).astype(
+        np.int64
+    )
+    sample_cols = np.rint(tail_rc[:, 1] + samples * (head_rc[:, 1] - tail_rc[:, 1])).astype(
+        np.int64
+    )
+    along = traversal[sample_rows, sample_cols]
+    dearest = float(lut[np.isfinite(lut)].max())
+    edge_cost = length * np.where(np.isfinite(along), along, dearest).mean(axis=0)
     indptr = np.zeros(count + 1, np.int64)
     np.cumsum(np.bincount(tail, minlength=count), out=indptr[1:])
     return CoarseGraph(
@@ -202,6 +216,10 @@ class CoarseRoutes:
         self._width = self._cost.shape[1]
         self._anchor_cells = anchor_m / grid.resolution
         self._bound = max(NEAR_BLOCKS * self.graph.block, 4 * self._anchor_cells + self.graph.block)
+        # Pairs this near that are not within each other's exact search (around walls,
+        # where each step costs more) get a plan of their own: a few centimetres off is
+        # a large part of a short way.
+        self._plan_within = max(PLAN_WITHIN_M / grid.resolution, 1.5 * self._bound)
         cells = np.full(len(places), -1, np.int64)
         for index, place in enumerate(places):
             row, col = grid.world_to_cell(*place)
@@ -279,6 +297,8 @@ class CoarseRoutes:
                 length[k] = near.places[other, 0]
                 depart[k] = int(near.places[other, 2])
                 arrive[k] = int(there.places[index, 2])
+            elif self._straight_cells(near.cell, there.cell) <= self._plan_within:
+                length[k], depart[k], arrive[k] = self._plan(near.cell, there.cell)
             elif there.nodes.size:
                 far.append(k)
         if far:
@@ -309,6 +329,24 @@ class CoarseRoutes:
         rows[found, 1] = self._headings(np.full(len(found), near.cell), depart[found])
         rows[found, 2] = self._headings(arrive[found], ends_cells)
         return rows
+
+    def _straight_cells(self, a: int, b: int) -> float:
+        (a_row, a_col), (b_row, b_col) = divmod(a, self._width), divmod(b, self._width)
+        return math.hypot(a_row - b_row, a_col - b_col)
+
+    def _plan(self, start: int, goal: int) -> tuple[float, int, int]:
+        """One A* plan (the planner's): its length in cells and its two anchor cells."""
+        from navseq.sim.planner import search_cells
+
+        found = search_cells(self._cost, divmod(start, self._width), divmod(goal, self._width))
+        if found is None:
+            return math.inf, -1, -1
+        cells = found[0]
+        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(cells, axis=0).T))))
+        leave = int(np.searchsorted(along, self._anchor_cells, side="right")) - 1
+        come = max(int(np.searchsorted(along, along[-1] - self._anchor_cells, side="right")) - 1, 0)
+        flat = cells[:, 0] * self._width + cells[:, 1]
+        return float(along[-1]), int(flat[leave]), int(flat[come])
 
     def _headings(self, tails: np.ndarray, heads: np.ndarray) -> np.ndarray:
         """Direction (rad) from each tail cell to its head cell (NaN: the same cell)."""
