@@ -31,7 +31,8 @@ Nav2's warehouse map (nav2_bringup's, 1006 x 1674 cells at 3 cm, where
 side (benchmarks/bench_studio.py's).
 
     .venv/bin/python benchmarks/bench_route.py [--sizes 100 200] [--seeds 1] \\
-        [--time-limit 1] [--reference 30] [--maps arena warehouse nav2-warehouse big]
+        [--time-limit 1] [--reference 30] [--maps arena warehouse nav2-warehouse big] \\
+        [--exact-up-to 200]
 """
 
 from __future__ import annotations
@@ -72,6 +73,7 @@ class Row:
     reference_s: list[float]
     exact_s: list[float]
     searches_s: list[float]
+    searches_cpu_s: list[float]
     errors: list[np.ndarray]
     solver_s: list[float]
 
@@ -108,7 +110,7 @@ def measure(
     reference_s: float,
     exact_up_to: int,
 ) -> Row:
-    row = Row(name, size, [], [], [], [], [], [], [], [])
+    row = Row(name, size, [], [], [], [], [], [], [], [], [])
     model = DriveModel.of(DEFAULT_PROFILE)
     for seed in range(seeds):
         places = free_spots(costmap, size, seed)
@@ -116,9 +118,10 @@ def measure(
         # Each measured on a costmap of its own: the distances kept per map and robot
         # (route/distances.py) would answer the second from the first.
         fresh = Costmap.from_grid(costmap.grid, costmap.params)
-        began = time.perf_counter()
+        began, began_cpu = time.perf_counter(), time.process_time()
         table = LegPlanner(fresh, size * size).routes(places, model.lookahead)
         row.searches_s.append(time.perf_counter() - began)
+        row.searches_cpu_s.append(time.process_time() - began_cpu)
         if size <= exact_up_to:
             began = time.perf_counter()
             exact = exact_metres(costmap, places, model.lookahead)
@@ -221,7 +224,7 @@ def main() -> None:
         "navseq / nearest",
         f"navseq / reference ({args.reference:g} s)",
         "exact search per waypoint [s]",
-        "navseq's distances [s]",
+        "navseq's distances [s] (CPU)",
         "length off: median / max",
         "solver [s]",
     ):
@@ -246,7 +249,7 @@ def main() -> None:
                 f"{mean(n / f for n, f in zip(row.navseq_s, row.nearest_s, strict=True)):.2f}",
                 ratio,
                 f"{mean(row.exact_s):.2f}" if row.exact_s else "-",
-                f"{mean(row.searches_s):.2f}",
+                f"{mean(row.searches_s):.2f} ({mean(row.searches_cpu_s):.2f})",
                 error_text(row.errors),
                 f"{mean(row.solver_s):.2f}",
             )

@@ -190,7 +190,7 @@ class _Near:
     """One place's exact search: the other places and the graph's nodes it reached."""
 
     cell: int
-    places: np.ndarray  # (n, 3) per place: length (cells), cost, departure anchor cell
+    places: dict[int, tuple[float, int]]  # per place reached: length (cells), departure anchor
     nodes: np.ndarray  # nodes reached (int64)
     node_rows: np.ndarray  # (len(nodes), 3) length, cost, departure anchor cell
     seed_cost: np.ndarray  # node_rows' costs and lengths, contiguous (for the C search)
@@ -256,8 +256,11 @@ class CoarseRoutes:
             if reached.size or math.isinf(bound):
                 break
             bound = bound * 4 if bound < 1e6 else math.inf
-        places = found[:count].copy()
-        places[self.cells < 0] = (math.inf, math.inf, -1.0)
+        # Only the places reached are kept (2000 places: a full row each is 100 MB).
+        near_places = {
+            int(other): (float(found[other, 0]), int(found[other, 2]))
+            for other in np.flatnonzero(np.isfinite(found[:count, 0]) & (self.cells >= 0))
+        }
         nodes = found[count:][reached]
         # Routes further away leave through the nodes a lookahead away or more (where
         # their heading is measured), when there are any.
@@ -266,7 +269,7 @@ class CoarseRoutes:
             reached, nodes = reached[beyond], nodes[beyond]
         self._near[index] = _Near(
             start,
-            places,
+            near_places,
             reached.astype(np.int64),
             nodes.copy(),
             np.ascontiguousarray(nodes[:, 1]),
@@ -293,10 +296,10 @@ class CoarseRoutes:
             there = self._near.get(int(other))
             if there is None:
                 continue
-            if np.isfinite(near.places[other, 0]) and np.isfinite(there.places[index, 0]):
-                length[k] = near.places[other, 0]
-                depart[k] = int(near.places[other, 2])
-                arrive[k] = int(there.places[index, 2])
+            out, back = near.places.get(int(other)), there.places.get(index)
+            if out is not None and back is not None:
+                length[k], depart[k] = out
+                arrive[k] = back[1]
             elif self._straight_cells(near.cell, there.cell) <= self._plan_within:
                 length[k], depart[k], arrive[k] = self._plan(near.cell, there.cell)
             elif there.nodes.size:
