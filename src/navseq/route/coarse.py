@@ -306,6 +306,7 @@ class CoarseRoutes:
                 far.append(k)
         if far:
             ends = [self._near[int(others[k])] for k in far]
+            end_nodes = np.concatenate([end.nodes for end in ends])
             raw = _astar.graph(
                 graph.indptr,
                 graph.indices,
@@ -314,18 +315,23 @@ class CoarseRoutes:
                 near.nodes,
                 near.seed_cost,
                 near.seed_length,
-                np.concatenate([end.nodes for end in ends]),
+                end_nodes,
             )
             over = np.frombuffer(raw, dtype=np.float64).reshape(-1, 3)
-            for k, end in zip(far, ends, strict=True):
-                total = over[end.nodes, 0] + end.node_rows[:, 1]
-                best = int(np.argmin(total))
-                if not np.isfinite(total[best]):
-                    continue
-                node = int(end.nodes[best])
-                length[k] = over[node, 1] + end.node_rows[best, 0]
-                depart[k] = int(near.node_rows[int(over[node, 2]), 2])
-                arrive[k] = int(end.node_rows[best, 2])
+            # Per far place, its cheapest node of all: the segments of the concatenation.
+            end_rows = np.concatenate([end.node_rows for end in ends])
+            sizes = np.array([len(end.nodes) for end in ends])
+            starts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
+            total = over[end_nodes, 0] + end_rows[:, 1]
+            cheapest = np.minimum.reduceat(total, starts)
+            at_min = np.flatnonzero(total == np.repeat(cheapest, sizes))
+            best = at_min[np.searchsorted(at_min, starts)]
+            reached = np.isfinite(cheapest)
+            best, ks = best[reached], np.asarray(far)[reached]
+            nodes = end_nodes[best]
+            length[ks] = over[nodes, 1] + end_rows[best, 0]
+            depart[ks] = near.node_rows[over[nodes, 2].astype(np.int64), 2].astype(np.int64)
+            arrive[ks] = end_rows[best, 2].astype(np.int64)
         rows[:, 0] = length * self.costmap.grid.resolution
         found = np.flatnonzero(np.isfinite(length))
         ends_cells = self.cells[others[found]]
