@@ -96,12 +96,12 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
     static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
     const double diagonal = sqrt(2.0), diagonal_extra = sqrt(2.0) - 1.0;
     const int64_t goal_row = goal / width, goal_col = goal % width;
-    int64_t n = height * width;
-    for (int64_t i = 0; i < n; i++) best[i] = INFINITY;
-
+    /* closed[]: 0 unseen (best[] not yet written: a short plan on a big map touches
+     * only the cells it expands, not every cell), 1 queued, 2 closed. */
     Heap heap = {NULL, 0, 0};
     Outcome outcome = NO_PATH;
     best[start] = 0.0;
+    closed[start] = 1;
     parent[start] = (int32_t)start;
     {
         int64_t dr = llabs(start / width - goal_row), dc = llabs(start % width - goal_col);
@@ -111,8 +111,8 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
     while (heap.size > 0) {
         Entry entry = heap_pop(&heap);
         int64_t cell = entry.cell;
-        if (closed[cell]) continue;
-        closed[cell] = 1;
+        if (closed[cell] == 2) continue;
+        closed[cell] = 2;
         if (cell == goal) {
             *total = entry.g;
             outcome = FOUND;
@@ -124,12 +124,13 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
             int64_t r = row + d_row[k], c = col + d_col[k];
             if (r < 0 || r >= height || c < 0 || c >= width) continue;
             int64_t next = r * width + c;
-            if (closed[next]) continue;
+            if (closed[next] == 2) continue;
             double there = lut[cost[next]];
             if (isinf(there)) continue;
             double step = (d_row[k] != 0 && d_col[k] != 0) ? diagonal : 1.0;
             double g = entry.g + step * 0.5 * (here + there);
-            if (g < best[next]) {
+            if (closed[next] == 0 || g < best[next]) {
+                closed[next] = 1;
                 best[next] = g;
                 parent[next] = (int32_t)cell;
                 int64_t dr = llabs(r - goal_row), dc = llabs(c - goal_col);
