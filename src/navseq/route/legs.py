@@ -103,10 +103,15 @@ class LegPlanner:
         the places after it, on one thread per core (the compiled search lets go of the
         GIL). For ordering hundreds of waypoints, where a plan per pair took minutes.
         Pairs measured before on the same map for the same robot, by this planner or
-        another, are not searched again (:mod:`navseq.route.distances`)."""
+        another, are not searched again (:mod:`navseq.route.distances`). On a big map,
+        the coarse routes of :mod:`navseq.route.coarse` (lengths within a few per cent,
+        the same pairs reachable)."""
+        from navseq.route import coarse
         from navseq.route.distances import distance_table
-        from navseq.sim.planner import reach_lengths
+        from navseq.sim.planner import compiled_search_available, reach_lengths
 
+        if compiled_search_available() and coarse.worth_it(self.costmap, len(places)):
+            return self.routes(places, 0.0).metres
         return distance_table(self.costmap, places, reach_lengths, workers=os.cpu_count() or 1)
 
     def routes(

@@ -136,7 +136,6 @@ def route_table(
     from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
     from navseq.route import distances
-    from navseq.sim.planner import reach_routes
 
     known = distances.known_distances(costmap)
     key = (*distances.costmap_key(costmap), round(anchor_m, 6))
@@ -158,12 +157,9 @@ def route_table(
             if row.any()
         ]
 
-        def measure(item: tuple[int, np.ndarray]) -> np.ndarray:
-            i, others = item
-            return reach_routes(costmap, places[i], [places[j] for j in others], anchor_m)
-
         pool = ThreadPoolExecutor(max_workers=max(1, workers))
         try:
+            measure = _measure(costmap, places, anchor_m, work, pool)
             pending = {pool.submit(measure, item): item for item in work}
             done_count = 0
             if progress is not None:
@@ -190,6 +186,33 @@ def route_table(
     np.fill_diagonal(depart, np.nan)
     np.fill_diagonal(arrive, np.nan)
     return RouteTable(metres, depart, arrive)
+
+
+def _measure(
+    costmap: Costmap,
+    places: Sequence[Place],
+    anchor_m: float,
+    work: list[tuple[int, np.ndarray]],
+    pool: Any,
+) -> Callable[[tuple[int, np.ndarray]], np.ndarray]:
+    """What measures one search of ``work`` (a place, the places it goes to): the exact
+    search per place, or on a big map the coarse routes (:mod:`navseq.route.coarse`),
+    whose searches near each place are made first on ``pool``."""
+    from navseq.route import coarse
+    from navseq.sim.planner import compiled_search_available, reach_routes
+
+    if not (compiled_search_available() and coarse.worth_it(costmap, len(work))):
+
+        def exact(item: tuple[int, np.ndarray]) -> np.ndarray:
+            i, others = item
+            return reach_routes(costmap, places[i], [places[j] for j in others], anchor_m)
+
+        return exact
+    routes = coarse.CoarseRoutes(costmap, places, anchor_m)
+    ends = {i for i, _ in work} | {int(j) for _, others in work for j in others}
+    for _ in pool.map(routes.prepare, sorted(ends)):
+        pass
+    return lambda item: routes.reach(*item)
 
 
 def _turn_seconds(angle: np.ndarray, within: float, model: DriveModel) -> np.ndarray:

@@ -11,6 +11,11 @@
  *
  * distances(cost, width, lut, start, targets) -> bytes (float64 per target)
  * routes(cost, width, lut, start, targets, anchor_cells) -> bytes (3 float64 per target)
+ * local(cost, width, lut, start, bound, queries, anchor_cells) -> bytes (3 float64 per query)
+ * graph(indptr, indices, edge_cost, edge_length, seeds, seed_cost, seed_length, wanted)
+ *
+ *   local and graph serve the coarse distances of navseq.route.coarse: an exact search
+ *   near a place, and a search over the coarse graph of a map's free space.
  *
  *   targets : int64 flat cell indices; the result is each one's length in cells along
  *             the cheapest route from start (inf when there is none), from one search
@@ -91,12 +96,12 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
     static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
     const double diagonal = sqrt(2.0), diagonal_extra = sqrt(2.0) - 1.0;
     const int64_t goal_row = goal / width, goal_col = goal % width;
-    int64_t n = height * width;
-    for (int64_t i = 0; i < n; i++) best[i] = INFINITY;
-
+    /* closed[]: 0 unseen (best[] not yet written: a short plan on a big map touches
+     * only the cells it expands, not every cell), 1 queued, 2 closed. */
     Heap heap = {NULL, 0, 0};
     Outcome outcome = NO_PATH;
     best[start] = 0.0;
+    closed[start] = 1;
     parent[start] = (int32_t)start;
     {
         int64_t dr = llabs(start / width - goal_row), dc = llabs(start % width - goal_col);
@@ -106,8 +111,8 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
     while (heap.size > 0) {
         Entry entry = heap_pop(&heap);
         int64_t cell = entry.cell;
-        if (closed[cell]) continue;
-        closed[cell] = 1;
+        if (closed[cell] == 2) continue;
+        closed[cell] = 2;
         if (cell == goal) {
             *total = entry.g;
             outcome = FOUND;
@@ -119,12 +124,13 @@ static Outcome astar(const uint8_t *cost, int64_t height, int64_t width, const d
             int64_t r = row + d_row[k], c = col + d_col[k];
             if (r < 0 || r >= height || c < 0 || c >= width) continue;
             int64_t next = r * width + c;
-            if (closed[next]) continue;
+            if (closed[next] == 2) continue;
             double there = lut[cost[next]];
             if (isinf(there)) continue;
             double step = (d_row[k] != 0 && d_col[k] != 0) ? diagonal : 1.0;
             double g = entry.g + step * 0.5 * (here + there);
-            if (g < best[next]) {
+            if (closed[next] == 0 || g < best[next]) {
+                closed[next] = 1;
                 best[next] = g;
                 parent[next] = (int32_t)cell;
                 int64_t dr = llabs(r - goal_row), dc = llabs(c - goal_col);
@@ -468,6 +474,252 @@ finish:
     return result;
 }
 
+/* local(cost, width, lut, start, bound, queries, anchor_cells) -> bytes (3 float64 per
+ * query): Dijkstra from `start` over the cells whose cost from it is at most `bound`
+ * (every one of them exactly, as a whole search would), then per query cell its length
+ * in cells along the cheapest route, that route's cost, and its departure anchor (the
+ * route's last cell within anchor_cells of the start) as a flat index; inf, inf, -1 for
+ * a query the bound did not reach. Memory is taken lazily (calloc'd state, untouched
+ * pages never written), so a small search on a big map costs what it expands. */
+static PyObject *local(PyObject *self, PyObject *args) {
+    Py_buffer cost_buffer, lut_buffer, query_buffer;
+    Py_ssize_t width, start;
+    double bound, anchor_cells;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*ny*ndy*d", &cost_buffer, &width, &lut_buffer, &start, &bound,
+                          &query_buffer, &anchor_cells))
+        return NULL;
+    PyObject *result = NULL;
+    double *best = NULL, *length = NULL;
+    int32_t *anchor = NULL;
+    uint8_t *state = NULL; /* 0 unseen, 1 queued, 2 closed */
+    Heap heap = {NULL, 0, 0};
+    Py_ssize_t n = cost_buffer.len;
+    Py_ssize_t count = query_buffer.len / (Py_ssize_t)sizeof(int64_t);
+    const int64_t *queries = query_buffer.buf;
+    if (width <= 0 || n % width != 0 || n > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+        goto finish;
+    }
+    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
+        query_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
+        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, queries int64 values");
+        goto finish;
+    }
+    if (start < 0 || start >= n) {
+        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
+        goto finish;
+    }
+    for (Py_ssize_t i = 0; i < count; i++) {
+        if (queries[i] < 0 || queries[i] >= n) {
+            PyErr_SetString(PyExc_IndexError, "query cell outside the grid");
+            goto finish;
+        }
+    }
+    best = malloc((size_t)n * sizeof(double));
+    length = malloc((size_t)n * sizeof(double));
+    anchor = malloc((size_t)n * sizeof(int32_t));
+    state = calloc((size_t)n, 1);
+    result = PyBytes_FromStringAndSize(NULL, 3 * count * (Py_ssize_t)sizeof(double));
+    if (best == NULL || length == NULL || anchor == NULL || state == NULL || result == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto finish;
+    }
+    const uint8_t *cost = cost_buffer.buf;
+    const double *lut = lut_buffer.buf;
+    double *out = (double *)PyBytes_AS_STRING(result);
+    int failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+    static const int d_row[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+    static const int d_col[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+    const double diagonal = sqrt(2.0);
+    const int64_t height = n / width;
+    if (!isinf(lut[cost[start]])) {
+        best[start] = length[start] = 0.0;
+        anchor[start] = (int32_t)start;
+        state[start] = 1;
+        failed = heap_push(&heap, (Entry){0.0, 0.0, start}) < 0;
+    }
+    while (!failed && heap.size > 0) {
+        Entry entry = heap_pop(&heap);
+        int64_t cell = entry.cell;
+        if (state[cell] == 2 || entry.g > best[cell]) continue;
+        if (entry.g > bound) break;
+        state[cell] = 2;
+        int64_t row = cell / width, col = cell % width;
+        double here = lut[cost[cell]];
+        for (int k = 0; k < 8; k++) {
+            int64_t r = row + d_row[k], c = col + d_col[k];
+            if (r < 0 || r >= height || c < 0 || c >= width) continue;
+            int64_t next = r * width + c;
+            if (state[next] == 2) continue;
+            double there = lut[cost[next]];
+            if (isinf(there)) continue;
+            double step = (d_row[k] != 0 && d_col[k] != 0) ? diagonal : 1.0;
+            double g = entry.g + step * 0.5 * (here + there);
+            if (state[next] == 0 || g < best[next]) {
+                state[next] = 1;
+                best[next] = g;
+                length[next] = length[cell] + step;
+                anchor[next] = length[next] <= anchor_cells ? (int32_t)next : anchor[cell];
+                if (heap_push(&heap, (Entry){g, g, next}) < 0) {
+                    failed = 1;
+                    break;
+                }
+            }
+        }
+    }
+    for (Py_ssize_t i = 0; i < count; i++) {
+        int64_t query = queries[i];
+        if (state[query] == 2) {
+            out[3 * i] = length[query];
+            out[3 * i + 1] = best[query];
+            out[3 * i + 2] = (double)anchor[query];
+        } else {
+            out[3 * i] = out[3 * i + 1] = INFINITY;
+            out[3 * i + 2] = -1.0;
+        }
+    }
+    Py_END_ALLOW_THREADS
+    if (failed) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+
+finish:
+    free(heap.items);
+    free(best);
+    free(length);
+    free(anchor);
+    free(state);
+    PyBuffer_Release(&cost_buffer);
+    PyBuffer_Release(&lut_buffer);
+    PyBuffer_Release(&query_buffer);
+    return result;
+}
+
+/* graph(indptr, indices, edge_cost, edge_length, seeds, seed_cost, seed_length, wanted)
+ * -> bytes (3 float64 per node): Dijkstra over a graph in compressed rows (int64
+ * indptr/indices, float64 costs and lengths per edge) from several seeds at once, each
+ * with a cost and a length already run up; per node its cheapest cost, the length along
+ * that route and the index of the seed it came from (inf, inf, -1: not reached). Stops
+ * once every `wanted` node (int64) is closed. */
+static PyObject *graph(PyObject *self, PyObject *args) {
+    Py_buffer b_indptr, b_indices, b_cost, b_length, b_seeds, b_seed_cost, b_seed_length, b_wanted;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*y*y*", &b_indptr, &b_indices, &b_cost, &b_length,
+                          &b_seeds, &b_seed_cost, &b_seed_length, &b_wanted))
+        return NULL;
+    PyObject *result = NULL;
+    uint8_t *state = NULL, *want = NULL;
+    Heap heap = {NULL, 0, 0};
+    Py_ssize_t nodes = b_indptr.len / (Py_ssize_t)sizeof(int64_t) - 1;
+    Py_ssize_t edges = b_indices.len / (Py_ssize_t)sizeof(int64_t);
+    Py_ssize_t seeds = b_seeds.len / (Py_ssize_t)sizeof(int64_t);
+    Py_ssize_t wanted_count = b_wanted.len / (Py_ssize_t)sizeof(int64_t);
+    const int64_t *indptr = b_indptr.buf, *indices = b_indices.buf, *seed = b_seeds.buf;
+    const int64_t *wanted = b_wanted.buf;
+    const double *edge_cost = b_cost.buf, *edge_length = b_length.buf;
+    const double *seed_cost = b_seed_cost.buf, *seed_length = b_seed_length.buf;
+    if (nodes < 0 || b_cost.len != edges * (Py_ssize_t)sizeof(double) ||
+        b_length.len != b_cost.len || indptr[nodes] != edges ||
+        b_seed_cost.len != seeds * (Py_ssize_t)sizeof(double) ||
+        b_seed_length.len != b_seed_cost.len) {
+        PyErr_SetString(PyExc_ValueError, "inconsistent graph or seed arrays");
+        goto finish;
+    }
+    for (Py_ssize_t i = 0; i < edges; i++) {
+        if (indices[i] < 0 || indices[i] >= nodes) {
+            PyErr_SetString(PyExc_IndexError, "edge to a node outside the graph");
+            goto finish;
+        }
+    }
+    for (Py_ssize_t i = 0; i < seeds; i++) {
+        if (seed[i] < 0 || seed[i] >= nodes) {
+            PyErr_SetString(PyExc_IndexError, "seed outside the graph");
+            goto finish;
+        }
+    }
+    for (Py_ssize_t i = 0; i < wanted_count; i++) {
+        if (wanted[i] < 0 || wanted[i] >= nodes) {
+            PyErr_SetString(PyExc_IndexError, "wanted node outside the graph");
+            goto finish;
+        }
+    }
+    state = calloc((size_t)nodes + 1, 1);
+    want = calloc((size_t)nodes + 1, 1);
+    result = PyBytes_FromStringAndSize(NULL, 3 * nodes * (Py_ssize_t)sizeof(double));
+    if (state == NULL || want == NULL || result == NULL) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+        goto finish;
+    }
+    double *out = (double *)PyBytes_AS_STRING(result);
+    int failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < nodes; i++) {
+        out[3 * i] = out[3 * i + 1] = INFINITY;
+        out[3 * i + 2] = -1.0;
+    }
+    int64_t remaining = 0;
+    for (Py_ssize_t i = 0; i < wanted_count; i++) {
+        if (!want[wanted[i]]) {
+            want[wanted[i]] = 1;
+            remaining++;
+        }
+    }
+    for (Py_ssize_t i = 0; i < seeds && !failed; i++) {
+        int64_t node = seed[i];
+        if (seed_cost[i] < out[3 * node]) {
+            out[3 * node] = seed_cost[i];
+            out[3 * node + 1] = seed_length[i];
+            out[3 * node + 2] = (double)i;
+            failed = heap_push(&heap, (Entry){seed_cost[i], seed_cost[i], node}) < 0;
+        }
+    }
+    while (!failed && heap.size > 0 && remaining > 0) {
+        Entry entry = heap_pop(&heap);
+        int64_t node = entry.cell;
+        if (state[node] || entry.g > out[3 * node]) continue;
+        state[node] = 1;
+        if (want[node]) remaining--;
+        for (int64_t e = indptr[node]; e < indptr[node + 1]; e++) {
+            int64_t next = indices[e];
+            if (state[next]) continue;
+            double g = entry.g + edge_cost[e];
+            if (g < out[3 * next]) {
+                out[3 * next] = g;
+                out[3 * next + 1] = out[3 * node + 1] + edge_length[e];
+                out[3 * next + 2] = out[3 * node + 2];
+                if (heap_push(&heap, (Entry){g, g, next}) < 0) {
+                    failed = 1;
+                    break;
+                }
+            }
+        }
+    }
+    Py_END_ALLOW_THREADS
+    if (failed) {
+        Py_CLEAR(result);
+        PyErr_NoMemory();
+    }
+
+finish:
+    free(heap.items);
+    free(state);
+    free(want);
+    PyBuffer_Release(&b_indptr);
+    PyBuffer_Release(&b_indices);
+    PyBuffer_Release(&b_cost);
+    PyBuffer_Release(&b_length);
+    PyBuffer_Release(&b_seeds);
+    PyBuffer_Release(&b_seed_cost);
+    PyBuffer_Release(&b_seed_length);
+    PyBuffer_Release(&b_wanted);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"search", search, METH_VARARGS,
      "search(cost, width, lut, start, goal, heuristic_scale) -> (total, cells) or None\n\n"
@@ -478,6 +730,12 @@ static PyMethodDef methods[] = {
     {"routes", routes, METH_VARARGS,
      "routes(cost, width, lut, start, targets, anchor_cells) -> bytes of float64 triples\n\n"
      "As distances, with each route's departure and arrival anchor cells (-1: no route)."},
+    {"local", local, METH_VARARGS,
+     "local(cost, width, lut, start, bound, queries, anchor_cells) -> bytes of float64 "
+     "triples\n\nDijkstra from start up to cost bound: per query length, cost, anchor."},
+    {"graph", graph, METH_VARARGS,
+     "graph(indptr, indices, edge_cost, edge_length, seeds, seed_cost, seed_length, "
+     "wanted) -> bytes of float64 triples\n\nMulti-seed Dijkstra over a graph."},
     {NULL, NULL, 0, NULL},
 };
 
