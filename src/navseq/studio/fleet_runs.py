@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
+from navseq.sim.fleet_world import FleetWorld
 from navseq.studio.fleet_replay import robot_colour
 from navseq.studio.runs import LiveView
 
@@ -213,16 +214,19 @@ class StudioFleetRun:
         """Every robot's pose, waypoint and state, and the fleet's totals and ETA."""
         run = self.run
         assert run is not None
+        world = run.world
+        # The studio runs fleets on the embedded simulator only (never on ROS stacks).
+        assert isinstance(world, FleetWorld)
         robots = []
         for robot in self.robots:
-            pose = run.world.world(robot.member.robot.name).robot.pose  # immutable Pose2D
+            pose = world.world(robot.member.robot.name).robot.pose  # immutable Pose2D
             robots.append(robot.snapshot((pose.x, pose.y, pose.yaw)))
         totals = {key: sum(r[key] for r in robots) for key in ("reached", "skipped", "failed")}
         running = [r["eta_s"] for r in robots if r["eta_s"] is not None and not _ended(r["state"])]
         with self._lock:
             version = self._version
             status = self.status
-        clock = run.world.now
+        clock = world.now
         return {
             "version": f"{version}:{clock:.3f}",
             "status": status,
@@ -235,7 +239,7 @@ class StudioFleetRun:
             "eta_s": max(running) if running and not self.done else None,
             "waypoints": sum(r["waypoints"] for r in robots),
             **totals,
-            "robot_overlaps": run.world.collisions,
+            "robot_overlaps": world.collisions,
             "robots": robots,
             "report": self.report,
             "error": self.error,
