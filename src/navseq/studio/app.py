@@ -28,6 +28,7 @@ from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from navseq.errors import NavseqError
+from navseq.eta.incremental import IncrementalPrediction
 from navseq.eta.memo import RememberedDrives
 from navseq.executor.control import operator_reason
 from navseq.extras import MissingExtra
@@ -44,7 +45,13 @@ from navseq.studio.documents import (
     problems_of,
     version_of,
 )
-from navseq.studio.edits import LastCheck, checked_after_edit, edited_mission, moved_waypoints
+from navseq.studio.edits import (
+    LastCheck,
+    changed_legs,
+    checked_after_edit,
+    edited_mission,
+    moved_waypoints,
+)
 from navseq.studio.mapview import MapView
 from navseq.studio.security import (
     COOKIE_NAME,
@@ -120,8 +127,13 @@ class Studio:
         # The opened file's answer, by (path, SHA-256, --map): not to be changed by callers.
         self._opened: tuple[tuple[Path, str, str | None], dict[str, Any]] | None = None
         self._answers: OrderedDict[
-            tuple[str, tuple[int, ...]], tuple[RobotProfile | None, dict[str, Any]]
+            tuple[str, tuple[int, ...]],
+            tuple[RobotProfile | None, dict[str, Any], LastCheck | None],
         ] = OrderedDict()
+        # The legs of the last answers, by their "check" number: a page names the one it
+        # holds, and is sent only the legs that differ from it.
+        self._legs_sent: OrderedDict[int, list[dict[str, Any]]] = OrderedDict()
+        self._checks = 0  # answers worked out, numbering them
         self.robot: RobotProfile | None = None  # the last checked draft's robot
         self._last_check: LastCheck | None = None  # an edit is checked from it
         self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
@@ -263,25 +275,41 @@ class Studio:
             raise ApiError(404, f"no such map file: {printable(self.roots.relative(path))}")
         return path
 
-    def check(self, document: Any) -> dict[str, Any]:
+    def check(self, document: Any, base: Any = None) -> dict[str, Any]:
         """Problems and planned legs of a draft (``POST /api/check``).
 
         One check at a time: a check that comes while another builds a costmap or plans
         legs waits for it and then finds them made, instead of doing the same work
         beside it on the same cores (the page's first check and :meth:`warm_up`).
+
+        Each answer is numbered (``check``). ``base``: the number of an answer whose legs
+        the caller holds; when it is one of the last ones, the answer carries only the
+        legs that differ from it (``legs_changed``: ``[position, leg]`` pairs, with
+        ``base``) instead of ``legs`` — a drag at 5000 waypoints changes two legs of 5000.
         """
         with self._check_lock:
             key = self._answer_key(document)
             if key is not None and key in self._answers:
                 self._answers.move_to_end(key)
-                self.robot, answer = self._answers[key]
+                self.robot, answer, self._last_check = self._answers[key]
+            else:
+                answer = self._check(document)
+                self._checks += 1
+                answer["check"] = self._checks
+                self._legs_sent[self._checks] = answer["legs"]
+                while len(self._legs_sent) > CHECK_ANSWERS_KEPT:
+                    self._legs_sent.popitem(last=False)
+                if key is not None:
+                    self._answers[key] = (self.robot, answer, self._last_check)
+                    while len(self._answers) > CHECK_ANSWERS_KEPT:
+                        self._answers.popitem(last=False)
+            held = self._legs_sent.get(base) if isinstance(base, int) else None
+            if held is None or len(held) != len(answer["legs"]):
                 return answer
-            answer = self._check(document)
-            if key is not None:
-                self._answers[key] = (self.robot, answer)
-                while len(self._answers) > CHECK_ANSWERS_KEPT:
-                    self._answers.popitem(last=False)
-            return answer
+            delta = {name: value for name, value in answer.items() if name != "legs"}
+            delta["base"] = base
+            delta["legs_changed"] = changed_legs(held, answer["legs"])
+            return delta
 
     def _answer_key(self, document: Any) -> tuple[str, tuple[int, ...]] | None:
         """What a check's answer depends on: the draft and its map file's stamp.
@@ -359,14 +387,16 @@ class Studio:
                 return answer  # the map's own problem is in the list already
             if moved is not None and last is not None:
                 legs = legs_after_edit(last.legs, mission, planner, moved)
+                eta = last.eta.after_edit(mission, moved)
             else:
                 legs = legs_of(mission, planner)
+                eta = IncrementalPrediction(mission, planner, self.drives(planner, robot))
             answer["legs"] = legs
             answer.update(route_summary(legs, robot))
-            answer.update(_expected_duration(mission, planner, robot, self.drives(planner, robot)))
+            answer.update(_expected_duration(eta))
             if isinstance(document, dict):
                 context = (map_stamp(checked.map_path), planner)
-                self._last_check = LastCheck(document, checked, context, legs)
+                self._last_check = LastCheck(document, checked, context, legs, eta)
         return answer
 
     def _checked_edit(
@@ -944,7 +974,7 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/map/image", get_map_image),
         Route(
             "/api/check",
-            answer_body(lambda body: studio.check(body.get("mission"))),
+            answer_body(lambda body: studio.check(body.get("mission"), body.get("base"))),
             methods=["POST"],
         ),
         Route("/api/save", answer_body(studio.save), methods=["POST"]),
@@ -967,16 +997,11 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
     return app
 
 
-def _expected_duration(
-    mission: Mission, planner: Legs, robot: RobotProfile, drives: RememberedDrives | None = None
-) -> dict[str, Any]:
+def _expected_duration(prediction: IncrementalPrediction) -> dict[str, Any]:
     """The mission's expected duration and upper bound (navseq.eta), as ``navseq plan``
-    says them; the legs come from the planner's cache and the legs driven on paper from
-    ``drives``, so an edit costs the visits it changed."""
-    from navseq.eta.predict import predict_legs
+    says them; an edit's prediction works out only the visits it changed."""
     from navseq.eta.text import format_duration
 
-    prediction = predict_legs(mission, planner, robot, mission.start, drives=drives)
     expected, upper = prediction.expected_s, prediction.upper_s
     if expected is None:  # a patrol that loops forever
         text = f"~{format_duration(prediction.loop_expected_s)} a loop"

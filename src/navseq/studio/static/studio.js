@@ -7,7 +7,7 @@
 const S = {
   doc: null, version: null, name: "", units: {},
   problems: [], legs: [], route: {}, selected: null,
-  undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
+  undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false, checkId: null,
   layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
   planned: false, painted: null, mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
 };
@@ -1214,19 +1214,28 @@ async function check() {
   S.checkBusy = true;
   const seq = ++S.checkSeq;
   // Written out once, now: the draft as it is at this moment (edits may follow while
-  // the answer is on its way), and no second copy of a mission of thousands.
-  const answer = await api("POST", "/api/check", JSON.stringify({ mission: S.doc }));
+  // the answer is on its way), and no second copy of a mission of thousands. "base":
+  // the answer whose legs the page holds; the server then sends only the legs that
+  // differ from them (a drag: two of 5000).
+  const body = JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  const answer = await api("POST", "/api/check", body);
   S.checkBusy = false;
-  if (S.checkAgain) { S.checkAgain = false; check(); return; }
-  if (seq !== S.checkSeq) return;
+  // Taken in even when a newer edit is to be checked: the next answer is sent against it.
   if (!answer.ok) {
     S.problems = answer.data.problems || [{ text: answer.data.error, waypoint: null }];
-    S.legs = []; S.route = {};
+    S.legs = []; S.route = {}; S.checkId = null;
   } else {
-    S.problems = answer.data.problems;
-    S.legs = answer.data.legs;
-    S.route = answer.data;
+    const data = answer.data;
+    let held = true;
+    if (!data.legs_changed) S.legs = data.legs;
+    else if (data.base === S.checkId) for (const [position, leg] of data.legs_changed) S.legs[position] = leg;
+    else { held = false; S.legs = []; S.checkAgain = true; }  // not the legs it was sent against: ask whole
+    S.problems = data.problems;
+    S.checkId = held ? data.check : null;
+    S.route = data;
   }
+  if (S.checkAgain) { S.checkAgain = false; check(); return; }
+  if (seq !== S.checkSeq) return;
   S.planned = true;
   await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
