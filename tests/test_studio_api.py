@@ -654,7 +654,7 @@ def test_warm_up_makes_the_map_image_before_the_first_check(
     monkeypatch.setattr(
         studio, "check", lambda document, base=None: done.append("check") or real_check(document)
     )
-    studio.warm_up()
+    studio.warm_up()  # no page to wait for
     assert done == ["map image", "check"]
     # What the page then asks for is made already.
     monkeypatch.setattr(mapview, "map_png", lambda grid: pytest.fail("made twice"))

@@ -1734,14 +1734,17 @@ async function main() {
   if (!S.allowRun) $("run").title = "run: tasks need the studio started with --allow-run";
   $("mission-name").textContent = answer.data.path || S.name;
   if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
-  // The first check (pre-flight problems and every leg planned: a second or more on a
-  // big map) goes out now and is worked on while the map is drawn; the page is ready
-  // (map drawn, markers placed, the file's own problems listed) without waiting for it.
+  // The page is ready (map drawn, markers placed, the file's own problems listed)
+  // without waiting for the first check (pre-flight problems and every leg planned: a
+  // second or more on a big map). That check goes out once the page is painted: worked
+  // on beside the first paint, it took the cores the browser draws with (the studio's
+  // warm-up waits for it too).
   S.painted = loadMap(true).then(() => {
     render();
     document.body.dataset.ready = "true";
   });
-  await Promise.all([S.painted, check()]);
+  await S.painted;
+  await check();
   loadRuns();
 }
 main();
