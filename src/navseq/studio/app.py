@@ -55,6 +55,7 @@ from navseq.studio.edits import (
     moved_waypoints,
 )
 from navseq.studio.mapview import MapView
+from navseq.studio.ordering import OrderJob, OrderJobs
 from navseq.studio.security import (
     COOKIE_NAME,
     LOCAL_NAMES,
@@ -71,6 +72,7 @@ if TYPE_CHECKING:
     from navseq.mission.costmap_filters import CostmapFilter
     from navseq.mission.model import Mission
     from navseq.mission.robot import RobotProfile
+    from navseq.route.order import OrderProgress
     from navseq.sim.costmap import Costmap
     from navseq.studio.runs import StudioRun
 
@@ -145,6 +147,7 @@ class Studio:
         self._drives: dict[RobotProfile, tuple[LegPlanner, RememberedDrives]] = {}
         self.edits_checked = 0  # checks worked out from the last one, for tests and benchmarks
         self.page_checked = threading.Event()  # a page asked for its first check
+        self.order_jobs = OrderJobs()
         self.run: StudioRun | None = None
 
     # -- where things are --------------------------------------------------------------
@@ -546,20 +549,58 @@ class Studio:
     def order(self, body: dict[str, Any]) -> dict[str, Any]:
         """The draft's shortest visiting order (``POST /api/order``), as ``navseq plan
         --order shortest`` finds it on the draft's map (straight lines without one)."""
-        from navseq.commands.common import choose_robot
-        from navseq.route.legs import StraightLegs, route_length
-        from navseq.route.order import shortest_order
+        return self._ordering(*self._order_request(body))
 
+    def start_order(self, body: dict[str, Any]) -> dict[str, Any]:
+        """:meth:`order` as a job (``POST /api/order/jobs``): its progress and answer
+        from :meth:`order_job`, stopped by :meth:`cancel_order`. A draft that cannot be
+        read is refused at once (422, with its problems)."""
+        checked, mission, keep_last = self._order_request(body)
+        job = self.order_jobs.start(
+            lambda progress: self._ordering(checked, mission, keep_last, progress)
+        )
+        return job.view()
+
+    def order_job(self, number: str) -> dict[str, Any]:
+        """``GET /api/order/jobs/N``: how far the job got, and its answer once done."""
+        return self._order_job(number).view()
+
+    def cancel_order(self, number: str) -> dict[str, Any]:
+        """``POST /api/order/jobs/N/cancel``: no search started after this one."""
+        job = self._order_job(number)
+        job.cancel()
+        return job.view()
+
+    def _order_job(self, number: str) -> OrderJob:
+        job = self.order_jobs.get(int(number)) if number.isdigit() else None
+        if job is None:
+            raise ApiError(404, f"no order job {printable(number)}")
+        return job
+
+    def _order_request(self, body: dict[str, Any]) -> tuple[CheckedDraft, Mission, bool]:
         keep_last = body.get("keep_last", False)
         if not isinstance(keep_last, bool):
             raise ApiError(400, "keep_last: true or false")
         checked, mission = self._readable(body.get("mission"), "ordering")
+        return checked, mission, keep_last
+
+    def _ordering(
+        self,
+        checked: CheckedDraft,
+        mission: Mission,
+        keep_last: bool,
+        progress: OrderProgress | None = None,
+    ) -> dict[str, Any]:
+        from navseq.commands.common import choose_robot
+        from navseq.route.legs import StraightLegs, route_length
+        from navseq.route.order import shortest_order
+
         robot = choose_robot(None, mission)
         legs: Legs = StraightLegs()
         if checked.map_path is not None and checked.map_path.is_file():
             legs = self.planner(checked.map_path, robot)
         ordering = shortest_order(
-            mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last, robot=robot
+            mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last, robot=robot, progress=progress
         )
         return {
             "order": list(ordering.order),
@@ -959,6 +1000,14 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         return Response(png, media_type="image/png")
 
     @api
+    async def order_job(request: Request) -> Response:
+        return JSONResponse(studio.order_job(request.path_params["job"]))
+
+    @api
+    async def cancel_order(request: Request) -> Response:
+        return JSONResponse(studio.cancel_order(request.path_params["job"]))
+
+    @api
     async def get_replay(request: Request) -> Response:
         folder = request.query_params.get("folder")
         return JSONResponse(await run_in_threadpool(studio.replay, folder))
@@ -1025,6 +1074,9 @@ def create_app(config: StudioConfig, studio: Studio | None = None) -> Starlette:
         Route("/api/import", answer_body(studio.import_file), methods=["POST"]),
         Route("/api/export", answer_body(studio.export_launch), methods=["POST"]),
         Route("/api/order", answer_body(studio.order), methods=["POST"]),
+        Route("/api/order/jobs", answer_body(studio.start_order), methods=["POST"]),
+        Route("/api/order/jobs/{job}", order_job),
+        Route("/api/order/jobs/{job}/cancel", cancel_order, methods=["POST"]),
         Route("/api/runs", answer(studio.runs)),
         Route("/api/replay", get_replay),
         Route("/api/run", answer_body(studio.start_run), methods=["POST"]),

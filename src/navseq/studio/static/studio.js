@@ -1336,31 +1336,51 @@ $("order").onchange = async (e) => {
   const choice = e.target.value;
   e.target.value = "";
   if (!choice || (S.run && !S.run.done) || S.replay || S.ordering) return;
-  // Seconds on a big mission: the time spent is shown, and Cancel gives the page back
-  // (the answer, when it comes, is dropped; the mission is as it was).
-  const aborter = new AbortController();
-  const began = performance.now();
-  const count = S.doc.waypoints.length;
-  const tell = () => say(`finding the shortest order of ${count} waypoints… ${Math.round((performance.now() - began) / 1000)} s (Cancel stops waiting)`);
-  S.ordering = aborter;
-  tell();
+  // Seconds to minutes on a big map: the server orders as a job, the page shows how
+  // far its searches got, and Cancel stops them (the mission stays as it was).
+  const count = S.doc.waypoints.length, began = performance.now();
+  let cancelled = false, job = null, view = { state: "measuring", searches: 0 };
+  const tell = () => {
+    const seconds = `${Math.round((performance.now() - began) / 1000)} s`;
+    let doing = `finding the shortest order of ${count} waypoints…`;
+    if (view.state === "solving") doing = `choosing the shortest order of ${count} waypoints…`;
+    else if (view.searches) doing = `measuring the ways between ${count} waypoints: ${view.searches_done} of ${view.searches} searches…`;
+    say(`${doing} ${seconds} (Cancel stops it)`);
+  };
   const ticker = setInterval(tell, 1000);
   const cancel = $("order-cancel");
+  const finish = () => { clearInterval(ticker); S.ordering = null; cancel.hidden = true; $("order").disabled = false; };
+  const stopJob = () => { if (job !== null) api("POST", `/api/order/jobs/${job}/cancel`, {}); };
+  S.ordering = true;
+  tell();
   cancel.hidden = false;
-  cancel.onclick = () => aborter.abort();
   $("order").disabled = true;
+  // Cancel gives the page back at once; the server's searches stop at the next one.
+  cancel.onclick = () => {
+    cancelled = true;
+    stopJob();
+    finish();
+    say("ordering cancelled: the waypoints are as they were");
+  };
   let answer;
   try {
-    answer = await api("POST", "/api/order", { mission: S.doc, keep_last: choice === "keep-last" }, aborter.signal);
+    answer = await api("POST", "/api/order/jobs", { mission: S.doc, keep_last: choice === "keep-last" });
+    if (answer.ok) { job = answer.data.job; view = answer.data; }
+    if (cancelled) { stopJob(); return; }
+    while (answer.ok && ["measuring", "solving"].includes(answer.data.state)) {
+      view = answer.data;
+      tell();
+      await new Promise((done) => setTimeout(done, 250));
+      if (cancelled) return;
+      answer = await api("GET", `/api/order/jobs/${job}`);
+      if (cancelled) return;
+    }
   } catch (error) {
-    answer = null;
-  } finally {
-    clearInterval(ticker);
-    S.ordering = null;
-    cancel.hidden = true;
-    $("order").disabled = false;
+    answer = { ok: false, data: { error: `ordering failed: ${error}` } };
   }
-  if (!answer) { say("ordering cancelled: the waypoints are as they were"); return; }
+  finish();
+  if (answer.ok && answer.data.state === "cancelled") { say("ordering cancelled: the waypoints are as they were"); return; }
+  if (answer.ok && answer.data.state === "failed") answer = { ok: false, status: answer.data.status, data: answer.data.failure };
   if (!answer.ok) {
     const first = (answer.data.problems || [])[0];
     say(first ? `${answer.data.error}: ${first.text}` : answer.data.error, true);
