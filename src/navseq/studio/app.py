@@ -341,7 +341,8 @@ class Studio:
         try:
             if isinstance(map_value, str):
                 stamp = map_stamp(self.roots.resolve(map_value, "map"))
-            text = json.dumps(document, sort_keys=True, allow_nan=True)
+            # Not sorted: the page sends its keys in one order (another only misses).
+            text = json.dumps(document, allow_nan=True)
         except (NavseqError, OSError, TypeError, ValueError, RecursionError):
             return None
         return text, stamp

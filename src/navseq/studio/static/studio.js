@@ -121,7 +121,8 @@ function restore(from, to) {
   S.doc = state.doc; S.selected = state.selected;
   changed();
 }
-function changed() { render(); check(); }
+// The check goes out first: the server works on it while the page redraws.
+function changed() { check(); render(); }
 // Edits not saved yet: closing or reloading the tab asks first (the browser's own dialog).
 const unsaved = () => S.saved !== undefined && JSON.stringify(S.doc) !== S.saved;
 window.addEventListener("beforeunload", (e) => {
