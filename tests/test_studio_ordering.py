@@ -118,3 +118,19 @@ def test_the_progress_of_a_real_ordering_is_shown(
         OrderJob.searching = real_searching  # type: ignore[method-assign]
     assert job["state"] == "done"
     assert seen and seen[-1][0] == seen[-1][1] == job["searches"] == job["searches_done"]
+
+
+def test_an_order_job_that_cannot_order_says_why_as_the_order_request_does(
+    client: TestClient,  # noqa: F811
+) -> None:
+    document = opened(client)["mission"]
+    document["waypoints"] = [{"x": 0.01 * k, "y": 0.0} for k in range(2001)]
+    at_once = client.post("/api/order", json={"mission": document})
+    assert at_once.status_code == 422
+    job = finished(client, client.post("/api/order/jobs", json={"mission": document}).json())
+    assert job["state"] == "failed"
+    assert job["status"] == 422
+    said = at_once.json()["error"]
+    assert "takes at most 2000" in said
+    # The same words (each names its own temporary copy of the draft first).
+    assert job["failure"]["error"].split(": ", 1)[1] == said.split(": ", 1)[1]

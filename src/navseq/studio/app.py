@@ -55,7 +55,7 @@ from navseq.studio.edits import (
     moved_waypoints,
 )
 from navseq.studio.mapview import MapView
-from navseq.studio.ordering import OrderJob, OrderJobs
+from navseq.studio.ordering import OrderFailed, OrderJob, OrderJobs
 from navseq.studio.security import (
     COOKIE_NAME,
     LOCAL_NAMES,
@@ -557,10 +557,19 @@ class Studio:
         from :meth:`order_job`, stopped by :meth:`cancel_order`. A draft that cannot be
         read is refused at once (422, with its problems)."""
         checked, mission, keep_last = self._order_request(body)
-        job = self.order_jobs.start(
-            lambda progress: self._ordering(checked, mission, keep_last, progress)
-        )
-        return job.view()
+
+        def work(progress: OrderProgress) -> dict[str, Any]:
+            try:
+                return self._ordering(checked, mission, keep_last, progress)
+            except ApiError as error:  # told to the page as POST /api/order tells it
+                raise OrderFailed(error.status, error.body) from error
+            except MissingExtra as error:
+                raise OrderFailed(501, {"error": str(error)}) from error
+            except NavseqError as error:
+                problems = [problem.as_json() for problem in problems_of([error])]
+                raise OrderFailed(422, {"error": str(error), "problems": problems}) from error
+
+        return self.order_jobs.start(work).view()
 
     def order_job(self, number: str) -> dict[str, Any]:
         """``GET /api/order/jobs/N``: how far the job got, and its answer once done."""

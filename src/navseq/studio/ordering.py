@@ -26,6 +26,16 @@ class OrderCancelled(Exception):
     """Raised in the ordering thread at its next search once the page cancelled."""
 
 
+class OrderFailed(Exception):
+    """The ordering's error answer (an HTTP status and its JSON), as ``POST /api/order``
+    would give it."""
+
+    def __init__(self, status: int, body: dict[str, Any]) -> None:
+        super().__init__(body.get("error"))
+        self.status = status
+        self.body = body
+
+
 class OrderJob:
     """One Order…: ``work(progress)`` run in a thread, where ``progress`` hears of the
     searches and the solver (:class:`navseq.route.order.OrderProgress`) and raises
@@ -90,22 +100,12 @@ class OrderJob:
             return view
 
     def _run(self) -> None:
-        from navseq.errors import NavseqError
-        from navseq.extras import MissingExtra
-        from navseq.studio.app import ApiError
-        from navseq.studio.documents import problems_of
-
         try:
             answer = self._work(self)
         except OrderCancelled:
             outcome: tuple[str, Any] = ("cancelled", None)
-        except ApiError as error:
-            outcome = ("failed", (error.status, error.body))
-        except MissingExtra as error:  # as the synchronous API says them
-            outcome = ("failed", (501, {"error": str(error)}))
-        except NavseqError as error:
-            problems = [problem.as_json() for problem in problems_of([error])]
-            outcome = ("failed", (422, {"error": str(error), "problems": problems}))
+        except OrderFailed as failure:
+            outcome = ("failed", (failure.status, failure.body))
         except Exception as error:  # a fault of ours: said to the page, not a hung job
             outcome = ("failed", (500, {"error": f"ordering failed: {error}"}))
         else:
@@ -146,4 +146,4 @@ class OrderJobs:
             return self._jobs.get(number)
 
 
-__all__ = ["JOBS_KEPT", "OrderCancelled", "OrderJob", "OrderJobs"]
+__all__ = ["JOBS_KEPT", "OrderCancelled", "OrderFailed", "OrderJob", "OrderJobs"]
