@@ -930,6 +930,8 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         assert len(legs) == 2
         into = legs[0] if legs[0]["to"] == 9 else legs[1]
         assert into["points"][-1] == pytest.approx(after, abs=0.06)
+        # The answer carried those two legs only; the page patched its own 2000.
+        assert page.evaluate("S.route.legs_changed.map(([position]) => position)") == [9, 10]
         assert _overlaps(page) == []
 
         # Tab goes on through the rows past the first ones built (4 stops a row).

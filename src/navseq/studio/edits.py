@@ -9,6 +9,8 @@ expected duration its legs driven (:mod:`navseq.eta.memo`), so those cost only w
 moved too. Anything else — a changed setting, a new map, a waypoint added, a name
 (names must be unique across the list), an edit that does not read — is checked whole,
 as before. Either way the answer is the one a full check gives (tests compare them).
+A page that holds the legs of an earlier answer is sent only the legs that differ from
+them (:func:`changed_legs`).
 """
 
 from __future__ import annotations
