@@ -313,7 +313,8 @@ class Studio:
                     self._answers[key] = (self.robot, answer, self._last_check)
                     while len(self._answers) > CHECK_ANSWERS_KEPT:
                         self._answers.popitem(last=False)
-            held = self._legs_sent.get(base) if isinstance(base, int) else None
+            numbered = isinstance(base, int) and not isinstance(base, bool)
+            held = self._legs_sent.get(base) if numbered else None
             if held is None or len(held) != len(answer["legs"]):
                 return answer
             delta = {name: value for name, value in answer.items() if name != "legs"}
