@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,9 @@ if TYPE_CHECKING:
     from navseq.eta.memo import RememberedDrives
     from navseq.mission.model import Mission, Policy
     from navseq.route.legs import Legs
+
+#: Planned paths kept by their ends' cells (a few visits' worth per edit).
+PATHS_KEPT = 8192
 
 #: Where a visit starts: the robot's place, heading (None: unknown) and speed.
 State = tuple[tuple[float, float], float | None, float]
@@ -76,6 +79,7 @@ class IncrementalPrediction:
         self.planned_visits = planned_visits
         self.loops: list[_Loop] = []
         self.visits_worked_out = 0  # visits driven or paced for this one, for tests
+        self._paths: dict[tuple[Any, ...], list[tuple[float, float]] | None] = {}
         count = len(mission.waypoints)
         if count:
             self.loops.append(self._whole_loop(0, self._first_start()))
@@ -138,6 +142,7 @@ class IncrementalPrediction:
         edited.drives = self.drives
         edited.planned_visits = self.planned_visits
         edited.visits_worked_out = 0
+        edited._paths = self._paths  # a cache of a pure function: shared
         edited.loops = []
         if not self.loops:
             return edited
@@ -228,7 +233,7 @@ class IncrementalPrediction:
         goal = (waypoint.x, waypoint.y)
         now.starts[index] = state
         now.planned_m[index] = math.dist(where, goal)
-        points = self.legs.leg(where, goal).points
+        points = self._path(where, goal)
         if points is None:
             now.planned_s[index] = math.nan
             now.ends[index] = (goal, waypoint.yaw_rad, 0.0)
@@ -249,6 +254,25 @@ class IncrementalPrediction:
             now.ends[index] = (driven.end_point, driven.end_heading, driven.end_speed)
             drive_s = driven.duration_s
         self._tasks(now, index, visit.policy, drive_s)
+
+    def _path(
+        self, where: tuple[float, float], goal: tuple[float, float]
+    ) -> list[tuple[float, float]] | None:
+        """``legs.leg(where, goal).points``. A :class:`~navseq.route.legs.LegPlanner`'s
+        plan depends only on the cells of its ends (the search snaps them to their
+        cells): the visits after a moved waypoint start a hair from where they did, in
+        the same cell, and their plans are the ones made before instead of new searches."""
+        from navseq.route.legs import LegPlanner
+
+        if type(self.legs) is not LegPlanner:
+            return self.legs.leg(where, goal).points
+        grid = self.legs.costmap.grid
+        key = (grid.world_to_cell(*where), grid.world_to_cell(*goal))  # one planner's
+        if key not in self._paths:
+            if len(self._paths) >= PATHS_KEPT:
+                self._paths.clear()
+            self._paths[key] = self.legs.leg(where, goal).points
+        return self._paths[key]
 
     def _pace_visit(
         self, now: _Loop, index: int, where: tuple[float, float], pace: float, planned: int
