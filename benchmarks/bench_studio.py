@@ -18,7 +18,8 @@ headless Chromium (Debian's ``/usr/bin/chromium`` through Playwright):
 - **typed change -> redrawn**: a new x typed in the waypoint form (its change event)
   until the next frame, everything redrawn; **-> checked**: until the check's answer
   is drawn;
-- **check (server)**: ``POST /api/check`` of the mission with one waypoint moved;
+- **check (server)**: ``POST /api/check`` of the mission with one waypoint moved, as the
+  page sends it (its answer: the legs that changed);
 - **Order…**: ``shortest route`` chosen, until the new order is drawn, at most
   ``--order-limit`` s (then Cancel is pressed: "> limit");
 - **live updates/s**: run updates the page drew per second while the mission ran on
@@ -262,13 +263,15 @@ def typed_changes(page: Any, repeat: int) -> tuple[float, float]:
 
 
 def check_latency(served: Served, moves: list[tuple[float, float]]) -> float:
-    """Median seconds of ``POST /api/check`` with waypoint 3 moved to each of ``moves``."""
+    """Median seconds of ``POST /api/check`` with waypoint 3 moved to each of ``moves``,
+    sent as the page sends it (naming the answer whose legs it holds)."""
     document = served.call("GET", "/api/mission")["mission"]
+    base = served.call("POST", "/api/check", {"mission": document})["check"]
     times = []
     for x, y in moves:
         document["waypoints"][2].update(x=x + 0.05, y=y)
         began = time.perf_counter()
-        served.call("POST", "/api/check", {"mission": document})
+        base = served.call("POST", "/api/check", {"mission": document, "base": base})["check"]
         times.append(time.perf_counter() - began)
     return statistics.median(times)
 

@@ -930,6 +930,8 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         assert len(legs) == 2
         into = legs[0] if legs[0]["to"] == 9 else legs[1]
         assert into["points"][-1] == pytest.approx(after, abs=0.06)
+        # The answer carried those two legs only; the page patched its own 2000.
+        assert page.evaluate("S.route.legs_changed.map(([position]) => position)") == [9, 10]
         assert _overlaps(page) == []
 
         # Tab goes on through the rows past the first ones built (4 stops a row).
@@ -985,10 +987,11 @@ def test_a_leg_with_no_path_is_drawn_named_and_left_out_of_the_total(page: Any) 
 
 
 def test_order_shows_the_time_spent_and_cancel_gives_the_page_back(page: Any) -> None:
-    """While the server orders the waypoints the page counts the seconds; Cancel stops
-    waiting, and the waypoints stay as they were (the late answer is dropped)."""
+    """While the server orders the waypoints the page counts the seconds; Cancel gives
+    the page back at once and stops the job, and the waypoints stay as they were (the
+    late answer is dropped)."""
     held: list[Any] = []
-    page.route("**/api/order", lambda route: held.append(route))
+    page.route("**/api/order/jobs", lambda route: held.append(route))
     before = page.evaluate("JSON.stringify(S.doc.waypoints)")
     page.get_by_test_id("order").select_option("shortest")
     page.wait_for_function(
@@ -1000,7 +1003,8 @@ def test_order_shows_the_time_spent_and_cancel_gives_the_page_back(page: Any) ->
     message_of(page, "ordering cancelled")
     assert page.get_by_test_id("order-cancel").is_hidden()
     assert page.get_by_test_id("order").is_enabled()
-    held[0].continue_()  # the server's answer comes late: nothing changes
+    with page.expect_request("**/api/order/jobs/*/cancel", timeout=10_000):
+        held[0].continue_()  # the job starts late: it is stopped, nothing changes
     page.wait_for_timeout(300)
     assert page.evaluate("JSON.stringify(S.doc.waypoints)") == before
     assert page.get_by_test_id("waypoint-row").count() == 7

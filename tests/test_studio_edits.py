@@ -56,10 +56,43 @@ def studio(workspace: Path) -> Studio:
 
 
 def full_check(checker: Studio, document: dict[str, Any]) -> dict[str, Any]:
-    """The draft checked whole: nothing kept from an earlier check of it."""
+    """The draft checked whole: nothing kept from an earlier check of it (the answer's
+    number left out: it counts the studio's checks)."""
     checker._last_check = None
     checker._answers.clear()
-    return checker.check(document)
+    return unnumbered(checker.check(document))
+
+
+def unnumbered(answer: dict[str, Any]) -> dict[str, Any]:
+    return {name: value for name, value in answer.items() if name != "check"}
+
+
+class Page:
+    """What the page holds of the last answer: it sends that answer's number as its
+    base and patches its legs with the answer's changed ones."""
+
+    def __init__(self, checker: Studio) -> None:
+        self.checker = checker
+        self.base: int | None = None
+        self.legs: list[dict[str, Any]] = []
+        self.sent_legs = 0  # legs that came in answers, for the test of their count
+
+    def check(self, document: dict[str, Any]) -> dict[str, Any]:
+        answer = self.checker.check(copy.deepcopy(document), self.base)
+        if "legs_changed" in answer:
+            assert answer["base"] == self.base
+            self.legs = list(self.legs)
+            for position, leg in answer["legs_changed"]:
+                self.legs[position] = leg
+            self.sent_legs += len(answer["legs_changed"])
+        else:
+            self.legs = answer["legs"]
+            self.sent_legs += len(self.legs)
+        self.base = answer["check"]
+        shown = {
+            name: value for name, value in answer.items() if name not in ("base", "legs_changed")
+        }
+        return unnumbered({**shown, "legs": self.legs})
 
 
 edit = st.tuples(
@@ -78,8 +111,9 @@ def test_a_check_after_edits_answers_as_a_check_of_the_whole_draft(
     workspace: Path, edits: list[list[tuple[int, tuple[float, float], int | None, Any]]]
 ) -> None:
     incremental, whole = studio(workspace), studio(workspace)
+    page = Page(incremental)
     document = incremental.mission()["mission"]
-    assert incremental.check(document) == full_check(whole, document)
+    assert page.check(document) == full_check(whole, document)
     for changes in edits:
         document = copy.deepcopy(document)
         for index, (x, y), yaw, extra in changes:
@@ -89,7 +123,7 @@ def test_a_check_after_edits_answers_as_a_check_of_the_whole_draft(
                 waypoint["yaw"] = yaw
             if extra is not None:
                 waypoint.update(extra)
-        assert incremental.check(document) == full_check(whole, document)
+        assert page.check(document) == full_check(whole, document)
 
 
 def test_a_moved_waypoint_changes_its_legs_and_drives_again_no_visit_before_it(
@@ -112,7 +146,7 @@ def test_a_moved_waypoint_changes_its_legs_and_drives_again_no_visit_before_it(
     # The three visits before it are recalled; from it on, each visit starts where the
     # robot stopped at the one before, which may move by a hair (it latches onto its goal).
     assert 2 <= drives.driven - (len(TOUR) - 1) <= len(TOUR) - 1 - 3
-    assert answer == full_check(studio(workspace), document)
+    assert unnumbered(answer) == full_check(studio(workspace), document)
 
 
 def test_a_changed_setting_checks_the_whole_draft(workspace: Path) -> None:
@@ -123,7 +157,7 @@ def test_a_changed_setting_checks_the_whole_draft(workspace: Path) -> None:
     answer = checker.check(patrol)
     assert answer["legs"][-1]["loop"] is True  # the way back to the first waypoint
     assert checker.edits_checked == 0
-    assert answer == full_check(studio(workspace), patrol)
+    assert unnumbered(answer) == full_check(studio(workspace), patrol)
 
 
 def test_a_map_file_changed_on_disk_checks_the_whole_draft(tmp_path: Path) -> None:
@@ -143,5 +177,22 @@ def test_a_map_file_changed_on_disk_checks_the_whole_draft(tmp_path: Path) -> No
     os.utime(map_yaml, ns=(stat.st_atime_ns, stat.st_mtime_ns + 5_000_000_000))
     document = copy.deepcopy(document)
     document["waypoints"][3].update(x=0.6, y=-1.7)
-    assert checker.check(document) == full_check(studio(tmp_path), document)
+    assert unnumbered(checker.check(document)) == full_check(studio(tmp_path), document)
     assert checker.edits_checked == 0
+
+
+def test_a_page_holding_the_last_answer_is_sent_only_the_legs_that_changed(
+    workspace: Path,
+) -> None:
+    checker = studio(workspace)
+    page = Page(checker)
+    document = checker.mission()["mission"]
+    page.check(document)
+    assert page.sent_legs == len(TOUR) - 1  # the first answer: every leg
+    document = copy.deepcopy(document)
+    document["waypoints"][3].update(x=0.6, y=-1.7)
+    answer = checker.check(document, page.base)
+    assert "legs" not in answer
+    assert [position for position, _ in answer["legs_changed"]] == [3, 4]
+    # A base the studio no longer knows (or none): every leg.
+    assert len(checker.check({**document, "loops": 2}, base=-1)["legs"]) == len(TOUR)

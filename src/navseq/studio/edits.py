@@ -9,6 +9,8 @@ expected duration its legs driven (:mod:`navseq.eta.memo`), so those cost only w
 moved too. Anything else — a changed setting, a new map, a waypoint added, a name
 (names must be unique across the list), an edit that does not read — is checked whole,
 as before. Either way the answer is the one a full check gives (tests compare them).
+A page that holds the legs of an earlier answer is sent only the legs that differ from
+them (:func:`changed_legs`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from navseq.errors import NavseqError
 
 if TYPE_CHECKING:
+    from navseq.eta.incremental import IncrementalPrediction
     from navseq.mission.model import Mission
     from navseq.studio.documents import CheckedDraft
 
@@ -35,6 +38,7 @@ class LastCheck:
     checked: CheckedDraft
     context: tuple[Any, ...]  # the map file's stamp and the planner the legs came from
     legs: list[dict[str, Any]]
+    eta: IncrementalPrediction  # the expected duration, kept per visit
 
 
 def moved_waypoints(before: dict[str, Any], after: Any) -> set[int] | None:
@@ -90,6 +94,19 @@ def edited_mission(last: LastCheck, document: dict[str, Any], moved: set[int]) -
     return replace(mission, waypoints=tuple(waypoints))
 
 
+def changed_legs(
+    before: list[dict[str, Any]], after: list[dict[str, Any]]
+) -> list[tuple[int, dict[str, Any]]]:
+    """The legs of ``after`` (from :func:`~navseq.route.legs.legs_after_edit` of
+    ``before``) that are not ``before``'s, by position: what an answer to a page holding
+    ``before`` carries instead of all of them (0.7 MB at 5000 waypoints)."""
+    return [
+        (position, leg)
+        for position, (was, leg) in enumerate(zip(before, after, strict=True))
+        if leg is not was and leg != was
+    ]
+
+
 def checked_after_edit(
     last: LastCheck, mission: Mission, problems_found: list[NavseqError], shown_as: str
 ) -> CheckedDraft:
@@ -107,6 +124,7 @@ def checked_after_edit(
 __all__ = [
     "MAX_MOVED",
     "LastCheck",
+    "changed_legs",
     "checked_after_edit",
     "edited_mission",
     "moved_waypoints",

@@ -13,7 +13,7 @@ import webbrowser
 from typing import TextIO
 
 from navseq.errors import NavseqError
-from navseq.studio.app import Studio, StudioConfig, create_app
+from navseq.studio.app import WARM_UP_WAIT_FOR_PAGE_S, Studio, StudioConfig, create_app
 from navseq.text import printable
 
 #: Seconds uvicorn gives open connections (the live view's stream) to close on Ctrl-C.
@@ -93,8 +93,14 @@ def serve(
     print("navseq studio: press Ctrl-C to stop", file=err, flush=True)
     # While the browser opens: read the map, inflate it and plan the opened mission's
     # legs, so that the page's first check finds them made (a 2000 x 2000 map takes
-    # over a second). The page's own requests do the same work if they come first.
-    threading.Thread(target=studio.warm_up, name="navseq-studio-warm-up", daemon=True).start()
+    # over a second). The page's own requests do the same work if they come first; the
+    # check waits for the page's first (its first paint comes first).
+    threading.Thread(
+        target=studio.warm_up,
+        args=(WARM_UP_WAIT_FOR_PAGE_S,),
+        name="navseq-studio-warm-up",
+        daemon=True,
+    ).start()
     server = uvicorn.Server(
         uvicorn.Config(
             app,

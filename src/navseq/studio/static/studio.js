@@ -7,7 +7,7 @@
 const S = {
   doc: null, version: null, name: "", units: {},
   problems: [], legs: [], route: {}, selected: null,
-  undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false,
+  undo: [], redo: [], checkSeq: 0, checkBusy: false, checkAgain: false, checkId: null,
   layers: { markers: [], legs: null, handle: null, start: null, run: null, map: null, cost: null },
   planned: false, painted: null, mapKey: null, events: null, run: null, placingStart: false, replay: null, replayTimer: null,
 };
@@ -121,7 +121,8 @@ function restore(from, to) {
   S.doc = state.doc; S.selected = state.selected;
   changed();
 }
-function changed() { render(); check(); }
+// The check goes out first: the server works on it while the page redraws.
+function changed() { check(); render(); }
 // Edits not saved yet: closing or reloading the tab asks first (the browser's own dialog).
 const unsaved = () => S.saved !== undefined && JSON.stringify(S.doc) !== S.saved;
 window.addEventListener("beforeunload", (e) => {
@@ -1214,19 +1215,28 @@ async function check() {
   S.checkBusy = true;
   const seq = ++S.checkSeq;
   // Written out once, now: the draft as it is at this moment (edits may follow while
-  // the answer is on its way), and no second copy of a mission of thousands.
-  const answer = await api("POST", "/api/check", JSON.stringify({ mission: S.doc }));
+  // the answer is on its way), and no second copy of a mission of thousands. "base":
+  // the answer whose legs the page holds; the server then sends only the legs that
+  // differ from them (a drag: two of 5000).
+  const body = JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  const answer = await api("POST", "/api/check", body);
   S.checkBusy = false;
-  if (S.checkAgain) { S.checkAgain = false; check(); return; }
-  if (seq !== S.checkSeq) return;
+  // Taken in even when a newer edit is to be checked: the next answer is sent against it.
   if (!answer.ok) {
     S.problems = answer.data.problems || [{ text: answer.data.error, waypoint: null }];
-    S.legs = []; S.route = {};
+    S.legs = []; S.route = {}; S.checkId = null;
   } else {
-    S.problems = answer.data.problems;
-    S.legs = answer.data.legs;
-    S.route = answer.data;
+    const data = answer.data;
+    let held = true;
+    if (!data.legs_changed) S.legs = data.legs;
+    else if (data.base === S.checkId) for (const [position, leg] of data.legs_changed) S.legs[position] = leg;
+    else { held = false; S.legs = []; S.checkAgain = true; }  // not the legs it was sent against: ask whole
+    S.problems = data.problems;
+    S.checkId = held ? data.check : null;
+    S.route = data;
   }
+  if (S.checkAgain) { S.checkAgain = false; check(); return; }
+  if (seq !== S.checkSeq) return;
   S.planned = true;
   await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
@@ -1327,31 +1337,51 @@ $("order").onchange = async (e) => {
   const choice = e.target.value;
   e.target.value = "";
   if (!choice || (S.run && !S.run.done) || S.replay || S.ordering) return;
-  // Seconds on a big mission: the time spent is shown, and Cancel gives the page back
-  // (the answer, when it comes, is dropped; the mission is as it was).
-  const aborter = new AbortController();
-  const began = performance.now();
-  const count = S.doc.waypoints.length;
-  const tell = () => say(`finding the shortest order of ${count} waypoints… ${Math.round((performance.now() - began) / 1000)} s (Cancel stops waiting)`);
-  S.ordering = aborter;
-  tell();
+  // Seconds to minutes on a big map: the server orders as a job, the page shows how
+  // far its searches got, and Cancel stops them (the mission stays as it was).
+  const count = S.doc.waypoints.length, began = performance.now();
+  let cancelled = false, job = null, view = { state: "measuring", searches: 0 };
+  const tell = () => {
+    const seconds = `${Math.round((performance.now() - began) / 1000)} s`;
+    let doing = `finding the shortest order of ${count} waypoints…`;
+    if (view.state === "solving") doing = `choosing the shortest order of ${count} waypoints…`;
+    else if (view.searches) doing = `measuring the ways between ${count} waypoints: ${view.searches_done} of ${view.searches} searches…`;
+    say(`${doing} ${seconds} (Cancel stops it)`);
+  };
   const ticker = setInterval(tell, 1000);
   const cancel = $("order-cancel");
+  const finish = () => { clearInterval(ticker); S.ordering = null; cancel.hidden = true; $("order").disabled = false; };
+  const stopJob = () => { if (job !== null) api("POST", `/api/order/jobs/${job}/cancel`, {}); };
+  S.ordering = true;
+  tell();
   cancel.hidden = false;
-  cancel.onclick = () => aborter.abort();
   $("order").disabled = true;
+  // Cancel gives the page back at once; the server's searches stop at the next one.
+  cancel.onclick = () => {
+    cancelled = true;
+    stopJob();
+    finish();
+    say("ordering cancelled: the waypoints are as they were");
+  };
   let answer;
   try {
-    answer = await api("POST", "/api/order", { mission: S.doc, keep_last: choice === "keep-last" }, aborter.signal);
+    answer = await api("POST", "/api/order/jobs", { mission: S.doc, keep_last: choice === "keep-last" });
+    if (answer.ok) { job = answer.data.job; view = answer.data; }
+    if (cancelled) { stopJob(); return; }
+    while (answer.ok && ["measuring", "solving"].includes(answer.data.state)) {
+      view = answer.data;
+      tell();
+      await new Promise((done) => setTimeout(done, 250));
+      if (cancelled) return;
+      answer = await api("GET", `/api/order/jobs/${job}`);
+      if (cancelled) return;
+    }
   } catch (error) {
-    answer = null;
-  } finally {
-    clearInterval(ticker);
-    S.ordering = null;
-    cancel.hidden = true;
-    $("order").disabled = false;
+    answer = { ok: false, data: { error: `ordering failed: ${error}` } };
   }
-  if (!answer) { say("ordering cancelled: the waypoints are as they were"); return; }
+  finish();
+  if (answer.ok && answer.data.state === "cancelled") { say("ordering cancelled: the waypoints are as they were"); return; }
+  if (answer.ok && answer.data.state === "failed") answer = { ok: false, status: answer.data.status, data: answer.data.failure };
   if (!answer.ok) {
     const first = (answer.data.problems || [])[0];
     say(first ? `${answer.data.error}: ${first.text}` : answer.data.error, true);
@@ -1728,14 +1758,17 @@ async function main() {
   if (!S.allowRun) $("run").title = "run: tasks need the studio started with --allow-run";
   $("mission-name").textContent = answer.data.path || S.name;
   if (!Array.isArray(S.doc.waypoints)) S.doc.waypoints = [];
-  // The first check (pre-flight problems and every leg planned: a second or more on a
-  // big map) goes out now and is worked on while the map is drawn; the page is ready
-  // (map drawn, markers placed, the file's own problems listed) without waiting for it.
+  // The page is ready (map drawn, markers placed, the file's own problems listed)
+  // without waiting for the first check (pre-flight problems and every leg planned: a
+  // second or more on a big map). That check goes out once the page is painted: worked
+  // on beside the first paint, it took the cores the browser draws with (the studio's
+  // warm-up waits for it too).
   S.painted = loadMap(true).then(() => {
     render();
     document.body.dataset.ready = "true";
   });
-  await Promise.all([S.painted, check()]);
+  await S.painted;
+  await check();
   loadRuns();
 }
 main();
