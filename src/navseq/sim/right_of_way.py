@@ -48,6 +48,7 @@ from scipy import ndimage
 
 from navseq.geometry import Pose2D
 from navseq.sim.costmap import Costmap
+from navseq.sim.detour import blocked_stretch, local_detour
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_cells
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.planner import Plan
@@ -74,6 +75,8 @@ class FleetNavigationServer(NavigationServer):
 
     sensing_range = 3.0  # m from this robot's centre to another's, for planning
     robot_replan_interval = 1.0  # s between re-plans caused by robots moving near the plan
+    detour_rejoin = 1.0  # m past the stretch robots block where a detour rejoins the plan
+    detour_margin = 2.0  # m round that stretch a detour may use (else: the whole map)
 
     def __init__(
         self,
@@ -86,6 +89,10 @@ class FleetNavigationServer(NavigationServer):
         self.aside_target: Pose2D | None = None
         self._at: Pose2D | None = None  # where the robot was at the last step or plan
         self._sensed: list[tuple[int, Pose2D]] = []  # (index, pose) in planning_costmap
+        self._robot_came_near = False  # the re-plan now due is for a robot near the plan
+        # Indices into the other robots of those that may be in sight (the fleet's broad
+        # phase, every step); None: look at every one.
+        self.in_sight: list[int] | None = None
 
     @property
     def giving_way(self) -> bool:
@@ -135,12 +142,54 @@ class FleetNavigationServer(NavigationServer):
             return super().compute_velocity(pose, v, w, dt)
         aside = self._aside
         assert aside is not None
-        aside.set_other_robots(self._others)
+        aside.set_other_robots(self._others, self._nearby)
         return aside.compute_velocity(pose, v, w, dt)
 
     def make_plan(self, start: Pose2D, goal: Pose2D) -> Plan | None:
         self._at = start
         return super().make_plan(start, goal)
+
+    def _replan(self, pose: Pose2D) -> bool:
+        """A robot came near the plan: keep the plan while it is clear, else go round
+        the robots through a window (:mod:`navseq.sim.detour`); otherwise, and for every
+        other cause, plan over the whole map."""
+        came_near, self._robot_came_near = self._robot_came_near, False
+        if (
+            came_near
+            and self.plan is not None
+            and self.goal is not None
+            and not (self._needs_plan or self._waiting)
+            and self._keep_or_go_round(pose, self.plan, self.goal)
+        ):
+            self._since_plan = 0.0
+            return True
+        return super()._replan(pose)
+
+    def _keep_or_go_round(self, pose: Pose2D, plan: Plan, goal: Pose2D) -> bool:
+        """True if the plan is kept (still clear of the robots) or replaced by a detour."""
+        self._at = pose
+        self._refresh_planning_costmap()
+        costmap = self.planning_costmap
+        rest = plan.points[self.controller.closest_index :]
+        blocked = blocked_stretch(costmap, rest)
+        if not blocked.any():
+            self._plan_others = self._costmap_others
+            return True
+        if not costmap.is_free(pose.x, pose.y):
+            return False  # hemmed in: the whole-map planner knows where to start from
+        detour = local_detour(
+            costmap,
+            (pose.x, pose.y),
+            rest,
+            blocked,
+            rejoin=self.detour_rejoin,
+            margin=self.detour_margin,
+        )
+        if detour is None:
+            return False
+        self._needs_plan = False
+        self._follow(detour, goal)
+        return True
 
     def _sensed_robots(self) -> list[tuple[int, Pose2D, Footprint]]:
         """The other robots within ``sensing_range`` (all of them before the first step)."""
@@ -164,18 +213,10 @@ class FleetNavigationServer(NavigationServer):
             return
         self._sensed = [(index, pose) for index, pose, _ in sensed]
         grid = self.costmap.grid
-        rows: list[np.ndarray] = []
-        cols: list[np.ndarray] = []
-        for _, pose, footprint in sensed:
-            cells = footprint_cells(grid, footprint, pose)
-            if cells is not None:
-                rows.append(cells[0])
-                cols.append(cells[1])
-        costmap = self.costmap
-        if rows:
-            costmap = costmap.with_obstacles(
-                np.concatenate(rows), np.concatenate(cols), padding=self.params.robot_margin
-            )
+        groups = [footprint_cells(grid, footprint, pose) for _, pose, footprint in sensed]
+        costmap = self.costmap.with_obstacle_groups(
+            [cells for cells in groups if cells is not None], padding=self.params.robot_margin
+        )
         self._use_planning_costmap(costmap)
 
     def _robot_near_plan(self) -> bool:
@@ -187,7 +228,10 @@ class FleetNavigationServer(NavigationServer):
         near_squared = self.params.robot_near_plan**2
         reach = self.sensing_range
         ahead: np.ndarray | None = None
-        for index, (pose, footprint) in enumerate(self._others):
+        others = self._others
+        looked_at = range(len(others)) if self.in_sight is None else self.in_sight
+        for index in looked_at:
+            pose, footprint = others[index]
             if at is not None and abs(pose.x - at.x) + abs(pose.y - at.y) > reach * 1.5:
                 continue  # out of sight (a cheap bound on the distance)
             if index < len(seen) and not self._robot_moved(seen[index], pose, footprint):
@@ -196,6 +240,7 @@ class FleetNavigationServer(NavigationServer):
                 ahead = plan.points[self.controller.closest_index :]
             squared = (ahead[:, 0] - pose.x) ** 2 + (ahead[:, 1] - pose.y) ** 2
             if squared.size and float(squared.min()) < near_squared:
+                self._robot_came_near = True
                 return True
         return False
 
