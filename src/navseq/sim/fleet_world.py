@@ -246,12 +246,15 @@ class FleetWorld:
         xy = np.array([(pose.x, pose.y) for pose in poses])
         gaps = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
         np.fill_diagonal(gaps, np.inf)
-        near = gaps < self._near_reach
-        sight = gaps < self._sight_reach
-        return (
-            [np.flatnonzero(row).tolist() for row in near],
-            [np.flatnonzero(row).tolist() for row in sight],
-        )
+        return self._rows_of(gaps < self._near_reach), self._rows_of(gaps < self._sight_reach)
+
+    @staticmethod
+    def _rows_of(pairs: np.ndarray) -> list[list[int]]:
+        """Per row of a square boolean matrix, the columns that are True (ascending)."""
+        rows: list[list[int]] = [[] for _ in range(len(pairs))]
+        for row, col in zip(*(index.tolist() for index in np.nonzero(pairs)), strict=True):
+            rows[row].append(col)
+        return rows
 
     def _overlapping_pairs(self, poses: list[Pose2D]) -> int:
         """Pairs of robots whose footprints overlap at ``poses`` (exactly, after a cheap

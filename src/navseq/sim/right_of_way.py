@@ -97,6 +97,9 @@ class FleetNavigationServer(NavigationServer):
         self._sensed: list[tuple[int, Pose2D]] = []  # (index, pose) in planning_costmap
         self._robot_came_near = False  # the re-plan now due is for a robot near the plan
         self._robot_check_in = 0.0  # s until robots near the plan are looked for again
+        # Which robots the plan went round (their indices): one standing still that came
+        # into sight since is news as much as one that moved.
+        self._plan_sensed: set[int] = set()
         # Indices into the other robots of those that may be in sight (the fleet's broad
         # phase, every step); None: look at every one.
         self.in_sight: list[int] | None = None
@@ -182,6 +185,7 @@ class FleetNavigationServer(NavigationServer):
         blocked = blocked_stretch(costmap, rest)
         if not blocked.any():
             self._plan_others = self._costmap_others
+            self._plan_sensed = {index for index, _ in self._sensed}
             return True
         if not costmap.is_free(pose.x, pose.y):
             return False  # hemmed in: the whole-map planner knows where to start from
@@ -239,12 +243,22 @@ class FleetNavigationServer(NavigationServer):
         reach = self.sensing_range
         others = self._others
         looked_at = range(len(others)) if self.in_sight is None else self.in_sight
+        planned_round = self._plan_sensed
         moved: list[tuple[float, float]] = []
         for index in looked_at:
             pose, footprint = others[index]
             if at is not None and abs(pose.x - at.x) + abs(pose.y - at.y) > reach * 1.5:
                 continue  # out of sight (a cheap bound on the distance)
-            if index < len(seen) and not self._robot_moved(seen[index], pose, footprint):
+            came_into_sight = (
+                index not in planned_round
+                and at is not None
+                and math.hypot(pose.x - at.x, pose.y - at.y) <= reach
+            )
+            if (
+                not came_into_sight
+                and index < len(seen)
+                and not self._robot_moved(seen[index], pose, footprint)
+            ):
                 continue
             moved.append((pose.x, pose.y))
         ahead = plan.points[self.controller.closest_index :]
@@ -256,6 +270,10 @@ class FleetNavigationServer(NavigationServer):
         ) ** 2
         self._robot_came_near = float(squared.min()) < self.params.robot_near_plan**2
         return self._robot_came_near
+
+    def _follow(self, plan: Plan, goal: Pose2D) -> None:
+        super()._follow(plan, goal)
+        self._plan_sensed = {index for index, _ in self._sensed}
 
     def _use_costmap(self, costmap: Costmap) -> None:
         super()._use_costmap(costmap)
