@@ -72,15 +72,14 @@ class FleetNavigationServer(NavigationServer):
     far away will have moved by the time this one gets there, and re-planning around
     all of them, in a fleet of twenty, would cost more than everything else together.
     For the same reason a robot that moves near the plan makes the server re-plan at
-    most every ``robot_replan_interval`` seconds (robots near the plan are looked for
-    every ``robot_check_period``), and such a re-plan keeps the plan while it is clear
-    of them, or goes round them through a window (:mod:`navseq.sim.detour`). The safety
-    test sees every robot the fleet finds near enough to touch.
+    most every ``robot_replan_interval`` seconds, and such a re-plan keeps the plan
+    while it is clear of them, or goes round them through a window
+    (:mod:`navseq.sim.detour`). The safety test sees every robot the fleet finds near
+    enough to touch.
     """
 
     sensing_range = 3.0  # m from this robot's centre to another's, for planning
     robot_replan_interval = 1.0  # s between re-plans caused by robots moving near the plan
-    robot_check_period = 0.2  # s between looks for robots near the plan
     detour_rejoin = 1.0  # m past the stretch robots block where a detour rejoins the plan
     detour_margin = 2.0  # m round that stretch a detour may use (else: the whole map)
 
@@ -96,7 +95,6 @@ class FleetNavigationServer(NavigationServer):
         self._at: Pose2D | None = None  # where the robot was at the last step or plan
         self._sensed: list[tuple[int, Pose2D]] = []  # (index, pose) in planning_costmap
         self._robot_came_near = False  # the re-plan now due is for a robot near the plan
-        self._robot_check_in = 0.0  # s until robots near the plan are looked for again
         # Which robots the plan went round (their indices): one standing still that came
         # into sight since is news as much as one that moved.
         self._plan_sensed: set[int] = set()
@@ -148,7 +146,6 @@ class FleetNavigationServer(NavigationServer):
 
     def compute_velocity(self, pose: Pose2D, v: float, w: float, dt: float) -> tuple[float, float]:
         self._at = pose
-        self._robot_check_in -= dt
         if self.aside_target is None:
             return super().compute_velocity(pose, v, w, dt)
         aside = self._aside
@@ -236,9 +233,6 @@ class FleetNavigationServer(NavigationServer):
         plan, at = self.plan, self._at
         if plan is None or self._since_plan < self.robot_replan_interval:
             return False
-        if self._robot_check_in > 0.0:
-            return False
-        self._robot_check_in = self.robot_check_period
         seen = self._plan_others
         reach = self.sensing_range
         others = self._others
