@@ -210,6 +210,7 @@ def main() -> None:
     parser.add_argument(
         "--no-baseline", action="store_true", help="skip the run without right of way"
     )
+    parser.add_argument("--verbose", action="store_true", help="one line per mission as it ends")
     args = parser.parse_args()
     missions = 10 if args.quick else args.missions
     seconds = 30.0 if args.quick else 120.0
@@ -235,6 +236,14 @@ def main() -> None:
         robots = 0
         for seed in range(missions):
             result = run_mission(seed, right_of_way=right_of_way)
+            if args.verbose:
+                console.print(
+                    f"seed {seed}: {result.robots} robots, reached {result.reached}/"
+                    f"{result.reachable}, collisions {result.collisions}, deadlock aborts "
+                    f"{result.deadlock_aborts}, sent aside {result.yields}, "
+                    f"{result.sim_s:.0f} sim s in {result.wall_s:.1f} s",
+                    highlight=False,
+                )
             robots += result.robots
             totals.add(seed, result)
         table.add_row(

@@ -235,6 +235,12 @@ def test_costmap_with_obstacles_equals_inflating_them_with_the_map() -> None:
     reference = Costmap.from_grid(OccupancyGrid(data, grid.resolution, grid.origin))
     with_robots = costmap.with_obstacles(rows, cols)
     assert np.array_equal(with_robots.cost, reference.cost)
+    # Where the planner may put the robot, recomputed near the robots only, is as if
+    # the whole costmap had been made with them.
+    rebuilt = Costmap(grid, costmap.params, with_robots.cost.copy(), with_robots.clearance.copy())
+    assert np.array_equal(with_robots.free_mask(), rebuilt.free_mask())
+    assert np.array_equal(with_robots.planning_cost, rebuilt.planning_cost)
+    assert not with_robots.free_mask()[rows, cols].any()
     assert with_robots.grid is grid  # the map itself is untouched
     assert costmap.with_obstacles(np.array([], int), np.array([], int)) is costmap
     # Padding grows them: cells within it are lethal too, and the inflation starts there.

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from navseq.geometry import Pose2D, normalize_angle
-from navseq.sim.costmap import INSCRIBED, Costmap
+from navseq.sim.costmap import INSCRIBED, Costmap, CostmapParams
 from navseq.sim.robot import DiffDriveLimits
 
 # How many plan points past the current closest one are searched each step: the robot
@@ -85,6 +85,7 @@ class RegulatedPurePursuit:
         self.distance_to_path = 0.0
         self.distance_remaining = 0.0
         self.goal_reached = False
+        self._factors_for: CostmapParams | None = None
         self.set_costmap(costmap)
 
     @property
@@ -94,8 +95,11 @@ class RegulatedPurePursuit:
 
     def set_costmap(self, costmap: Costmap) -> None:
         """Use ``costmap`` for the obstacle slowdown (after a costmap is rebuilt)."""
+        if costmap.params != self._factors_for:
+            # They depend on the inflation only, which costmaps with robots in share.
+            self._speed_factor_by_cost = speed_factors_by_cost(self.params, costmap)
+            self._factors_for = costmap.params
         self.costmap = costmap
-        self._speed_factor_by_cost = speed_factors_by_cost(self.params, costmap)
 
     def set_path(self, points: np.ndarray, goal: Pose2D) -> None:
         """Start following ``points`` (N, 2) toward ``goal``; the last point should be the goal.

@@ -32,6 +32,7 @@ per cell, the distance from its centre to the nearest blocked cell's square (m).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -149,26 +150,71 @@ class Costmap:
         ``inflation_radius`` of the new cells nothing changes. ``padding`` (m) grows the
         new obstacles all round before they are inflated.
         """
-        rows, cols = np.asarray(rows, dtype=np.intp), np.asarray(cols, dtype=np.intp)
-        if rows.size == 0:
+        return self.with_obstacle_groups([(rows, cols)], padding=padding)
+
+    def with_obstacle_groups(
+        self, groups: Sequence[tuple[np.ndarray, np.ndarray]], *, padding: float = 0.0
+    ) -> Costmap:
+        """:meth:`with_obstacles` for several groups of cells (rows, cols) at once, each
+        inflated in a window of its own: robots metres apart cost a few small windows
+        rather than one that spans them all. The same costs as one group of them all,
+        for the same reason (the larger cost of each, the smaller clearance)."""
+        groups = [
+            (np.asarray(rows, dtype=np.intp), np.asarray(cols, dtype=np.intp))
+            for rows, cols in groups
+        ]
+        groups = [(rows, cols) for rows, cols in groups if rows.size]
+        if not groups:
             return self
         reach = math.ceil((self.params.inflation_radius + padding) / self.grid.resolution) + 1
         height, width = self.cost.shape
-        top, bottom = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
-        left, right = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
-        blocked = np.zeros((bottom - top, right - left), dtype=bool)
-        blocked[rows - top, cols - left] = True
-        distance, to_square = _distances(blocked, self.grid.resolution)
-        if padding > 0.0:
-            distance = np.maximum(distance - padding, 0.0)
-            to_square = np.maximum(to_square - padding, 0.0)
         cost = self.cost.copy()
-        window = cost[top:bottom, left:right]
-        np.maximum(window, cost_of_distance(distance, self.params), out=window)
         clearance = self.clearance.copy()
-        window = clearance[top:bottom, left:right]
-        np.minimum(window, to_square.astype(np.float32), out=window)
-        return Costmap(self.grid, self.params, cost, clearance)
+        windows = []
+        for rows, cols in groups:
+            top, bottom = max(int(rows.min()) - reach, 0), min(int(rows.max()) + reach + 1, height)
+            left, right = max(int(cols.min()) - reach, 0), min(int(cols.max()) + reach + 1, width)
+            blocked = np.zeros((bottom - top, right - left), dtype=bool)
+            blocked[rows - top, cols - left] = True
+            distance, to_square = _distances(blocked, self.grid.resolution)
+            if padding > 0.0:
+                distance = np.maximum(distance - padding, 0.0)
+                to_square = np.maximum(to_square - padding, 0.0)
+            window = (slice(top, bottom), slice(left, right))
+            np.maximum(cost[window], cost_of_distance(distance, self.params), out=cost[window])
+            np.minimum(clearance[window], to_square.astype(np.float32), out=clearance[window])
+            windows.append(window)
+        return self._patched(cost, clearance, windows)
+
+    def _patched(
+        self, cost: np.ndarray, clearance: np.ndarray, windows: list[tuple[slice, slice]]
+    ) -> Costmap:
+        """A costmap with ``cost`` and ``clearance``, which differ from this one's only in
+        ``windows``: what derives from them is recomputed there only (fleets rebuild a
+        costmap with the robots in it many times a second; the whole map each time cost
+        more than the rest of the rebuild)."""
+        patched = object.__new__(Costmap)
+        for name, value in (
+            ("grid", self.grid),
+            ("params", self.params),
+            ("cost", cost),
+            ("clearance", clearance),
+        ):
+            object.__setattr__(patched, name, value)
+        cost.setflags(write=False)
+        clearance.setflags(write=False)
+        traversable = self.free_mask().copy()
+        planning = self.planning_cost.copy()
+        for window in windows:
+            traversable[window] = (cost[window] < INSCRIBED) & (
+                clearance[window] >= np.float32(self.params.circumscribed_radius)
+            )
+            planning[window] = np.where(traversable[window], cost[window], np.uint8(INSCRIBED))
+        traversable.setflags(write=False)
+        planning.setflags(write=False)
+        object.__setattr__(patched, "_traversable", traversable)
+        object.__setattr__(patched, "_planning_cost", planning)
+        return patched
 
 
 def inflate(grid: OccupancyGrid, params: CostmapParams) -> np.ndarray:

@@ -51,12 +51,18 @@ class FleetRobot:
 class FleetWorld:
     """Robots on ``grid`` stepped together every ``dt`` seconds; see the module docstring.
 
+    Pairs of robots are sorted every ``broad_phase_steps`` steps into those near enough
+    to touch (only they get the exact collision tests) and those in sight of each other
+    (only they can make a server re-plan), with room for what they move meanwhile.
+
     ``nav_params``, when given, tunes every robot's server (each robot's profile still
     sets its limits and tolerances). ``right_of_way=False`` leaves conflicts to the
     servers alone (they wait for each other and may give up: the comparison the
     benchmark makes). Raises :class:`NavseqError` for two robots of one name, a start in
     an obstacle, or two starts whose footprints overlap.
     """
+
+    broad_phase_steps = 5
 
     def __init__(
         self,
@@ -108,6 +114,9 @@ class FleetWorld:
         self._by_name = dict(zip(self.names, self._worlds, strict=True))
         self.footprints: tuple[Footprint, ...] = tuple(world.footprint for world in self._worlds)
         self._radii = np.array([fp.circumscribed_radius for fp in self.footprints])
+        self._near_reach, self._sight_reach = self._broad_phase_reaches()
+        self._neighbours_now: tuple[list[list[int]], list[list[int]]] = ([], [])
+        self._neighbours_until = 0  # the step from which they must be sorted again
         self.right_of_way: RightOfWay | None = RightOfWay(self) if right_of_way else None
         self.steps = 0
         self.collisions = 0  # robot pairs found overlapping after a step, summed over steps
@@ -149,15 +158,25 @@ class FleetWorld:
             self.right_of_way.before_step()
         worlds = self._worlds
         footprints = self.footprints
+        servers = self.servers
         poses = [world.robot.pose for world in worlds]
+        if self.steps >= self._neighbours_until:
+            self._neighbours_now = self._neighbours(poses)
+            self._neighbours_until = self.steps + self.broad_phase_steps
+        near, in_sight = self._neighbours_now
         for index, world in enumerate(worlds):
             world.set_other_robots(
                 [
                     (pose, footprint)
                     for other, (pose, footprint) in enumerate(zip(poses, footprints, strict=True))
                     if other != index
-                ]
+                ],
+                [(poses[other], footprints[other]) for other in near[index]],
             )
+            # Indices among the others, which leave this robot out.
+            servers[index].in_sight = [
+                other if other < index else other - 1 for other in in_sight[index]
+            ]
             world.step()
             poses[index] = world.robot.pose
         self.steps += 1
@@ -199,6 +218,43 @@ class FleetWorld:
                         f"robots {first.name} and {second.name} start overlapping each other",
                         source=self.grid.source,
                     )
+
+    def _broad_phase_reaches(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per pair of robots, the distance between centres within which (1) one could
+        touch the other, or come within the margin its server keeps, during a step and
+        the braking after it, and (2) one may see the other (its server's sight, plus
+        what both move in a step)."""
+        pads = []
+        sights = []
+        for server in self.servers:
+            limits = server.params.limits
+            # Until the pairs are sorted again, each robot moves, and then may brake.
+            moves = limits.max_v * self.dt * (self.broad_phase_steps + 1)
+            travel = moves + limits.max_v * self.dt + limits.max_v**2 / (2.0 * limits.acc_v)
+            pads.append(travel + server.params.robot_margin + 0.05)
+            sights.append(server.sensing_range * 1.5 + moves)
+        pad = np.array(pads)
+        near = self._radii[:, None] + self._radii[None, :] + pad[:, None] + pad[None, :]
+        sight = np.array(sights)[:, None] + pad[None, :]
+        return near, sight
+
+    def _neighbours(self, poses: list[Pose2D]) -> tuple[list[list[int]], list[list[int]]]:
+        """For each robot, the others it may touch this step, and those it may see."""
+        count = len(poses)
+        if count < 2:
+            return [[] for _ in poses], [[] for _ in poses]
+        xy = np.array([(pose.x, pose.y) for pose in poses])
+        gaps = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+        np.fill_diagonal(gaps, np.inf)
+        return self._rows_of(gaps < self._near_reach), self._rows_of(gaps < self._sight_reach)
+
+    @staticmethod
+    def _rows_of(pairs: np.ndarray) -> list[list[int]]:
+        """Per row of a square boolean matrix, the columns that are True (ascending)."""
+        rows: list[list[int]] = [[] for _ in range(len(pairs))]
+        for row, col in zip(*(index.tolist() for index in np.nonzero(pairs)), strict=True):
+            rows[row].append(col)
+        return rows
 
     def _overlapping_pairs(self, poses: list[Pose2D]) -> int:
         """Pairs of robots whose footprints overlap at ``poses`` (exactly, after a cheap

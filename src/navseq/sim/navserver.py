@@ -155,6 +155,7 @@ class NavigationServer:
         self._escape_command = (0.0, 0.0)
         self._escape_time_left = 0.0
         self._others: OtherRobots = ()
+        self._nearby: OtherRobots = ()  # those of them the safety test could meet
         self._costmap_others: list[Pose2D] = []  # where planning_costmap has the others
         self._plan_others: list[Pose2D] = []  # ... and where the current plan had them
         self._waiting = False  # holding still until a replan finds a way past another robot
@@ -211,13 +212,20 @@ class NavigationServer:
         self.plan_version += 1
         self.controller.set_path(points, goal)
 
-    def set_other_robots(self, others: Iterable[tuple[Pose2D, Footprint]]) -> None:
+    def set_other_robots(
+        self,
+        others: Iterable[tuple[Pose2D, Footprint]],
+        nearby: OtherRobots | None = None,
+    ) -> None:
         """The other robots' poses (map frame) and footprints now; call every control step.
 
         Cheap: the costmap is rebuilt only when planning. A robot is expected to keep its
-        place in the sequence and its footprint from one call to the next.
+        place in the sequence and its footprint from one call to the next. ``nearby``,
+        when the caller knows it (a fleet sorts every pair once a step), holds those of
+        them the safety test could meet this step; None: all of them.
         """
         self._others = others if isinstance(others, list | tuple) else list(others)
+        self._nearby = self._others if nearby is None else nearby
 
     def cancel(self) -> None:
         """Stop pursuing the active goal (state CANCELED); nothing happens when idle."""
@@ -340,20 +348,12 @@ class NavigationServer:
         if not self._others_moved(self._costmap_others):
             return
         grid = self.costmap.grid
-        rows: list[np.ndarray] = []
-        cols: list[np.ndarray] = []
-        for at, footprint in self._others:
-            cells = footprint_cells(grid, footprint, at)
-            if cells is not None:  # None: partly off the map, where no plan goes anyway
-                rows.append(cells[0])
-                cols.append(cells[1])
-        costmap = self.costmap
-        if rows:
-            # Grown by the margin the safety test keeps, or plans squeeze through gaps
-            # the robot then may not drive.
-            costmap = costmap.with_obstacles(
-                np.concatenate(rows), np.concatenate(cols), padding=self.params.robot_margin
-            )
+        groups = [footprint_cells(grid, footprint, at) for at, footprint in self._others]
+        # None: partly off the map, where no plan goes anyway. Grown by the margin the
+        # safety test keeps, or plans squeeze through gaps the robot then may not drive.
+        costmap = self.costmap.with_obstacle_groups(
+            [cells for cells in groups if cells is not None], padding=self.params.robot_margin
+        )
         self._costmap_others = [at for at, _ in self._others]
         self._use_planning_costmap(costmap)
 
@@ -445,6 +445,11 @@ class NavigationServer:
             else:
                 self._stuck(PLAN_FAILED, why)
             return False
+        self._follow(plan, goal)
+        return True
+
+    def _follow(self, plan: Plan, goal: Pose2D) -> None:
+        """Make ``plan`` (to ``goal``) the one the controller follows from now on."""
         self.plan = plan
         self.plan_version += 1
         self._plan_others = self._costmap_others
@@ -453,7 +458,6 @@ class NavigationServer:
         # goal checker is satisfied at the plan's end, as Nav2's controller is.
         end_x, end_y = (float(value) for value in plan.points[-1])
         self.controller.set_path(plan.points, Pose2D(end_x, end_y, goal.yaw))
-        return True
 
     # -- recovery behaviours (move_base's, in small) -------------------------------------
 
@@ -666,19 +670,21 @@ class NavigationServer:
         limits = self.params.limits
         grid = self.costmap.grid
         footprint = self.footprint
-        others = self._others if with_others else ()
+        others = self._nearby if with_others else ()
         start = pose
         v, w = next_velocity(limits, v, w, cmd_v, cmd_w, dt)
         pose = integrate_arc(pose.x, pose.y, pose.yaw, v, w, dt)
-        if footprint_collides(grid, footprint, pose) or (
+        clearance = self._clearance_at(pose.x, pose.y)
+        # Far from every blocked cell the footprint cannot touch one (clearance_map):
+        # the exact test, the dearest part of a step, is needed near walls only.
+        near_map = clearance <= footprint.circumscribed_radius + 2.0 * grid.resolution
+        if (near_map and footprint_collides(grid, footprint, pose)) or (
             others and self._too_close_to_robot(start, pose, others)
         ):
             return False
         travel = abs(v) * dt + v * v / (2.0 * limits.acc_v)
         margin = footprint.circumscribed_radius + travel + 2.0 * grid.resolution
-        if self._clearance_at(pose.x, pose.y) > margin and not (
-            others and self._other_robot_within(pose, others, travel)
-        ):
+        if clearance > margin and not (others and self._other_robot_within(pose, others, travel)):
             return True
         while v != 0.0 or w != 0.0:
             v, w = next_velocity(limits, v, w, 0.0, 0.0, dt)

@@ -16,7 +16,9 @@ and priority inheritance, in the spirit of PIBT (Okumura et al., 2022):
   is the plan it follows, or, when the robots leave it no plan, the plan on the bare
   map: where it would go were the others not there.
 - **Giving way.** Every lower-ranked robot whose footprint could touch the blocked
-  robot's footprint anywhere along that route gives way: it drives to the nearest
+  robot's footprint along the stretch of that route within the blocked robot's sight
+  (its server's sensing range, plus ``sight_margin``: a robot farther along is not
+  what holds it up) gives way: it drives to the nearest
   *refuge* (:func:`find_refuge`: a place out of that route's band and away from the
   other robots, reached without passing through any of them) and holds there. Its goal
   is kept (the server stays ACTIVE; a mission sees nothing but a slower leg); it takes
@@ -48,6 +50,7 @@ from scipy import ndimage
 
 from navseq.geometry import Pose2D
 from navseq.sim.costmap import Costmap
+from navseq.sim.detour import blocked_stretch, local_detour
 from navseq.sim.footprint import TURTLEBOT3_BURGER, Footprint, footprint_cells
 from navseq.sim.navserver import NavigationServer, NavParams, NavState
 from navseq.sim.planner import Plan
@@ -69,11 +72,16 @@ class FleetNavigationServer(NavigationServer):
     far away will have moved by the time this one gets there, and re-planning around
     all of them, in a fleet of twenty, would cost more than everything else together.
     For the same reason a robot that moves near the plan makes the server re-plan at
-    most every ``robot_replan_interval`` seconds. The safety test sees every robot.
+    most every ``robot_replan_interval`` seconds, and such a re-plan keeps the plan
+    while it is clear of them, or goes round them through a window
+    (:mod:`navseq.sim.detour`). The safety test sees every robot the fleet finds near
+    enough to touch.
     """
 
     sensing_range = 3.0  # m from this robot's centre to another's, for planning
     robot_replan_interval = 1.0  # s between re-plans caused by robots moving near the plan
+    detour_rejoin = 1.0  # m past the stretch robots block where a detour rejoins the plan
+    detour_margin = 2.0  # m round that stretch a detour may use (else: the whole map)
 
     def __init__(
         self,
@@ -86,6 +94,13 @@ class FleetNavigationServer(NavigationServer):
         self.aside_target: Pose2D | None = None
         self._at: Pose2D | None = None  # where the robot was at the last step or plan
         self._sensed: list[tuple[int, Pose2D]] = []  # (index, pose) in planning_costmap
+        self._robot_came_near = False  # the re-plan now due is for a robot near the plan
+        # Which robots the plan went round (their indices): one standing still that came
+        # into sight since is news as much as one that moved.
+        self._plan_sensed: set[int] = set()
+        # Indices into the other robots of those that may be in sight (the fleet's broad
+        # phase, every step); None: look at every one.
+        self.in_sight: list[int] | None = None
 
     @property
     def giving_way(self) -> bool:
@@ -135,12 +150,55 @@ class FleetNavigationServer(NavigationServer):
             return super().compute_velocity(pose, v, w, dt)
         aside = self._aside
         assert aside is not None
-        aside.set_other_robots(self._others)
+        aside.set_other_robots(self._others, self._nearby)
         return aside.compute_velocity(pose, v, w, dt)
 
     def make_plan(self, start: Pose2D, goal: Pose2D) -> Plan | None:
         self._at = start
         return super().make_plan(start, goal)
+
+    def _replan(self, pose: Pose2D) -> bool:
+        """A robot came near the plan: keep the plan while it is clear, else go round
+        the robots through a window (:mod:`navseq.sim.detour`); otherwise, and for every
+        other cause, plan over the whole map."""
+        came_near, self._robot_came_near = self._robot_came_near, False
+        if (
+            came_near
+            and self.plan is not None
+            and self.goal is not None
+            and not (self._needs_plan or self._waiting)
+            and self._keep_or_go_round(pose, self.plan, self.goal)
+        ):
+            self._since_plan = 0.0
+            return True
+        return super()._replan(pose)
+
+    def _keep_or_go_round(self, pose: Pose2D, plan: Plan, goal: Pose2D) -> bool:
+        """True if the plan is kept (still clear of the robots) or replaced by a detour."""
+        self._at = pose
+        self._refresh_planning_costmap()
+        costmap = self.planning_costmap
+        rest = plan.points[self.controller.closest_index :]
+        blocked = blocked_stretch(costmap, rest)
+        if not blocked.any():
+            self._plan_others = self._costmap_others
+            self._plan_sensed = {index for index, _ in self._sensed}
+            return True
+        if not costmap.is_free(pose.x, pose.y):
+            return False  # hemmed in: the whole-map planner knows where to start from
+        detour = local_detour(
+            costmap,
+            (pose.x, pose.y),
+            rest,
+            blocked,
+            rejoin=self.detour_rejoin,
+            margin=self.detour_margin,
+        )
+        if detour is None:
+            return False
+        self._needs_plan = False
+        self._follow(detour, goal)
+        return True
 
     def _sensed_robots(self) -> list[tuple[int, Pose2D, Footprint]]:
         """The other robots within ``sensing_range`` (all of them before the first step)."""
@@ -164,18 +222,10 @@ class FleetNavigationServer(NavigationServer):
             return
         self._sensed = [(index, pose) for index, pose, _ in sensed]
         grid = self.costmap.grid
-        rows: list[np.ndarray] = []
-        cols: list[np.ndarray] = []
-        for _, pose, footprint in sensed:
-            cells = footprint_cells(grid, footprint, pose)
-            if cells is not None:
-                rows.append(cells[0])
-                cols.append(cells[1])
-        costmap = self.costmap
-        if rows:
-            costmap = costmap.with_obstacles(
-                np.concatenate(rows), np.concatenate(cols), padding=self.params.robot_margin
-            )
+        groups = [footprint_cells(grid, footprint, pose) for _, pose, footprint in sensed]
+        costmap = self.costmap.with_obstacle_groups(
+            [cells for cells in groups if cells is not None], padding=self.params.robot_margin
+        )
         self._use_planning_costmap(costmap)
 
     def _robot_near_plan(self) -> bool:
@@ -184,20 +234,40 @@ class FleetNavigationServer(NavigationServer):
         if plan is None or self._since_plan < self.robot_replan_interval:
             return False
         seen = self._plan_others
-        near_squared = self.params.robot_near_plan**2
         reach = self.sensing_range
-        ahead: np.ndarray | None = None
-        for index, (pose, footprint) in enumerate(self._others):
+        others = self._others
+        looked_at = range(len(others)) if self.in_sight is None else self.in_sight
+        planned_round = self._plan_sensed
+        moved: list[tuple[float, float]] = []
+        for index in looked_at:
+            pose, footprint = others[index]
             if at is not None and abs(pose.x - at.x) + abs(pose.y - at.y) > reach * 1.5:
                 continue  # out of sight (a cheap bound on the distance)
-            if index < len(seen) and not self._robot_moved(seen[index], pose, footprint):
+            came_into_sight = (
+                index not in planned_round
+                and at is not None
+                and math.hypot(pose.x - at.x, pose.y - at.y) <= reach
+            )
+            if (
+                not came_into_sight
+                and index < len(seen)
+                and not self._robot_moved(seen[index], pose, footprint)
+            ):
                 continue
-            if ahead is None:
-                ahead = plan.points[self.controller.closest_index :]
-            squared = (ahead[:, 0] - pose.x) ** 2 + (ahead[:, 1] - pose.y) ** 2
-            if squared.size and float(squared.min()) < near_squared:
-                return True
-        return False
+            moved.append((pose.x, pose.y))
+        ahead = plan.points[self.controller.closest_index :]
+        if not moved or not len(ahead):
+            return False
+        robots = np.array(moved)
+        squared = (ahead[None, :, 0] - robots[:, None, 0]) ** 2 + (
+            ahead[None, :, 1] - robots[:, None, 1]
+        ) ** 2
+        self._robot_came_near = float(squared.min()) < self.params.robot_near_plan**2
+        return self._robot_came_near
+
+    def _follow(self, plan: Plan, goal: Pose2D) -> None:
+        super()._follow(plan, goal)
+        self._plan_sensed = {index for index, _ in self._sensed}
 
     def _use_costmap(self, costmap: Costmap) -> None:
         super()._use_costmap(costmap)
@@ -254,6 +324,9 @@ class RightOfWay:
     way_margin = 0.3
     refuge_margin = 0.1  # m more that a refuge keeps, so that it is out of the way for good
     yield_limit = 90.0  # s a robot gives way before it takes its goal up again anyway
+    # m beyond a blocked robot's sensing range within which its route's points count for
+    # who is in its way: a robot its server sees blocks route points this near it
+    sight_margin = 1.0
 
     def __init__(self, fleet: FleetWorld) -> None:
         self.fleet = fleet
@@ -365,10 +438,11 @@ class RightOfWay:
             if route is None:
                 continue
             rank = self._rank(index)
+            ahead = self._stretch_in_reach(index, route, poses[index])
             in_way = [
                 other
                 for other in range(count)
-                if other != index and self._in_band(other, index, route, poses)
+                if other != index and self._in_band(other, index, ahead, poses)
             ]
             helped = False
             giving_way_to = self._yields[index].to if index in self._yields else None
@@ -397,6 +471,22 @@ class RightOfWay:
                         break
             if helped:
                 servers[index].extend_patience()
+
+    def _stretch_in_reach(self, index: int, route: np.ndarray, pose: Pose2D) -> np.ndarray:
+        """The points of robot ``index``'s ``route`` that robots blocking it now can be on.
+
+        Its server sees (plans around, waits for) the robots within its sensing range
+        only, so a robot farther along the route is not what holds it up: sending that
+        one aside now would be a needless move, made again, if at all, when the robot
+        gets there. A robot giving way plans around every robot: its whole (short)
+        route counts.
+        """
+        server = self.fleet.servers[index]
+        if server.giving_way:
+            return route
+        reach = server.sensing_range + self.sight_margin
+        squared = (route[:, 0] - pose.x) ** 2 + (route[:, 1] - pose.y) ** 2
+        return route[squared <= reach * reach]
 
     def _send_aside(
         self, index: int, to: int, route: np.ndarray, poses: list[Pose2D], now: float

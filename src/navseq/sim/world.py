@@ -124,13 +124,20 @@ class SimWorld:
         self.body.command(v, w)
         self.body.step(self.dt)
 
-    def set_other_robots(self, others: Sequence[tuple[Pose2D, Footprint]]) -> None:
+    def set_other_robots(
+        self,
+        others: Sequence[tuple[Pose2D, Footprint]],
+        nearby: Sequence[tuple[Pose2D, Footprint]] | None = None,
+    ) -> None:
         """Other robots (poses in the map frame, footprints) for the body and the server.
 
         The world does not move them: the caller sets them again whenever they move.
+        ``nearby``: those of them this robot could touch within the next step or its
+        braking (a fleet's broad phase); only they get the exact collision tests.
         """
-        self.body.set_other_robots(others)
-        self.server.set_other_robots(others)
+        near = others if nearby is None else nearby
+        self.body.set_other_robots(near)
+        self.server.set_other_robots(others, near)
 
     def run(self, seconds: float) -> None:
         """Step for ``seconds`` of simulated time."""
