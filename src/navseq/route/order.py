@@ -40,6 +40,7 @@ import numpy as np
 
 from navseq.errors import NavseqError
 from navseq.extras import require_extra
+from navseq.route.exact import EXACT_UP_TO, exact_route
 
 if TYPE_CHECKING:
     from navseq.mission.model import Mission
@@ -318,6 +319,11 @@ def shortest_tour(
     began = time.perf_counter()
     costs = np.zeros((nodes, nodes), dtype=np.int64)
     costs[:count, :count] = np.rint(matrix * _MM).astype(np.int64)
+    if nodes - (1 if end == 0 else 2) <= EXACT_UP_TO:
+        route = exact_route(costs, end)
+        if on_solution is not None:
+            on_solution(tour_length(costs.astype(float), route, closed=False) / _MM)
+        return route[:-1] if last is None else route
     manager, routing = _routing_model(costs, end)
     parameters = pywrapcp.DefaultRoutingSearchParameters()
     parameters.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC

@@ -288,6 +288,39 @@ static Outcome reach(const uint8_t *cost, int64_t height, int64_t width, const d
     return FOUND;
 }
 
+/* What a search from `start` to `cells` (int64 flat indices) over a cost grid of `n`
+ * cells `width` wide is given, checked alike by every multi-target search: 0 when it
+ * holds, else -1 with the Python error set (`plural` / `singular` name the cells:
+ * "targets" / "target"). */
+static int check_search(Py_ssize_t n, Py_ssize_t width, const Py_buffer *lut, Py_ssize_t start,
+                        const Py_buffer *cells, const char *plural, const char *singular) {
+    if (width <= 0 || n % width != 0) {
+        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+        return -1;
+    }
+    if (n > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "grids above 2**31 cells are not supported");
+        return -1;
+    }
+    if (lut->len != 256 * (Py_ssize_t)sizeof(double) ||
+        cells->len % (Py_ssize_t)sizeof(int64_t) != 0) {
+        PyErr_Format(PyExc_ValueError, "lut must hold 256 float64, %s int64 values", plural);
+        return -1;
+    }
+    if (start < 0 || start >= n) {
+        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
+        return -1;
+    }
+    const int64_t *cell = cells->buf;
+    for (Py_ssize_t i = 0; i < cells->len / (Py_ssize_t)sizeof(int64_t); i++) {
+        if (cell[i] < 0 || cell[i] >= n) {
+            PyErr_Format(PyExc_IndexError, "%s cell outside the grid", singular);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 static PyObject *distances(PyObject *self, PyObject *args) {
     Py_buffer cost_buffer, lut_buffer, target_buffer;
     Py_ssize_t width, start;
@@ -301,25 +334,8 @@ static PyObject *distances(PyObject *self, PyObject *args) {
     Py_ssize_t n = cost_buffer.len;
     Py_ssize_t count = target_buffer.len / (Py_ssize_t)sizeof(int64_t);
     const int64_t *targets = target_buffer.buf;
-    if (width <= 0 || n % width != 0) {
-        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+    if (check_search(n, width, &lut_buffer, start, &target_buffer, "targets", "target") < 0)
         goto finish;
-    }
-    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
-        target_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
-        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, targets int64 values");
-        goto finish;
-    }
-    if (start < 0 || start >= n) {
-        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
-        goto finish;
-    }
-    for (Py_ssize_t i = 0; i < count; i++) {
-        if (targets[i] < 0 || targets[i] >= n) {
-            PyErr_SetString(PyExc_IndexError, "target cell outside the grid");
-            goto finish;
-        }
-    }
     best = malloc((size_t)n * sizeof(double));
     length = malloc((size_t)n * sizeof(double));
     closed = calloc((size_t)n, 1);
@@ -387,29 +403,8 @@ static PyObject *routes(PyObject *self, PyObject *args) {
     Py_ssize_t n = cost_buffer.len;
     Py_ssize_t count = target_buffer.len / (Py_ssize_t)sizeof(int64_t);
     const int64_t *targets = target_buffer.buf;
-    if (width <= 0 || n % width != 0) {
-        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+    if (check_search(n, width, &lut_buffer, start, &target_buffer, "targets", "target") < 0)
         goto finish;
-    }
-    if (n > INT32_MAX) {
-        PyErr_SetString(PyExc_ValueError, "grids above 2**31 cells are not supported");
-        goto finish;
-    }
-    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
-        target_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
-        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, targets int64 values");
-        goto finish;
-    }
-    if (start < 0 || start >= n) {
-        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
-        goto finish;
-    }
-    for (Py_ssize_t i = 0; i < count; i++) {
-        if (targets[i] < 0 || targets[i] >= n) {
-            PyErr_SetString(PyExc_IndexError, "target cell outside the grid");
-            goto finish;
-        }
-    }
     best = malloc((size_t)n * sizeof(double));
     length = malloc((size_t)n * sizeof(double));
     parent = malloc((size_t)n * sizeof(int32_t));
@@ -497,25 +492,8 @@ static PyObject *local(PyObject *self, PyObject *args) {
     Py_ssize_t n = cost_buffer.len;
     Py_ssize_t count = query_buffer.len / (Py_ssize_t)sizeof(int64_t);
     const int64_t *queries = query_buffer.buf;
-    if (width <= 0 || n % width != 0 || n > INT32_MAX) {
-        PyErr_SetString(PyExc_ValueError, "cost buffer size is not a multiple of width");
+    if (check_search(n, width, &lut_buffer, start, &query_buffer, "queries", "query") < 0)
         goto finish;
-    }
-    if (lut_buffer.len != 256 * (Py_ssize_t)sizeof(double) ||
-        query_buffer.len % (Py_ssize_t)sizeof(int64_t) != 0) {
-        PyErr_SetString(PyExc_ValueError, "lut must hold 256 float64, queries int64 values");
-        goto finish;
-    }
-    if (start < 0 || start >= n) {
-        PyErr_SetString(PyExc_IndexError, "start cell outside the grid");
-        goto finish;
-    }
-    for (Py_ssize_t i = 0; i < count; i++) {
-        if (queries[i] < 0 || queries[i] >= n) {
-            PyErr_SetString(PyExc_IndexError, "query cell outside the grid");
-            goto finish;
-        }
-    }
     best = malloc((size_t)n * sizeof(double));
     length = malloc((size_t)n * sizeof(double));
     anchor = malloc((size_t)n * sizeof(int32_t));
