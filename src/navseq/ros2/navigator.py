@@ -55,7 +55,6 @@ clients are one node; :meth:`close` then leaves the session to its owner.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import threading
 import time
@@ -532,9 +531,7 @@ class Nav2Navigator:
         self.now()  # keep the clock's last value for after close
         self._closed = True
         if self._owns_session:
-            with contextlib.suppress(Exception):
-                self._client.destroy()
-            self._session.close()
+            self._session.close(self._client)
 
     # -- lookups -----------------------------------------------------------------------
 

@@ -77,8 +77,7 @@ class Ros2Session:
         self._thread.start()
 
     def _spin(self) -> None:
-        with contextlib.suppress(ExternalShutdownException, ShutdownException):
-            self.executor.spin()
+        spin_until_shutdown(self.executor, lambda: self._closed)
 
     def call_soon(self, callback: Callable[..., Any], *args: Any) -> None:
         """Run ``callback(*args)`` on the executor's thread (rclpy is not used from two)."""
@@ -97,13 +96,32 @@ class Ros2Session:
         overrides: dict[str, Parameter] = dict(getattr(self.node, "_parameter_overrides", {}))
         return {name: self.node.get_parameter(name) for name in overrides}
 
-    def close(self) -> None:
-        """Stop the executor, destroy the node, shut the context down (idempotent)."""
+    def close(self, *entities: Any) -> None:
+        """Stop the executor, destroy ``entities`` (action clients: a node does not
+        destroy them) and the node, shut the context down (idempotent). Nothing is
+        destroyed while the executor still spins: its next wait would use it."""
         if self._closed:
             return
         self._closed = True
         self.executor.shutdown(timeout_sec=SHUTDOWN_WAIT)
         self._thread.join(timeout=SHUTDOWN_WAIT)
+        for entity in entities:
+            with contextlib.suppress(Exception):
+                entity.destroy()
         with contextlib.suppress(Exception):
             self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
+
+
+def spin_until_shutdown(executor: Any, closing: Callable[[], bool]) -> None:
+    """Spin ``executor`` until it is shut down. Once ``closing()`` says the owner is
+    shutting it down, an error from a callback still in flight meeting a handle already
+    destroyed (rclpy's ``InvalidHandle`` and the like) is part of going away, not a fault
+    to print as a thread's traceback."""
+    try:
+        executor.spin()
+    except (ExternalShutdownException, ShutdownException):
+        pass
+    except Exception:
+        if not closing():
+            raise

@@ -122,7 +122,7 @@ from nav2_msgs.action import (
 from nav2_msgs.srv import ClearEntireCostmap
 from nav_msgs.msg import Odometry, Path
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -161,6 +161,7 @@ from navseq.ros2.messages import (
 from navseq.ros2.path_actions import PathActions
 from navseq.ros2.route_server import RouteServer
 from navseq.ros2.scan_topic import ScanTopic, base_scan_transform
+from navseq.ros2.session import spin_until_shutdown
 from navseq.ros2.standin import (
     NAV2_PLANNER_TOLERANCE,
     Ending,
@@ -740,7 +741,9 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
         for helper in helpers:
             executor.add_node(helper)
         lifecycle.start()
-        spinner = threading.Thread(target=_spin, args=(executor,), name="navseq-ros2")
+        spinner = threading.Thread(
+            target=spin_until_shutdown, args=(executor, stop.is_set), name="navseq-ros2"
+        )
         spinner.start()
         sim.start()
         pose = sim.standin.world.robot.pose
@@ -770,6 +773,7 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
             pass
         return 0
     finally:
+        stop.set()  # from here on the spinner's errors are the shutdown's own
         if sim is not None:
             sim.stop()
         executor.shutdown(timeout_sec=5.0)
@@ -818,11 +822,6 @@ def velocity_smoother_parameters(limits: SmootherLimits) -> list[Parameter]:
         Parameter("max_decel", value=[-limits.decel_v, 0.0, -limits.decel_w]),
         Parameter("velocity_timeout", value=limits.timeout),
     ]
-
-
-def _spin(executor: MultiThreadedExecutor) -> None:
-    with contextlib.suppress(ExternalShutdownException):
-        executor.spin()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
