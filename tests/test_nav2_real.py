@@ -185,7 +185,10 @@ def test_a_goal_inside_a_pillar_is_never_recorded_reached(placed: RealNav2, tmp_
     if attempt["status"] == "SUCCEEDED":
         assert attempt["reason"].startswith("succeeded far from goal")
     else:
-        assert attempt["status"] == "ABORTED" and "error_code" in attempt["text"], attempt
+        # A failed server names its error_code; a tree node that timed out on a loaded
+        # machine ends the goal with error_code 0 and no words, as Nav2 reports it.
+        assert attempt["status"] == "ABORTED", attempt
+        assert attempt["text"] == "" or "error_code" in attempt["text"], attempt
 
 
 def test_a_goal_in_an_unknown_frame_fails_with_nav2s_words(

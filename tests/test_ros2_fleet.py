@@ -317,10 +317,11 @@ def test_robot1_drives_around_robot2_parked_on_its_straight_path(
     if speed == "1":
         assert report["clock"] is None, report  # wall-clock time: nobody publishes /clock
     else:
-        # One simulated time: robot2's odometry is stamped with robot1's /clock.
+        # One simulated time: robot2's odometry is stamped with robot1's /clock (wall time
+        # would be 1.8e9 s off; at 4x a loaded machine lags a step or two behind).
         assert report["clock"] is not None, report
-        assert abs(report["stamps"]["robot2"] - report["clock"]) < 0.5, report
-        assert abs(report["stamps"]["robot1"] - report["clock"]) < 0.5, report
+        assert abs(report["stamps"]["robot2"] - report["clock"]) < 2.0, report
+        assert abs(report["stamps"]["robot1"] - report["clock"]) < 2.0, report
         assert "following /clock" in output, output
 
 
