@@ -60,6 +60,7 @@ from navseq.navigators.base import (
 from navseq.sim.costmap import Costmap
 from navseq.sim.footprint import Footprint, footprints_overlap
 from navseq.sim.occupancy import OccupancyGrid
+from navseq.sim.right_of_way import in_band, way_reach
 
 
 class Mode:
@@ -483,18 +484,10 @@ class FleetCoordinator:
         return watch.route
 
     def _way(self, index: int, of: int) -> float:
-        footprints = self._footprints
-        return (
-            footprints[index].circumscribed_radius
-            + footprints[of].circumscribed_radius
-            + self.way_margin
-        )
+        return way_reach(self._footprints, index, of, self.way_margin)
 
     def _in_band(self, index: int, of: int, route: np.ndarray, poses: list[Pose2D]) -> bool:
-        pose = poses[index]
-        reach = self._way(index, of)
-        squared = (route[:, 0] - pose.x) ** 2 + (route[:, 1] - pose.y) ** 2
-        return bool(squared.size) and float(squared.min()) < reach * reach
+        return in_band(poses[index], route, self._way(index, of))
 
     # -- decisions -----------------------------------------------------------------------
 

@@ -42,6 +42,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -525,20 +526,21 @@ class RightOfWay:
         return True
 
     def _way(self, index: int, of: int) -> float:
-        """How near robot ``index``'s centre to a point of robot ``of``'s route blocks it."""
-        footprints = self.fleet.footprints
-        return (
-            footprints[index].circumscribed_radius
-            + footprints[of].circumscribed_radius
-            + self.way_margin
-        )
+        return way_reach(self.fleet.footprints, index, of, self.way_margin)
 
     def _in_band(self, index: int, of: int, route: np.ndarray, poses: list[Pose2D]) -> bool:
-        """True if robot ``index`` could touch robot ``of`` anywhere along ``route``."""
-        pose = poses[index]
-        reach = self._way(index, of)
-        squared = (route[:, 0] - pose.x) ** 2 + (route[:, 1] - pose.y) ** 2
-        return bool(squared.size) and float(squared.min()) < reach * reach
+        return in_band(poses[index], route, self._way(index, of))
+
+
+def way_reach(footprints: Sequence[Footprint], index: int, of: int, margin: float) -> float:
+    """How near robot ``index``'s centre to a point of robot ``of``'s route blocks it."""
+    return footprints[index].circumscribed_radius + footprints[of].circumscribed_radius + margin
+
+
+def in_band(pose: Pose2D, route: np.ndarray, reach: float) -> bool:
+    """True if a robot at ``pose`` is within ``reach`` of some point of ``route``."""
+    squared = (route[:, 0] - pose.x) ** 2 + (route[:, 1] - pose.y) ** 2
+    return bool(squared.size) and float(squared.min()) < reach * reach
 
 
 def find_refuge(
