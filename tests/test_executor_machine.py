@@ -314,6 +314,69 @@ def test_on_failure_retry_retries_without_limit() -> None:
     assert result.success and result.visits[0].attempts == 26
 
 
+def waits_between_goals(h: Harness, statuses: list[str]) -> list[float]:
+    """End each goal with the next status and tick until the retry goes out; the waits."""
+    waits = []
+    t = 0.0
+    for status in statuses:
+        h.done(status, t)
+        if h.executor.finished:
+            break
+        sent = len(h.goals())
+        failed_at = t
+        while len(h.goals()) == sent:
+            t += 0.5
+            h.tick(t)
+        waits.append(t - failed_at)
+    return waits
+
+
+def test_rejected_goals_back_off_longer_each_time_and_end_the_retry_mission() -> None:
+    # A stack that refuses every goal (bt_navigator inactive) must not be asked once a
+    # second for ever: the waits grow, and after five refusals in a row the mission ends.
+    h = Harness(line_mission(2, retries=0, on_failure=FailureAction.RETRY))
+    h.start(0.0)
+    waits = waits_between_goals(h, ["REJECTED"] * 10)
+    assert waits == [1.0, 2.0, 4.0, 8.0, 16.0]
+    assert h.executor.finished and len(h.goals()) == 6
+    assert [f.will_retry for f in h.of_type(AttemptFailed)] == [True] * 5 + [False]
+    result = h.executor.result
+    assert outcomes(h) == [WaypointOutcome.FAILED, WaypointOutcome.NOT_RUN]
+    assert result.exit_code == 1
+    assert result.reason == "stopped: waypoint 1 'p1' failed (REJECTED 6 times in a row)"
+
+
+def test_rejections_honour_retries_and_the_back_off_stops_growing_at_30_s() -> None:
+    h = Harness(line_mission(1, retries=7, on_failure=FailureAction.RETRY))
+    h.start(0.0)
+    waits = waits_between_goals(h, ["REJECTED"] * 10)
+    assert waits == [1.0, 2.0, 4.0, 8.0, 16.0, 30.0, 30.0]
+    assert h.executor.finished and len(h.goals()) == 8
+
+
+def test_an_attempt_that_is_not_rejected_starts_the_count_again() -> None:
+    # Between refusals the stack took a goal and aborted it: the stack works again, so
+    # the wait is back to one second and the count of refusals starts anew.
+    h = Harness(line_mission(1, retries=0, on_failure=FailureAction.RETRY))
+    h.start(0.0)
+    statuses = ["REJECTED"] * 4 + ["ABORTED"] + ["REJECTED"] * 5
+    waits = waits_between_goals(h, statuses)
+    assert waits == [1.0, 2.0, 4.0, 8.0, 1.0, 1.0, 2.0, 4.0, 8.0, 16.0]
+    assert not h.executor.finished
+    h.succeed(200.0)
+    assert h.executor.result.success
+
+
+def test_rejections_under_skip_back_off_too_within_the_retries() -> None:
+    h = Harness(line_mission(2, retries=3, on_failure=FailureAction.SKIP))
+    h.start(0.0)
+    waits = waits_between_goals(h, ["REJECTED"] * 3)
+    assert waits == [1.0, 2.0, 4.0]
+    h.done("REJECTED", 100.0)  # the retries are used up: the next waypoint at once
+    assert outcomes(h)[0] is WaypointOutcome.SKIPPED
+    assert h.goals()[-1].goal.pose.x == 2.0
+
+
 # ---------------------------------------------------------------- pass-through, dwell
 
 

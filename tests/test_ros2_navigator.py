@@ -684,9 +684,10 @@ def test_a_goal_rejected_before_bt_navigator_is_activated_is_retried_and_reached
     mission = write_mission(
         tmp_path / "m.yaml",
         "  - {name: near, x: -1.5, y: -0.5, yaw: 0}\n",
-        # on_failure: retry: a rejection is retried at once, and the activation comes from
-        # a ROS 2 process that may take seconds to start on a loaded machine.
-        "defaults: {on_failure: retry, goal_timeout: 60}\n",
+        # on_failure: retry: a rejection is retried after a growing back-off (1, 2, 4 ...
+        # 30 s), and the activation comes from a ROS 2 process that may take seconds to
+        # start on a loaded machine: 8 rejections in a row give it two minutes.
+        "defaults: {on_failure: retry, retries: 8, goal_timeout: 60}\n",
     )
     out = tmp_path / "out"
     run = Nav2Run(env, mission, out)

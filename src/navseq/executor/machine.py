@@ -68,6 +68,7 @@ from dataclasses import dataclass, replace
 
 from navseq.errors import NavseqError
 from navseq.executor.arrival import arrival_miss, goal_tolerance
+from navseq.executor.backoff import RETRY_BACKOFF, rejection_limit, retry_wait
 from navseq.executor.commands import (
     CancelGoal,
     CancelRecovery,
@@ -110,6 +111,7 @@ from navseq.mission.recovery import Recovery
 from navseq.mission.robot import DEFAULT_PROFILE, GoalTolerance, RobotProfile
 from navseq.mission.tasks import Task
 from navseq.navigators.base import (
+    REJECTED_STATUS,
     Goal,
     GoalDone,
     GoalFeedback,
@@ -123,8 +125,6 @@ from navseq.navigators.base import (
 from navseq.tasks.base import TaskDone, TaskOutcome
 from navseq.track import simplify_path
 
-#: Pause between a failed attempt and the next one, so a failing stack is not hammered.
-RETRY_BACKOFF = 1.0
 #: Planned paths are told to sinks simplified to within this distance (m).
 PLAN_TOLERANCE = 0.01
 #: Reason recorded when the navigation server stayed away longer than allowed.
@@ -859,7 +859,15 @@ class MissionExecutor:
         commands: list[Command] = [CancelGoal()] if cancel else []
         attempts = visit.result.attempts
         policy = visit.policy
-        will_retry = policy.on_failure is FailureAction.RETRY or attempts <= policy.retries
+        # A refused goal comes back at once: rejections in a row wait longer each time and,
+        # under on_failure: retry, end the waypoint after a bound (navseq.executor.backoff).
+        visit.rejections_in_row = visit.rejections_in_row + 1 if status == REJECTED_STATUS else 0
+        if policy.on_failure is FailureAction.RETRY:
+            will_retry = visit.rejections_in_row <= rejection_limit(policy)
+            if not will_retry:
+                reason = f"{reason} {visit.rejections_in_row} times in a row"
+        else:
+            will_retry = attempts <= policy.retries
         self._monitor = None
         visit.result.reason = reason
         record = visit.close_attempt(now, reached=False, status=status, reason=reason, text=text)
@@ -880,7 +888,7 @@ class MissionExecutor:
         )
         if will_retry:
             self._move(Trigger.RETRY_LATER)
-            self._deadline = now + RETRY_BACKOFF
+            self._deadline = now + retry_wait(visit.rejections_in_row)
             self._clear_costmaps_before_send = policy.clear_costmaps_on_retry
             visit.next_recovery = 0 if policy.recoveries else None
             return commands

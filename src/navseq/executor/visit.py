@@ -38,6 +38,9 @@ class Visit:
     # The policy's recoveries before the next attempt: the 0-based position of the one to
     # run next; None when none is due.
     next_recovery: int | None = None
+    # Attempts the stack rejected since the last attempt that ended otherwise: the
+    # back-off before a retry grows with it (navseq.executor.backoff).
+    rejections_in_row: int = 0
 
     @classmethod
     def of(cls, mission: Mission, loop: int, index: int) -> Visit:

@@ -33,6 +33,11 @@ class GoalOutcome(str, enum.Enum):
     LOST = "lost"  # the stack lost track of the goal (server gone or restarted)
 
 
+#: The status every navigator gives a goal the stack refused without pursuing it
+#: (actionlib's and Nav2's name alike); the executor backs off longer after each in a row.
+REJECTED_STATUS = "REJECTED"
+
+
 @dataclass(frozen=True)
 class Goal:
     """A pose to reach. ``goal_id`` is chosen by the executor and echoed in events."""

@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from navseq.navigators.base import GoalDone, NavEvent, ServerBack, ServerLost
+from navseq.navigators.base import REJECTED_STATUS, GoalDone, NavEvent, ServerBack, ServerLost
 from navseq.navigators.inbox import EventInbox
 from navseq.navigators.plans import PlanMatcher
 from navseq.roscore.client import ClientLibrary
@@ -39,7 +39,6 @@ from navseq.roscore.server import ServerWatch, server_lost_text
 CANCEL_WAIT = 2.0  # s of wall time to wait for the server's answer to a cancel on close
 SERVER_POLL = 0.02  # s of wall time between looks for the server at the start
 CLOCK_TICK_WAIT = 5.0  # s of wall time for a returned server's clock to tick
-REJECTED_STATUS = "REJECTED"
 
 
 def rejected(goal_id: int, server_text: str, likely_cause: str) -> GoalDone:
