@@ -346,6 +346,31 @@ def test_save_changes_only_the_lines_of_what_was_edited(
     assert load_mission(path).waypoints[1].x == pytest.approx(1.7)
 
 
+def test_recoveries_added_to_the_defaults_save_as_one_line_the_way_files_write_them(
+    client: TestClient, workspace: Path
+) -> None:
+    path = workspace / "examples/turtlebot3_world.yaml"
+
+    def add_recovery(document: dict) -> None:
+        document["defaults"]["recovery"] = [{"spin": 90}, {"backup": 0.15}, "clear_costmaps"]
+
+    assert save_edited(client, path, add_recovery) == [
+        "+  recovery: [spin: 90, backup: 0.15, clear_costmaps]"
+    ]
+    recoveries = load_mission(path).defaults.recoveries
+    assert [(r.kind, r.amount) for r in recoveries] == [
+        ("spin", 90.0),
+        ("backup", 0.15),
+        ("clear_costmaps", None),
+    ]
+    # Opened again, the page gets the list back as it saved it.
+    assert opened(client)["mission"]["defaults"]["recovery"] == [
+        {"spin": 90},
+        {"backup": 0.15},
+        "clear_costmaps",
+    ]
+
+
 def test_inserting_and_deleting_waypoints_leaves_the_others_and_comments_alone(
     client: TestClient, workspace: Path
 ) -> None:

@@ -446,6 +446,50 @@ def test_defaults_loops_and_a_start_pose_placed_and_turned_on_the_map(
     assert page.errors == []  # type: ignore[attr-defined]
 
 
+def test_the_defaults_recovery_is_typed_with_the_keyboard_checked_and_saved(
+    page: Any, studio: tuple[str, Path, Any]
+) -> None:
+    """The defaults form has the mission's ``recovery:`` list, labelled, reached with Tab
+    from the field before it; a bad entry is named by the check, a good list saves as
+    the file writes it and comes back in the form when the file is opened again."""
+    _, workspace, _ = studio
+    _axe_or_skip()
+    accept_dialogs(page)
+    recovery = page.get_by_label("recovery", exact=True)
+    assert recovery.input_value() == ""
+    page.locator("#defaults select[name=clear_costmaps_on_retry]").focus()
+    page.keyboard.press("Tab")
+    assert page.evaluate("document.activeElement.id") == "defaults-recovery"
+    checked_after(page, lambda: (page.keyboard.type("twirl: 90"), page.keyboard.press("Enter")))
+    problems = page.get_by_test_id("problem")
+    assert problems.count() == 1 and "unknown recovery 'twirl'" in problems.first.inner_text()
+    page.keyboard.press("Control+a")
+    checked_after(
+        page,
+        lambda: (
+            page.keyboard.type("spin: 90, wait: 2, clear_costmaps"),
+            page.keyboard.press("Tab"),
+        ),
+    )
+    assert page.get_by_test_id("problem").count() == 0
+    assert serious_violations(page) == []
+    page.get_by_test_id("save").click()
+    message_of(page, "saved")
+    path = workspace / "examples/turtlebot3_world.yaml"
+    assert "  recovery: [spin: 90, wait: 2, clear_costmaps]\n" in path.read_text()
+    assert "# s for one attempt at a waypoint" in path.read_text()  # the rest kept
+    recoveries = load_mission(path).defaults.recoveries
+    assert [(r.kind, r.amount) for r in recoveries] == [
+        ("spin", 90.0),
+        ("wait", 2.0),
+        ("clear_costmaps", None),
+    ]
+    page.reload()
+    page.wait_for_selector("body[data-ready=true]", state="attached", timeout=20_000)
+    assert recovery.input_value() == "spin: 90, wait: 2, clear_costmaps"
+    assert page.errors == []  # type: ignore[attr-defined]
+
+
 def test_a_past_run_replays_with_the_time_slider(page: Any, studio: tuple[str, Path, Any]) -> None:
     page.get_by_test_id("run").click()
     page.wait_for_function(

@@ -146,7 +146,8 @@ def _fresh(value: Any, like: Any) -> Any:
         return fresh
     if isinstance(value, list):
         seq = CommentedSeq(_fresh(item, like=None) for item in value)
-        if _scalars(value):
+        if all(not isinstance(item, list) and _pair_or_scalar(item) for item in value):
+            # One line, as files write them: tasks: [wait: 5], recovery: [spin: 90, ...]
             seq.fa.set_flow_style()
         return seq
     return value
@@ -154,6 +155,11 @@ def _fresh(value: Any, like: Any) -> Any:
 
 def _scalars(values: Any) -> bool:
     return all(not isinstance(item, dict | list) for item in values)
+
+
+def _pair_or_scalar(item: Any) -> bool:
+    """A scalar, or a mapping of one key to a scalar (a recovery such as ``spin: 90``)."""
+    return not isinstance(item, dict) or (len(item) == 1 and _scalars(item.values()))
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -19,7 +19,7 @@ const WP_FIELDS = [
 // Mission-wide defaults (docs/mission-format.md); empty = the loader's default.
 const DEFAULT_FIELDS = [
   ["goal_timeout", "number"], ["stall_timeout", "number"], ["retries", "number"],
-  ["clear_costmaps_on_retry", ["", "true", "false"]], ["on_failure", ["", "stop", "skip", "retry"]],
+  ["clear_costmaps_on_retry", ["", "true", "false"]], ["recovery", "text"], ["on_failure", ["", "stop", "skip", "retry"]],
   ["pass_through", "number"], ["dwell", "number"], ["xy_tolerance", "number"], ["yaw_tolerance", "number"],
 ];
 const $ = (id) => document.getElementById(id);
@@ -908,15 +908,34 @@ function renderSettings() {
       }) },
   ]);
 }
+// The recovery list (docs/mission-format.md, Recoveries before a retry) typed as the file
+// writes it inside its brackets: "spin: 90, backup: 0.15, clear_costmaps". Entries are
+// kept as typed (a number where one is given): the server names a bad one.
+function recoveryText(list) {
+  if (!Array.isArray(list)) return list == null ? "" : String(list);
+  return list.map((r) => (r && typeof r === "object" ? Object.entries(r).map(([k, v]) => `${k}: ${v}`).join(", ") : String(r))).join(", ");
+}
+function recoveryList(text) {
+  const entries = text.split(",").map((part) => part.trim()).filter((part) => part);
+  if (!entries.length) return undefined;
+  return entries.map((entry) => {
+    const colon = entry.indexOf(":");
+    if (colon < 0) return entry;
+    const amount = entry.slice(colon + 1).trim();
+    return { [entry.slice(0, colon).trim()]: fieldValue("number", amount) ?? null };
+  });
+}
 function renderDefaults() {
   const defaults = S.doc.defaults || {};
   fillForm($("defaults"), DEFAULT_FIELDS.map(([key, kind]) => {
     const unit = S.units[key] ? ` [${S.units[key]}]` : "";
-    return { key, label: key + unit, kind, placeholder: "loader's default",
-      value: typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key],
+    const recovery = key === "recovery";
+    return { key, label: key + unit, kind, placeholder: recovery ? "none, e.g. spin: 90, wait: 2, clear_costmaps" : "loader's default",
+      value: recovery ? recoveryText(defaults[key]) : typeof defaults[key] === "boolean" ? String(defaults[key]) : defaults[key],
       onChange: (text) => edit(() => {
         const d = { ...(S.doc.defaults || {}) };
-        const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true" : fieldValue(kind, text);
+        const value = key === "clear_costmaps_on_retry" && text !== "" ? text === "true"
+          : recovery ? recoveryList(text) : fieldValue(kind, text);
         if (value === undefined) delete d[key]; else d[key] = value;
         S.doc.defaults = d;
       }) };
