@@ -25,6 +25,11 @@ and prints one JSON object on its last stdout line: what it saw. Verbs:
 - ``manage COMMAND``: ``lifecycle_manager_navigation/manage_nodes`` with COMMAND (pause,
   resume, reset, startup, shutdown) as ``nav2_simple_commander``'s lifecycle calls make
   it, then ``is_active``, bt_navigator's state, and whether a ``spin`` goal is accepted;
+- ``filters``: the keepout filter's servers as a client of their lifecycle sees them:
+  subscribed to the mask and its filter info from the start, then
+  ``lifecycle_manager_keepout_zone/manage_nodes`` PAUSE and RESUME, each followed by
+  ``is_active``, both servers' ``get_state`` and the mask server's ``map`` service; says
+  how many masks and filter infos arrived (each activation publishes them);
 - ``ready``: the lifecycle ``get_state`` of bt_navigator and amcl, then an
   ``initialpose`` and the ``amcl_pose`` that follows, then a clear-costmap call — what
   nav2_simple_commander's ``waitUntilNav2Active`` and ``clearAllCostmaps`` do.
@@ -279,6 +284,64 @@ def manage(node: Node, args: argparse.Namespace) -> dict:
     return out
 
 
+def filters(node: Node, args: argparse.Namespace) -> dict:
+    from nav2_msgs.msg import CostmapFilterInfo
+    from nav2_msgs.srv import ManageLifecycleNodes
+    from nav_msgs.srv import GetMap
+    from std_srvs.srv import Trigger
+
+    masks: list[OccupancyGrid] = []
+    infos: list[Any] = []
+    node.create_subscription(
+        OccupancyGrid, name(args.ns, "keepout_filter_mask"), masks.append, LATCHED
+    )
+    node.create_subscription(
+        CostmapFilterInfo, name(args.ns, "keepout_costmap_filter_info"), infos.append, LATCHED
+    )
+
+    def until(done: Any) -> None:
+        end = time.monotonic() + args.timeout
+        while not done() and time.monotonic() < end:
+            rclpy.spin_once(node, timeout_sec=0.05)
+
+    def service(kind: Any, service_name: str) -> Any:
+        client = node.create_client(kind, name(args.ns, service_name))
+        if not client.wait_for_service(timeout_sec=args.timeout):
+            raise SystemExit(f"no {service_name}")
+        return client
+
+    manager = "lifecycle_manager_keepout_zone"
+    manage = service(ManageLifecycleNodes, f"{manager}/manage_nodes")
+    is_active = service(Trigger, f"{manager}/is_active")
+    servers = ("keepout_filter_mask_server", "keepout_costmap_filter_info_server")
+    states = {server: service(GetState, f"{server}/get_state") for server in servers}
+    get_map = service(GetMap, "keepout_filter_mask_server/map")
+
+    def look() -> dict:
+        out: dict[str, Any] = {
+            "is_active": wait(node, is_active.call_async(Trigger.Request()), args.timeout).success
+        }
+        for server, client in states.items():
+            reply = wait(node, client.call_async(GetState.Request()), args.timeout)
+            out[server] = reply.current_state.label
+        served = wait(node, get_map.call_async(GetMap.Request()), args.timeout).map
+        out["map_service"] = [served.info.width, served.info.height]
+        return out
+
+    until(lambda: masks and infos)
+    seen: dict[str, Any] = {"at_start": look()}
+    for command in ("pause", "resume"):
+        request = ManageLifecycleNodes.Request(
+            command=getattr(ManageLifecycleNodes.Request, command.upper())
+        )
+        success = wait(node, manage.call_async(request), args.timeout).success
+        seen[command] = {"success": success, **look()}
+    until(lambda: len(masks) >= 2 and len(infos) >= 2)
+    seen["masks"] = [[m.info.width, m.info.height, m.header.frame_id] for m in masks]
+    seen["infos"] = [[i.type, i.filter_mask_topic] for i in infos]
+    return seen
+
+
 def late_map(node: Node, args: argparse.Namespace) -> dict:
     got: list[OccupancyGrid] = []
     node.create_subscription(OccupancyGrid, name(args.ns, "map"), got.append, LATCHED)
@@ -529,6 +592,7 @@ VERBS = {
     "behavior": behavior,
     "refusals": refusals,
     "manage": manage,
+    "filters": filters,
     "dock": dock,
     "undock": undock,
 }

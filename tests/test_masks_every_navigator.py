@@ -268,6 +268,63 @@ def test_the_keepout_mission_on_nav2_with_the_filter_topics(tmp_path: Path) -> N
 
 
 @pytest.mark.ros2
+def test_the_filter_servers_are_lifecycle_nodes_under_their_managers_as_in_nav2(
+    tmp_path: Path,
+) -> None:
+    """The mask and filter info servers are lifecycle nodes of nav2_bringup's names, one
+    manager per kind: pausing the keepout zone's manager deactivates its two servers
+    (the mask service answers empty) and leaves navigation active; resuming activates
+    them, and they publish the mask and its filter info again, as Nav2's on_activate."""
+    from test_ros2_sim import SPEED, SimProcess
+
+    env = ros2_env()
+    sim = SimProcess(
+        env, "--map", str(TURTLEBOT3_MAP), f"--start={START}", "--speed", SPEED,
+        "--filters", str(EXAMPLES / "keepout.yaml"),
+    )  # fmt: skip
+    try:
+        nodes = subprocess.run(
+            ["ros2", "node", "list", "--no-daemon"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        seen = sim.client("filters")
+        navigation = sim.client("manage", "resume")  # changes nothing: says the state
+    finally:
+        err = sim.stop()
+    assert "Traceback" not in err
+    listed = set(nodes.stdout.split())
+    assert {
+        "/keepout_filter_mask_server",
+        "/keepout_costmap_filter_info_server",
+        "/lifecycle_manager_keepout_zone",
+        "/speed_filter_mask_server",
+        "/speed_costmap_filter_info_server",
+        "/lifecycle_manager_speed_zone",
+    } <= listed, nodes.stdout
+    active = {
+        "is_active": True,
+        "keepout_filter_mask_server": "active",
+        "keepout_costmap_filter_info_server": "active",
+        "map_service": [100, 100],
+    }
+    assert seen["at_start"] == active
+    assert seen["pause"] == {
+        "success": True,
+        "is_active": False,
+        "keepout_filter_mask_server": "inactive",
+        "keepout_costmap_filter_info_server": "inactive",
+        "map_service": [0, 0],
+    }
+    assert seen["resume"] == {"success": True, **active}
+    assert seen["masks"] == [[100, 100, "map"]] * 2
+    assert seen["infos"] == [[0, "/keepout_filter_mask"]] * 2
+    assert navigation["bt_navigator"] == "active" and navigation["spin_accepted"]
+
+
+@pytest.mark.ros2
 def test_a_goal_deep_in_a_keepout_zone_is_refused_by_nav2s_planner(tmp_path: Path) -> None:
     """A keepout square 1.3 m wide: its centre is further from any allowed cell than the
     planner's tolerance (0.5 m), so compute_path_to_pose fails as NavFn does on Nav2's

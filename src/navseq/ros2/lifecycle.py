@@ -13,7 +13,14 @@ service). So the stand-in runs the same:
 - ``lifecycle_manager_navigation`` and ``lifecycle_manager_localization`` with
   ``manage_nodes`` (``nav2_msgs/srv/ManageLifecycleNodes``: STARTUP, PAUSE, RESUME, RESET,
   SHUTDOWN, CONFIGURE, CLEANUP, in Nav2's order — bring-up in list order, tear-down in
-  reverse) and ``is_active`` (``std_srvs/srv/Trigger``).
+  reverse) and ``is_active`` (``std_srvs/srv/Trigger``);
+- more groups of servers with their own manager when the run has them (``groups``: the
+  costmap filters' mask and filter info servers, :mod:`navseq.ros2.filter_topics`),
+  brought up after localization and before navigation.
+
+A server may do something when it is activated (:meth:`_ManagedServer.when_activated`:
+the filter servers publish their mask and filter info then, as Nav2's do in
+``on_activate``).
 
 The simulator asks :meth:`Nav2Lifecycle.active` before it takes a goal: an action whose
 server is not active rejects new goals, as Nav2's action servers do between configure and
@@ -86,6 +93,7 @@ class _ManagedServer(LifecycleNode):
     """
 
     owned: list[_ManagedServer]
+    activated: list[Callable[[], None]]
 
     @property
     def state_id(self) -> int:
@@ -105,9 +113,19 @@ class _ManagedServer(LifecycleNode):
         self._follow(_UNCONFIGURED, "trigger_configure")
         return super().on_configure(state)
 
+    def when_activated(self, callback: Callable[[], None]) -> None:
+        """Call ``callback`` at each activation (the first one: the manager's startup)."""
+        if not hasattr(self, "activated"):
+            self.activated = []
+        self.activated.append(callback)
+
     def on_activate(self, state: Any) -> TransitionCallbackReturn:
         self._follow(_INACTIVE, "trigger_activate")
-        return super().on_activate(state)
+        result = super().on_activate(state)
+        if result == TransitionCallbackReturn.SUCCESS:
+            for callback in getattr(self, "activated", []):
+                callback()
+        return result
 
     def on_deactivate(self, state: Any) -> TransitionCallbackReturn:
         self._follow(_ACTIVE, "trigger_deactivate")
@@ -135,16 +153,21 @@ def managed_node(
 
 
 class Nav2Lifecycle:
-    """The managed nodes and both managers; see the module docstring.
+    """The managed nodes and their managers; see the module docstring.
 
-    ``parameters`` gives some nodes their parameters (the robot where Nav2 keeps it).
+    ``parameters`` gives some nodes their parameters (the robot where Nav2 keeps it);
+    ``groups`` adds, per ``(manager name, server names)``, those servers and their manager.
     """
 
     def __init__(
-        self, namespace: str | None, parameters: dict[str, list[Parameter]] | None = None
+        self,
+        namespace: str | None,
+        parameters: dict[str, list[Parameter]] | None = None,
+        groups: Sequence[tuple[str, Sequence[str]]] = (),
     ) -> None:
         given = parameters or {}
         self._lock = threading.Lock()
+        extra = [name for _manager, names in groups for name in names]
         self.servers = {
             name: _ManagedServer(
                 name,
@@ -152,12 +175,16 @@ class Nav2Lifecycle:
                 parameter_overrides=given.get(name, []),
                 automatically_declare_parameters_from_overrides=True,
             )
-            for name in (*NAVIGATION_NODES, *LOCALIZATION_NODES)
+            for name in (*NAVIGATION_NODES, *LOCALIZATION_NODES, *extra)
         }
         self.managers = [
             self._manager("lifecycle_manager_navigation", NAVIGATION_NODES, namespace),
             self._manager("lifecycle_manager_localization", LOCALIZATION_NODES, namespace),
+            *(self._manager(manager, names, namespace) for manager, names in groups),
         ]
+        # Bring-up order: the map, then what reads it (filter masks), then navigation.
+        self._startup_order = [LOCALIZATION_NODES, *(tuple(names) for _m, names in groups)]
+        self._startup_order.append(NAVIGATION_NODES)
 
     @property
     def nodes(self) -> list[Node]:
@@ -165,7 +192,7 @@ class Nav2Lifecycle:
 
     def start(self) -> None:
         """Configure and activate every server, as nav2_bringup's autostart does."""
-        for names in (LOCALIZATION_NODES, NAVIGATION_NODES):
+        for names in self._startup_order:
             self._startup(names)
 
     def active(self, action: str) -> bool:

@@ -51,8 +51,9 @@ on ``/NS/tf`` with plain frame names, Nav2's multi-robot convention, or with
   while no goal runs (:mod:`navseq.ros2.velocity_topics`);
 - Nav2's costmap filters given by ``--keepout``, ``--speed-mask`` or ``--filters``: a
   keepout zone is lethal in both costmaps (never planned through; a goal deeper in it
-  than the planner's tolerance aborts), a speed zone limits the controller; the masks,
-  their filter info and the speed filter's ``speed_limit`` are published
+  than the planner's tolerance aborts), a speed zone limits the controller; the masks and
+  their filter info are published by lifecycle nodes of Nav2's names under their own
+  lifecycle managers, the speed filter's ``speed_limit`` by this node
   (:mod:`navseq.ros2.filter_topics`);
 - services ``global_costmap/clear_entirely_global_costmap``,
   ``local_costmap/clear_entirely_local_costmap`` (``nav2_msgs/srv/ClearEntireCostmap``);
@@ -143,7 +144,11 @@ from navseq.ros2.costmap_nodes import nav2_costmap_nodes
 from navseq.ros2.costmap_services import CostmapServices
 from navseq.ros2.costmap_topics import CostmapTopics
 from navseq.ros2.docking_actions import DockingActions
-from navseq.ros2.filter_topics import FilterTopics
+from navseq.ros2.filter_topics import (
+    FilterTopics,
+    filter_lifecycle_groups,
+    filter_server_parameters,
+)
 from navseq.ros2.gps_actions import GpsWaypointActions
 from navseq.ros2.lifecycle import Nav2Lifecycle
 from navseq.ros2.localization_topics import LocalizationTopics
@@ -372,8 +377,8 @@ class SimNode:
         )
         self._velocities = VelocityTopics(node, self.standin, self._lock, group)
         self._filters = FilterTopics(
-            node, self.standin, self._lock, group, filters=config.filters, stamp=self._stamp,
-            frame=MAP_FRAME,
+            node, self.standin, self._lock, group, lifecycle, filters=config.filters,
+            stamp=self._stamp, frame=MAP_FRAME,
         )  # fmt: skip
         # -- costmap layers and the collision monitor (issue 20) --
         self._layers = CostmapLayers(
@@ -727,7 +732,14 @@ def run(config: SimConfig, ros_args: Sequence[str] | None = None) -> int:
     try:
         overrides = [Parameter("use_sim_time", value=True)] if config.sim_time else []
         node = Node(NODE_NAME, namespace=config.namespace or None, parameter_overrides=overrides)
-        lifecycle = Nav2Lifecycle(config.namespace, nav2_server_parameters(config.robot))
+        lifecycle = Nav2Lifecycle(
+            config.namespace,
+            {
+                **nav2_server_parameters(config.robot),
+                **filter_server_parameters(config.filters, config.namespace),
+            },
+            groups=filter_lifecycle_groups(config.filters),
+        )
         helpers = [
             *lifecycle.nodes,
             *nav2_costmap_nodes(config.robot, config.namespace, lifecycle),
