@@ -29,7 +29,11 @@ _FLEET_REFUSES = {
     "from_waypoint": ("--from", "the fleet's split chooses each robot's waypoints"),
     "to_waypoint": ("--to", "the fleet's split chooses each robot's waypoints"),
     "only": ("--only", "the fleet's split chooses each robot's waypoints"),
-    "record": ("--record", "a fleet run is not recorded as MCAP yet"),
+    "record_topics": (
+        "--record-topics",
+        "a fleet's recording holds what navseq knows of each robot; a stack's own topics "
+        "are not recorded in it yet",
+    ),
     "json": ("--json", "a fleet run shows a live table; its fleet-report.json has the figures"),
 }
 
@@ -96,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
         picture=not args.no_picture,
         resume=_run_folder(args.resume),
         navigator=_stack_settings(args),
+        record=args.record,
+        record_format=args.record_format,
     )
     lock = None
     if request.resume is not None and request.resume.is_dir():
