@@ -241,8 +241,24 @@ def test_a_resumed_recorded_fleet_run_records_beside_the_first_file(tmp_path: Pa
     assert sorted(done_before + ends) == [0, 1, 2]  # each of b's waypoints reached once
 
 
-def test_record_topics_is_refused_for_a_fleet(tmp_path: Path) -> None:
-    done = navseq("run", "--fleet", FLEET, "--record", "--record-topics", "/scan", cwd=tmp_path)
-    assert_clean_error(done)
-    assert "--record-topics" in done.stderr and "not recorded in it yet" in done.stderr
-    assert not (tmp_path / "navseq-out").exists()
+def test_record_topics_is_refused_where_a_fleet_cannot_record_them(tmp_path: Path) -> None:
+    for extra, said in (
+        (("--record-topics", "/scan"), "add --record"),
+        (("--record", "--record-topics", "/scan"), "with --navigator ros1 or nav2 only"),
+        (
+            (
+                "--record",
+                "--record-topics",
+                "/scan",
+                "--navigator",
+                "nav2",
+                "--record-format",
+                "ros1",
+            ),
+            "add --record-format ros2",
+        ),
+    ):
+        done = navseq("run", "--fleet", FLEET, *extra, cwd=tmp_path)
+        assert_clean_error(done)
+        assert "--record-topics" in done.stderr and said in done.stderr
+        assert not (tmp_path / "navseq-out").exists()

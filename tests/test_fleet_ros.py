@@ -160,7 +160,7 @@ def test_a_fleet_run_on_stacks_is_recorded_in_one_file_and_printed_as_json(
     )
     running += stacks(env, tmp_path, {"robot1": "1.2,1.2,0", "robot2": "3.7,1.2,180"})
     out = tmp_path / "run"
-    done = fleet_run(env, fleet, out, "--record", "--json")
+    done = fleet_run(env, fleet, out, "--record", "--json", "--record-topics", "/scan,/odom")
     assert done.returncode == 0, done.stderr
     records = [json.loads(line) for line in done.stdout.splitlines()]
     assert {r["robot"] for r in records} == {"robot1"}  # robot2 has no share: no events
@@ -177,9 +177,18 @@ def test_a_fleet_run_on_stacks_is_recorded_in_one_file_and_printed_as_json(
             for connection, _, raw in bag.messages(connections=tf)
             for transform in bag.deserialize(raw, connection.msgtype).transforms
         }
-    assert {"/map", "/tf", "/robot1/odom", "/robot1/plan", "/robot1/navseq/goal"} <= topics
+        # --record-topics: the robot's stack's own, under its namespace, as published.
+        stack = {c.topic: c for c in bag.connections if c.topic in ("/robot1/scan", "/robot1/odom")}
+        odom_frames = {
+            bag.deserialize(raw, connection.msgtype).header.frame_id
+            for connection, _, raw in bag.messages(connections=[stack["/robot1/odom"]])
+        }
+    assert {"/map", "/tf", "/robot1/plan", "/robot1/navseq/goal"} <= topics
     assert len(stamps) > 10 and stamps == sorted(stamps)  # the stack's ROS time, forward
     assert frames == {"robot1/odom", "robot1/base_footprint"}
+    assert stack["/robot1/scan"].msgtype == "sensor_msgs/msg/LaserScan"
+    assert stack["/robot1/scan"].msgcount > 10
+    assert odom_frames == {"odom"}  # the stand-in's (Nav2's convention), not navseq's
 
 
 def test_a_namespace_no_stack_serves_is_refused_before_anything_moves(

@@ -31,11 +31,6 @@ _FLEET_REFUSES = {
     "from_waypoint": ("--from", "the fleet's split chooses each robot's waypoints"),
     "to_waypoint": ("--to", "the fleet's split chooses each robot's waypoints"),
     "only": ("--only", "the fleet's split chooses each robot's waypoints"),
-    "record_topics": (
-        "--record-topics",
-        "a fleet's recording holds what navseq knows of each robot; a stack's own topics "
-        "are not recorded in it yet",
-    ),
 }
 
 
@@ -103,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
         navigator=_stack_settings(args),
         record=args.record,
         record_format=args.record_format,
+        record_topics=args.record_topics,
     )
     lock = None
     if request.resume is not None and request.resume.is_dir():

@@ -37,10 +37,16 @@ FLEET_METADATA = "navseq.fleet"
 
 @dataclass(frozen=True)
 class FleetRecordingChoice:
-    """Whether a fleet run is recorded, and in which encoding."""
+    """Whether a fleet run is recorded, in which encoding, and which of each robot's
+    stack's own topics (``--record-topics``, under each robot's namespace)."""
 
     record: bool
     record_format: RecordingFormat = "ros2"
+    topics: tuple[str, ...] = ()
+
+
+#: The encoding a kind's stacks publish in: their messages are recorded as they come.
+STACK_ENCODINGS = {"ros1": "ros1", "nav2": "ros2"}
 
 
 def choose(
@@ -48,27 +54,70 @@ def choose(
     given_format: str | None,
     mission_record: bool,
     earlier: FleetRecordingChoice | None = None,
+    *,
+    topics: tuple[str, ...] = (),
+    kind: str | None = None,
 ) -> FleetRecordingChoice:
     """``--record`` (else the mission's ``record:``; a resume also records when the run
-    it continues did) and ``--record-format`` (else the earlier run's, else ros2)."""
+    it continues did), ``--record-format`` (else the earlier run's, else ros2) and
+    ``--record-topics`` on ``kind``'s stacks (None: the embedded simulator).
+
+    Raises :class:`NavseqError` for what cannot be recorded, before anything is written
+    or moves: no ``record`` extra, topics without ``--record``, topics of the simulator
+    (navseq writes its topics itself), or in another encoding than the stacks'.
+    """
     record = bool(given) or mission_record or (earlier is not None and earlier.record)
     chosen = given_format or (earlier.record_format if earlier is not None else None)
-    if record:  # refused before anything is written or moves, as for one robot
+    record_format: RecordingFormat = "ros1" if chosen == "ros1" else "ros2"
+    if record:
         from navseq.extras import require_extra
 
         require_extra("record", "recording the run (--record)")
-    return FleetRecordingChoice(record, "ros1" if chosen == "ros1" else "ros2")
+    if topics:
+        _check_topics(record, record_format, kind)
+    return FleetRecordingChoice(record, record_format, topics if record else ())
+
+
+def _check_topics(record: bool, record_format: str, kind: str | None) -> None:
+    from navseq.errors import NavseqError
+
+    if not record:
+        raise NavseqError("adds topics to a recording: add --record", source="--record-topics")
+    if kind not in STACK_ENCODINGS:
+        raise NavseqError(
+            "records each robot's stack's topics under its namespace, with --navigator ros1 "
+            "or nav2 only (not the embedded simulator, whose map, poses, odometry, /tf and "
+            "plans are recorded anyway)",
+            source="--record-topics",
+        )
+    if record_format != STACK_ENCODINGS[kind]:
+        ros = "ROS 1" if kind == "ros1" else "ROS 2"
+        raise NavseqError(
+            f"records the {ros} stacks' messages as they are published: add "
+            f"--record-format {STACK_ENCODINGS[kind]}",
+            source="--record-topics",
+        )
+
+
+def robot_topic(namespace: str, topic: str) -> str:
+    """``/scan`` of the robot in ``alpha``: ``/alpha/scan``."""
+    from navseq.sinks.recording.sink import namespace_prefix
+
+    return f"{namespace_prefix(namespace)}/{topic.lstrip('/')}"
 
 
 class FleetRecording:
     """The fleet's file: opened with the map before the robots move, one sink per robot
     with waypoints (a robot's listener), finished when every robot's run has ended."""
 
-    def __init__(self, path: Path, record_format: RecordingFormat) -> None:
+    def __init__(
+        self, path: Path, record_format: RecordingFormat, topics: tuple[str, ...] = ()
+    ) -> None:
         from navseq.sinks.recording.sink import RecordingFile
 
         self.path = path
         self.file: RecordingFile = RecordingFile(path, record_format)
+        self.topics = topics
 
     @property
     def error(self) -> str | None:
@@ -99,16 +148,18 @@ class FleetRecording:
         for member in run.members:
             if member.session is None:
                 continue
-            member.listeners.append(
-                RecordingSink(
-                    self.path,
-                    self.file.record_format,
-                    member.session.mission,
-                    numbers=member.session.numbers,
-                    namespace=member.robot.namespace,
-                    shared=self.file,
-                )
+            namespace = member.robot.namespace
+            sink = RecordingSink(
+                self.path,
+                self.file.record_format,
+                member.session.mission,
+                numbers=member.session.numbers,
+                published_topics=[robot_topic(namespace, topic) for topic in self.topics],
+                namespace=namespace,
+                shared=self.file,
             )
+            member.listeners.append(sink)
+            sink.tap(member.navigator)  # its stack's own topics, from now on
 
     def finish(self) -> None:
         self.file.finish()
@@ -118,7 +169,9 @@ def new_fleet_recording(folder: Path, choice: FleetRecordingChoice) -> FleetReco
     """``folder/fleet.mcap``, or the first free ``fleet-N.mcap`` (a resumed run's)."""
     from navseq.run.folder import reserve_file
 
-    return FleetRecording(reserve_file(folder, FLEET_RECORDING), choice.record_format)
+    return FleetRecording(
+        reserve_file(folder, FLEET_RECORDING), choice.record_format, choice.topics
+    )
 
 
 def _clock_of(run: FleetRun) -> Callable[[], float]:
@@ -132,8 +185,10 @@ def _clock_of(run: FleetRun) -> Callable[[], float]:
 __all__ = [
     "FLEET_METADATA",
     "FLEET_RECORDING",
+    "STACK_ENCODINGS",
     "FleetRecording",
     "FleetRecordingChoice",
     "choose",
     "new_fleet_recording",
+    "robot_topic",
 ]

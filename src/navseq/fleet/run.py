@@ -56,6 +56,8 @@ class FleetRunRequest:
     # says (a resume: also as the run it continues did).
     record: bool | None = None
     record_format: str | None = None  # ros2 (the default) or ros1
+    # On ROS stacks: each robot's stack's own topics to record, under its namespace.
+    record_topics: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -267,7 +269,12 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     )
     grid = plan.grid
     assert grid is not None  # need_map
-    record = choose(request.record, request.record_format, plan.fleet.mission.record)
+    record = choose(
+        request.record,
+        request.record_format,
+        plan.fleet.mission.record,
+        topics=request.record_topics,
+    )
     world = FleetWorld(grid, [SimRobot(r.name, r.start, r.profile) for r in plan.fleet.robots])
     with_work = [share.robot.name for share in plan.split.shares if share.order]
     clock = FleetClock(world, with_work, realtime=request.realtime)

@@ -166,7 +166,13 @@ def prepare_stack_fleet_run(request: FleetRunRequest) -> FleetRun:
         time_limit_s=request.time_limit_s,
         need_map=True,
     )
-    record = choose(request.record, request.record_format, plan.fleet.mission.record)
+    record = choose(
+        request.record,
+        request.record_format,
+        plan.fleet.mission.record,
+        topics=request.record_topics,
+        kind=kind_name(request.navigator),
+    )
     connected = connect_all(plan, request.navigator)
     try:
         poses = robot_poses(connected)
