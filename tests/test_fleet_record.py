@@ -241,6 +241,44 @@ def test_a_resumed_recorded_fleet_run_records_beside_the_first_file(tmp_path: Pa
     assert sorted(done_before + ends) == [0, 1, 2]  # each of b's waypoints reached once
 
 
+def test_a_fleet_run_killed_mid_run_leaves_a_file_read_up_to_its_last_chunk(
+    tmp_path: Path,
+) -> None:
+    import io
+    import struct
+
+    from mcap.exceptions import EndOfFile
+    from mcap.reader import NonSeekingReader
+
+    from cli_support import kill_9_when
+
+    fleet = two_robot_fleet(tmp_path)
+    run = tmp_path / "run"
+    process = start_navseq(
+        "run", "--fleet", fleet, "--out", run, "--record", "--realtime", "4", cwd=tmp_path
+    )
+
+    def a_done_and_b_later() -> bool:
+        # b steps on past a's end only once a's run has left the fleet's clock: its
+        # recording's part is handed to the system by then (flushed as it ends).
+        a_end = journal_events(run / "a" / "journal.jsonl", "MissionFinished")
+        b_ends = journal_events(run / "b" / "journal.jsonl", "WaypointFinished")
+        return bool(a_end) and any(e["t"] > a_end[0]["t"] for e in b_ends)
+
+    kill_9_when(process, a_done_and_b_later, 60, "robot a done, then b at a waypoint")
+    topics = []
+    reader = NonSeekingReader(io.BytesIO((run / "fleet.mcap").read_bytes()))
+    try:  # no summary: a streaming reader reads the records in file order
+        for _, channel, _ in reader.iter_messages(log_time_order=False):
+            topics.append(channel.topic)
+    except (EndOfFile, struct.error):
+        pass
+    # Flushed at every waypoint's end: what a's journal says is done is in the file.
+    assert topics.count("/map") == 1 and "/a/navseq/goal" in topics
+    assert topics.count("/a/navseq/pose") > 5 and "/b/navseq/pose" in topics
+    assert "/a/navseq/events" in topics
+
+
 def test_record_topics_is_refused_where_a_fleet_cannot_record_them(tmp_path: Path) -> None:
     for extra, said in (
         (("--record-topics", "/scan"), "add --record"),
