@@ -88,9 +88,11 @@ def running(env: dict[str, str], tmp_path: Path) -> Iterator[list[SimNode]]:
         assert "Traceback" not in log, log
 
 
-def fleet_run(env: dict[str, str], fleet: Path, out: Path) -> subprocess.CompletedProcess[str]:
+def fleet_run(
+    env: dict[str, str], fleet: Path, out: Path, *extra: str
+) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [NAVSEQ, "run", "--fleet", fleet, "--navigator", "nav2", "--out", out],
+        [NAVSEQ, "run", "--fleet", fleet, "--navigator", "nav2", "--out", out, *extra],
         env=env,
         cwd=fleet.parent,
         capture_output=True,
@@ -142,6 +144,51 @@ def test_a_robot_parked_on_the_others_goal_moves_aside(
     assert (report["reached"], report["failed"]) == (2, 0), report
     assert report["coordinator"]["sent_aside"] >= 1, report
     assert "blocked" not in journal_text(tmp_path / "run", "robot1")
+
+
+def test_a_fleet_run_on_stacks_is_recorded_in_one_file_and_printed_as_json(
+    env: dict[str, str], tmp_path: Path, running: list[SimNode]
+):
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    fleet = write_fleet(
+        tmp_path,
+        3.7,
+        {"middle": (3.7, 1.2, 0), "far": (6.2, 1.2, 0)},
+        {"middle": "robot1", "far": "robot1"},
+    )
+    running += stacks(env, tmp_path, {"robot1": "1.2,1.2,0", "robot2": "3.7,1.2,180"})
+    out = tmp_path / "run"
+    done = fleet_run(env, fleet, out, "--record", "--json", "--record-topics", "/scan,/odom")
+    assert done.returncode == 0, done.stderr
+    records = [json.loads(line) for line in done.stdout.splitlines()]
+    assert {r["robot"] for r in records} == {"robot1"}  # robot2 has no share: no events
+    assert [r["outcome"] for r in records if r["event"] == "WaypointFinished"] == ["reached"] * 2
+    report = json.loads((out / "fleet-report.json").read_text())
+    assert report["files"]["recording"] == str(out / "fleet.mcap")
+    with AnyReader([out / "fleet.mcap"], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as bag:
+        topics = {c.topic for c in bag.connections}
+        poses = [c for c in bag.connections if c.topic == "/robot1/navseq/pose"]
+        stamps = [t for _, t, _ in bag.messages(connections=poses)]
+        tf = [c for c in bag.connections if c.topic == "/tf"]
+        frames = {
+            transform.child_frame_id
+            for connection, _, raw in bag.messages(connections=tf)
+            for transform in bag.deserialize(raw, connection.msgtype).transforms
+        }
+        # --record-topics: the robot's stack's own, under its namespace, as published.
+        stack = {c.topic: c for c in bag.connections if c.topic in ("/robot1/scan", "/robot1/odom")}
+        odom_frames = {
+            bag.deserialize(raw, connection.msgtype).header.frame_id
+            for connection, _, raw in bag.messages(connections=[stack["/robot1/odom"]])
+        }
+    assert {"/map", "/tf", "/robot1/plan", "/robot1/navseq/goal"} <= topics
+    assert len(stamps) > 10 and stamps == sorted(stamps)  # the stack's ROS time, forward
+    assert frames == {"robot1/odom", "robot1/base_footprint"}
+    assert stack["/robot1/scan"].msgtype == "sensor_msgs/msg/LaserScan"
+    assert stack["/robot1/scan"].msgcount > 10
+    assert odom_frames == {"odom"}  # the stand-in's (Nav2's convention), not navseq's
 
 
 def test_a_namespace_no_stack_serves_is_refused_before_anything_moves(

@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
+from mcap.reader import make_reader
 
 from cli_support import NAVSEQ
 from navseq.sim.mapgen import save_map
@@ -78,7 +79,11 @@ def test_the_robots_give_way_and_every_waypoint_is_reached(
         ros_master.wait_for_action_server(f"/{robot}/move_base", timeout=60)
     out = tmp_path / "run"
     navseq = ros_master.start(
-        [NAVSEQ, "run", "--fleet", fleet, "--navigator", "ros1", "--out", out],
+        [
+            *(NAVSEQ, "run", "--fleet", fleet, "--navigator", "ros1", "--out", out),
+            # Recorded as ROS 1 tools read it, with each robot's stack's footprint.
+            *("--record", "--record-format", "ros1", "--record-topics", "/footprint"),
+        ],
         cwd=tmp_path,
         label="navseq",
     )
@@ -91,3 +96,15 @@ def test_the_robots_give_way_and_every_waypoint_is_reached(
         if row["waypoints"]:
             assert "blocked" not in (out / row["name"] / "journal.jsonl").read_text()
     assert "Traceback" not in navseq.output()
+    with (out / "fleet.mcap").open("rb") as stream:
+        reader = make_reader(stream)
+        summary = reader.get_summary()
+        assert reader.get_header().profile == "ros1"
+    assert summary is not None and summary.statistics is not None
+    counts = summary.statistics.channel_message_counts
+    channels = {c.topic: c for c in summary.channels.values()}
+    schemas = {c.topic: summary.schemas[c.schema_id].name for c in channels.values() if c.schema_id}
+    assert counts[channels["/robot1/navseq/pose"].id] > 10
+    assert schemas["/robot1/footprint"] == "geometry_msgs/PolygonStamped"
+    assert counts[channels["/robot1/footprint"].id] > 0
+    assert {"/map", "/tf", "/robot1/odom", "/robot1/plan"} <= set(channels)

@@ -90,6 +90,7 @@ def test_options_a_fleet_run_cannot_honour_are_refused(tmp_path: Path) -> None:
         (("--start", "0,0,0"), "--start"),
         (("--resume", tmp_path / "run", "--out", tmp_path / "other"), "--out"),
         (("--resume", tmp_path / "journal.jsonl"), "is not a folder"),
+        (("--record", "--record-topics", "/scan"), "--record-topics"),
     ):
         done = navseq("run", "--fleet", FLEET, *extra, cwd=tmp_path)
         assert_clean_error(done)
@@ -128,3 +129,32 @@ def test_ctrl_c_stops_every_robot_and_the_fleet_s_outputs_are_still_written(
     for name in ("alpha", "beta", "gamma"):
         robot_report = json.loads((out / name / "report.json").read_text())
         assert robot_report["totals"]["reached"] < robot_report["totals"]["visits"]
+
+
+def test_json_prints_every_robot_s_events_one_record_a_line_each_naming_its_robot(
+    tmp_path: Path,
+) -> None:
+    import jsonschema
+
+    from cli_support import REPO
+
+    out = tmp_path / "run"
+    done = navseq("run", "--fleet", FLEET, "--out", out, "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    schema = json.loads((REPO / "docs" / "schemas" / "events.schema.json").read_text())
+    records = [json.loads(line) for line in done.stdout.splitlines()]  # nothing but records
+    for record in records:
+        jsonschema.validate(record, schema)
+    report = fleet_report(out)
+    for row in report["robots"]:
+        own = [r for r in records if r["robot"] == row["name"]]
+        # Each robot's records are a one-robot run's: started, its waypoints, finished.
+        assert own[0]["event"] == "MissionStarted" and own[-1]["event"] == "RunFinished"
+        assert own[-1]["exit_code"] == row["exit_status"] == 0
+        finished = [r for r in own if r["event"] == "WaypointFinished"]
+        assert [r["outcome"] for r in finished] == ["reached"] * row["waypoints"]
+        stamps = [r["t_s"] for r in own if "t_s" in r]
+        assert stamps == sorted(stamps)  # on the fleet's one clock, forward
+    assert {r["robot"] for r in records} == {"alpha", "beta", "gamma"}
+    # The fleet's line goes to stderr: stdout is for programs.
+    assert "fleet: 7 reached, 0 skipped, 0 failed" in done.stderr

@@ -10,6 +10,7 @@ every robot reached all its waypoints, 1 otherwise, 130/143 when interrupted.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -21,6 +22,7 @@ if TYPE_CHECKING:
 
     from navseq.fleet.run import FleetRun, Member
     from navseq.navigators.settings import NavigatorSettings
+    from navseq.sinks.json_events import JsonProgress
 
 #: Options of a one-robot run that a fleet run takes from the fleet file, or lacks yet.
 _FLEET_REFUSES = {
@@ -29,8 +31,6 @@ _FLEET_REFUSES = {
     "from_waypoint": ("--from", "the fleet's split chooses each robot's waypoints"),
     "to_waypoint": ("--to", "the fleet's split chooses each robot's waypoints"),
     "only": ("--only", "the fleet's split chooses each robot's waypoints"),
-    "record": ("--record", "a fleet run is not recorded as MCAP yet"),
-    "json": ("--json", "a fleet run shows a live table; its fleet-report.json has the figures"),
 }
 
 
@@ -96,6 +96,9 @@ def run(args: argparse.Namespace) -> int:
         picture=not args.no_picture,
         resume=_run_folder(args.resume),
         navigator=_stack_settings(args),
+        record=args.record,
+        record_format=args.record_format,
+        record_topics=args.record_topics,
     )
     lock = None
     if request.resume is not None and request.resume.is_dir():
@@ -119,11 +122,16 @@ def run(args: argparse.Namespace) -> int:
             if member.session is not None:
                 for note in member.session.notes:
                     print(f"navseq run: {member.robot.name}: {note}", file=sys.stderr)
-        status, report = _execute(fleet_run, getattr(args, "exits_after_command", False))
+        json_lines = _json_lines(fleet_run) if args.json else None
+        status, report = _execute(
+            fleet_run, getattr(args, "exits_after_command", False), json_lines
+        )
     finally:
         if lock is not None:
             lock.release()
-    _print_summary(fleet_run, report)
+    if json_lines is not None:
+        _json_finished(fleet_run, json_lines)
+    _print_summary(fleet_run, report, json_lines is not None)
     return status
 
 
@@ -153,10 +161,59 @@ def _run_folder(given: Path | None) -> Path | None:
     return given
 
 
-def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any]]:
-    """Run the robots with a live table; Ctrl-C / SIGTERM / SIGHUP stop them all (also
-    where the shell started navseq with SIGINT ignored), then the outputs are written
-    and later signals are only counted."""
+def _json_lines(fleet_run: FleetRun) -> dict[str, JsonProgress]:
+    """``--json``: each robot at work prints its events as ``navseq run --json`` does, each
+    record naming the robot, whole lines at a time on the one stdout."""
+    import threading
+
+    from navseq.commands.run_outputs import StdoutGuard
+    from navseq.sinks.json_events import JsonProgress
+
+    lock = threading.Lock()
+    printers = {}
+    for member in fleet_run.members:
+        if member.session is None:
+            continue
+        printer = JsonProgress(
+            sys.stdout,
+            member.session.numbers,
+            member.session.eta(),
+            robot=member.robot.name,
+            lock=lock,
+        )
+        member.listeners.append(StdoutGuard(printer))
+        printers[member.robot.name] = printer
+    return printers
+
+
+def _json_finished(fleet_run: FleetRun, printers: dict[str, JsonProgress]) -> None:
+    """Each robot's last record, ``RunFinished``, as a one-robot run ends its lines."""
+    from navseq.commands.run_outputs import silence_stdout
+
+    for member in fleet_run.members:
+        outcome, printer = member.outcome, printers.get(member.robot.name)
+        if outcome is None or printer is None:
+            continue  # its error is said on stderr
+        try:
+            printer.run_finished(
+                success=outcome.result.success,
+                reason=outcome.result.reason,
+                exit_code=outcome.exit_status,
+                interrupted=outcome.interrupted,
+                files=outcome.files.paths if outcome.files is not None else {},
+                clock=outcome.clock,
+            )
+        except BrokenPipeError:
+            silence_stdout()
+            return
+
+
+def _execute(
+    fleet_run: FleetRun, exits_after: bool, json_lines: dict[str, JsonProgress] | None = None
+) -> tuple[int, dict[str, Any]]:
+    """Run the robots with a live table (none with ``--json``); Ctrl-C / SIGTERM / SIGHUP
+    stop them all (also where the shell started navseq with SIGINT ignored), then the
+    outputs are written and later signals are only counted."""
     from rich.console import Console
     from rich.live import Live
 
@@ -167,11 +224,13 @@ def _execute(fleet_run: FleetRun, exits_after: bool) -> tuple[int, dict[str, Any
     console = Console(stderr=True)
     interrupted: str | None = None
     try:
-        with Live(_table(fleet_run), console=console, auto_refresh=False, transient=True) as live:
+        live = Live(_table(fleet_run), console=console, auto_refresh=False, transient=True)
+        with live if json_lines is None else contextlib.nullcontext():
             while any(thread.is_alive() for thread in threads):
                 fleet_run.clock.stepped.wait(0.2)
                 fleet_run.clock.stepped.clear()
-                live.update(_table(fleet_run), refresh=True)
+                if json_lines is None:
+                    live.update(_table(fleet_run), refresh=True)
     except (KeyboardInterrupt, Terminated) as stop:
         interrupted = stop.signal_name if isinstance(stop, Terminated) else "SIGINT"
     finally:
@@ -243,7 +302,9 @@ def _fleet_eta(fleet_run: FleetRun) -> str:
     return f", done in ~{max(left):.0f} s" if left else ""
 
 
-def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
+def _print_summary(fleet_run: FleetRun, report: dict[str, Any], json_lines: bool) -> None:
+    """The robots' table and the fleet's line on stdout; with ``--json``, where stdout is
+    for programs, only the fleet's lines, on stderr."""
     from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
@@ -251,7 +312,7 @@ def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
     from navseq.commands.plan_fleet import shown_path
     from navseq.sinks.summary import print_table
 
-    console = Console()
+    console = Console(stderr=json_lines)
     table = Table()
     for header, justify in (
         ("robot", "left"),
@@ -273,7 +334,8 @@ def _print_summary(fleet_run: FleetRun, report: dict[str, Any]) -> None:
             "" if row["mission_time_s"] is None else f"{row['mission_time_s']:.0f}",
             "" if row["distance_m"] is None else f"{row['distance_m']:.1f}",
         )
-    print_table(table, console)
+    if not json_lines:
+        print_table(table, console)
     console.print(
         f"fleet: {report['reached']} reached, {report['skipped']} skipped, "
         f"{report['failed']} failed; makespan {report['makespan_s']:.0f} s "

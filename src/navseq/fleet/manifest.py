@@ -13,11 +13,14 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from navseq.errors import NavseqError
 from navseq.fleet.model import Fleet
 from navseq.fleet.split import Share, Split
+
+if TYPE_CHECKING:
+    from navseq.fleet.recording import FleetRecordingChoice
 
 MANIFEST_NAME = "fleet-run.json"
 MANIFEST_VERSION = 1
@@ -34,12 +37,28 @@ class FleetManifest:
     shares: dict[str, tuple[tuple[int, ...], float, float]]  # robot: order, metres, seconds
     dropped: tuple[int, ...]
     navigator: str = "sim"  # the kind the robots ran on: sim (one world), nav2, ros1
+    # Whether the run is recorded (fleet.mcap), and its encoding: a resume records too.
+    record: bool = False
+    record_format: str = "ros2"
 
     def with_navigator(self, kind: str) -> FleetManifest:
         """This manifest for a run on ``kind``'s stacks (a resume runs on the same kind)."""
         import dataclasses
 
         return dataclasses.replace(self, navigator=kind)
+
+    def with_recording(self, choice: FleetRecordingChoice) -> FleetManifest:
+        """This manifest for a run recorded (or not) as ``choice`` says."""
+        import dataclasses
+
+        return dataclasses.replace(self, record=choice.record, record_format=choice.record_format)
+
+    @property
+    def recording(self) -> FleetRecordingChoice:
+        """Whether the run was recorded, and how (for its resume)."""
+        from navseq.fleet.recording import FleetRecordingChoice
+
+        return FleetRecordingChoice(self.record, "ros1" if self.record_format == "ros1" else "ros2")
 
     def split(self, fleet: Fleet) -> Split:
         """The run's split, for ``fleet`` (the same fleet file, checked by its digest)."""
@@ -62,6 +81,8 @@ class FleetManifest:
             },
             "dropped": list(self.dropped),
             "navigator": self.navigator,
+            "record": self.record,
+            "record_format": self.record_format,
         }
 
 
@@ -130,6 +151,9 @@ def read_manifest(folder: Path) -> FleetManifest:
             shares=shares,
             dropped=tuple(int(i) for i in doc["dropped"]),
             navigator=str(doc.get("navigator", "sim")),  # runs before stacks: the simulator
+            # runs before recording: not recorded
+            record=bool(doc.get("record", False)),
+            record_format=str(doc.get("record_format", "ros2")),
         )
     except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise NavseqError(

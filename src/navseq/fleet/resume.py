@@ -41,6 +41,7 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     from navseq.fleet.lockstep import FleetClock
     from navseq.fleet.manifest import read_manifest
     from navseq.fleet.planning import FleetPlan
+    from navseq.fleet.recording import choose
     from navseq.fleet.run import FleetRun
     from navseq.sim.fleet_world import FleetRobot as SimRobot
     from navseq.sim.fleet_world import FleetWorld
@@ -72,8 +73,12 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
                     NavseqError(error_text(error), source=f"robot '{share.robot.name}'")
                 )
     raise_all(problems)
+    # A recorded run goes on recording, into a new file beside the first (fleet-2.mcap).
+    record = choose(request.record, request.record_format, fleet.mission.record, manifest.recording)
     if manifest.navigator != "sim":
-        return _resume_on_stacks(request, manifest.navigator, plan, journals)
+        run = _resume_on_stacks(request, manifest.navigator, plan, journals)
+        run.record = record
+        return run
     poses = {name: found.pose for name, found in journals.items()}
     world = FleetWorld(
         grid,
@@ -82,7 +87,9 @@ def prepare_fleet_resume(request: FleetRunRequest) -> FleetRun:
     going_on = [name for name, found in journals.items() if not found.done]
     clock = FleetClock(world, going_on, realtime=request.realtime)
     members = _members(plan, world, clock, folder, journals)
-    return FleetRun(plan, world, clock, folder, members, picture=request.picture)
+    run = FleetRun(plan, world, clock, folder, members, picture=request.picture)
+    run.record = record
+    return run
 
 
 def _same_kind(request: FleetRunRequest, kind: str) -> NavigatorSettings:
@@ -218,7 +225,8 @@ def _members(
                         grid=plan.grid,
                     ),
                     start=found.pose,
-                    outputs=Outputs(folder=found.journal.parent, picture=False),
+                    # The fleet records its robots in one file (FleetRun.record).
+                    outputs=Outputs(folder=found.journal.parent, picture=False, record=False),
                     resume=found.journal,
                 )
             )

@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from navseq.fleet.coordinator import CoordinatedNavigator, FleetCoordinator
     from navseq.fleet.lockstep import FleetClock, MemberNavigator
     from navseq.fleet.planning import FleetPlan
+    from navseq.fleet.recording import FleetRecording, FleetRecordingChoice
     from navseq.navigators.settings import NavigatorSettings
     from navseq.run.outcome import RunOutcome
     from navseq.run.session import Session
@@ -51,6 +52,12 @@ class FleetRunRequest:
     # None: the embedded simulator; a ROS kind's settings (nav2, ros1): one namespaced
     # stack per robot (navseq.fleet.stack_run), their namespaces from the fleet file.
     navigator: NavigatorSettings | None = None
+    # One MCAP for the fleet (navseq.fleet.recording); None: as the mission's record:
+    # says (a resume: also as the run it continues did).
+    record: bool | None = None
+    record_format: str | None = None  # ros2 (the default) or ros1
+    # On ROS stacks: each robot's stack's own topics to record, under its namespace.
+    record_topics: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -140,6 +147,10 @@ class FleetRun:
     on_close: list[Callable[[], None]] = field(default_factory=list, init=False)
     #: One line each for stderr, said before the robots move.
     notes: list[str] = field(default_factory=list, init=False)
+    #: Whether (and how) the run is recorded as one MCAP (``--record``).
+    record: FleetRecordingChoice | None = field(default=None, init=False)
+    #: The fleet's MCAP recording, made when the run starts if it is recorded.
+    recording: FleetRecording | None = field(default=None, init=False)
 
     def stop(self, signal_name: str) -> None:
         """End every robot's mission as an operator's cancel would (each cancels its goal,
@@ -151,6 +162,16 @@ class FleetRun:
 
     def start(self) -> list[threading.Thread]:
         """One thread per robot with waypoints, running its session; started."""
+        if (
+            self.record is not None
+            and self.record.record
+            and any(member.session is not None for member in self.members)
+        ):  # (a resume of a finished run moves nothing: nothing to record)
+            from navseq.fleet.recording import new_fleet_recording
+
+            # The map and every robot's sink, before the robots move.
+            self.recording = new_fleet_recording(self.folder, self.record)
+            self.recording.start(self)
         threads = []
         for member in self.members:
             if member.session is None:
@@ -199,6 +220,12 @@ class FleetRun:
         if self.coordinator is not None:
             report["coordinator"] = self.coordinator.summary()
         files: dict[str, str] = {}
+        if self.recording is not None:
+            self.recording.finish()  # every robot's run has ended: its summary now
+            if self.recording.error is None:
+                files["recording"] = str(self.recording.path)
+            else:  # the robots went on without it; the report says why
+                report["files_not_written"] = {"recording": self.recording.error}
         if self.picture:
             try:
                 picture = self.folder / "fleet.png"
@@ -224,6 +251,7 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     from navseq.fleet.lockstep import FleetClock
     from navseq.fleet.manifest import manifest_of, write_manifest
     from navseq.fleet.planning import plan_fleet
+    from navseq.fleet.recording import choose
     from navseq.run.folder import create_run_folder, default_run_folder
     from navseq.sim.fleet_world import FleetRobot as SimRobot
     from navseq.sim.fleet_world import FleetWorld
@@ -241,6 +269,12 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     )
     grid = plan.grid
     assert grid is not None  # need_map
+    record = choose(
+        request.record,
+        request.record_format,
+        plan.fleet.mission.record,
+        topics=request.record_topics,
+    )
     world = FleetWorld(grid, [SimRobot(r.name, r.start, r.profile) for r in plan.fleet.robots])
     with_work = [share.robot.name for share in plan.split.shares if share.order]
     clock = FleetClock(world, with_work, realtime=request.realtime)
@@ -251,12 +285,15 @@ def prepare_fleet_run(request: FleetRunRequest) -> FleetRun:
     )
     try:
         members = _members(plan, world, clock, folder)
-        write_manifest(folder, manifest_of(request.fleet, request.mission, request.map, plan.split))
+        manifest = manifest_of(request.fleet, request.mission, request.map, plan.split)
+        write_manifest(folder, manifest.with_recording(record))
     except BaseException:
         if made_here:  # a refused run leaves nothing behind
             _remove_tree(folder)
         raise
-    return FleetRun(plan, world, clock, folder, members, picture=request.picture)
+    run = FleetRun(plan, world, clock, folder, members, picture=request.picture)
+    run.record = record
+    return run
 
 
 def _members(plan: FleetPlan, world: FleetWorld, clock: FleetClock, folder: Path) -> list[Member]:
@@ -291,7 +328,8 @@ def _members(plan: FleetPlan, world: FleetWorld, clock: FleetClock, folder: Path
                         grid=plan.grid,
                     ),
                     start=robot.start,
-                    outputs=Outputs(folder=own, picture=False),
+                    # The fleet records its robots in one file (FleetRun.record).
+                    outputs=Outputs(folder=own, picture=False, record=False),
                 )
             )
         except NavseqError as error:

@@ -154,6 +154,7 @@ def prepare_stack_fleet_run(request: FleetRunRequest) -> FleetRun:
     MissionErrors (every problem at once) before anything moves or is written."""
     from navseq.fleet.manifest import manifest_of, write_manifest
     from navseq.fleet.planning import plan_fleet
+    from navseq.fleet.recording import choose
     from navseq.fleet.run import FleetRun
     from navseq.run.folder import create_run_folder, default_run_folder
 
@@ -164,6 +165,13 @@ def prepare_stack_fleet_run(request: FleetRunRequest) -> FleetRun:
         map_path=request.map,
         time_limit_s=request.time_limit_s,
         need_map=True,
+    )
+    record = choose(
+        request.record,
+        request.record_format,
+        plan.fleet.mission.record,
+        topics=request.record_topics,
+        kind=kind_name(request.navigator),
     )
     connected = connect_all(plan, request.navigator)
     try:
@@ -178,7 +186,8 @@ def prepare_stack_fleet_run(request: FleetRunRequest) -> FleetRun:
         try:
             members = stack_members(plan, connected, poses, folder, None)
             manifest = manifest_of(request.fleet, request.mission, request.map, plan.split)
-            write_manifest(folder, manifest.with_navigator(kind_name(request.navigator)))
+            manifest = manifest.with_navigator(kind_name(request.navigator))
+            write_manifest(folder, manifest.with_recording(record))
         except BaseException:
             if made_here:
                 import shutil
@@ -190,6 +199,7 @@ def prepare_stack_fleet_run(request: FleetRunRequest) -> FleetRun:
         raise
     run = FleetRun(plan, coordinator, coordinator, folder, members, picture=request.picture)
     run.coordinator = coordinator
+    run.record = record
     run.on_close.append(lambda: close_all(connected))
     run.notes.extend(notes)
     return run
@@ -245,7 +255,8 @@ def stack_members(
                     mission=mission_path,
                     navigator=UseNavigator(navigator, item.info, grid=plan.grid),
                     start=poses.get(robot.name, robot.start),
-                    outputs=Outputs(folder=own, picture=False),
+                    # The fleet records its robots in one file (FleetRun.record).
+                    outputs=Outputs(folder=own, picture=False, record=False),
                     resume=found.journal if found is not None else None,
                 )
             )

@@ -136,8 +136,12 @@ def _continued_options(
         recorded = {**recorded, "no_picture": outputs.picture is False, "record": False}
     no_picture = None if outputs.picture is None else not outputs.picture
     picture = not notes.settle("--no-picture", no_picture, bool(recorded.get("no_picture", False)))
-    # A recorded run goes on recording, into a new file beside the first (run-2.mcap).
-    record = outputs.record or bool(recorded.get("record", False)) or None
+    # A recorded run goes on recording, into a new file beside the first (run-2.mcap);
+    # a face with its own navigator (a fleet, which records its robots in one file of
+    # its own) says itself whether the robot's run records.
+    record = (
+        outputs.record if own else outputs.record or bool(recorded.get("record", False)) or None
+    )
     record_format = notes.settle(
         "--record-format", outputs.record_format, recorded.get("record_format")
     )

@@ -15,7 +15,8 @@ JSON Schema is ``docs/schemas/events.schema.json``; :data:`SCHEMA_VERSION` goes 
 whenever a field is renamed, removed or changes meaning, and when one is added
 (version 2: ``recoveries`` and ``navigation_time_s`` in ``WaypointProgress``,
 ``recoveries`` in ``AttemptFailed``, from stacks that count them, like Nav2; version 3:
-``number`` beside every ``index``, and ``RunFinished``'s ``clock``).
+``number`` beside every ``index``, and ``RunFinished``'s ``clock``; version 6: ``robot``
+in every record of ``navseq run --fleet --json``).
 
 The renames live in one table, :data:`FIELDS`, applied to every event type, so a
 field means the same in every record; a new event field without an entry is written
@@ -24,16 +25,18 @@ under its own name, and the schema test fails until the schema says what it is.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 from collections.abc import Callable, Mapping, Sequence
+from contextlib import AbstractContextManager
 from dataclasses import asdict
 from typing import IO, Any, Protocol
 
 from navseq.executor.events import MissionEvent, WaypointOutcome, WaypointProgress
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 
 
 #: Decimals kept in every number of a record.
@@ -200,11 +203,21 @@ class JsonProgress:
     """
 
     def __init__(
-        self, stream: IO[str], numbers: Sequence[int] | None = None, eta: Eta | None = None
+        self,
+        stream: IO[str],
+        numbers: Sequence[int] | None = None,
+        eta: Eta | None = None,
+        *,
+        robot: str | None = None,
+        lock: AbstractContextManager[Any] | None = None,
     ):
         self.stream = stream
         self.numbers = numbers
         self.eta = eta
+        #: A fleet's robot: every record names it (``robot``), and the robots' threads
+        #: take ``lock`` to write whole lines to the one stream.
+        self.robot = robot
+        self._lock = lock if lock is not None else contextlib.nullcontext()
 
     def __enter__(self) -> JsonProgress:
         return self
@@ -217,8 +230,7 @@ class JsonProgress:
         if self.eta is not None and isinstance(event, WaypointProgress):
             record["eta_s"] = _rounded(self.eta.eta_s)
             record["eta_upper_s"] = _rounded(self.eta.eta_upper_s)
-        self.stream.write(_dumps(record) + "\n")
-        self.stream.flush()
+        self._write(record)
 
     def run_finished(
         self,
@@ -239,5 +251,14 @@ class JsonProgress:
             files=files,
             clock=clock,
         )
-        self.stream.write(_dumps(json_safe(record)) + "\n")
-        self.stream.flush()
+        self._write(json_safe(record))
+
+    def _write(self, record: dict[str, Any]) -> None:
+        if self.robot is not None:  # after event and schema_version, as the schema lists it
+            head: dict[str, Any] = {
+                key: record.pop(key) for key in ("event", "schema_version") if key in record
+            }
+            record = {**head, "robot": self.robot, **record}
+        with self._lock:
+            self.stream.write(_dumps(record) + "\n")
+            self.stream.flush()

@@ -55,6 +55,7 @@ class McapRecording:
         self._schemas: dict[str, int] = {}
         self._channels: dict[str, int] = {}
         self._encoders: dict[str, Encoder] = {}
+        self._attached: set[str] = set()
         self._finished = False
 
     @property
@@ -115,9 +116,11 @@ class McapRecording:
         """
         channel = self._channels.get(topic)
         if channel is None:
-            self._writer.add_attachment(
-                0, log_time_ns, schema_file, "application/schema+json", schema.encode()
-            )
+            if schema_file not in self._attached:  # once per file (a fleet: a topic a robot)
+                self._attached.add(schema_file)
+                self._writer.add_attachment(
+                    0, log_time_ns, schema_file, "application/schema+json", schema.encode()
+                )
             channel = self._writer.register_channel(
                 topic, "json", 0, {"schema_attachment": schema_file}
             )
