@@ -369,9 +369,8 @@ class CoarseRoutes:
         rest = there & ~both
         straight = np.hypot(self._rows[others] - near.cell // self._width,
                             self._cols[others] - near.cell % self._width)  # fmt: skip
-        for k in np.flatnonzero(rest & (straight <= self._plan_within)):
-            length[k], depart[k], arrive[k] = self._plan(near.cell, int(self.cells[others[k]]))
-        far = np.flatnonzero(rest & (straight > self._plan_within) & (flat.node_count[others] > 0))
+        far = np.flatnonzero(rest & (flat.node_count[others] > 0))
+        planned = rest & (straight <= self._plan_within) & (flat.node_count[others] == 0)
         if far.size:
             # The far places' nodes, one segment per place, gathered from the flat arrays.
             sizes = flat.node_count[others[far]]
@@ -403,6 +402,12 @@ class CoarseRoutes:
             length[ks] = over[nodes, 1] + end_rows[best, 0]
             depart[ks] = near.node_rows[over[nodes, 2].astype(np.int64), 2].astype(np.int64)
             arrive[ks] = end_rows[best, 2].astype(np.int64)
+            # Only the routes that come out short are planned: a few cells off is much of
+            # a short way, little of a long one. (Planning every pair near in a straight
+            # line planned those around a long shelf too: most of the time on a big map.)
+            planned[ks[length[ks] <= self._plan_within]] = True
+        for k in np.flatnonzero(planned):
+            length[k], depart[k], arrive[k] = self._plan(near.cell, int(self.cells[others[k]]))
         rows[:, 0] = length * self.costmap.grid.resolution
         found = np.flatnonzero(np.isfinite(length))
         ends_cells = self.cells[others[found]]
