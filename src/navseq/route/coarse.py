@@ -18,8 +18,9 @@ graph of the map about a hundred times smaller than the grid:
   route, exactly the planner's.
 - **Further**, the cheapest of: the exact way from the first place to a node near it,
   the graph from there to a node near the second place, the exact way from that node to
-  the second place. Lengths come out within a few per cent of the planner's (the
-  benchmark measures it); the headings a route leaves and arrives with come from the
+  the second place; a route that comes out short this way is planned exactly. Lengths
+  come out within a few per cent of the planner's but for near ties (the bounds:
+  docs/performance.md, held by tests/test_route_coarse.py); the headings a route leaves and arrives with come from the
   exact searches, so the turns at both ends are counted as before.
 """
 
@@ -49,7 +50,7 @@ TARGET_BLOCKS = 12_000
 NEAR_BLOCKS = 4.0
 #: Cells looked at along each edge of the graph for its cost.
 SAMPLES_PER_EDGE = 5
-#: Places nearer than this (m, in a straight line) get an exact plan between them.
+#: Pairs whose route (found the coarse way) is shorter than this (m) get an exact plan.
 PLAN_WITHIN_M = 3.0
 #: Coarse routes are taken when one exact search per place would expand more cells than
 #: this in all (about three seconds on two cores).
@@ -236,9 +237,9 @@ class CoarseRoutes:
         self._width = self._cost.shape[1]
         self._anchor_cells = anchor_m / grid.resolution
         self._bound = max(NEAR_BLOCKS * self.graph.block, 4 * self._anchor_cells + self.graph.block)
-        # Pairs this near that are not within each other's exact search (around walls,
-        # where each step costs more) get a plan of their own: a few centimetres off is
-        # a large part of a short way.
+        # Pairs with a route this short that are not within each other's exact search
+        # (around walls, where each step costs more) get a plan of their own: a few
+        # centimetres off is a large part of a short way.
         self._plan_within = max(PLAN_WITHIN_M / grid.resolution, 1.5 * self._bound)
         cells = np.full(len(places), -1, np.int64)
         for index, place in enumerate(places):
