@@ -20,8 +20,9 @@ graph of the map about a hundred times smaller than the grid:
   the graph from there to a node near the second place, the exact way from that node to
   the second place; a route that comes out short this way is planned exactly. Lengths
   come out within a few per cent of the planner's but for near ties (the bounds:
-  docs/performance.md, held by tests/test_route_coarse.py); the headings a route leaves and arrives with come from the
-  exact searches, so the turns at both ends are counted as before.
+  docs/performance.md, held by tests/test_route_coarse.py); the headings a route
+  leaves and arrives with come from the exact searches, so the turns at both ends are
+  counted as before.
 """
 
 from __future__ import annotations
