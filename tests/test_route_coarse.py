@@ -180,3 +180,30 @@ def test_the_coarse_distances_are_kept_per_map_and_robot_for_the_next_order(
     moved = [*places[:-1], spots(costmap, 31, seed=9)[-1]]
     route_table(again, moved, ANCHOR_M)
     assert known.searched == searched + 1
+
+
+def test_the_graph_made_ahead_is_the_one_the_first_ordering_uses(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The studio's warm-up makes the graph once the opened mission is checked
+    (LegPlanner.prepare_ordering): the first Order… then does not wait for it. A map
+    where the exact searches pay makes none."""
+    from navseq.route import distances, travel
+    from navseq.route.legs import LegPlanner
+
+    monkeypatch.setattr(distances, "_KEPT", type(distances._KEPT)())
+    monkeypatch.setattr(travel, "_KEPT", type(travel._KEPT)())
+    monkeypatch.setattr(coarse, "_GRAPHS", type(coarse._GRAPHS)())
+    made = []
+    real_graph = coarse.build_graph
+    monkeypatch.setattr(
+        coarse, "build_graph", lambda *args: made.append(args[2]) or real_graph(*args)
+    )
+    planner = LegPlanner(doorway_costmap())
+    planner.prepare_ordering(12)
+    assert made == []  # 12 places on a small map: the exact searches
+    monkeypatch.setattr(coarse, "EXACT_CELLS_AT_MOST", 0)
+    planner.prepare_ordering(12)
+    assert len(made) == 1
+    planner.routes(spots(planner.costmap, 12, seed=2), ANCHOR_M)
+    assert len(made) == 1  # the same graph
