@@ -113,3 +113,97 @@ def test_big_maps_take_the_coarse_way_and_small_ones_the_exact(
     np.testing.assert_array_equal(np.isfinite(rough.metres), np.isfinite(exact.metres))
     finite = np.isfinite(exact.metres)
     np.testing.assert_allclose(rough.metres[finite], exact.metres[finite], rtol=0.1)
+
+
+def test_coarse_lengths_on_generated_warehouses_stay_within_the_documented_bounds() -> None:
+    """docs/performance.md's bounds, on two generated warehouses (shelves, aisles, where
+    two ways round a shelf often cost the planner nearly the same): the coarse lengths
+    against one exact search per place, with the graph sized as for a big map."""
+    from navseq.commands.common import costmap_for_robot
+    from navseq.sim.mapgen import warehouse_map
+
+    errors, nearest = [], []
+    for seed in (0, 3):
+        costmap = costmap_for_robot(warehouse_map(seed))
+        places = spots(costmap, 40, seed=seed)
+        routes = coarse.CoarseRoutes(costmap, places, ANCHOR_M)
+        for index in range(len(places)):
+            routes.prepare(index)
+        count = len(places)
+        rough, exact = np.zeros((count, count)), np.zeros((count, count))
+        for i in range(count - 1):
+            rough[i, i + 1 :] = routes.reach(i, np.arange(i + 1, count))[:, 0]
+            exact[i, i + 1 :] = reach_routes(costmap, places[i], places[i + 1 :], ANCHOR_M)[:, 0]
+        rough, exact = rough + rough.T, exact + exact.T
+        np.testing.assert_array_equal(np.isfinite(rough), np.isfinite(exact))
+        pairs = ~np.eye(count, dtype=bool) & np.isfinite(exact)
+        off = np.abs(rough - exact) / np.where(pairs, exact, 1.0)
+        errors.append(off[pairs])
+        # Each place's three nearest (the legs a short tour is made of).
+        closest = np.argsort(np.where(pairs, exact, np.inf), axis=1)[:, :3]
+        nearest.append(np.take_along_axis(off, closest, axis=1).ravel())
+    every, near = np.concatenate(errors), np.concatenate(nearest)
+    assert np.median(every) < 0.01
+    assert np.quantile(every, 0.95) < 0.04
+    assert every.max() < 0.4  # a near tie round a shelf: the graph takes the other way
+    assert np.quantile(near, 0.95) < 0.03 and near.max() < 0.15
+
+
+def test_the_coarse_distances_are_kept_per_map_and_robot_for_the_next_order(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The studio's second Order… on a big map searches nothing again, nor makes the
+    graph again, even from another costmap of the same map and robot; one moved place
+    is one search."""
+    from navseq.route import distances, travel
+    from navseq.route.travel import route_table
+
+    monkeypatch.setattr(coarse, "EXACT_CELLS_AT_MOST", 0)  # the coarse way, as on a big map
+    monkeypatch.setattr(distances, "_KEPT", type(distances._KEPT)())
+    monkeypatch.setattr(travel, "_KEPT", type(travel._KEPT)())
+    monkeypatch.setattr(coarse, "_GRAPHS", type(coarse._GRAPHS)())
+    made = []
+    real_graph = coarse.build_graph
+    monkeypatch.setattr(
+        coarse, "build_graph", lambda *args: made.append(args[2]) or real_graph(*args)
+    )
+    costmap = doorway_costmap()
+    places = spots(costmap, 30, seed=8)
+    first = route_table(costmap, places, ANCHOR_M)
+    known = distances.known_distances(costmap)
+    searched = known.searched
+    assert len(made) == 1 and searched == len(places) - 1
+    again = Costmap.from_grid(costmap.grid, costmap.params)
+    second = route_table(again, places[::-1], ANCHOR_M)
+    assert known.searched == searched and len(made) == 1
+    np.testing.assert_array_equal(second.metres, first.metres[::-1, ::-1])
+    moved = [*places[:-1], spots(costmap, 31, seed=9)[-1]]
+    route_table(again, moved, ANCHOR_M)
+    assert known.searched == searched + 1
+
+
+def test_the_graph_made_ahead_is_the_one_the_first_ordering_uses(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The studio's warm-up makes the graph once the opened mission is checked
+    (LegPlanner.prepare_ordering): the first Order… then does not wait for it. A map
+    where the exact searches pay makes none."""
+    from navseq.route import distances, travel
+    from navseq.route.legs import LegPlanner
+
+    monkeypatch.setattr(distances, "_KEPT", type(distances._KEPT)())
+    monkeypatch.setattr(travel, "_KEPT", type(travel._KEPT)())
+    monkeypatch.setattr(coarse, "_GRAPHS", type(coarse._GRAPHS)())
+    made = []
+    real_graph = coarse.build_graph
+    monkeypatch.setattr(
+        coarse, "build_graph", lambda *args: made.append(args[2]) or real_graph(*args)
+    )
+    planner = LegPlanner(doorway_costmap())
+    planner.prepare_ordering(12)
+    assert made == []  # 12 places on a small map: the exact searches
+    monkeypatch.setattr(coarse, "EXACT_CELLS_AT_MOST", 0)
+    planner.prepare_ordering(12)
+    assert len(made) == 1
+    planner.routes(spots(planner.costmap, 12, seed=2), ANCHOR_M)
+    assert len(made) == 1  # the same graph

@@ -18,9 +18,11 @@ graph of the map about a hundred times smaller than the grid:
   route, exactly the planner's.
 - **Further**, the cheapest of: the exact way from the first place to a node near it,
   the graph from there to a node near the second place, the exact way from that node to
-  the second place. Lengths come out within a few per cent of the planner's (the
-  benchmark measures it); the headings a route leaves and arrives with come from the
-  exact searches, so the turns at both ends are counted as before.
+  the second place; a route that comes out short this way is planned exactly. Lengths
+  come out within a few per cent of the planner's but for near ties (the bounds:
+  docs/performance.md, held by tests/test_route_coarse.py); the headings a route
+  leaves and arrives with come from the exact searches, so the turns at both ends are
+  counted as before.
 """
 
 from __future__ import annotations
@@ -39,15 +41,17 @@ if TYPE_CHECKING:
 
 Place = tuple[float, float]
 #: The coarse graph is made with about this many blocks at most (its searches cost what
-#: its nodes are, about 8 ms for 25 000).
-TARGET_BLOCKS = 25_000
+#: its nodes are: 3.5 ms for 32 000 nodes, 25 000 blocks, on the 2000 x 2000 map; half
+#: as many blocks halved them, and the lengths came out as close to the planner's:
+#: median 0.45 % off instead of 1.0 % there, 0.30 % instead of 0.16 % on a warehouse).
+TARGET_BLOCKS = 12_000
 #: Exact search to this many blocks around each place (and at least one lookahead and a
 #: block further): pairs nearer than that are measured exactly, and the graph's ends get
 #: exact ways to a ring of nodes around each place.
 NEAR_BLOCKS = 4.0
 #: Cells looked at along each edge of the graph for its cost.
 SAMPLES_PER_EDGE = 5
-#: Places nearer than this (m, in a straight line) get an exact plan between them.
+#: Pairs whose route (found the coarse way) is shorter than this (m) get an exact plan.
 PLAN_WITHIN_M = 3.0
 #: Coarse routes are taken when one exact search per place would expand more cells than
 #: this in all (about three seconds on two cores).
@@ -190,11 +194,29 @@ class _Near:
     """One place's exact search: the other places and the graph's nodes it reached."""
 
     cell: int
-    places: dict[int, tuple[float, int]]  # per place reached: length (cells), departure anchor
+    place_ids: np.ndarray  # the places reached (int64), their lengths (cells) and
+    place_length: np.ndarray  # departure anchor cells
+    place_anchor: np.ndarray
     nodes: np.ndarray  # nodes reached (int64)
     node_rows: np.ndarray  # (len(nodes), 3) length, cost, departure anchor cell
     seed_cost: np.ndarray  # node_rows' costs and lengths, contiguous (for the C search)
     seed_length: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Index:
+    """Every prepared place's search in flat arrays, so that :meth:`CoarseRoutes.reach`
+    looks up a thousand places at once rather than one by one (the loop over them
+    in Python took as long as the graph search on 2000 places)."""
+
+    prepared: np.ndarray  # per place: searched around
+    node_start: np.ndarray  # per place: where its nodes begin in `nodes`
+    node_count: np.ndarray
+    nodes: np.ndarray
+    node_rows: np.ndarray
+    pair_keys: np.ndarray  # sorted `from * places + to` of the pairs searched exactly
+    pair_length: np.ndarray
+    pair_anchor: np.ndarray
 
 
 class CoarseRoutes:
@@ -216,9 +238,9 @@ class CoarseRoutes:
         self._width = self._cost.shape[1]
         self._anchor_cells = anchor_m / grid.resolution
         self._bound = max(NEAR_BLOCKS * self.graph.block, 4 * self._anchor_cells + self.graph.block)
-        # Pairs this near that are not within each other's exact search (around walls,
-        # where each step costs more) get a plan of their own: a few centimetres off is
-        # a large part of a short way.
+        # Pairs with a route this short that are not within each other's exact search
+        # (around walls, where each step costs more) get a plan of their own: a few
+        # centimetres off is a large part of a short way.
         self._plan_within = max(PLAN_WITHIN_M / grid.resolution, 1.5 * self._bound)
         cells = np.full(len(places), -1, np.int64)
         for index, place in enumerate(places):
@@ -230,6 +252,9 @@ class CoarseRoutes:
             np.concatenate((np.where(cells >= 0, cells, 0), self.graph.node_cell))
         )
         self._near: dict[int, _Near] = {}
+        self._index: _Index | None = None
+        self._index_lock = threading.Lock()
+        self._rows, self._cols = np.divmod(cells, self._width)
 
     def prepare(self, index: int) -> None:
         """The exact search around place ``index`` (nothing for a place off the free space)."""
@@ -257,24 +282,66 @@ class CoarseRoutes:
                 break
             bound = bound * 4 if bound < 1e6 else math.inf
         # Only the places reached are kept (2000 places: a full row each is 100 MB).
-        near_places = {
-            int(other): (float(found[other, 0]), int(found[other, 2]))
-            for other in np.flatnonzero(np.isfinite(found[:count, 0]) & (self.cells >= 0))
-        }
+        near_ids = np.flatnonzero(np.isfinite(found[:count, 0]) & (self.cells >= 0))
         nodes = found[count:][reached]
         # Routes further away leave through the nodes a lookahead away or more (where
         # their heading is measured), when there are any.
         beyond = nodes[:, 0] >= self._anchor_cells
         if beyond.any():
             reached, nodes = reached[beyond], nodes[beyond]
-        self._near[index] = _Near(
+        near = _Near(
             start,
-            near_places,
+            near_ids.astype(np.int64),
+            found[near_ids, 0].copy(),
+            found[near_ids, 2].astype(np.int64),
             reached.astype(np.int64),
             nodes.copy(),
             np.ascontiguousarray(nodes[:, 1]),
             np.ascontiguousarray(nodes[:, 0]),
         )
+        with self._index_lock:
+            self._near[index] = near
+            self._index = None
+
+    def _flat(self) -> _Index:
+        """The prepared searches as :class:`_Index` (made at the first :meth:`reach`)."""
+        with self._index_lock:
+            if self._index is not None:
+                return self._index
+            count = len(self.cells)
+            prepared = np.zeros(count, bool)
+            node_count = np.zeros(count, np.int64)
+            for index, near in self._near.items():
+                prepared[index] = True
+                node_count[index] = len(near.nodes)
+            node_start = np.concatenate(([0], np.cumsum(node_count)[:-1])).astype(np.int64)
+            ids = [int(i) for i in np.flatnonzero(prepared)]
+            searched = [self._near[i] for i in ids]
+            keys = [i * count + near.place_ids for i, near in zip(ids, searched, strict=True)]
+
+            def joined(parts: list[np.ndarray], dtype: Any, shape: tuple[int, ...]) -> np.ndarray:
+                return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype)
+
+            pair_keys = joined(keys, np.int64, (0,))
+            order = np.argsort(pair_keys, kind="stable")
+            self._index = _Index(
+                prepared,
+                node_start,
+                node_count,
+                joined([near.nodes for near in searched], np.int64, (0,)),
+                joined([near.node_rows for near in searched], np.float64, (0, 3)),
+                pair_keys[order],
+                joined([near.place_length for near in searched], np.float64, (0,))[order],
+                joined([near.place_anchor for near in searched], np.int64, (0,))[order],
+            )
+            return self._index
+
+    def _pairs(self, flat: _Index, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which of ``keys`` (``from * places + to``) were searched exactly, and where."""
+        at = np.minimum(np.searchsorted(flat.pair_keys, keys), max(len(flat.pair_keys) - 1, 0))
+        if not len(flat.pair_keys):
+            return np.zeros(len(keys), bool), at
+        return flat.pair_keys[at] == keys, at
 
     def reach(self, index: int, others: np.ndarray) -> np.ndarray:
         """Per place of ``others`` (indices): metres, the heading leaving place ``index``
@@ -282,31 +349,39 @@ class CoarseRoutes:
         :func:`navseq.sim.planner.reach_routes` gives them."""
         from navseq.sim import _astar  # type: ignore[attr-defined]
 
+        others = np.asarray(others, dtype=np.int64)
         rows = np.full((len(others), 3), np.nan)
         rows[:, 0] = np.inf
         near = self._near.get(index)
         if near is None or len(others) == 0:
             return rows
         graph = self.graph
+        flat = self._flat()
+        count = len(self.cells)
         length = np.full(len(others), np.inf)
         depart = np.full(len(others), -1, np.int64)
         arrive = np.full(len(others), -1, np.int64)
-        far = []
-        for k, other in enumerate(others):
-            there = self._near.get(int(other))
-            if there is None:
-                continue
-            out, back = near.places.get(int(other)), there.places.get(index)
-            if out is not None and back is not None:
-                length[k], depart[k] = out
-                arrive[k] = back[1]
-            elif self._straight_cells(near.cell, there.cell) <= self._plan_within:
-                length[k], depart[k], arrive[k] = self._plan(near.cell, there.cell)
-            elif there.nodes.size:
-                far.append(k)
-        if far:
-            ends = [self._near[int(others[k])] for k in far]
-            end_nodes = np.concatenate([end.nodes for end in ends])
+        there = flat.prepared[others]
+        out, out_at = self._pairs(flat, index * count + others)
+        back, back_at = self._pairs(flat, others * count + index)
+        both = there & out & back
+        length[both] = flat.pair_length[out_at[both]]
+        depart[both] = flat.pair_anchor[out_at[both]]
+        arrive[both] = flat.pair_anchor[back_at[both]]
+        rest = there & ~both
+        straight = np.hypot(self._rows[others] - near.cell // self._width,
+                            self._cols[others] - near.cell % self._width)  # fmt: skip
+        far = np.flatnonzero(rest & (flat.node_count[others] > 0))
+        planned = rest & (straight <= self._plan_within) & (flat.node_count[others] == 0)
+        if far.size:
+            # The far places' nodes, one segment per place, gathered from the flat arrays.
+            sizes = flat.node_count[others[far]]
+            starts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
+            gather = np.repeat(flat.node_start[others[far]] - starts, sizes) + np.arange(
+                int(sizes.sum())
+            )
+            end_nodes = np.ascontiguousarray(flat.nodes[gather])
+            end_rows = flat.node_rows[gather]
             raw = _astar.graph(
                 graph.indptr,
                 graph.indices,
@@ -319,29 +394,28 @@ class CoarseRoutes:
             )
             over = np.frombuffer(raw, dtype=np.float64).reshape(-1, 3)
             # Per far place, its cheapest node of all: the segments of the concatenation.
-            end_rows = np.concatenate([end.node_rows for end in ends])
-            sizes = np.array([len(end.nodes) for end in ends])
-            starts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
             total = over[end_nodes, 0] + end_rows[:, 1]
             cheapest = np.minimum.reduceat(total, starts)
             at_min = np.flatnonzero(total == np.repeat(cheapest, sizes))
             best = at_min[np.searchsorted(at_min, starts)]
             reached = np.isfinite(cheapest)
-            best, ks = best[reached], np.asarray(far)[reached]
+            best, ks = best[reached], far[reached]
             nodes = end_nodes[best]
             length[ks] = over[nodes, 1] + end_rows[best, 0]
             depart[ks] = near.node_rows[over[nodes, 2].astype(np.int64), 2].astype(np.int64)
             arrive[ks] = end_rows[best, 2].astype(np.int64)
+            # Only the routes that come out short are planned: a few cells off is much of
+            # a short way, little of a long one. (Planning every pair near in a straight
+            # line planned those around a long shelf too: most of the time on a big map.)
+            planned[ks[length[ks] <= self._plan_within]] = True
+        for k in np.flatnonzero(planned):
+            length[k], depart[k], arrive[k] = self._plan(near.cell, int(self.cells[others[k]]))
         rows[:, 0] = length * self.costmap.grid.resolution
         found = np.flatnonzero(np.isfinite(length))
         ends_cells = self.cells[others[found]]
         rows[found, 1] = self._headings(np.full(len(found), near.cell), depart[found])
         rows[found, 2] = self._headings(arrive[found], ends_cells)
         return rows
-
-    def _straight_cells(self, a: int, b: int) -> float:
-        (a_row, a_col), (b_row, b_col) = divmod(a, self._width), divmod(b, self._width)
-        return math.hypot(a_row - b_row, a_col - b_col)
 
     def _plan(self, start: int, goal: int) -> tuple[float, int, int]:
         """One A* plan (the planner's): its length in cells and its two anchor cells."""

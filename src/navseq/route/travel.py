@@ -133,7 +133,8 @@ def route_table(
     search per place (:func:`navseq.sim.planner.reach_routes`) on ``workers`` threads.
     A KeyboardInterrupt drops the searches not started and waits only for the running
     ones."""
-    from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+    import queue
+    from concurrent.futures import Future, ThreadPoolExecutor
 
     from navseq.route import distances
 
@@ -160,22 +161,32 @@ def route_table(
         pool = ThreadPoolExecutor(max_workers=max(1, workers))
         try:
             measure = _measure(costmap, places, anchor_m, work, pool)
-            pending = {pool.submit(measure, item): item for item in work}
+            # Each search says it is over on a queue: waiting on all the pending ones
+            # at once (concurrent.futures.wait) cost the main thread a waiter per
+            # future per search, and 2000 places took more CPU than the searches did.
+            finished: queue.SimpleQueue[Future[np.ndarray]] = queue.SimpleQueue()
+            pending: dict[Future[np.ndarray], tuple[int, np.ndarray]] = {}
+            for item in work:
+                future = pool.submit(measure, item)
+                pending[future] = item
+                future.add_done_callback(finished.put)
             done_count = 0
             if progress is not None:
                 progress(0, len(work))
             while pending:
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    i, others = pending.pop(future)
-                    found = future.result()
-                    known.store(int(rows[i]), rows[others], found[:, 0])
-                    known.searched += 1
-                    at, to = int(heading_rows[i]), heading_rows[others]
-                    headings.depart[at, to] = found[:, 1]
-                    headings.arrive[at, to] = found[:, 2]
-                    headings.measured[at, to] = True
-                    done_count += 1
+                try:  # with a timeout: Ctrl-C is heard while searches run
+                    future = finished.get(timeout=0.5)
+                except queue.Empty:
+                    continue
+                i, others = pending.pop(future)
+                found = future.result()
+                known.store(int(rows[i]), rows[others], found[:, 0])
+                known.searched += 1
+                at, to = int(heading_rows[i]), heading_rows[others]
+                headings.depart[at, to] = found[:, 1]
+                headings.arrive[at, to] = found[:, 2]
+                headings.measured[at, to] = True
+                done_count += 1
                 if progress is not None:
                     progress(done_count, len(work))
         finally:

@@ -577,6 +577,36 @@ finish:
     return result;
 }
 
+/* The buckets of Dinitz's Dijkstra: bucket k holds the nodes whose cost may be in
+ * [k * width, (k + 1) * width), width at most the cheapest edge. A node popped from the
+ * lowest bucket is then final whatever its place in the bucket (an edge from another
+ * node of the bucket adds at least a width), so no heap is needed: pushes and pops cost
+ * a constant, where the heap's log of a hundred thousand entries missed the cache at
+ * every level (the coarse graph's searches took twice as long). Costs never span more
+ * than the dearest edge (or the seeds' spread) past the lowest bucket, so `count`
+ * buckets are used round and round. */
+typedef struct {
+    int64_t *items;
+    size_t size;
+    size_t capacity;
+} Bucket;
+
+static int bucket_push(Bucket *bucket, int64_t node) {
+    if (bucket->size == bucket->capacity) {
+        size_t capacity = bucket->capacity ? 2 * bucket->capacity : 64;
+        int64_t *items = realloc(bucket->items, capacity * sizeof(int64_t));
+        if (items == NULL) return -1;
+        bucket->items = items;
+        bucket->capacity = capacity;
+    }
+    bucket->items[bucket->size++] = node;
+    return 0;
+}
+
+/* Buckets used round and round at most (more: the edges' costs spread too far for
+ * buckets, and the heap is used). */
+#define MAX_BUCKETS 65536
+
 /* graph(indptr, indices, edge_cost, edge_length, seeds, seed_cost, seed_length, wanted)
  * -> bytes (3 float64 per node): Dijkstra over a graph in compressed rows (int64
  * indptr/indices, float64 costs and lengths per edge) from several seeds at once, each
@@ -647,32 +677,106 @@ static PyObject *graph(PyObject *self, PyObject *args) {
             remaining++;
         }
     }
-    for (Py_ssize_t i = 0; i < seeds && !failed; i++) {
-        int64_t node = seed[i];
-        if (seed_cost[i] < out[3 * node]) {
-            out[3 * node] = seed_cost[i];
-            out[3 * node + 1] = seed_length[i];
-            out[3 * node + 2] = (double)i;
-            failed = heap_push(&heap, (Entry){seed_cost[i], seed_cost[i], node}) < 0;
-        }
+    /* The bucket width: a little under the cheapest edge (rounding must not put a
+     * node pushed from the lowest bucket into that bucket again). */
+    double cheapest = INFINITY, dearest = 0.0, seed_low = INFINITY, seed_high = -INFINITY;
+    for (Py_ssize_t e = 0; e < edges; e++) {
+        if (edge_cost[e] < cheapest) cheapest = edge_cost[e];
+        if (edge_cost[e] > dearest) dearest = edge_cost[e];
     }
-    while (!failed && heap.size > 0 && remaining > 0) {
-        Entry entry = heap_pop(&heap);
-        int64_t node = entry.cell;
-        if (state[node] || entry.g > out[3 * node]) continue;
-        state[node] = 1;
-        if (want[node]) remaining--;
-        for (int64_t e = indptr[node]; e < indptr[node + 1]; e++) {
-            int64_t next = indices[e];
-            if (state[next]) continue;
-            double g = entry.g + edge_cost[e];
-            if (g < out[3 * next]) {
-                out[3 * next] = g;
-                out[3 * next + 1] = out[3 * node + 1] + edge_length[e];
-                out[3 * next + 2] = out[3 * node + 2];
-                if (heap_push(&heap, (Entry){g, g, next}) < 0) {
-                    failed = 1;
-                    break;
+    for (Py_ssize_t i = 0; i < seeds; i++) {
+        if (seed_cost[i] < seed_low) seed_low = seed_cost[i];
+        if (seed_cost[i] > seed_high) seed_high = seed_cost[i];
+    }
+    double spread = seeds > 0 ? fmax(dearest, seed_high - seed_low) : dearest;
+    double bucket_width = 0.999 * cheapest;
+    size_t bucket_count = 0;
+    if (edges > 0 && isfinite(spread) && bucket_width > 0.0 && spread / bucket_width < MAX_BUCKETS - 2)
+        bucket_count = (size_t)(spread / bucket_width) + 2;
+    if (bucket_count > 0) {
+        Bucket *buckets = calloc(bucket_count, sizeof(Bucket));
+        failed = buckets == NULL;
+        size_t queued = 0;
+        int64_t lowest = 0;
+        for (Py_ssize_t i = 0; i < seeds && !failed; i++) {
+            int64_t node = seed[i];
+            if (seed_cost[i] < out[3 * node]) {
+                out[3 * node] = seed_cost[i];
+                out[3 * node + 1] = seed_length[i];
+                out[3 * node + 2] = (double)i;
+            }
+        }
+        if (!failed && seeds > 0) lowest = (int64_t)floor(seed_low / bucket_width);
+        for (Py_ssize_t i = 0; i < seeds && !failed; i++) {
+            int64_t node = seed[i];
+            if ((double)i != out[3 * node + 2]) continue; /* a cheaper seed of the node */
+            int64_t k = (int64_t)floor(out[3 * node] / bucket_width);
+            failed = bucket_push(&buckets[(size_t)k % bucket_count], node) < 0;
+            queued++;
+        }
+        while (!failed && queued > 0 && remaining > 0) {
+            Bucket *bucket = &buckets[(size_t)lowest % bucket_count];
+            /* Nothing is pushed into the lowest bucket while it is emptied. */
+            for (size_t at = 0; at < bucket->size && !failed && remaining > 0; at++) {
+                int64_t node = bucket->items[at];
+                queued--;
+                if (state[node]) continue;
+                if ((int64_t)floor(out[3 * node] / bucket_width) != lowest) continue; /* stale */
+                state[node] = 1;
+                if (want[node]) remaining--;
+                double g0 = out[3 * node];
+                for (int64_t e = indptr[node]; e < indptr[node + 1]; e++) {
+                    int64_t next = indices[e];
+                    if (state[next]) continue;
+                    double g = g0 + edge_cost[e];
+                    if (g < out[3 * next]) {
+                        out[3 * next] = g;
+                        out[3 * next + 1] = out[3 * node + 1] + edge_length[e];
+                        out[3 * next + 2] = out[3 * node + 2];
+                        int64_t k = (int64_t)floor(g / bucket_width);
+                        if (bucket_push(&buckets[(size_t)k % bucket_count], next) < 0) {
+                            failed = 1;
+                            break;
+                        }
+                        queued++;
+                    }
+                }
+            }
+            bucket->size = 0;
+            lowest++;
+        }
+        if (buckets != NULL) {
+            for (size_t k = 0; k < bucket_count; k++) free(buckets[k].items);
+            free(buckets);
+        }
+    } else {
+        for (Py_ssize_t i = 0; i < seeds && !failed; i++) {
+            int64_t node = seed[i];
+            if (seed_cost[i] < out[3 * node]) {
+                out[3 * node] = seed_cost[i];
+                out[3 * node + 1] = seed_length[i];
+                out[3 * node + 2] = (double)i;
+                failed = heap_push(&heap, (Entry){seed_cost[i], seed_cost[i], node}) < 0;
+            }
+        }
+        while (!failed && heap.size > 0 && remaining > 0) {
+            Entry entry = heap_pop(&heap);
+            int64_t node = entry.cell;
+            if (state[node] || entry.g > out[3 * node]) continue;
+            state[node] = 1;
+            if (want[node]) remaining--;
+            for (int64_t e = indptr[node]; e < indptr[node + 1]; e++) {
+                int64_t next = indices[e];
+                if (state[next]) continue;
+                double g = entry.g + edge_cost[e];
+                if (g < out[3 * next]) {
+                    out[3 * next] = g;
+                    out[3 * next + 1] = out[3 * node + 1] + edge_length[e];
+                    out[3 * next + 2] = out[3 * node + 2];
+                    if (heap_push(&heap, (Entry){g, g, next}) < 0) {
+                        failed = 1;
+                        break;
+                    }
                 }
             }
         }

@@ -744,8 +744,20 @@ class Studio:
                     self.page_checked.wait(wait_for_page_s)
                     _lower_this_threads_priority()
                     self.check(opened["mission"])
+                    self._prepare_ordering(opened["mission"])
         except Exception:  # the same request from the page reports it
             pass
+
+    def _prepare_ordering(self, document: Any) -> None:
+        """What the first Order… of the opened mission needs before its searches (the
+        coarse graph of a big map), made by the warm-up rather than in the user's wait."""
+        from navseq.commands.common import choose_robot
+
+        checked = self._checked(document)
+        if checked.mission is None or checked.map_path is None or not checked.map_path.is_file():
+            return
+        planner = self.planner(checked.map_path, choose_robot(None, checked.mission))
+        planner.prepare_ordering(len(checked.mission.waypoints) + 1)
 
     def close(self, reason: str = "the studio was stopped") -> None:
         """Cancel a running simulation and wait until its outputs are written."""
