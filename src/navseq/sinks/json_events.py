@@ -15,7 +15,8 @@ JSON Schema is ``docs/schemas/events.schema.json``; :data:`SCHEMA_VERSION` goes 
 whenever a field is renamed, removed or changes meaning, and when one is added
 (version 2: ``recoveries`` and ``navigation_time_s`` in ``WaypointProgress``,
 ``recoveries`` in ``AttemptFailed``, from stacks that count them, like Nav2; version 3:
-``number`` beside every ``index``, and ``RunFinished``'s ``clock``).
+``number`` beside every ``index``, and ``RunFinished``'s ``clock``; version 6:
+``WaypointHeld`` and ``WaypointReleased``, a fleet holding a robot back).
 
 The renames live in one table, :data:`FIELDS`, applied to every event type, so a
 field means the same in every record; a new event field without an entry is written
@@ -33,7 +34,7 @@ from typing import IO, Any, Protocol
 from navseq.executor.events import MissionEvent, WaypointOutcome, WaypointProgress
 
 #: Version of the record layout (``schema_version`` in every record).
-SCHEMA_VERSION = 5
+SCHEMA_VERSION = 6
 
 
 #: Decimals kept in every number of a record.
@@ -67,6 +68,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "distance_remaining": ("distance_remaining_m", None),
     "navigation_time": ("navigation_time_s", None),
     "seconds": ("dwell_s", None),
+    "held_for": ("held_s", None),  # WaypointReleased, as the report's held_s
     # WaypointFinished's count; the report's ``attempts`` is the list of attempts.
     "attempts": ("attempt_count", None),
     "loops": ("loops", _loops),
