@@ -125,3 +125,15 @@ def test_the_journal_keeps_the_time_held_for_a_rebuilt_report(tmp_path: Path) ->
     assert [a.held for a in first.attempt_results] == [3.0, 2.5]
     assert first.held_s == 5.5 and second.held_s == 0.5
     assert [a.held for a in h.executor.result.visits[0].attempt_results] == [3.0, 2.5]
+
+
+def test_a_person_reads_when_and_for_whom_the_robot_was_held() -> None:
+    from navseq.sinks.progress import RunView, describe
+
+    view = RunView(line_mission(1))
+    hold = WaypointHeld(2.0, 0, 0, "giving way to r1")
+    release = WaypointReleased(9.5, 0, 0, 7.5)
+    assert describe(hold, view) == "waypoint 1/1 'p1': held back by the fleet (giving way to r1)"
+    assert describe(release, view) == (
+        "waypoint 1/1 'p1': on its way again after 7.5 s held (not counted against its timeouts)"
+    )
