@@ -318,6 +318,10 @@ class FleetCoordinator:
     yield_limit = 90.0  # s a robot gives way before it takes its goal up again anyway
     hold_limit = 30.0  # s a robot is held back at most for one robot's way aside
     route_age = 2.0  # s before a robot's route on the bare map is planned again
+    # s after robot A was sent aside for robot B during which A does not send B aside,
+    # nor make B make way for it, in turn (the rule's ``return_guard``: two robots almost
+    # touching would send each other aside for ever).
+    return_guard = 10.0
 
     def __init__(
         self,
@@ -345,6 +349,7 @@ class FleetCoordinator:
         self._watch = [_Watch() for _ in robots]
         self._yields: dict[int, _Yield] = {}
         self._holds: dict[int, _Hold] = {}
+        self._sent: dict[tuple[int, int], float] = {}  # (index, for whom) -> when sent aside
         self._next = -math.inf
         self._running: set[str] = set()  # robots whose mission's thread polls their navigator
         self._stop = threading.Event()
@@ -616,6 +621,8 @@ class FleetCoordinator:
             for other in sorted(in_way, key=self._rank):
                 if other in self._yields and self._yields[other].to == index:
                     continue  # already on its way aside for this one
+                if now - self._sent.get((index, other), -math.inf) < self.return_guard:
+                    continue  # sent aside for it a moment ago: it waits for it to move
                 if other == giving_way_to:
                     self._send_aside(other, index, route, poses, now)
                     continue
@@ -626,7 +633,10 @@ class FleetCoordinator:
                     break
                 if self._send_aside(other, index, route, poses, now):
                     self._hold(index, other, now)
-                elif self._nav(other).pursuing:
+                elif (
+                    self._nav(other).pursuing
+                    and now - self._sent.get((other, index), -math.inf) >= self.return_guard
+                ):
                     # Inversion: the robot in the way cannot get out of it; make way for it.
                     other_route = self._route(other, poses[other], now)
                     if other_route is not None and self._send_aside(
@@ -668,6 +678,7 @@ class FleetCoordinator:
             f"for {self.names[to]}"
         )
         self._yields[index] = _Yield(to, now)
+        self._sent[(index, to)] = now
         watch = self._watch[index]
         watch.route, watch.moved_at, watch.travelled_at = None, now, now
         self.sent_aside += 1

@@ -332,11 +332,17 @@ class RightOfWay:
     # m beyond a blocked robot's sensing range within which its route's points count for
     # who is in its way: a robot its server sees blocks route points this near it
     sight_margin = 1.0
+    # s after robot A was sent aside for robot B during which A does not send B aside,
+    # nor B make way for A, in turn: two robots almost touching would otherwise send each
+    # other aside at every decision, each new way aside replacing the last before either
+    # moved (a livelock). A waits for B to move instead.
+    return_guard = 10.0
 
     def __init__(self, fleet: FleetWorld) -> None:
         self.fleet = fleet
         self._watch = [_Watch(world.robot.pose) for world in fleet.worlds]
         self._yields: dict[int, _Yield] = {}
+        self._sent: dict[tuple[int, int], float] = {}  # (index, for whom) -> when sent aside
         self._next = 0.0
         self.yields_started = 0  # how often a robot was sent aside (benchmarks, tests)
 
@@ -467,6 +473,11 @@ class RightOfWay:
             helped: int | None = None  # the first robot the fleet deals with for it
             giving_way_to = self._yields[index].to if index in self._yields else None
             for other in sorted(in_way, key=self._rank):
+                if self._sent_for_lately(index, other, now):
+                    # Sent aside for ``other`` a moment ago: it does not send ``other``
+                    # aside in turn, it waits for it to move (see ``return_guard``).
+                    helped = other if helped is None else helped
+                    continue
                 if other == giving_way_to:
                     # The robot this one makes way for blocks its way aside: it steps
                     # out of that way instead (a cycle of giving way, which ends as
@@ -482,7 +493,7 @@ class RightOfWay:
                     continue
                 if self._send_aside(other, index, route, poses, now):
                     helped = other if helped is None else helped
-                elif self._pursuing(other):
+                elif self._pursuing(other) and not self._sent_for_lately(other, index, now):
                     # Inversion: the robot in the way cannot get out of it; make way for it.
                     other_route = self._route(other, poses[other], now)
                     if other_route is not None and self._send_aside(
@@ -494,6 +505,11 @@ class RightOfWay:
                 servers[index].extend_patience()
                 waiting[index] = helped
         return waiting
+
+    def _sent_for_lately(self, index: int, other: int, now: float) -> bool:
+        """True if robot ``index`` was sent aside for ``other`` less than
+        ``return_guard`` seconds ago."""
+        return now - self._sent.get((index, other), -math.inf) < self.return_guard
 
     def _stretch_in_reach(self, index: int, route: np.ndarray, pose: Pose2D) -> np.ndarray:
         """The points of robot ``index``'s ``route`` that robots blocking it now can be on.
@@ -544,6 +560,7 @@ class RightOfWay:
             return False
         server.give_way(refuge)
         self._yields[index] = _Yield(to, now)
+        self._sent[(index, to)] = now
         self.yields_started += 1
         return True
 
