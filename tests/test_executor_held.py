@@ -137,3 +137,14 @@ def test_a_person_reads_when_and_for_whom_the_robot_was_held() -> None:
     assert describe(release, view) == (
         "waypoint 1/1 'p1': on its way again after 7.5 s held (not counted against its timeouts)"
     )
+
+
+def test_the_hold_events_as_json_records_follow_the_events_schema() -> None:
+    from navseq.sinks.json_events import event_record
+    from test_json_schemas import problems, validator
+
+    check = validator("events")
+    held_record = event_record(WaypointHeld(2.0, 0, 0, "giving way to r1"))
+    released_record = event_record(WaypointReleased(9.5, 0, 0, 7.5))
+    assert problems(check, held_record) == [] and problems(check, released_record) == []
+    assert released_record["held_s"] == 7.5  # the report's name for it
