@@ -72,6 +72,7 @@ def test_report_lists_every_attempt_of_every_visit() -> None:
     assert attempts[0]["status"] == "ABORTED" and attempts[0]["text"] == NO_PLAN
     assert set(attempts[0]) == {
         "number", "reached", "status", "reason", "text", "duration_s", "distance_m", "recoveries",
+        "held_s",
     }  # fmt: skip
     assert report["visits"][1]["attempts"][1]["status"] is None
     assert [a["reached"] for a in report["visits"][2]["attempts"]] == [True]

@@ -25,9 +25,9 @@ from navseq.fleet.coordinator import (
 )
 from navseq.fleet.lockstep import FleetClock, MemberNavigator
 from navseq.geometry import Pose2D
-from navseq.mission.model import Mission, Waypoint
+from navseq.mission.model import Mission, Policy, Waypoint
 from navseq.mission.robot import DEFAULT_PROFILE
-from navseq.navigators.base import Goal, GoalAccepted, GoalDone
+from navseq.navigators.base import Goal, GoalAccepted, GoalDone, GoalHeld, GoalReleased
 from navseq.signals import SignalGuard
 from navseq.sim.fleet_world import FleetRobot, FleetWorld
 from navseq.sim.footprint import footprints_overlap
@@ -45,11 +45,20 @@ class Outcome:
 
 
 def run_fleet(
-    grid, robots: list[tuple[str, Pose2D, list[Pose2D]]], *, coordinate: bool = True
+    grid,
+    robots: list[tuple[str, Pose2D, list[Pose2D]]],
+    *,
+    coordinate: bool = True,
+    policy: Policy | None = None,
+    right_of_way: bool = False,
+    listeners: dict[str, list] | None = None,
 ) -> Outcome:
-    """Each robot with goals runs them as a mission (one executor per thread); robots
-    without stay parked. Returns every mission's result and the stacks' statuses."""
-    world = FleetWorld(grid, [FleetRobot(n, s) for n, s, _ in robots], right_of_way=False)
+    """Each robot with goals runs them as a mission (one executor per thread, the
+    mission's defaults ``policy``); robots without stay parked. Returns every mission's
+    result and the stacks' statuses. ``right_of_way``: the simulator's own rule instead
+    of the coordinator (pass ``coordinate=False`` with it); ``listeners``: more mission
+    listeners per robot."""
+    world = FleetWorld(grid, [FleetRobot(n, s) for n, s, _ in robots], right_of_way=right_of_way)
     busy = [name for name, _, goals in robots if goals]
     clock = FleetClock(world, busy)
     navigators = {
@@ -81,10 +90,17 @@ def run_fleet(
             if isinstance(event, WaypointFinished):
                 statuses.append(f"{event.outcome.value} {event.reason}")
 
-        mission = Mission(tuple(Waypoint(g.x, g.y, yaw_rad=g.yaw) for g in goals))
+        mission = Mission(
+            tuple(Waypoint(g.x, g.y, yaw_rad=g.yaw) for g in goals), defaults=policy or Policy()
+        )
+        more = (listeners or {}).get(name, [])
         try:
             outcome.results[name] = run_mission(
-                mission, navigators[name], [hear], signals=SignalGuard(), robot=DEFAULT_PROFILE
+                mission,
+                navigators[name],
+                [hear, *more],
+                signals=SignalGuard(),
+                robot=DEFAULT_PROFILE,
             )
         finally:
             coordinator.leave(name)
@@ -188,19 +204,21 @@ def test_a_held_goal_waits_off_the_stack_and_the_executor_never_sees_the_way_asi
     navigator.send_goal(goal)
     stack.events = [GoalAccepted(7)]
     assert navigator.poll() == [GoalAccepted(7)]
-    navigator.hold()
+    navigator.hold("held back for q")
     assert navigator.mode == Mode.HELD and stack.cancels == 1
     stack.events = [GoalDone.failed(7, "CANCELED")]  # the hold's cancel: not the mission's
-    assert navigator.poll() == []
-    navigator.aside(Pose2D(0.0, 1.0, 0.0))
+    # The executor hears that its goal is held (its clocks stand still), not the cancel.
+    assert navigator.poll() == [GoalHeld(7, "held back for q")]
+    navigator.aside(Pose2D(0.0, 1.0, 0.0), "giving way to q")
     aside = stack.sent[-1]
     assert aside.goal_id < 0
     stack.events = [GoalAccepted(aside.goal_id), GoalDone.succeeded(aside.goal_id)]
-    assert navigator.poll() == [] and not navigator.aside_driving
+    assert navigator.poll() == [] and not navigator.aside_driving  # held already: once
     navigator.release()
     assert stack.sent[-1] == goal  # the mission's goal again, same id
     stack.events = [GoalAccepted(7), GoalDone.succeeded(7)]
-    assert navigator.poll() == [GoalDone.succeeded(7)]  # accepted once is enough
+    # Released, then the goal's own end; accepted once is enough.
+    assert navigator.poll() == [GoalReleased(7), GoalDone.succeeded(7)]
     assert navigator.goal is None and not navigator.busy
 
 
@@ -211,8 +229,10 @@ def test_a_goal_sent_while_held_waits_for_the_release():
     navigator.hold()
     navigator.send_goal(Goal(2, Pose2D(2.0, 0.0, 0.0)))
     assert [g.goal_id for g in stack.sent] == [1]
+    assert navigator.poll() == [GoalHeld(1), GoalHeld(2)]  # the new goal is held too
     navigator.release()
     assert [g.goal_id for g in stack.sent] == [1, 2]
+    assert navigator.poll() == [GoalReleased(2)]
 
 
 @pytest.mark.parametrize("mode", ["hold", "aside"])

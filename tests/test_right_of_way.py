@@ -199,3 +199,23 @@ def test_robots_that_start_overlapping_are_refused() -> None:
             rooms_with_one_door(),
             [FleetRobot("a", Pose2D(1.0, 1.0, 0.0)), FleetRobot("b", Pose2D(1.1, 1.0, 0.0))],
         )
+
+
+def test_two_robots_almost_touching_do_not_send_each_other_aside_over_and_over() -> None:
+    """The livelock of issue 21 (seed 8 of the fleet benchmark, from where it began): two
+    robots 0.28 m apart in an office, the second sent aside for the first, find each
+    other in their ways aside. The rule used to send them aside for each other at every
+    decision, four times a second, each new way aside replacing the last before either
+    could move (64 ways aside in this scenario); a robot sent aside for another now
+    waits for it rather than sending it aside in turn."""
+    from navseq.sim.mapgen import office_map
+
+    first, second = Pose2D(3.467, 7.105, -1.756), Pose2D(3.661, 6.909, -2.864)
+    fleet = FleetWorld(office_map(8), [FleetRobot("a", first), FleetRobot("b", second)])
+    goals = {"a": Pose2D(4.875, 6.325, -0.694), "b": Pose2D(15.025, 8.825, 2.559)}
+    for name, goal in goals.items():
+        fleet.set_goal(name, goal)
+    arrived = drive(fleet)
+    for name, goal in goals.items():
+        assert near(arrived.get(name), goal), states(fleet)
+    assert fleet.right_of_way is not None and fleet.right_of_way.yields_started <= 10

@@ -64,7 +64,7 @@ def test_the_report_of_a_long_patrol_says_what_it_aggregated() -> None:
         mission, harness.executor.result, exit_code=130, navigator={"kind": "scripted"}
     )
     report = json.loads(json.dumps(report))
-    assert report["schema_version"] == SCHEMA_VERSION == 8
+    assert report["schema_version"] == SCHEMA_VERSION == 9
     assert report["totals"]["visits"] == 4001 and report["totals"]["reached"] == 4000
     assert report["visits_listed"]["listed"] == len(report["visits"]) == KEEP_LAST_VISITS
     assert report["visits_listed"]["omitted"] == 4001 - KEEP_LAST_VISITS

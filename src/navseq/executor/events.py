@@ -213,6 +213,29 @@ class MissionResumed:
 
 
 @dataclass(frozen=True)
+class WaypointHeld:
+    """The fleet holds the robot back from the waypoint's goal (it waits, or gives way
+    to another robot: ``reason``). The goal's timeout and stall clocks stand still until
+    :class:`WaypointReleased`: the wait is the fleet's doing, not the robot's."""
+
+    t: float
+    index: int
+    loop: int
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class WaypointReleased:
+    """The hold ended (the robot is back on its way, or the attempt ended while held);
+    ``held_for`` seconds were not counted against the goal's timeout and stall clocks."""
+
+    t: float
+    index: int
+    loop: int
+    held_for: float
+
+
+@dataclass(frozen=True)
 class MissionFinished:
     t: float
     success: bool  # every waypoint reached
@@ -232,6 +255,8 @@ MissionEvent = (
     | RecoveryStarted
     | RecoveryFinished
     | WaypointFinished
+    | WaypointHeld
+    | WaypointReleased
     | ServerStatusChanged
     | MissionPaused
     | MissionResumed

@@ -43,6 +43,13 @@ apply to the navigator, in order. What happened is told to listeners as mission
 events (:mod:`navseq.executor.events`), and :attr:`~MissionExecutor.result`
 summarises the run. :func:`navseq.executor.runner.run_mission` is the usual driver.
 
+Fleets: a navigator whose robot the fleet holds back (it waits, or gives way to another
+robot) says so with ``GoalHeld`` and ``GoalReleased`` about the goal out. In between the
+goal's timeout and stall clocks stand still (the wait is the fleet's doing; the fleet
+bounds it), and :class:`~navseq.executor.events.WaypointHeld` /
+:class:`~navseq.executor.events.WaypointReleased` tell the sinks; each attempt's result
+keeps the seconds held (``held``), part of its duration as a pause's are.
+
 Navigators are expected to report a vanished server with ``ServerLost`` (or the
 goal's ``LOST`` status) and its return with ``ServerBack``; the executor then resends
 the active goal without counting it as a failed attempt.
@@ -94,9 +101,11 @@ from navseq.executor.events import (
     TaskStarted,
     WaypointDwelling,
     WaypointFinished,
+    WaypointHeld,
     WaypointOutcome,
     WaypointPlan,
     WaypointProgress,
+    WaypointReleased,
     WaypointStarted,
 )
 from navseq.executor.monitor import AttemptMonitor
@@ -115,8 +124,10 @@ from navseq.navigators.base import (
     Goal,
     GoalDone,
     GoalFeedback,
+    GoalHeld,
     GoalOutcome,
     GoalPlan,
+    GoalReleased,
     NavEvent,
     RecoveryDone,
     ServerBack,
@@ -327,6 +338,11 @@ class MissionExecutor:
             return []  # about a goal we replaced or gave up on
         if isinstance(event, GoalFeedback):
             return self._on_feedback(now, event)
+        if isinstance(event, GoalHeld):
+            return self._on_held(now, event)
+        if isinstance(event, GoalReleased):
+            self._end_hold(now)
+            return []
         if isinstance(event, GoalPlan):
             self._monitor.adopt_plan(event.path, self._latest_pose)
             # Sinks get the plan's corners only: a journal, a picture and markers need no
@@ -399,6 +415,7 @@ class MissionExecutor:
         interrupted: ExecutorState = self._state
         if interrupted is ExecutorState.PAUSED:
             interrupted = self._end_pause(now)
+        self._end_hold(now)
         stopped = [*self._stop_task(now, reason), *self._stop_recovery(now, reason)]
         if interrupted is ExecutorState.DWELLING:
             self._finish_visit(now, WaypointOutcome.REACHED, "")
@@ -420,6 +437,7 @@ class MissionExecutor:
             return []
         commands: list[Command] = []
         if self._state is ExecutorState.ACTIVE:
+            self._end_hold(now)  # the pause holds every clock now; a new goal is held anew
             commands.append(CancelGoal())
         if self._task is not None:  # run again from its start on resume
             commands.append(CancelTask(self._task.task_id))
@@ -486,6 +504,7 @@ class MissionExecutor:
             self._started_at = now
             self._finish_mission(now, reason)
             return []
+        self._end_hold(now)
         stopped = [*self._stop_task(now, reason), *self._stop_recovery(now, reason)]
         self._finish_visit(now, WaypointOutcome.FAILED, reason)
         self._finish_mission(now, reason)
@@ -565,6 +584,7 @@ class MissionExecutor:
     def _reached(
         self, now: float, *, passed_through: bool, status: str | None = None, text: str = ""
     ) -> list[Command]:
+        self._end_hold(now)
         visit = self._current
         visit.reached_at = now
         visit.close_attempt(now, reached=True, status=status, reason="", text=text)
@@ -855,6 +875,7 @@ class MissionExecutor:
         status: str | None = None,
         text: str = "",
     ) -> list[Command]:
+        self._end_hold(now)
         visit = self._current
         commands: list[Command] = [CancelGoal()] if cancel else []
         attempts = visit.result.attempts
@@ -911,6 +932,7 @@ class MissionExecutor:
         if event.outcome is GoalOutcome.LOST:
             # Not the waypoint's fault: the stack lost track of the goal. Treat it as
             # a vanished server and resend once it reports back.
+            self._end_hold(now)
             self._mark_server_lost(now, event.text or f"goal {event.status or 'LOST'}")
             self._move(Trigger.SERVER_AWAY)
             self._monitor = None
@@ -941,6 +963,7 @@ class MissionExecutor:
     def _on_server_lost(self, now: float, reason: str) -> list[Command]:
         self._mark_server_lost(now, reason)
         if self._state is ExecutorState.ACTIVE:
+            self._end_hold(now)
             self._move(Trigger.SERVER_AWAY)
             self._monitor = None
         return []
@@ -952,6 +975,29 @@ class MissionExecutor:
         if self._state is ExecutorState.WAITING_SERVER:
             return self._send_goal(now)  # same attempt: the loss was not the waypoint's fault
         return []
+
+    # ------------------------------------------------------------------ fleet holds
+
+    def _on_held(self, now: float, event: GoalHeld) -> list[Command]:
+        """The fleet holds the robot back: the goal's clocks stand still until released."""
+        monitor = self._monitor
+        assert monitor is not None
+        if monitor.held_since is None:
+            monitor.hold(now)
+            visit = self._current
+            self._emit(WaypointHeld(t=now, index=visit.index, loop=visit.loop, reason=event.reason))
+        return []
+
+    def _end_hold(self, now: float) -> None:
+        """End a hold of the goal out, if any (released, or the attempt ends while held):
+        its deadlines move on by the time held, which the attempt's result keeps."""
+        monitor = self._monitor
+        held = monitor.release(now) if monitor is not None else None
+        if held is None:
+            return
+        visit = self._current
+        visit.attempt_held += held
+        self._emit(WaypointReleased(t=now, index=visit.index, loop=visit.loop, held_for=held))
 
     # ------------------------------------------------------------------ clock
 

@@ -10,6 +10,10 @@ measure restarts the best distance from the new measure's value; a re-plan shift
 by how much longer or shorter the new plan is from where the robot stands, so neither
 counts as progress nor as its loss. The stall clock itself is never restarted by
 either. Near the goal, turning towards the goal's yaw is progress too.
+
+While the fleet holds the robot back (:meth:`AttemptMonitor.hold` to
+:meth:`AttemptMonitor.release`: it waits, or gives way to another robot) both clocks
+stand still, and progress is judged afresh after it: the robot was moved off its way.
 """
 
 from __future__ import annotations
@@ -53,6 +57,7 @@ class AttemptMonitor:
         self.measure: Measure | None = None  # the best measure seen so far
         self.best_distance: float | None = None  # on ``measure``; None: the next value sets it
         self.best_yaw_error: float | None = None
+        self.held_since: float | None = None  # while the fleet holds the robot back
 
     def resumed(self, goal: Goal, paused_for: float) -> AttemptMonitor:
         """A monitor for ``goal``, sent again after a pause of ``paused_for`` seconds.
@@ -64,10 +69,30 @@ class AttemptMonitor:
         monitor.last_progress_at = self.last_progress_at + paused_for
         return monitor
 
+    def hold(self, now: float) -> None:
+        """The fleet holds the robot back from now on: the clocks stand still."""
+        if self.held_since is None:
+            self.held_since = now
+
+    def release(self, now: float) -> float | None:
+        """The hold ended at ``now``: the deadlines move on by its length (returned;
+        None when the robot was not held), and progress is judged afresh."""
+        since, self.held_since = self.held_since, None
+        if since is None:
+            return None
+        held = max(0.0, now - since)
+        self.sent_at += held
+        self.last_progress_at += held
+        self.measure, self.best_distance, self.best_yaw_error = None, None, None
+        return held
+
     def overdue(
         self, now: float, goal_timeout_s: float | None, stall_timeout_s: float | None
     ) -> str | None:
-        """``"timeout"`` or ``"stalled"`` when the goal ran out of time, else None."""
+        """``"timeout"`` or ``"stalled"`` when the goal ran out of time, else None
+        (never while the robot is held back: its clocks stand still)."""
+        if self.held_since is not None:
+            return None
         if goal_timeout_s is not None and now - self.sent_at >= goal_timeout_s:
             return "timeout"
         if stall_timeout_s is not None and now - self.last_progress_at >= stall_timeout_s:
@@ -104,7 +129,10 @@ class AttemptMonitor:
         """Judge a pose (and the navigator's distance remaining, if it gave one).
 
         Returns whether it is progress; the stall clock restarts at ``now`` if so.
+        Nothing is judged while the robot is held back (it drives aside, or waits).
         """
+        if self.held_since is not None:
+            return False
         goal = self.goal.pose
         straight = pose.distance_to(goal)
         progressed = self._distance_progressed(pose, straight, navigator_distance)

@@ -39,6 +39,9 @@ class AttemptResult:
     # Recovery behaviours the stack ran for this goal (Nav2's number_of_recoveries, as
     # last reported); None where the stack does not count them.
     recoveries: int | None = None
+    # s of ``duration`` the fleet held the robot back (waiting, or giving way to another
+    # robot): not counted against the goal's timeout and stall clocks.
+    held: float = 0.0
 
     @property
     def duration_s(self) -> float:
@@ -49,6 +52,11 @@ class AttemptResult:
     def distance_m(self) -> float:
         """Metres driven during this attempt."""
         return self.distance_driven
+
+    @property
+    def held_s(self) -> float:
+        """Seconds of the attempt the fleet held the robot back (waiting, giving way)."""
+        return self.held
 
 
 @dataclass
@@ -97,6 +105,12 @@ class WaypointResult:
     attempt_results: list[AttemptResult] = field(default_factory=list)  # in order
     tasks: list[TaskResult] = field(default_factory=list)  # every task run, in order
     recoveries: list[RecoveryResult] = field(default_factory=list)  # run before retries
+
+    @property
+    def held_s(self) -> float:
+        """Seconds the fleet held the robot back during this visit (waiting, giving way
+        to another robot), all attempts together; part of ``duration_s``."""
+        return sum(attempt.held for attempt in self.attempt_results)
 
     @property
     def yaw_deg(self) -> float:

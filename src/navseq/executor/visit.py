@@ -31,6 +31,7 @@ class Visit:
     # The stack's count of recovery behaviours for the current attempt's goal, when the
     # stack gives one (Nav2's number_of_recoveries); None: not known.
     attempt_recoveries: int | None = None
+    attempt_held: float = 0.0  # s the fleet held the robot back during the current attempt
     # The waypoint's tasks: the 0-based position of the one to run next (tasks before it
     # have succeeded), and which run of it this is (1 + its failures so far).
     next_task: int = 0
@@ -72,6 +73,7 @@ class Visit:
         self.attempt_sent_at = now
         self.attempt_start_distance = self.result.distance_driven
         self.attempt_recoveries = None
+        self.attempt_held = 0.0
 
     def goal_sent(self, now: float) -> None:
         if self.first_sent_at is None:
@@ -90,6 +92,7 @@ class Visit:
             duration=max(0.0, now - self.attempt_sent_at),
             distance_driven=self.result.distance_driven - self.attempt_start_distance,
             recoveries=self.attempt_recoveries,
+            held=self.attempt_held,
         )
         self.result.attempt_results.append(record)
         return record

@@ -53,7 +53,9 @@ from navseq.navigators.base import (
     Goal,
     GoalAccepted,
     GoalDone,
+    GoalHeld,
     GoalOutcome,
+    GoalReleased,
     NavEvent,
     Navigator,
 )
@@ -78,8 +80,10 @@ class CoordinatedNavigator:
     :meth:`hold` the robot (its goal is cancelled on the stack but stays the mission's)
     or send it :meth:`aside` (a goal of the coordinator's, whose events the executor
     never sees), and :meth:`release` it (the mission's goal is sent again, same id).
-    A goal the executor sends meanwhile waits until then. Every other attribute (ROS
-    tasks, recoveries, recording taps) is the wrapped navigator's.
+    A goal the executor sends meanwhile waits until then. While held or aside, the
+    executor hears ``GoalHeld`` about its goal, and ``GoalReleased`` after: the wait is
+    the fleet's doing, so its goal's timeout and stall clocks stand still. Every other
+    attribute (ROS tasks, recoveries, recording taps) is the wrapped navigator's.
     """
 
     def __init__(self, inner: Navigator, name: str) -> None:
@@ -95,6 +99,9 @@ class CoordinatedNavigator:
         self.aside_driving = False  # the way aside is being driven (not there, not failed)
         self.aside_failed = False
         self.goal_changed = 0  # counts goals sent to the stack, for the coordinator's watch
+        self._news: list[NavEvent] = []  # GoalHeld / GoalReleased for the executor
+        self._held_goal: int | None = None  # the mission's goal the executor knows is held
+        self._held_reason = ""
         self.trajectory: list[tuple[float, float, float]] = []  # (t, x, y), for the picture
 
     def __getattr__(self, name: str) -> Any:
@@ -118,6 +125,8 @@ class CoordinatedNavigator:
             self._accepted.discard(goal.goal_id)
             if self.mode == Mode.FREE:
                 self._to_stack(goal)
+            else:
+                self._tell_held()  # a new goal while held: it waits too
 
     def cancel_goal(self) -> None:
         with self._lock:
@@ -140,7 +149,8 @@ class CoordinatedNavigator:
 
     def poll(self) -> list[NavEvent]:
         with self._lock:
-            return [event for event in self.inner.poll() if self._passes(event)]
+            news, self._news = self._news, []
+            return news + [event for event in self.inner.poll() if self._passes(event)]
 
     def spin(self, seconds: float) -> None:
         self.inner.spin(seconds)
@@ -174,10 +184,11 @@ class CoordinatedNavigator:
             return self.aside_target
         return self._goal.pose if self._goal is not None else None
 
-    def hold(self) -> None:
+    def hold(self, reason: str = "") -> None:
         """Stand still: the mission's goal off the stack (a way aside ends where the
-        robot is), kept for :meth:`release`."""
+        robot is), kept for :meth:`release`. ``reason``: for whom, for the executor."""
         with self._lock:
+            self._held_reason = reason
             if (self.mode == Mode.FREE and self._goal is not None) or (
                 self.mode == Mode.ASIDE and self.aside_driving
             ):
@@ -185,10 +196,12 @@ class CoordinatedNavigator:
             self.mode = Mode.HELD
             self.aside_target, self._aside_id = None, None
             self.aside_driving = False
+            self._tell_held()
 
-    def aside(self, target: Pose2D) -> None:
+    def aside(self, target: Pose2D, reason: str = "") -> None:
         """Drive to ``target`` and stay there; the mission's goal waits."""
         with self._lock:
+            self._held_reason = reason
             self._aside_ids -= 1  # the executor's ids are positive: these never clash
             self._aside_id = self._aside_ids
             frame = self._goal.frame if self._goal is not None else "map"
@@ -197,6 +210,7 @@ class CoordinatedNavigator:
             self.aside_driving, self.aside_failed = True, False
             self.goal_changed += 1
             self.inner.send_goal(Goal(self._aside_id, target, frame=frame))
+            self._tell_held()
 
     def release(self) -> None:
         """Back to the mission: its goal (if one is out) is sent again."""
@@ -207,10 +221,20 @@ class CoordinatedNavigator:
             self.mode = Mode.FREE
             self.aside_target, self._aside_id = None, None
             self.aside_driving = False
+            if self._held_goal is not None:
+                self._news.append(GoalReleased(self._held_goal))
+                self._held_goal = None
             if self._goal is not None:
                 self._to_stack(self._goal)
             elif driving:
                 self.inner.cancel_goal()
+
+    def _tell_held(self) -> None:
+        """The executor hears once that its goal out is held (aside counts as held)."""
+        goal = self._goal
+        if goal is not None and self._held_goal != goal.goal_id:
+            self._held_goal = goal.goal_id
+            self._news.append(GoalHeld(goal.goal_id, self._held_reason))
 
     def _to_stack(self, goal: Goal) -> None:
         self.goal_changed += 1
@@ -294,6 +318,10 @@ class FleetCoordinator:
     yield_limit = 90.0  # s a robot gives way before it takes its goal up again anyway
     hold_limit = 30.0  # s a robot is held back at most for one robot's way aside
     route_age = 2.0  # s before a robot's route on the bare map is planned again
+    # s after robot A was sent aside for robot B during which A does not send B aside,
+    # nor make B make way for it, in turn (the rule's ``return_guard``: two robots almost
+    # touching would send each other aside for ever).
+    return_guard = 10.0
 
     def __init__(
         self,
@@ -321,6 +349,7 @@ class FleetCoordinator:
         self._watch = [_Watch() for _ in robots]
         self._yields: dict[int, _Yield] = {}
         self._holds: dict[int, _Hold] = {}
+        self._sent: dict[tuple[int, int], float] = {}  # (index, for whom) -> when sent aside
         self._next = -math.inf
         self._running: set[str] = set()  # robots whose mission's thread polls their navigator
         self._stop = threading.Event()
@@ -515,7 +544,7 @@ class FleetCoordinator:
                     if mine is not None and self._in_band(yielding.to, index, mine, poses):
                         # Its own way runs where the other robot still goes: it waits
                         # here, its goal off the stack, rather than for the stack to give up.
-                        navigator.hold()
+                        navigator.hold(f"waiting aside for {self.names[yielding.to]}")
                         self._holds[index] = _Hold(yielding.to, now)
                         self._say(f"{self.names[index]} waits aside for {self.names[yielding.to]}")
                         continue
@@ -547,7 +576,7 @@ class FleetCoordinator:
         """Robot ``index`` waits, its goal off the stack, while ``for_`` clears its way."""
         navigator = self._nav(index)
         if navigator.mode == Mode.FREE and navigator.goal is not None:
-            navigator.hold()
+            navigator.hold(f"held back for {self.names[for_]}")
             self._holds[index] = _Hold(for_, now)
             self.held_back += 1
             self._say(f"{self.names[index]} held back for {self.names[for_]}")
@@ -592,6 +621,8 @@ class FleetCoordinator:
             for other in sorted(in_way, key=self._rank):
                 if other in self._yields and self._yields[other].to == index:
                     continue  # already on its way aside for this one
+                if now - self._sent.get((index, other), -math.inf) < self.return_guard:
+                    continue  # sent aside for it a moment ago: it waits for it to move
                 if other == giving_way_to:
                     self._send_aside(other, index, route, poses, now)
                     continue
@@ -602,7 +633,10 @@ class FleetCoordinator:
                     break
                 if self._send_aside(other, index, route, poses, now):
                     self._hold(index, other, now)
-                elif self._nav(other).pursuing:
+                elif (
+                    self._nav(other).pursuing
+                    and now - self._sent.get((other, index), -math.inf) >= self.return_guard
+                ):
                     # Inversion: the robot in the way cannot get out of it; make way for it.
                     other_route = self._route(other, poses[other], now)
                     if other_route is not None and self._send_aside(
@@ -638,12 +672,13 @@ class FleetCoordinator:
         if refuge is None:
             return False
         self._holds.pop(index, None)  # held for another robot: now it moves out of the way
-        self._nav(index).aside(refuge)
+        self._nav(index).aside(refuge, f"giving way to {self.names[to]}")
         self._say(
             f"{self.names[index]} sent aside to ({refuge.x:.2f}, {refuge.y:.2f}) "
             f"for {self.names[to]}"
         )
         self._yields[index] = _Yield(to, now)
+        self._sent[(index, to)] = now
         watch = self._watch[index]
         watch.route, watch.moved_at, watch.travelled_at = None, now, now
         self.sent_aside += 1

@@ -27,6 +27,7 @@ def member_summary(member: Member) -> dict[str, Any]:
         "failed": member.counts["failed"],
         "mission_time_s": None,
         "distance_m": None,
+        "held_s": None,
         "exit_status": None,
         "folder": None,
     }
@@ -45,6 +46,8 @@ def member_summary(member: Member) -> dict[str, Any]:
             row[key] = next((n for o, n in counts.items() if o.value == key), 0)
         row["mission_time_s"] = round(result.duration_s, 1)
         row["distance_m"] = round(result.distance_m, 2)
+        # Waiting or giving way for the others: not counted against its goals' timeouts.
+        row["held_s"] = round(sum(visit.held_s for visit in result.visits), 1)
         row["exit_status"] = outcome.exit_status
         row["folder"] = str(outcome.folder) if outcome.folder is not None else None
         # A resumed run's report is beside the first one (report-2.json ...).

@@ -58,6 +58,8 @@ EVENT_TYPES: dict[str, type] = {
         ev.RecoveryStarted,
         ev.RecoveryFinished,
         ev.WaypointFinished,
+        ev.WaypointHeld,
+        ev.WaypointReleased,
         ev.MissionPaused,
         ev.MissionResumed,
         ev.ServerStatusChanged,

@@ -103,6 +103,8 @@ class _VisitTrail:
     recoveries: int | None = None
     # The recoveries run before its retries (RecoveryFinished), in order.
     recovery_runs: list[RecoveryResult] = field(default_factory=list)
+    # Seconds the fleet held the robot back, per attempt number (WaypointReleased).
+    held: dict[int, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -213,10 +215,19 @@ class VisitHistory:
                 )
             )
 
+    def release(self, event: ev.WaypointReleased) -> None:
+        """A hold of the fleet's ended: its time goes to the attempt last started."""
+        trail = self._trail
+        if trail is not None and trail.key == (event.loop, event.index) and trail.sent_at:
+            attempt = max(trail.sent_at)
+            trail.held[attempt] = trail.held.get(attempt, 0.0) + max(0.0, event.held_for)
+
     def fail_attempt(self, event: ev.AttemptFailed) -> None:
         # The visit is the one last started: older journals name no loop here.
         if self._trail is not None:
-            self._trail.failures[event.attempt] = _attempt_of(event)
+            attempt = _attempt_of(event)
+            attempt.held = self._trail.held.get(event.attempt, 0.0)
+            self._trail.failures[event.attempt] = attempt
 
     def finish_visit(self, event: ev.WaypointFinished, where: str) -> None:
         key = (event.loop, event.index)
@@ -360,6 +371,8 @@ def _fold(state: JournalState, entries: Iterable[Entry]) -> None:
             visits.start_visit(event)
         elif isinstance(event, ev.AttemptFailed):
             visits.fail_attempt(event)
+        elif isinstance(event, ev.WaypointReleased):
+            visits.release(event)
         elif isinstance(event, ev.TaskFinished):
             visits.finish_task(event)
         elif isinstance(event, ev.RecoveryFinished):
@@ -454,6 +467,7 @@ def _attempts_of(event: ev.WaypointFinished, trail: _VisitTrail | None) -> list[
                 duration=0.0 if end is None or last_sent is None else max(0.0, end - last_sent),
                 distance_driven=max(0.0, event.distance_driven - before),
                 recoveries=trail.recoveries if trail is not None else None,
+                held=trail.held.get(last, 0.0) if trail is not None else 0.0,
             )
         )
     return attempts

@@ -129,8 +129,38 @@ class RecoveryDone:
     detail: str = ""
 
 
+@dataclass(frozen=True)
+class GoalHeld:
+    """The fleet holds the robot back from goal ``goal_id``: it waits, or was sent aside,
+    while another robot passes (navseq's fleet coordinator, the simulator's right of way).
+
+    The goal stays the mission's; the wait is the fleet's doing, not the robot's, so the
+    executor stops the goal's timeout and stall clocks until :class:`GoalReleased`. The
+    holder bounds the wait itself (the coordinator's ``hold_limit`` / ``yield_limit``,
+    the rule's ``yield_limit``). ``reason`` says for whom, in people's words.
+    """
+
+    goal_id: int
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class GoalReleased:
+    """The robot is back on its way to goal ``goal_id`` after :class:`GoalHeld`."""
+
+    goal_id: int
+
+
 NavEvent = (
-    GoalAccepted | GoalFeedback | GoalPlan | GoalDone | ServerLost | ServerBack | RecoveryDone
+    GoalAccepted
+    | GoalFeedback
+    | GoalPlan
+    | GoalDone
+    | GoalHeld
+    | GoalReleased
+    | ServerLost
+    | ServerBack
+    | RecoveryDone
 )
 
 

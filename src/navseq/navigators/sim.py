@@ -10,6 +10,9 @@ Events follow what an actionlib client of move_base would see:
 - ``GoalPlan`` each time the navigation server adopts a new plan for it;
 - ``GoalFeedback`` (pose, distance remaining along the plan) every ``feedback_period``
   seconds of simulated time while the goal is active;
+- ``GoalHeld`` / ``GoalReleased`` while a fleet's right of way holds the robot back
+  (it waits for a robot the rule deals with, or gives way to one; the goal's server
+  stays ACTIVE);
 - ``GoalDone`` succeeded (status SUCCEEDED) or failed (ABORTED), the server's verdict
   and its reason, or failed (PREEMPTED) for a goal that was cancelled or replaced by
   a newer one.
@@ -30,7 +33,9 @@ from navseq.navigators.base import (
     GoalAccepted,
     GoalDone,
     GoalFeedback,
+    GoalHeld,
     GoalPlan,
+    GoalReleased,
     NavEvent,
     RecoveryDone,
 )
@@ -92,6 +97,7 @@ class SimNavigator:
         self.trajectory.append((world.time, pose.x, pose.y))
         self._events: list[NavEvent] = []
         self._active: Goal | None = None
+        self._held = False  # GoalHeld told about the active goal, GoalReleased not yet
         self._plan_version = world.server.plan_version
         self._next_feedback = math.inf
         self._unspun = 0.0  # simulated seconds asked for but shorter than a step
@@ -132,6 +138,7 @@ class SimNavigator:
                 GoalDone.failed(self._active.goal_id, _PREEMPTED, "replaced by a new goal")
             )
         self._active = goal
+        self._held = False  # a goal still held is told so at the next step
         self.world.server.set_goal(goal.pose)
         self._events.append(GoalAccepted(goal.goal_id))
         self._next_feedback = self.world.time + self.feedback_period
@@ -233,6 +240,12 @@ class SimNavigator:
         """Turn what the server did during the last step into events."""
         world = self.world
         server = world.server
+        held = server.held_reason
+        if (held is not None) != self._held:
+            self._held = held is not None
+            self._events.append(
+                GoalHeld(goal.goal_id, held) if held is not None else GoalReleased(goal.goal_id)
+            )
         if server.plan_version != self._plan_version and server.plan is not None:
             self._plan_version = server.plan_version
             path = tuple((float(x), float(y)) for x, y in server.plan.points)

@@ -167,6 +167,9 @@ class NavigationServer:
         self._remaining_at_recovery = math.inf
         self.recoveries_run = 0
         self.costmap_version = 0
+        # Set by a fleet's right of way while it holds the robot back (it waits for a
+        # robot the fleet deals with, or gives way to one): for whom. None: not held.
+        self.held_reason: str | None = None
         self._use_costmap(costmap)
 
     # -- goal life cycle -------------------------------------------------------------

@@ -31,6 +31,10 @@ and priority inheritance, in the spirit of PIBT (Okumura et al., 2022):
 - **Patience.** A blocked robot for which some robot is giving way, or that waits for
   a higher-ranked one, has its server's patience (``blocked_patience``) restarted: the
   fleet is dealing with it. A conflict nobody can resolve still ends ABORTED.
+- **Held.** Such a robot, and one giving way, is *held* (``held_reason`` on its server,
+  until the next decision finds it no longer so): a mission's executor stops its goal's
+  timeout and stall clocks meanwhile (``GoalHeld`` / ``GoalReleased`` from the ``sim``
+  navigator), since the wait is the fleet's doing.
 
 The highest-ranked blocked robot always has its way cleared whenever refuges exist,
 so it progresses; when it is done the next one is highest. Decisions are taken every
@@ -328,11 +332,17 @@ class RightOfWay:
     # m beyond a blocked robot's sensing range within which its route's points count for
     # who is in its way: a robot its server sees blocks route points this near it
     sight_margin = 1.0
+    # s after robot A was sent aside for robot B during which A does not send B aside,
+    # nor B make way for A, in turn: two robots almost touching would otherwise send each
+    # other aside at every decision, each new way aside replacing the last before either
+    # moved (a livelock). A waits for B to move instead.
+    return_guard = 10.0
 
     def __init__(self, fleet: FleetWorld) -> None:
         self.fleet = fleet
         self._watch = [_Watch(world.robot.pose) for world in fleet.worlds]
         self._yields: dict[int, _Yield] = {}
+        self._sent: dict[tuple[int, int], float] = {}  # (index, for whom) -> when sent aside
         self._next = 0.0
         self.yields_started = 0  # how often a robot was sent aside (benchmarks, tests)
 
@@ -345,7 +355,19 @@ class RightOfWay:
         poses = [world.robot.pose for world in self.fleet.worlds]
         self._note_motion(poses, now)
         self._end_yields(poses, now)
-        self._resolve(poses, now)
+        self._mark_held(self._resolve(poses, now))
+
+    def _mark_held(self, waiting: dict[int, int]) -> None:
+        """Say on each server whether the fleet holds its robot back, and for whom:
+        giving way, or waiting (``waiting``: index -> the robot it waits on)."""
+        names = self.fleet.names
+        for index, server in enumerate(self.fleet.servers):
+            if index in self._yields:
+                server.held_reason = f"giving way to {names[self._yields[index].to]}"
+            elif index in waiting:
+                server.held_reason = f"waiting for {names[waiting[index]]}"
+            else:
+                server.held_reason = None
 
     # -- state -----------------------------------------------------------------------
 
@@ -426,7 +448,10 @@ class RightOfWay:
                 if server.giving_way:
                     server.end_give_way()
 
-    def _resolve(self, poses: list[Pose2D], now: float) -> None:
+    def _resolve(self, poses: list[Pose2D], now: float) -> dict[int, int]:
+        """Start the giving way that is needed; returns the blocked robots the fleet is
+        dealing with (index -> the robot it waits on, or that gives way for it)."""
+        waiting: dict[int, int] = {}
         count = len(poses)
         blocked = sorted(
             (index for index in range(count) if self._blocked(index, now)), key=self._rank
@@ -445,33 +470,46 @@ class RightOfWay:
                 for other in range(count)
                 if other != index and self._in_band(other, index, ahead, poses)
             ]
-            helped = False
+            helped: int | None = None  # the first robot the fleet deals with for it
             giving_way_to = self._yields[index].to if index in self._yields else None
             for other in sorted(in_way, key=self._rank):
+                if self._sent_for_lately(index, other, now):
+                    # Sent aside for ``other`` a moment ago: it does not send ``other``
+                    # aside in turn, it waits for it to move (see ``return_guard``).
+                    helped = other if helped is None else helped
+                    continue
                 if other == giving_way_to:
                     # The robot this one makes way for blocks its way aside: it steps
                     # out of that way instead (a cycle of giving way, which ends as
                     # soon as either is through).
-                    helped = self._send_aside(other, index, route, poses, now) or helped
+                    if self._send_aside(other, index, route, poses, now) and helped is None:
+                        helped = other
                     continue
                 if self._rank(other) < rank:
-                    helped = True  # a higher-ranked robot: wait for it
+                    helped = other if helped is None else helped  # higher-ranked: wait
                     continue
                 if other in self._yields and self._yields[other].to == index:
-                    helped = True  # already on its way aside
+                    helped = other if helped is None else helped  # already on its way aside
                     continue
                 if self._send_aside(other, index, route, poses, now):
-                    helped = True
-                elif self._pursuing(other):
+                    helped = other if helped is None else helped
+                elif self._pursuing(other) and not self._sent_for_lately(other, index, now):
                     # Inversion: the robot in the way cannot get out of it; make way for it.
                     other_route = self._route(other, poses[other], now)
                     if other_route is not None and self._send_aside(
                         index, other, other_route, poses, now
                     ):
-                        helped = True
+                        helped = other if helped is None else helped
                         break
-            if helped:
+            if helped is not None:
                 servers[index].extend_patience()
+                waiting[index] = helped
+        return waiting
+
+    def _sent_for_lately(self, index: int, other: int, now: float) -> bool:
+        """True if robot ``index`` was sent aside for ``other`` less than
+        ``return_guard`` seconds ago."""
+        return now - self._sent.get((index, other), -math.inf) < self.return_guard
 
     def _stretch_in_reach(self, index: int, route: np.ndarray, pose: Pose2D) -> np.ndarray:
         """The points of robot ``index``'s ``route`` that robots blocking it now can be on.
@@ -522,6 +560,7 @@ class RightOfWay:
             return False
         server.give_way(refuge)
         self._yields[index] = _Yield(to, now)
+        self._sent[(index, to)] = now
         self.yields_started += 1
         return True
 

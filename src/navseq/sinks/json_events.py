@@ -16,7 +16,8 @@ whenever a field is renamed, removed or changes meaning, and when one is added
 (version 2: ``recoveries`` and ``navigation_time_s`` in ``WaypointProgress``,
 ``recoveries`` in ``AttemptFailed``, from stacks that count them, like Nav2; version 3:
 ``number`` beside every ``index``, and ``RunFinished``'s ``clock``; version 6: ``robot``
-in every record of ``navseq run --fleet --json``).
+in every record of ``navseq run --fleet --json``, and ``WaypointHeld`` and
+``WaypointReleased``, a fleet holding a robot back).
 
 The renames live in one table, :data:`FIELDS`, applied to every event type, so a
 field means the same in every record; a new event field without an entry is written
@@ -70,6 +71,7 @@ FIELDS: dict[str, tuple[str, Callable[[Any], Any] | None]] = {
     "distance_remaining": ("distance_remaining_m", None),
     "navigation_time": ("navigation_time_s", None),
     "seconds": ("dwell_s", None),
+    "held_for": ("held_s", None),  # WaypointReleased, as the report's held_s
     # WaypointFinished's count; the report's ``attempts`` is the list of attempts.
     "attempts": ("attempt_count", None),
     "loops": ("loops", _loops),

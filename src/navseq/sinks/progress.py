@@ -46,8 +46,10 @@ from navseq.executor.events import (
     TaskStarted,
     WaypointDwelling,
     WaypointFinished,
+    WaypointHeld,
     WaypointOutcome,
     WaypointProgress,
+    WaypointReleased,
     WaypointStarted,
 )
 from navseq.mission.model import Mission
@@ -391,6 +393,14 @@ def describe(event: MissionEvent, view: RunView) -> str | None:
         return f"{view.waypoint_label(event.index)}: paused{why}, the robot stopped"
     if isinstance(event, MissionResumed):
         return f"{view.waypoint_label(event.index)}: resumed after {event.paused_for:.1f} s"
+    if isinstance(event, WaypointHeld):
+        why = f" ({printable(event.reason)})" if event.reason else ""
+        return f"{view.waypoint_label(event.index)}: held back by the fleet{why}"
+    if isinstance(event, WaypointReleased):
+        return (
+            f"{view.waypoint_label(event.index)}: on its way again after {event.held_for:.1f} s"
+            " held (not counted against its timeouts)"
+        )
     if isinstance(event, MissionFinished):
         return f"mission finished: {final_status(event.reason, event.success)}"
     return None  # WaypointProgress, WaypointPlan

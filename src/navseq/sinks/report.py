@@ -1,12 +1,12 @@
 """The run report: one JSON document saying what happened to every waypoint visit.
 
-Schema (``schema_version`` 5; the unit is in every field's name where there is one:
+Schema (``schema_version`` 9; the unit is in every field's name where there is one:
 ``_s`` seconds, ``_m`` metres, ``_deg`` degrees; ``x``, ``y`` are metres in the
 mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
 ``--json`` events (:mod:`navseq.sinks.json_events`) use the same field names::
 
     {
-      "schema_version": 5,
+      "schema_version": 9,
       "navseq_version": "0.1.0",
       "created": "2026-11-22T04:30:00+00:00",        # wall clock, UTC
       "mission": {"source", "name", "digest", "frame", "waypoints", "loops"},
@@ -27,8 +27,8 @@ mission's frame). The JSON Schema is ``docs/schemas/report.schema.json``; the
       "visits_listed": {"listed", "omitted", "kept"},
       "visits": [{"index", "number", "loop", "name", "x", "y", "yaw_deg", "outcome",
                   "attempts": [{"number", "reached", "status", "reason", "text",
-                                "duration_s", "distance_m", "recoveries"}],
-                  "duration_s", "distance_m", "reason", "passed_through",
+                                "duration_s", "distance_m", "recoveries", "held_s"}],
+                  "duration_s", "distance_m", "held_s", "reason", "passed_through",
                   "tasks": [{"number", "kind", "attempt", "outcome", "duration_s",
                              "detail", "files", "output"}],
                   "recoveries_run": [{"number", "kind", "amount", "attempt", "outcome",
@@ -69,6 +69,9 @@ Version 4 had no ``clock`` (how fast the navigator's clock ran, see
 costmap filters the run drove with: each ``{"mask", "type", "base", "multiplier"}``,
 ``--keepout`` / ``--speed-mask`` or the mission's) and ``datum`` (``{"latitude",
 "longitude", "altitude", "yaw_deg"}`` its GPS waypoints were converted with, or null).
+Version 9 added ``held_s`` to attempts and visits: the seconds of ``duration_s`` a fleet
+held the robot back (waiting, or giving way to another robot), which its goal's timeout
+and stall clocks did not count.
 """
 
 from __future__ import annotations
@@ -105,7 +108,7 @@ try:  # a dependency, but a ROS install of the package may not have it (see repo
 except ImportError:  # pragma: no cover - the tests run with it installed
     orjson = None  # type: ignore[assignment]
 
-SCHEMA_VERSION = 8
+SCHEMA_VERSION = 9
 #: What ``visits_listed.kept`` says when a run made more visits than the report lists.
 KEPT_VISITS = (
     f"the last {KEEP_LAST_VISITS} visits and up to {KEEP_NOT_REACHED_VISITS} earlier "
@@ -148,6 +151,7 @@ def _attempt_dict(attempt: AttemptResult) -> dict[str, Any]:
         "duration_s": _rounded(attempt.duration, 2),
         "distance_m": _rounded(attempt.distance_driven),
         "recoveries": attempt.recoveries,
+        "held_s": _rounded(attempt.held, 2),
     }
 
 
@@ -164,6 +168,7 @@ def _visit_dict(visit: WaypointResult) -> dict[str, Any]:
         "attempts": [_attempt_dict(attempt) for attempt in visit.attempt_results],
         "duration_s": _rounded(visit.duration, 2),
         "distance_m": _rounded(visit.distance_driven),
+        "held_s": _rounded(visit.held_s, 2),
         "reason": visit.reason,
         "passed_through": visit.passed_through,
         "tasks": [_task_dict(task) for task in visit.tasks],
