@@ -1210,21 +1210,58 @@ function fixButton(p) {
 }
 
 // ---- checking (the same code as navseq validate --map) ----------------------------------
+// An edit of a few waypoints goes as those waypoints only, against the draft the server
+// checked for the answer the page holds (S.sent: what was sent for it, copied): a drag
+// sends one waypoint, not the 180 kB of a mission of 5000 for the server to read and
+// compare. Past this many, or when anything else changed, the whole draft goes.
+const MAX_CHANGES = 64;
+const otherKeys = (doc) => JSON.stringify({ ...doc, waypoints: null });
+const sameValue = (a, b) => a === b || (typeof a === "object" && typeof b === "object" && JSON.stringify(a) === JSON.stringify(b));
+function sameWaypoint(a, b) {
+  if (a === b) return true;
+  if (!a || !b || typeof a !== "object" || typeof b !== "object" || Array.isArray(a) !== Array.isArray(b)) return false;
+  const keys = Object.keys(a);
+  if (keys.length !== Object.keys(b).length) return false;
+  return keys.every((key) => Object.prototype.hasOwnProperty.call(b, key) && sameValue(a[key], b[key]));
+}
+// [[index, waypoint], ...] changed since the draft sent for S.checkId, or null (send whole).
+function draftChanges() {
+  const sent = S.sent, wps = S.doc.waypoints;
+  if (!sent || S.checkId === null || sent.check !== S.checkId || !Array.isArray(wps)) return null;
+  if (wps.length !== sent.waypoints.length || otherKeys(S.doc) !== sent.rest) return null;
+  const changes = [];
+  for (let i = 0; i < wps.length; i++) {
+    if (sameWaypoint(wps[i], sent.waypoints[i])) continue;
+    if (changes.length === MAX_CHANGES) return null;
+    changes.push([i, wps[i]]);
+  }
+  return changes;
+}
 async function check() {
   if (S.checkBusy) { S.checkAgain = true; return; }
   S.checkBusy = true;
   const seq = ++S.checkSeq;
-  // Written out once, now: the draft as it is at this moment (edits may follow while
-  // the answer is on its way), and no second copy of a mission of thousands. "base":
-  // the answer whose legs the page holds; the server then sends only the legs that
-  // differ from them (a drag: two of 5000).
-  const body = JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  // Written out once, now: the draft (or its changes) as it is at this moment (edits may
+  // follow while the answer is on its way). "base": the answer whose legs the page
+  // holds; the server then sends only the legs that differ from them (a drag: two of 5000).
+  const changes = draftChanges();
+  const body = changes ? JSON.stringify({ base: S.checkId, changes }) : JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  // What the server will hold as this answer's draft: the sent one with the changes, or
+  // the whole draft as sent (copies: the page edits its own in place).
+  const sending = changes
+    ? { rest: S.sent.rest, waypoints: S.sent.waypoints.slice() }
+    : { rest: otherKeys(S.doc), waypoints: Array.isArray(S.doc.waypoints) ? JSON.parse(body).mission.waypoints : [] };
+  if (changes) for (const [i, w] of changes) sending.waypoints[i] = JSON.parse(JSON.stringify(w));
   const answer = await api("POST", "/api/check", body);
   S.checkBusy = false;
   // Taken in even when a newer edit is to be checked: the next answer is sent against it.
-  if (!answer.ok) {
+  if (answer.status === 409 && answer.data.conflict === "base") {
+    // The server no longer holds that draft (restarted, or other pages' checks pushed it
+    // out): the whole draft goes at once.
+    S.sent = null; S.checkId = null; S.legs = []; S.checkAgain = true;
+  } else if (!answer.ok) {
     S.problems = answer.data.problems || [{ text: answer.data.error, waypoint: null }];
-    S.legs = []; S.route = {}; S.checkId = null;
+    S.legs = []; S.route = {}; S.checkId = null; S.sent = null;
   } else {
     const data = answer.data;
     let held = true;
@@ -1233,6 +1270,7 @@ async function check() {
     else { held = false; S.legs = []; S.checkAgain = true; }  // not the legs it was sent against: ask whole
     S.problems = data.problems;
     S.checkId = held ? data.check : null;
+    S.sent = held ? { ...sending, check: data.check } : null;
     S.route = data;
   }
   if (S.checkAgain) { S.checkAgain = false; check(); return; }
