@@ -289,6 +289,11 @@ def test_changes_to_a_draft_the_studio_no_longer_holds_are_refused_and_the_page_
     answer = client.post("/api/check", json={"base": first["check"], "changes": [[3, moved]]})
     assert answer.status_code == 200
     assert [position for position, _ in answer.json()["legs_changed"]] == [3, 4]
+    # A waypoint dropped where it was: that answer again, nothing worked out.
+    again = client.post(
+        "/api/check", json={"base": answer.json()["check"], "changes": [[3, moved]]}
+    ).json()
+    assert again["check"] == answer.json()["check"] and again["legs_changed"] == []
     # Against one it does not hold (dropped, or from before a restart): 409, nothing checked.
     for base in (first["check"] + 100, None):
         refused = client.post("/api/check", json={"base": base, "changes": [[3, moved]]})

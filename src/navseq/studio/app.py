@@ -87,6 +87,8 @@ MISSION_SUFFIXES = (".yaml", ".yml", ".launch", ".xml", ".csv")
 MAX_FILES_LISTED = 500
 #: Check answers kept for drafts seen again (the opened mission on each page load, undo).
 CHECK_ANSWERS_KEPT = 16
+#: A check's answer as kept: the draft's robot, the answer, what an edit is checked from.
+Kept = tuple["RobotProfile | None", dict[str, Any], LastCheck | None]
 #: How much lower the warm-up's check runs than the page's requests (a nice value).
 WARM_UP_NICENESS = 10
 #: Seconds ``navseq studio``'s warm-up waits for the page's own first check.
@@ -124,14 +126,11 @@ class Studio:
         self._open_lock = threading.Lock()  # one reading of the mission file at a time
         # The opened file's answer, by (path, SHA-256, --map): not to be changed by callers.
         self._opened: tuple[tuple[Path, str, str | None], dict[str, Any]] | None = None
-        self._answers: OrderedDict[
-            tuple[str, tuple[int, ...]],
-            tuple[RobotProfile | None, dict[str, Any], LastCheck | None],
-        ] = OrderedDict()
+        self._answers: OrderedDict[tuple[str, tuple[int, ...]], Kept] = OrderedDict()
         # The draft and legs of the last answers, by their "check" number: a page names
         # the one it holds, is sent only the legs that differ from it, and may send an
         # edit as the waypoints it changed in that draft.
-        self._held: OrderedDict[int, tuple[dict[str, Any], list[dict[str, Any]]]] = OrderedDict()
+        self._held: OrderedDict[int, tuple[Any, list[dict[str, Any]], Kept]] = OrderedDict()
         # The legs the last check was worked out from and the positions it planned again.
         self._replanned: tuple[list[dict[str, Any]], list[int]] | None = None
         self._checks = 0  # answers worked out, numbering them
@@ -301,13 +300,21 @@ class Studio:
             numbered = isinstance(base, int) and not isinstance(base, bool)
             held = self._held.get(base) if numbered else None
             edit: tuple[dict[str, Any], set[int]] | None = None
+            same: Kept | None = None
             if changes is not None:
                 document, edit = self._edited_document(held, changes)
+                assert held is not None
+                old, new = held[0]["waypoints"], document["waypoints"]
+                if all(old[index] == new[index] for index in edit[1]):
+                    # Nothing changed (a waypoint dropped where it was): that answer again.
+                    document, edit, same = held[0], None, held[2]
             # An edit sent as its changes is not looked up by its text (that text, 180 kB
             # at 5000 waypoints, would be written out for it).
-            key = None if edit is not None else self._answer_key(document)
+            key = None if edit is not None or same is not None else self._answer_key(document)
             self._replanned = None
-            if key is not None and key in self._answers:
+            if same is not None:
+                self.robot, answer, self._last_check = same
+            elif key is not None and key in self._answers:
                 self._answers.move_to_end(key)
                 self.robot, answer, self._last_check = self._answers[key]
             else:
@@ -318,7 +325,8 @@ class Studio:
                     self._answers[key] = (self.robot, answer, self._last_check)
                     while len(self._answers) > CHECK_ANSWERS_KEPT:
                         self._answers.popitem(last=False)
-            self._held[answer["check"]] = (document, answer["legs"])
+            kept = (self.robot, answer, self._last_check)
+            self._held[answer["check"]] = (document, answer["legs"], kept)
             self._held.move_to_end(answer["check"])
             while len(self._held) > CHECK_ANSWERS_KEPT:
                 self._held.popitem(last=False)
@@ -333,7 +341,7 @@ class Studio:
 
     @staticmethod
     def _edited_document(
-        held: tuple[dict[str, Any], list[dict[str, Any]]] | None, changes: Any
+        held: tuple[Any, list[dict[str, Any]], Kept] | None, changes: Any
     ) -> tuple[dict[str, Any], tuple[dict[str, Any], set[int]]]:
         """The draft an edit sent as its changes makes of the held draft ``held``, and
         (that draft, the indices changed)."""
