@@ -324,11 +324,13 @@ const MissionLayer = L.Layer.extend({
   drawLegs(ctx, f) {
     const kinds = { leg: [], loop: [], noPath: [], moving: [] };
     const dragged = S.drag ? S.drag.target : undefined;
+    const seen = this.viewBox(f, 8);
     for (const leg of S.legs) {
       let pts = leg.points, kind = leg.loop ? "loop" : "leg";
       if (dragged !== undefined && (leg.from === dragged || leg.to === dragged || (dragged === "start" && leg.from === "start"))) {
         pts = null; kind = "moving";
       } else if (!pts) kind = "noPath";
+      else if (!overlaps(legBox(leg), seen)) continue;  // nothing of it in the view
       if (!pts) {
         const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
         if (!a || !b) continue;
@@ -345,14 +347,28 @@ const MissionLayer = L.Layer.extend({
       const [colour, width, dash] = styles[kind];
       ctx.beginPath();
       for (const pts of paths) {
-        ctx.moveTo(f.ox + pts[0][0] * f.s, f.oy - pts[0][1] * f.s);
-        for (let k = 1; k < pts.length; k++) ctx.lineTo(f.ox + pts[k][0] * f.s, f.oy - pts[k][1] * f.s);
+        // A point under a pixel from the last one drawn is left out (never a leg's end):
+        // zoomed out on 5000 legs of a 5 cm grid's cells, most of some 140 000 points
+        // fell on the pixel before, and the canvas's raster of them took most of a redraw.
+        let px = f.ox + pts[0][0] * f.s, py = f.oy - pts[0][1] * f.s;
+        ctx.moveTo(px, py);
+        const last = pts.length - 1;
+        for (let k = 1; k <= last; k++) {
+          const x = f.ox + pts[k][0] * f.s, y = f.oy - pts[k][1] * f.s;
+          if (k < last && Math.abs(x - px) < 1 && Math.abs(y - py) < 1) continue;
+          ctx.lineTo(x, y); px = x; py = y;
+        }
       }
       ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.setLineDash(dash);
       ctx.globalAlpha = kind === "leg" || kind === "loop" ? 0.85 : 1;
       ctx.stroke();
     }
     ctx.setLineDash([]); ctx.globalAlpha = 1;
+  },
+  // The view in metres [xmin, ymin, xmax, ymax], ``margin`` pixels wider each way.
+  viewBox(f, margin) {
+    const size = this.size || map.getSize();
+    return [(-margin - f.ox) / f.s, (f.oy - size.y - margin) / f.s, (size.x + margin - f.ox) / f.s, (f.oy + margin) / f.s];
   },
   // The colour a waypoint is filled with: its state in the run shown, else its kind.
   fillOf(i, w, bad) {
@@ -496,8 +512,10 @@ const MissionLayer = L.Layer.extend({
     ctx.font = LABEL_FONT;
     const shortest = 2 * MARK_R + 30;  // px: no label is narrower than 30 px
     const made = [];
+    const seen = this.viewBox(f, 0);
     for (const leg of S.legs) {
       if (made.length >= MAX_LABELS) break;
+      if (leg.points && !overlaps(legBox(leg), seen)) continue;  // its middle is not in sight
       let pts = leg.points;
       if (!pts) {
         const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
@@ -578,6 +596,23 @@ const MissionLayer = L.Layer.extend({
   },
 });
 const missionLayer = new MissionLayer().addTo(map);
+// A planned leg's bounding box in metres, worked out once per leg the server sent: at
+// 5000 waypoints zoomed in, the legs out of the view are neither drawn nor measured for
+// a label (the drag's two redraws drew and measured all 5000 with every point before).
+const legBoxes = new WeakMap();
+function legBox(leg) {
+  let box = legBoxes.get(leg);
+  if (!box) {
+    box = [Infinity, Infinity, -Infinity, -Infinity];
+    for (const [x, y] of leg.points) {
+      if (x < box[0]) box[0] = x; if (y < box[1]) box[1] = y;
+      if (x > box[2]) box[2] = x; if (y > box[3]) box[3] = y;
+    }
+    legBoxes.set(leg, box);
+  }
+  return box;
+}
+const overlaps = (a, b) => a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
 // Why a leg has no path: the pre-flight's problem about its end waypoint, if it has one.
 function noPathReason(leg) {
   const problem = S.problems.find((p) => p.waypoint === leg.to);
