@@ -516,6 +516,9 @@ const MissionLayer = L.Layer.extend({
     for (const leg of S.legs) {
       if (made.length >= MAX_LABELS) break;
       if (leg.points && !overlaps(legBox(leg), seen)) continue;  // its middle is not in sight
+      // Too short on the screen for a label, by its length (the points' own, to the mm):
+      // zoomed out, that is every leg, each measured point by point before.
+      if (leg.points && typeof leg.length_m === "number" && leg.length_m * f.s + 1 < shortest) continue;
       let pts = leg.points;
       if (!pts) {
         const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
