@@ -637,8 +637,17 @@ function render() {
   const el = document.querySelector(`[data-focus="${focused}"]`);
   if (el && el !== document.activeElement) el.focus({ preventScroll: true });
 }
+const SETTLE_MS = 250;
+// The drop's wait for its answer is over: the canvas is drawn as everything else is
+// (``draw``: at once, when the answer did not come in time).
+function settle(settling, draw) {
+  if (S.settling !== settling) return;
+  S.settling = null;
+  if (S.drag === settling) S.drag = null;
+  if (draw) missionLayer.draw();
+}
 function renderAll() {
-  missionLayer.draw();
+  if (!S.settling) missionLayer.draw();
   drawHandle();
   if (S.selected !== S.listedSelection) {  // a waypoint selected on the map: its row shown
     S.listedSelection = S.selected;
@@ -701,9 +710,16 @@ document.addEventListener("mouseup", () => {
   S.drag = null;
   const began = performance.now();
   if (p.moved && drag) {
+    // The canvas keeps the drag's last frame (the point where it was dropped, its legs
+    // straight and dashed) until the check's answer is drawn, SETTLE_MS at most: at 5000
+    // waypoints each redraw is rasterised whole, on the page's thread in a browser
+    // without a GPU, and the answer waited behind the drop's own redraw (40-140 ms).
+    const settling = { target: drag.target, x: round(drag.x, 2), y: round(drag.y, 2) };
+    S.drag = S.settling = settling;
+    setTimeout(() => settle(settling, true), SETTLE_MS);
     edit(() => {
       const point = drag.target === "start" ? S.doc.start : S.doc.waypoints[drag.target];
-      point.x = round(drag.x, 2); point.y = round(drag.y, 2);
+      point.x = settling.x; point.y = settling.y;
       S.selected = drag.target;
     });
   } else { S.selected = p.hit; render(); }
@@ -1318,6 +1334,7 @@ async function check() {
   }
   if (S.checkAgain) { S.checkAgain = false; check(); return; }
   if (seq !== S.checkSeq) return;
+  if (S.settling) settle(S.settling, false);  // drawn below, with the answer
   S.planned = true;
   await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
