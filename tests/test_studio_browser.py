@@ -666,6 +666,31 @@ def test_an_edit_goes_as_the_waypoint_it_changed_and_whole_when_the_studio_lost_
     assert not page.locator("[data-testid=problem]").count()
 
 
+def test_a_drop_whose_answer_is_late_is_drawn_before_it_and_again_with_it(page: Any) -> None:
+    """After a drop the canvas waits for the check's answer (the list shows the new
+    position at once), but not for long: an answer held back, the waypoint is drawn
+    where it was dropped all the same; the answer, when it comes, is drawn with it."""
+    held: list[Any] = []
+    page.route("**/api/check", lambda route: held.append(route))
+    start = mark_point(page, 3)
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.mouse.move(start[0] + 30, start[1] + 12, steps=4)
+    page.mouse.up()
+    dropped = page.evaluate("[S.doc.waypoints[3].x, S.doc.waypoints[3].y]")
+    assert _row_xy(page, 3) == pytest.approx(dropped, abs=1e-9)
+    page.wait_for_function("S.settling === null && S.drag === null", timeout=5_000)
+    assert len(held) == 1  # no answer yet
+    assert drawn(page)["marks"][3]["x"] == pytest.approx(
+        page.evaluate("([x, y]) => map.latLngToContainerPoint(L.latLng(y, x)).x", dropped),
+        abs=0.5,
+    )
+    checked_after(page, held[0].continue_)
+    legs = page.evaluate("S.legs.filter((leg) => leg.to === 3)")
+    assert legs[0]["points"][-1] == pytest.approx(dropped, abs=0.06)
+    assert page.errors == []
+
+
 def test_the_run_status_is_announced(page: Any) -> None:
     live = page.get_by_test_id("run-live")
     assert live.get_attribute("aria-live") == "polite"
