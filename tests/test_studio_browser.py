@@ -10,6 +10,7 @@ Skipped with a reason where Chromium or Playwright is missing
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import shutil
@@ -664,6 +665,76 @@ def test_the_mission_is_edited_with_the_keyboard_alone(page: Any) -> None:
     assert page.errors == []  # type: ignore[attr-defined]
 
 
+def test_an_edit_goes_as_the_waypoint_it_changed_and_whole_when_the_studio_lost_its_draft(
+    page: Any,
+) -> None:
+    """A moved waypoint is sent as itself against the draft of the answer the page
+    holds, not as the whole draft; when the studio answers that it no longer holds that
+    draft (409), the page sends the whole draft at once and draws its answer."""
+    sent: list[dict[str, Any]] = []
+    lost = {"once": True}
+
+    def watch(route: Any) -> None:
+        body = json.loads(route.request.post_data)
+        sent.append(body)
+        if "changes" in body and len(sent) == 2 and lost.pop("once", False):
+            route.fulfill(
+                status=409,
+                content_type="application/json",
+                body=json.dumps({"error": "no longer held", "conflict": "base"}),
+            )
+        else:
+            route.continue_()
+
+    page.route("**/api/check", watch)
+    rows = page.get_by_test_id("waypoint-row")
+    x2, y2 = _row_xy(page, 2)
+    rows.nth(2).locator("button.pick").focus()
+    page.keyboard.press("Enter")
+    checked_after(page, lambda: page.keyboard.press("ArrowRight"))
+    moved = page.evaluate("S.doc.waypoints[2]")
+    assert list(sent[0]) == ["base", "changes"] and sent[0]["changes"] == [[2, moved]]
+    held = page.evaluate("S.checkId")
+    assert held is not None
+    # The studio lost the draft: the next edit's changes are refused, the whole goes.
+    checked_after(page, lambda: page.keyboard.press("ArrowUp"))
+    page.wait_for_function(f"S.checkId !== null && S.checkId !== {held}", timeout=10_000)
+    assert [sorted(body) for body in sent[1:]] == [["base", "changes"], ["base", "mission"]]
+    assert sent[2]["mission"]["waypoints"][2] == page.evaluate("S.doc.waypoints[2]")
+    assert _row_xy(page, 2) == pytest.approx((x2 + 0.05, y2 + 0.05), abs=1e-9)
+    legs = page.evaluate("S.legs.filter((leg) => leg.to === 2 || leg.from === '2')")
+    assert len(legs) == 2 and all(leg["points"] for leg in legs)
+    # Nothing said to the user (the browser itself logs the 409 it was answered).
+    assert "409" in page.errors[0] and page.errors[1:] == []
+    assert page.locator("#message.error").count() == 0
+    assert not page.locator("[data-testid=problem]").count()
+
+
+def test_a_drop_whose_answer_is_late_is_drawn_before_it_and_again_with_it(page: Any) -> None:
+    """After a drop the canvas waits for the check's answer (the list shows the new
+    position at once), but not for long: an answer held back, the waypoint is drawn
+    where it was dropped all the same; the answer, when it comes, is drawn with it."""
+    held: list[Any] = []
+    page.route("**/api/check", lambda route: held.append(route))
+    start = mark_point(page, 3)
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.mouse.move(start[0] + 30, start[1] + 12, steps=4)
+    page.mouse.up()
+    dropped = page.evaluate("[S.doc.waypoints[3].x, S.doc.waypoints[3].y]")
+    assert _row_xy(page, 3) == pytest.approx(dropped, abs=1e-9)
+    page.wait_for_function("S.settling === null && S.drag === null", timeout=5_000)
+    assert len(held) == 1  # no answer yet
+    assert drawn(page)["marks"][3]["x"] == pytest.approx(
+        page.evaluate("([x, y]) => map.latLngToContainerPoint(L.latLng(y, x)).x", dropped),
+        abs=0.5,
+    )
+    checked_after(page, held[0].continue_)
+    legs = page.evaluate("S.legs.filter((leg) => leg.to === 3)")
+    assert legs[0]["points"][-1] == pytest.approx(dropped, abs=0.06)
+    assert page.errors == []
+
+
 def test_the_run_status_is_announced(page: Any) -> None:
     live = page.get_by_test_id("run-live")
     assert live.get_attribute("aria-live") == "polite"
@@ -959,6 +1030,11 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
             " map.setView([w.y, w.x], map.getZoom(), { animate: false }); missionLayer.draw();"
         )
         before = page.evaluate("[S.doc.waypoints[9].x, S.doc.waypoints[9].y]")
+        bodies: list[str] = []
+        page.on(
+            "request",
+            lambda r: bodies.append(r.post_data) if r.url.endswith("/api/check") else None,
+        )
         start = mark_point(page, 9)
         page.mouse.move(*start)
         page.mouse.down()
@@ -974,8 +1050,11 @@ def test_a_mission_of_2000_waypoints_opens_drags_and_labels_nothing_over_anythin
         assert len(legs) == 2
         into = legs[0] if legs[0]["to"] == 9 else legs[1]
         assert into["points"][-1] == pytest.approx(after, abs=0.06)
-        # The answer carried those two legs only; the page patched its own 2000.
+        # The answer carried those two legs only; the page patched its own 2000. It sent
+        # the moved waypoint only, not the draft of 2000.
         assert page.evaluate("S.route.legs_changed.map(([position]) => position)") == [9, 10]
+        assert [change[0] for change in json.loads(bodies[-1])["changes"]] == [9]
+        assert len(bodies[-1]) < 200
         assert _overlaps(page) == []
 
         # Tab goes on through the rows past the first ones built (4 stops a row).

@@ -324,11 +324,13 @@ const MissionLayer = L.Layer.extend({
   drawLegs(ctx, f) {
     const kinds = { leg: [], loop: [], noPath: [], moving: [] };
     const dragged = S.drag ? S.drag.target : undefined;
+    const seen = this.viewBox(f, 8);
     for (const leg of S.legs) {
       let pts = leg.points, kind = leg.loop ? "loop" : "leg";
       if (dragged !== undefined && (leg.from === dragged || leg.to === dragged || (dragged === "start" && leg.from === "start"))) {
         pts = null; kind = "moving";
       } else if (!pts) kind = "noPath";
+      else if (!overlaps(legBox(leg), seen)) continue;  // nothing of it in the view
       if (!pts) {
         const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
         if (!a || !b) continue;
@@ -345,14 +347,28 @@ const MissionLayer = L.Layer.extend({
       const [colour, width, dash] = styles[kind];
       ctx.beginPath();
       for (const pts of paths) {
-        ctx.moveTo(f.ox + pts[0][0] * f.s, f.oy - pts[0][1] * f.s);
-        for (let k = 1; k < pts.length; k++) ctx.lineTo(f.ox + pts[k][0] * f.s, f.oy - pts[k][1] * f.s);
+        // A point under a pixel from the last one drawn is left out (never a leg's end):
+        // zoomed out on 5000 legs of a 5 cm grid's cells, most of some 140 000 points
+        // fell on the pixel before, and the canvas's raster of them took most of a redraw.
+        let px = f.ox + pts[0][0] * f.s, py = f.oy - pts[0][1] * f.s;
+        ctx.moveTo(px, py);
+        const last = pts.length - 1;
+        for (let k = 1; k <= last; k++) {
+          const x = f.ox + pts[k][0] * f.s, y = f.oy - pts[k][1] * f.s;
+          if (k < last && Math.abs(x - px) < 1 && Math.abs(y - py) < 1) continue;
+          ctx.lineTo(x, y); px = x; py = y;
+        }
       }
       ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.setLineDash(dash);
       ctx.globalAlpha = kind === "leg" || kind === "loop" ? 0.85 : 1;
       ctx.stroke();
     }
     ctx.setLineDash([]); ctx.globalAlpha = 1;
+  },
+  // The view in metres [xmin, ymin, xmax, ymax], ``margin`` pixels wider each way.
+  viewBox(f, margin) {
+    const size = this.size || map.getSize();
+    return [(-margin - f.ox) / f.s, (f.oy - size.y - margin) / f.s, (size.x + margin - f.ox) / f.s, (f.oy + margin) / f.s];
   },
   // The colour a waypoint is filled with: its state in the run shown, else its kind.
   fillOf(i, w, bad) {
@@ -496,8 +512,13 @@ const MissionLayer = L.Layer.extend({
     ctx.font = LABEL_FONT;
     const shortest = 2 * MARK_R + 30;  // px: no label is narrower than 30 px
     const made = [];
+    const seen = this.viewBox(f, 0);
     for (const leg of S.legs) {
       if (made.length >= MAX_LABELS) break;
+      if (leg.points && !overlaps(legBox(leg), seen)) continue;  // its middle is not in sight
+      // Too short on the screen for a label, by its length (the points' own, to the mm):
+      // zoomed out, that is every leg, each measured point by point before.
+      if (leg.points && typeof leg.length_m === "number" && leg.length_m * f.s + 1 < shortest) continue;
       let pts = leg.points;
       if (!pts) {
         const a = this.endOf(leg.from === "start" ? "start" : Number(leg.from)), b = this.endOf(leg.to);
@@ -578,6 +599,23 @@ const MissionLayer = L.Layer.extend({
   },
 });
 const missionLayer = new MissionLayer().addTo(map);
+// A planned leg's bounding box in metres, worked out once per leg the server sent: at
+// 5000 waypoints zoomed in, the legs out of the view are neither drawn nor measured for
+// a label (the drag's two redraws drew and measured all 5000 with every point before).
+const legBoxes = new WeakMap();
+function legBox(leg) {
+  let box = legBoxes.get(leg);
+  if (!box) {
+    box = [Infinity, Infinity, -Infinity, -Infinity];
+    for (const [x, y] of leg.points) {
+      if (x < box[0]) box[0] = x; if (y < box[1]) box[1] = y;
+      if (x > box[2]) box[2] = x; if (y > box[3]) box[3] = y;
+    }
+    legBoxes.set(leg, box);
+  }
+  return box;
+}
+const overlaps = (a, b) => a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
 // Why a leg has no path: the pre-flight's problem about its end waypoint, if it has one.
 function noPathReason(leg) {
   const problem = S.problems.find((p) => p.waypoint === leg.to);
@@ -599,8 +637,17 @@ function render() {
   const el = document.querySelector(`[data-focus="${focused}"]`);
   if (el && el !== document.activeElement) el.focus({ preventScroll: true });
 }
+const SETTLE_MS = 250;
+// The drop's wait for its answer is over: the canvas is drawn as everything else is
+// (``draw``: at once, when the answer did not come in time).
+function settle(settling, draw) {
+  if (S.settling !== settling) return;
+  S.settling = null;
+  if (S.drag === settling) S.drag = null;
+  if (draw) missionLayer.draw();
+}
 function renderAll() {
-  missionLayer.draw();
+  if (!S.settling) missionLayer.draw();
   drawHandle();
   if (S.selected !== S.listedSelection) {  // a waypoint selected on the map: its row shown
     S.listedSelection = S.selected;
@@ -663,9 +710,16 @@ document.addEventListener("mouseup", () => {
   S.drag = null;
   const began = performance.now();
   if (p.moved && drag) {
+    // The canvas keeps the drag's last frame (the point where it was dropped, its legs
+    // straight and dashed) until the check's answer is drawn, SETTLE_MS at most: at 5000
+    // waypoints each redraw is rasterised whole, on the page's thread in a browser
+    // without a GPU, and the answer waited behind the drop's own redraw (40-140 ms).
+    const settling = { target: drag.target, x: round(drag.x, 2), y: round(drag.y, 2) };
+    S.drag = S.settling = settling;
+    setTimeout(() => settle(settling, true), SETTLE_MS);
     edit(() => {
       const point = drag.target === "start" ? S.doc.start : S.doc.waypoints[drag.target];
-      point.x = round(drag.x, 2); point.y = round(drag.y, 2);
+      point.x = settling.x; point.y = settling.y;
       S.selected = drag.target;
     });
   } else { S.selected = p.hit; render(); }
@@ -1229,21 +1283,63 @@ function fixButton(p) {
 }
 
 // ---- checking (the same code as navseq validate --map) ----------------------------------
+// An edit of a few waypoints goes as those waypoints only, against the draft the server
+// checked for the answer the page holds (S.sent: what was sent for it, copied): a drag
+// sends one waypoint, not the 180 kB of a mission of 5000 for the server to read and
+// compare. Past this many, or when anything else changed, the whole draft goes.
+const MAX_CHANGES = 64;
+const otherKeys = (doc) => JSON.stringify({ ...doc, waypoints: null });
+const sameValue = (a, b) => a === b || (typeof a === "object" && typeof b === "object" && JSON.stringify(a) === JSON.stringify(b));
+// Key by key, allocating nothing: it runs over every waypoint at each edit.
+function sameWaypoint(a, b) {
+  if (a === b) return true;
+  if (!a || !b || typeof a !== "object" || typeof b !== "object" || Array.isArray(a) !== Array.isArray(b)) return false;
+  let keys = 0;
+  for (const key in a) {
+    if (!Object.prototype.hasOwnProperty.call(b, key) || !sameValue(a[key], b[key])) return false;
+    keys++;
+  }
+  for (const key in b) keys--;
+  return keys === 0;
+}
+// [[index, waypoint], ...] changed since the draft sent for S.checkId, or null (send whole).
+function draftChanges() {
+  const sent = S.sent, wps = S.doc.waypoints;
+  if (!sent || S.checkId === null || sent.check !== S.checkId || !Array.isArray(wps)) return null;
+  if (wps.length !== sent.waypoints.length || otherKeys(S.doc) !== sent.rest) return null;
+  const changes = [];
+  for (let i = 0; i < wps.length; i++) {
+    if (sameWaypoint(wps[i], sent.waypoints[i])) continue;
+    if (changes.length === MAX_CHANGES) return null;
+    changes.push([i, wps[i]]);
+  }
+  return changes;
+}
 async function check() {
   if (S.checkBusy) { S.checkAgain = true; return; }
   S.checkBusy = true;
   const seq = ++S.checkSeq;
-  // Written out once, now: the draft as it is at this moment (edits may follow while
-  // the answer is on its way), and no second copy of a mission of thousands. "base":
-  // the answer whose legs the page holds; the server then sends only the legs that
-  // differ from them (a drag: two of 5000).
-  const body = JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  // Written out once, now: the draft (or its changes) as it is at this moment (edits may
+  // follow while the answer is on its way). "base": the answer whose legs the page
+  // holds; the server then sends only the legs that differ from them (a drag: two of 5000).
+  const changes = draftChanges();
+  const body = changes ? JSON.stringify({ base: S.checkId, changes }) : JSON.stringify({ mission: S.doc, base: S.checkId ?? null });
+  // What the server will hold as this answer's draft: the sent one with the changes, or
+  // the whole draft as sent (copies: the page edits its own in place).
+  const sending = changes
+    ? { rest: S.sent.rest, waypoints: S.sent.waypoints.slice() }
+    : { rest: otherKeys(S.doc), waypoints: Array.isArray(S.doc.waypoints) ? JSON.parse(body).mission.waypoints : [] };
+  if (changes) for (const [i, w] of changes) sending.waypoints[i] = JSON.parse(JSON.stringify(w));
   const answer = await api("POST", "/api/check", body);
   S.checkBusy = false;
   // Taken in even when a newer edit is to be checked: the next answer is sent against it.
-  if (!answer.ok) {
+  if (answer.status === 409 && answer.data.conflict === "base") {
+    // The server no longer holds that draft (restarted, or other pages' checks pushed it
+    // out): the whole draft goes at once.
+    S.sent = null; S.checkId = null; S.legs = []; S.checkAgain = true;
+  } else if (!answer.ok) {
     S.problems = answer.data.problems || [{ text: answer.data.error, waypoint: null }];
-    S.legs = []; S.route = {}; S.checkId = null;
+    S.legs = []; S.route = {}; S.checkId = null; S.sent = null;
   } else {
     const data = answer.data;
     let held = true;
@@ -1252,10 +1348,12 @@ async function check() {
     else { held = false; S.legs = []; S.checkAgain = true; }  // not the legs it was sent against: ask whole
     S.problems = data.problems;
     S.checkId = held ? data.check : null;
+    S.sent = held ? { ...sending, check: data.check } : null;
     S.route = data;
   }
   if (S.checkAgain) { S.checkAgain = false; check(); return; }
   if (seq !== S.checkSeq) return;
+  if (S.settling) settle(S.settling, false);  // drawn below, with the answer
   S.planned = true;
   await S.painted;  // Leaflet draws nothing before the map has its view
   await loadMap(false);
