@@ -46,7 +46,9 @@ typedef struct {
 
 #define C(s, a, b) ((s)->cost[(a) * (s)->n + (b)])
 #define LONGEST_RUN 3
-#define LONGEST_KICK 50
+#ifndef LONGEST_KICK
+#define LONGEST_KICK 35
+#endif
 
 static void sums(Search *s) {
     s->fwd[0] = s->bwd[0] = 0;

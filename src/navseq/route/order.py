@@ -59,7 +59,7 @@ NO_PATH_M = 1.0e6
 IMPROVE_SHARE = 0.6
 #: Seconds of each slice of the iterated local search (navseq.route.search): the best
 #: route so far is reported between slices, and a Ctrl-C heard.
-SLICE_S = 0.2
+SLICE_S = 0.1
 #: Places at most for the numpy first route (each move weighs every pair of places).
 IMPROVE_UP_TO = 500
 #: Distances go to the solver in millimetres (it works in integers).

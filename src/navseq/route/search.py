@@ -9,7 +9,7 @@ search does better in the same second (``benchmarks/bench_route.py``):
   round) and 2-opt (a stretch of the route driven backwards), each priced with the arcs
   it really drives (the costs differ each way: the turns at the waypoints make them).
   Only the waypoints at arcs a move changed are looked at again ("don't-look bits");
-- **kicks**: two neighbouring stretches of the route (up to 50 waypoints each) swap
+- **kicks**: two neighbouring stretches of the route (up to 35 waypoints each) swap
   places, which keeps each stretch's direction; the local search then starts from the
   waypoints at the three arcs the kick changed, and the result is kept when it is no
   longer than the route before the kick (otherwise that route is taken back).
@@ -36,7 +36,7 @@ except ImportError:  # no C compiler at install time
 #: Or-opt moves runs of this many nodes at most.
 LONGEST_RUN = 3
 #: A kick swaps two stretches of this many nodes at most.
-LONGEST_KICK = 50
+LONGEST_KICK = 35
 _MASK = (1 << 64) - 1
 
 
