@@ -2,10 +2,11 @@
 
 A travelling-salesman problem over the lengths the robot would drive: the planned path
 between every two waypoints on the robot's costmap (the planner the simulator drives
-with), or straight lines when no map is known. OR-tools' routing solver finds the
-order (a first tour by nearest neighbour improved by 2-opt and Or-opt moves, then
-guided local search for the rest of ``time_limit_s``);
-it comes with the ``navseq[plan]`` extra.
+with), or straight lines when no map is known. The order: a first tour by nearest
+neighbour, then the iterated local search of :mod:`navseq.route.search` (Or-opt and 2-opt
+moves, kicks) for ``time_limit_s``; without that search's C extension, 2-opt and Or-opt
+in numpy, then OR-tools' routing solver (guided local search) for the rest. It comes
+with the ``navseq[plan]`` extra.
 
 What stays where it is, so that the new order is a mission the user still recognises:
 
@@ -148,6 +149,7 @@ def shortest_order(
     keep_last: bool = False,
     robot: RobotProfile | None = None,
     progress: OrderProgress | None = None,
+    settle_s: float | None = None,
 ) -> Ordering:
     """The order of ``mission``'s waypoints that drives the least (see the module doc).
 
@@ -155,7 +157,9 @@ def shortest_order(
     ``length`` measures a leg, or (a :class:`Distances`, such as a leg planner) all of
     them at once. ``robot``: order by the time that robot takes, turns included, where
     ``length`` measures routes with their headings (:class:`navseq.route.travel.Routes`);
-    otherwise by metres. ``progress`` hears of the searches and the solver.
+    otherwise by metres. ``progress`` hears of the searches and the solver. ``settle_s``:
+    the solver also stops once it found no better order for that long (see
+    :func:`shortest_tour`).
     """
     require_extra("plan", "the shortest order")
     waypoints = [(w.x, w.y) for w in mission.waypoints]
@@ -179,7 +183,12 @@ def shortest_order(
     if shown is not None:
         shown(None)
     tour = shortest_tour(
-        matrix, closed=closed, last=last, time_limit_s=time_limit_s, on_solution=shown
+        matrix,
+        closed=closed,
+        last=last,
+        time_limit_s=time_limit_s,
+        on_solution=shown,
+        settle_s=settle_s,
     )
     as_in_file = list(range(len(places)))
     # An order no shorter than the file's (a patrol run the other way round, a tie) is
