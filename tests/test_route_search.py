@@ -90,3 +90,21 @@ def test_a_search_told_to_settle_still_gives_a_whole_order() -> None:
     matrix = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
     tour = shortest_tour(matrix, closed=False, time_limit_s=5.0, settle_s=order.SLICE_S)
     assert sorted(tour) == list(range(60)) and tour[0] == 0
+
+
+def test_ctrl_c_ends_a_long_search_with_keyboard_interrupt() -> None:
+    """``navseq plan``'s Ctrl-C: the search stops at its next slice, not at its limit."""
+    import os
+    import signal
+    import threading
+
+    rng = np.random.default_rng(9)
+    points = rng.random((300, 2)) * 50.0
+    matrix = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            shortest_tour(matrix, closed=False, time_limit_s=60.0)
+    finally:
+        timer.cancel()
