@@ -52,11 +52,15 @@ def search(
     *,
     kicks: int = -1,
     seed: int = 0,
+    settled: bool = False,
     use_compiled: bool = True,
-) -> list[int]:
+) -> tuple[list[int], bool]:
     """The shortest route found from ``path`` (every node of the integer ``costs`` once,
     its first and last staying put) in ``seconds`` (<= 0: no limit) or ``kicks`` kicks
-    (< 0: no limit), whichever ends first; never longer than ``path``."""
+    (< 0: no limit), whichever ends first; never longer than ``path``. ``settled``: the
+    path is a search's answer that was settled, so the first descent over every node
+    (tens of milliseconds on 2000) is skipped. With the route comes whether it is settled
+    (its local search ran to the end, not cut short by the time limit)."""
     arcs = np.ascontiguousarray(costs, dtype=np.int64)
     route = np.ascontiguousarray(path, dtype=np.int64)
     if arcs.shape != (len(route), len(route)) or sorted(route.tolist()) != list(range(len(route))):
@@ -64,8 +68,11 @@ def search(
     if seconds <= 0 and kicks < 0:
         raise ValueError("a search needs a time limit or a number of kicks")
     if use_compiled and _compiled is not None:
-        return list(_compiled.search(arcs, route, float(seconds), int(kicks), int(seed)))
-    return _search_python(arcs, route.tolist(), seconds, kicks, seed)
+        found, done = _compiled.search(
+            arcs, route, float(seconds), int(kicks), int(seed), bool(settled)
+        )
+        return list(found), bool(done)
+    return _search_python(arcs, route.tolist(), seconds, kicks, seed, settled)
 
 
 class _Path:
@@ -188,17 +195,19 @@ def _next_random(state: int) -> int:
 
 
 def _search_python(
-    costs: np.ndarray, path: list[int], seconds: float, kicks: int, seed: int
-) -> list[int]:
+    costs: np.ndarray, path: list[int], seconds: float, kicks: int, seed: int, settled: bool
+) -> tuple[list[int], bool]:
     """The C search's twin (the queue is a deque, not a ring: the same order)."""
     n = len(path)
     if n < 4:
-        return list(path)
+        return list(path), True
     began = time.perf_counter()
     route = _Path(costs, path, began + seconds if seconds > 0 else 0.0)
-    for k in range(1, n - 1):
-        route.push(route.path[k])
+    if not settled:
+        for k in range(1, n - 1):
+            route.push(route.path[k])
     route.local_search()
+    best_settled = not route.queue
     length = best = route.length
     current, best_path = list(route.path), list(route.path)
     state = (seed * 2654435761 + 88172645463325252) & _MASK
@@ -225,11 +234,11 @@ def _search_python(
         if route.length <= length:
             length, current = route.length, list(route.path)
             if length < best:
-                best, best_path = length, list(route.path)
+                best, best_path, best_settled = length, list(route.path), not route.queue
         else:
             route.path = list(current)
             route.sums()
-    return best_path
+    return best_path, best_settled
 
 
 __all__ = ["LONGEST_KICK", "LONGEST_RUN", "compiled", "search"]
