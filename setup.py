@@ -2,8 +2,9 @@
 
 - pip: packages from ``src/`` plus two optional C extensions, ``navseq.sim._astar``
   (the global planner's A* search) and ``navseq.route._tour`` (the ordering's local
-  search). ``optional=True``: without a C compiler the install still succeeds and each
-  falls back on its pure-Python twin (same answers, slower).
+  search). ``optional=True``: without a C compiler the install still succeeds: the
+  planner falls back on its pure-Python search (same plans, slower), the ordering on
+  OR-tools' routing solver.
 - catkin: ``catkin_python_setup()`` (CMakeLists.txt) runs this file through catkin's
   ``interrogate_setup_dot_py.py`` to learn where the package lives (devel space), and
   ``catkin_make install`` runs it for real with ``CATKIN_BINARY_DIR`` set. Catkin needs

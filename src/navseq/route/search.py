@@ -17,7 +17,8 @@ search does better in the same second (``benchmarks/bench_route.py``):
 The route's first and last node stay where they are. The search runs in a small C
 extension (``navseq.route._tour``) when it is built, thousands of kicks a second;
 otherwise in :func:`_search_python`, which makes the same moves (the same answer for the
-same kicks and seed) far more slowly.
+same kicks and seed) far more slowly: :mod:`navseq.route.order` then uses OR-tools
+instead, and the tests check the two against each other.
 """
 
 from __future__ import annotations
