@@ -9,7 +9,8 @@
   ``interrogate_setup_dot_py.py`` to learn where the package lives (devel space), and
   ``catkin_make install`` runs it for real with ``CATKIN_BINARY_DIR`` set. Catkin needs
   the name and version in the ``setup()`` call: they come from package.xml (keep its
-  version equal to pyproject.toml's). Catkin installs use the pure-Python search.
+  version equal to pyproject.toml's). Catkin installs use the pure-Python search and
+  order with OR-tools.
 """
 
 import os
