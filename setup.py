@@ -1,14 +1,16 @@
 """Build hook shared by pip and catkin; pip's project metadata lives in pyproject.toml.
 
-- pip: packages from ``src/`` plus the one optional C extension, ``navseq.sim._astar``
-  (the global planner's A* search). ``optional=True``: without a C compiler the install
-  still succeeds and the planner falls back on its pure-Python search (same plans,
-  slower).
+- pip: packages from ``src/`` plus two optional C extensions, ``navseq.sim._astar``
+  (the global planner's A* search) and ``navseq.route._tour`` (the ordering's local
+  search). ``optional=True``: without a C compiler the install still succeeds: the
+  planner falls back on its pure-Python search (same plans, slower), the ordering on
+  OR-tools' routing solver.
 - catkin: ``catkin_python_setup()`` (CMakeLists.txt) runs this file through catkin's
   ``interrogate_setup_dot_py.py`` to learn where the package lives (devel space), and
   ``catkin_make install`` runs it for real with ``CATKIN_BINARY_DIR`` set. Catkin needs
   the name and version in the ``setup()`` call: they come from package.xml (keep its
-  version equal to pyproject.toml's). Catkin installs use the pure-Python search.
+  version equal to pyproject.toml's). Catkin installs use the pure-Python search and
+  order with OR-tools.
 """
 
 import os
@@ -61,6 +63,12 @@ else:
                 sources=["src/navseq/sim/_astar.c"],
                 extra_compile_args=["-O3"],
                 optional=True,
-            )
+            ),
+            Extension(
+                "navseq.route._tour",
+                sources=["src/navseq/route/_tour.c"],
+                extra_compile_args=["-O3"],
+                optional=True,
+            ),
         ],
     )

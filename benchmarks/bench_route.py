@@ -10,8 +10,9 @@ by, side by side over the same matrix:
 - **file order**: the route as drawn;
 - **nearest neighbour**: from waypoint 1 always to the nearest waypoint not yet
   visited — what a hand-written reordering usually does;
-- **navseq**: :func:`navseq.route.order.shortest_tour` (OR-tools: cheapest arc, then
-  guided local search for ``--time-limit`` seconds);
+- **navseq**: :func:`navseq.route.order.shortest_tour` (nearest neighbour, then the
+  iterated local search of :mod:`navseq.route.search` for ``--time-limit`` seconds;
+  OR-tools' guided local search where its C extension is not built);
 - **reference**: the same solver given ``--reference`` seconds (0: not run), the
   long solve navseq's tour is measured against.
 

@@ -2,10 +2,11 @@
 
 A travelling-salesman problem over the lengths the robot would drive: the planned path
 between every two waypoints on the robot's costmap (the planner the simulator drives
-with), or straight lines when no map is known. OR-tools' routing solver finds the
-order (a first tour by nearest neighbour improved by 2-opt and Or-opt moves, then
-guided local search for the rest of ``time_limit_s``);
-it comes with the ``navseq[plan]`` extra.
+with), or straight lines when no map is known. The order: a first tour by nearest
+neighbour, then the iterated local search of :mod:`navseq.route.search` (Or-opt and 2-opt
+moves, kicks) for ``time_limit_s``; without that search's C extension, 2-opt and Or-opt
+in numpy, then OR-tools' routing solver (guided local search) for the rest. It comes
+with the ``navseq[plan]`` extra.
 
 What stays where it is, so that the new order is a mission the user still recognises:
 
@@ -27,6 +28,7 @@ that drives the fewest metres.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import os
 import signal
@@ -51,11 +53,15 @@ if TYPE_CHECKING:
 MAX_WAYPOINTS = 2000
 #: The cost of a leg with no path, in metres: more than any route on any map.
 NO_PATH_M = 1.0e6
-#: The share of the solver's time a first route gets from 2-opt and Or-opt moves
-#: before OR-tools' guided local search starts from it (its own first route plus the
-#: search did worse in the same second: benchmarks/bench_route.py).
+#: Without the C extension of navseq.route.search: the share of the solver's time a first
+#: route gets from 2-opt and Or-opt moves in numpy before OR-tools' guided local search
+#: starts from it (its own first route plus the search did worse in the same second:
+#: benchmarks/bench_route.py).
 IMPROVE_SHARE = 0.6
-#: Places at most for that first route (each move weighs every pair of places).
+#: Seconds of each slice of the iterated local search (navseq.route.search): the best
+#: route so far is reported between slices, and a Ctrl-C heard.
+SLICE_S = 0.1
+#: Places at most for the numpy first route (each move weighs every pair of places).
 IMPROVE_UP_TO = 500
 #: Distances go to the solver in millimetres (it works in integers).
 _MM = 1000.0
@@ -143,6 +149,7 @@ def shortest_order(
     keep_last: bool = False,
     robot: RobotProfile | None = None,
     progress: OrderProgress | None = None,
+    settle_s: float | None = None,
 ) -> Ordering:
     """The order of ``mission``'s waypoints that drives the least (see the module doc).
 
@@ -150,7 +157,9 @@ def shortest_order(
     ``length`` measures a leg, or (a :class:`Distances`, such as a leg planner) all of
     them at once. ``robot``: order by the time that robot takes, turns included, where
     ``length`` measures routes with their headings (:class:`navseq.route.travel.Routes`);
-    otherwise by metres. ``progress`` hears of the searches and the solver.
+    otherwise by metres. ``progress`` hears of the searches and the solver. ``settle_s``:
+    the solver also stops once it found no better order for that long (see
+    :func:`shortest_tour`).
     """
     require_extra("plan", "the shortest order")
     waypoints = [(w.x, w.y) for w in mission.waypoints]
@@ -174,7 +183,12 @@ def shortest_order(
     if shown is not None:
         shown(None)
     tour = shortest_tour(
-        matrix, closed=closed, last=last, time_limit_s=time_limit_s, on_solution=shown
+        matrix,
+        closed=closed,
+        last=last,
+        time_limit_s=time_limit_s,
+        on_solution=shown,
+        settle_s=settle_s,
     )
     as_in_file = list(range(len(places)))
     # An order no shorter than the file's (a patrol run the other way round, a tie) is
@@ -279,16 +293,76 @@ def tour_length(matrix: np.ndarray, tour: Sequence[int], closed: bool) -> float:
 
 
 def _first_route(costs: np.ndarray, end: int, deadline: float) -> np.ndarray | None:
-    """A first route from node 0 to ``end`` (0 again for a patrol) for the solver,
-    improved by 2-opt and Or-opt (:mod:`navseq.route.improve`) until ``deadline``; None
-    for more than :data:`IMPROVE_UP_TO` places (one move would take longer than the
-    solver's whole search)."""
+    """Without the C search: a first route from node 0 to ``end`` (0 again for a patrol)
+    for OR-tools, improved by 2-opt and Or-opt (:mod:`navseq.route.improve`) until
+    ``deadline``; None for more than :data:`IMPROVE_UP_TO` places (one move would take
+    longer than the solver's whole search)."""
     from navseq.route.improve import improve, nearest_neighbour
 
     if not 4 <= len(costs) <= IMPROVE_UP_TO:
         return None
     arcs = costs.astype(float)
     return improve(nearest_neighbour(arcs, 0, end), arcs, deadline)
+
+
+def _searched_tour(
+    costs: np.ndarray,
+    end: int,
+    last: int | None,
+    deadline: float,
+    on_solution: Callable[[float], None] | None,
+    settle_s: float | None,
+) -> list[int]:
+    """The route from node 0 to ``end`` found by :mod:`navseq.route.search` (nearest
+    neighbour, then its iterated local search until ``deadline``), as
+    :func:`shortest_tour` gives it. The search runs in slices of :data:`SLICE_S`, each
+    from the best route so far: between them the best is reported, the settling time
+    checked and a Ctrl-C raised; the first slice lasts until the local search from nearest
+    neighbour is over (a fraction of a second on 2000 places)."""
+    from navseq.route.improve import nearest_neighbour
+    from navseq.route.search import search
+
+    count = len(costs)
+    arcs, final = costs, end
+    if end == 0:
+        # The search keeps a path's two ends in place: a patrol's way back to node 0
+        # ends at a copy of it (the same costs in, none out).
+        arcs = np.zeros((count + 1, count + 1), dtype=np.int64)
+        arcs[:count, :count] = costs
+        arcs[:count, count] = costs[:, 0]
+        final = count
+    route = nearest_neighbour(arcs.astype(float), 0, final).tolist()
+
+    def cost_of(path: list[int]) -> int:
+        return int(arcs[path[:-1], path[1:]].sum())
+
+    best = cost_of(route)
+    if on_solution is not None:
+        on_solution(best / _MM)
+    better_at = time.perf_counter()
+    settled = False
+    for seed in itertools.count():
+        now = time.perf_counter()
+        if now >= deadline or (settle_s is not None and now - better_at >= settle_s):
+            break
+        # The first descent (from nearest neighbour), with no kick after it, is not cut
+        # into slices: each slice would begin it again over every node (on 2000 nodes,
+        # longer than a slice).
+        left_s = deadline - now
+        if settled:
+            found, done = search(arcs, route, min(left_s, SLICE_S), seed=seed, settled=True)
+        else:
+            found, done = search(arcs, route, left_s, kicks=0)
+        length = cost_of(found)
+        if length <= best:  # as short, elsewhere: the next slice starts from there
+            route, settled = found, done
+        if length < best:
+            best, better_at = length, time.perf_counter()
+            if on_solution is not None:
+                on_solution(best / _MM)
+    if end == 0:
+        route[-1] = 0
+    return route[:-1] if last is None else route
 
 
 def shortest_tour(
@@ -298,14 +372,19 @@ def shortest_tour(
     last: int | None = None,
     time_limit_s: float = 2.0,
     on_solution: Callable[[float], None] | None = None,
+    settle_s: float | None = None,
 ) -> list[int]:
     """The order of the places of ``matrix`` (metres from each to each) that drives the
     least: node 0 first, every node once, node ``last`` last if given, and back to node 0
     when ``closed`` (a fixed last node makes the way back a constant: the route ends there).
-    ``on_solution`` hears the cost of each better order the solver finds. Ctrl-C in the
-    main thread ends the search at its next order found (or its time limit) and raises
-    KeyboardInterrupt then."""
+    ``on_solution`` hears the cost of each better order the solver finds. ``settle_s``:
+    the search also ends once it found nothing better for that long (the iterated local
+    search only; None: it runs for ``time_limit_s``). Ctrl-C in the main thread ends the
+    search (within :data:`SLICE_S` of the iterated local search, or at OR-tools' next
+    order found) and raises KeyboardInterrupt then."""
     from ortools.constraint_solver import pywrapcp, routing_enums_pb2
+
+    from navseq.route.search import compiled as search_compiled
 
     count = len(matrix)
     if last is not None:
@@ -324,6 +403,8 @@ def shortest_tour(
         if on_solution is not None:
             on_solution(tour_length(costs.astype(float), route, closed=False) / _MM)
         return route[:-1] if last is None else route
+    if search_compiled():
+        return _searched_tour(costs, end, last, began + time_limit_s, on_solution, settle_s)
     manager, routing = _routing_model(costs, end)
     parameters = pywrapcp.DefaultRoutingSearchParameters()
     parameters.first_solution_strategy = routing_enums_pb2.FirstSolutionStrategy.PATH_CHEAPEST_ARC

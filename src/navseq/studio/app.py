@@ -95,6 +95,10 @@ WARM_UP_NICENESS = 10
 WARM_UP_WAIT_FOR_PAGE_S = 3.0
 #: Seconds the route solver searches for the page's "shortest order" (a click, not a batch).
 ORDER_TIME_LIMIT_S = 1.0
+#: ... or less: it stops once it found no better order for this long (on the bench's
+#: missions of 100 to 200 waypoints its last better order came within 0.1 to 0.4 s of
+#: a 1 s search, mostly in its first tenth: benchmarks/bench_route.py, docs/performance.md).
+ORDER_SETTLE_S = 0.25
 
 
 @dataclass
@@ -669,7 +673,13 @@ class Studio:
         if checked.map_path is not None and checked.map_path.is_file():
             legs = self.planner(checked.map_path, robot)
         ordering = shortest_order(
-            mission, legs, ORDER_TIME_LIMIT_S, keep_last=keep_last, robot=robot, progress=progress
+            mission,
+            legs,
+            ORDER_TIME_LIMIT_S,
+            keep_last=keep_last,
+            robot=robot,
+            progress=progress,
+            settle_s=ORDER_SETTLE_S,
         )
         return {
             "order": list(ordering.order),
