@@ -26,8 +26,10 @@ fi
 
 packages=(zstd libpython3.11 libyaml-0-2 python3-numpy python3-yaml python3-lark
   python3-psutil python3-packaging)
-# A larger tree (the real Nav2, scripts/install-nav2.sh) names the libraries it needs too.
-read -r -a extra <<< "${NAVSEQ_ROS2_EXTRA_PACKAGES:-}"
+# A larger tree (the real Nav2, scripts/install-nav2.sh) names the libraries it needs too,
+# separated by spaces or newlines: `read -d ''` takes them all (without it, only the
+# first line was read, and the Nav2 servers needing the rest could not start).
+read -r -d '' -a extra <<< "${NAVSEQ_ROS2_EXTRA_PACKAGES:-}" || true
 packages+=("${extra[@]}")
 missing=()
 for p in "${packages[@]}"; do

@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING, Any
 from navseq.errors import NavseqError
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
     from navseq.eta.incremental import IncrementalPrediction
     from navseq.mission.model import Mission
     from navseq.studio.documents import CheckedDraft
@@ -54,17 +56,7 @@ def moved_waypoints(before: dict[str, Any], after: Any) -> set[int] | None:
         return None
     if any(after[key] != before[key] for key in after if key != "waypoints"):
         return None
-    moved = set()
-    for index, (was, now) in enumerate(zip(old, new, strict=True)):
-        if was == now:
-            continue
-        # A name must differ from every other: a renamed waypoint is checked whole.
-        if not isinstance(now, dict) or not isinstance(was, dict) or "name" in now or "name" in was:
-            return None
-        moved.add(index)
-        if len(moved) > MAX_MOVED:
-            return None
-    return moved
+    return _moved(old, new, range(len(new)))
 
 
 def moved_among(
@@ -73,12 +65,18 @@ def moved_among(
     """:func:`moved_waypoints` of ``after``, a copy of ``before`` with only the
     waypoints ``changed`` (indices) given anew (:func:`edited_document`): only those are
     compared."""
-    old, new = before["waypoints"], after["waypoints"]
+    return _moved(before["waypoints"], after["waypoints"], changed)
+
+
+def _moved(old: list[Any], new: list[Any], indices: Iterable[int]) -> set[int] | None:
+    """Which of ``indices`` hold another waypoint in ``new`` than in ``old``, or None
+    when one was renamed or more than :data:`MAX_MOVED` moved."""
     moved = set()
-    for index in changed:
+    for index in indices:
         was, now = old[index], new[index]
         if was == now:
             continue
+        # A name must differ from every other: a renamed waypoint is checked whole.
         if not isinstance(now, dict) or not isinstance(was, dict) or "name" in now or "name" in was:
             return None
         moved.add(index)
